@@ -1,0 +1,53 @@
+//! # deadreckon-core
+//!
+//! The mathematics of deadreckon, with no I/O: the in-memory [`drive::Drive`]
+//! (every sensor stream of a recording, SI units, local east-north frame), the
+//! four-wheel car model of Welte, Xu and Bonnifait (ICRA 2019), its extended
+//! Kalman filter and Rauch–Tung–Striebel smoother, the least-squares calibration
+//! of gyro bias, speed scale and wheel circumferences, dead reckoning, and the
+//! papers' evaluation metrics.
+//!
+//! ## Conventions
+//!
+//! - Positions are metres east (`east_m`) and north (`north_m`) of a local origin.
+//! - Yaw is radians counter-clockwise from east; yaw rate is counter-clockwise
+//!   positive. GNSS course (`course_deg`) is the navigation convention, degrees
+//!   clockwise from north: convert with [`drive::course_deg_to_yaw_rad`].
+//! - The position estimated is that of the rear-axle centre (point M of the paper).
+//! - Every sample carries its own timestamp `t_s` (s); `dt` is derived.
+#![deny(missing_docs)]
+
+pub mod angle;
+pub mod drive;
+pub mod track;
+pub mod vehicle;
+
+pub use drive::Drive;
+pub use track::{Track, TrackPoint};
+pub use vehicle::{Params, ParamsWithStd, Vehicle};
+
+/// Errors of the core library.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// The drive breaks an invariant (unsorted time, non-finite value, too short).
+    #[error("invalid drive: {0}")]
+    InvalidDrive(String),
+    /// The vehicle description is not usable.
+    #[error("invalid vehicle: {0}")]
+    InvalidVehicle(String),
+    /// Calibration parameters are not usable.
+    #[error("invalid parameters: {0}")]
+    InvalidParams(String),
+    /// A covariance lost positive definiteness or a matrix could not be inverted.
+    #[error("numerical failure at t={t_s} s: {what}")]
+    Numerical {
+        /// Timestamp of the failing step.
+        t_s: f64,
+        /// What failed.
+        what: String,
+    },
+    /// The data cannot support the requested computation (e.g. no GNSS for RTS calibration).
+    #[error("insufficient data: {0}")]
+    Insufficient(String),
+}

@@ -1,0 +1,246 @@
+//! Vehicle geometry, nominal parameters and noise (the contents of `vehicle.toml`),
+//! and the six calibrated parameters of eq. (9).
+
+use serde::{Deserialize, Serialize};
+
+use crate::Error;
+
+/// A geodetic origin for drives recorded in latitude/longitude.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Origin {
+    /// Latitude, degrees north (WGS84).
+    pub lat_deg: f64,
+    /// Longitude, degrees east (WGS84).
+    pub lon_deg: f64,
+}
+
+/// Noise standard deviations: the paper's tables I (evolution, per 20 ms step) and
+/// II (observations). Every field has the paper's value as its default.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Noise {
+    /// α_xy: position process noise per reference step, m (table I: 1e-3).
+    pub process_xy_m: f64,
+    /// α_ψ: yaw process noise per reference step, rad (table I: 1e-5).
+    pub process_yaw_rad: f64,
+    /// α_v: speed process noise per reference step, m/s (table I: 10).
+    pub process_speed_mps: f64,
+    /// α_ψ̇: yaw-rate process noise per reference step, rad/s (table I: 1).
+    pub process_yaw_rate_rps: f64,
+    /// The step the process noise above refers to, s (the paper's wheel period, 0.02).
+    /// The filter scales the variances by `dt / process_step_s` for other steps.
+    pub process_step_s: f64,
+    /// β_ω: gyro noise, rad/s (table II: 0.003).
+    pub gyro_rps: f64,
+    /// β_v: CAN speed noise, m/s (table II: 0.1).
+    pub speed_mps: f64,
+    /// β_XX: wheel tick noise, ticks (table II: 1), used with `wheel_ticks.csv`.
+    pub wheel_ticks: f64,
+    /// Wheel speed noise, m/s, used with `wheel_speeds.csv` (not in the paper; 0.05).
+    pub wheel_speed_mps: f64,
+    /// β_δ: steering noise on tan(δ/r_s), unitless (table II: 0.02).
+    pub steering: f64,
+    /// Mahalanobis gate for GNSS fixes: the chi-square (2 degrees of freedom) value
+    /// above which a fix is rejected and counted (default 13.82, p = 0.001).
+    pub gnss_gate_chi2: f64,
+}
+
+impl Default for Noise {
+    fn default() -> Self {
+        Noise {
+            process_xy_m: 1e-3,
+            process_yaw_rad: 1e-5,
+            process_speed_mps: 10.0,
+            process_yaw_rate_rps: 1.0,
+            process_step_s: 0.02,
+            gyro_rps: 0.003,
+            speed_mps: 0.1,
+            wheel_ticks: 1.0,
+            wheel_speed_mps: 0.05,
+            steering: 0.02,
+            gnss_gate_chi2: 13.815510557964274,
+        }
+    }
+}
+
+/// The vehicle: geometry (figure 1 of the paper), nominal parameters and noise.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Vehicle {
+    /// l_RF: distance from the rear axle to the front axle, m.
+    pub wheelbase_m: f64,
+    /// l_F: front track width, m.
+    pub track_front_m: f64,
+    /// l_R: rear track width, m.
+    pub track_rear_m: f64,
+    /// l_GNSS: GNSS antenna distance forward of the rear-axle centre, m.
+    pub gnss_lever_arm_m: f64,
+    /// N_wheel: encoder ticks per wheel revolution.
+    pub ticks_per_rev: u32,
+    /// Nominal wheel circumference, all wheels, m.
+    pub wheel_circumference_m: f64,
+    /// r_s: steering wheel angle / virtual front wheel angle.
+    pub steering_ratio: f64,
+    /// Origin for drives in latitude/longitude (otherwise the first fix is the origin).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub origin: Option<Origin>,
+    /// Noise overrides (defaults: the paper's tables I and II).
+    #[serde(default)]
+    pub noise: Noise,
+}
+
+impl Vehicle {
+    /// The paper's experimental car (Heudiasyc), with the noise of tables I and II.
+    /// Geometry values are those of a typical compact car (the paper gives none).
+    pub fn paper_car() -> Self {
+        Vehicle {
+            wheelbase_m: 2.58,
+            track_front_m: 1.48,
+            track_rear_m: 1.46,
+            gnss_lever_arm_m: 1.2,
+            ticks_per_rev: 48,
+            wheel_circumference_m: 1.92,
+            steering_ratio: 15.9,
+            origin: None,
+            noise: Noise::default(),
+        }
+    }
+
+    /// Checks every value is finite and physically meaningful.
+    pub fn validate(&self) -> Result<(), Error> {
+        let pos = [
+            ("wheelbase_m", self.wheelbase_m),
+            ("track_front_m", self.track_front_m),
+            ("track_rear_m", self.track_rear_m),
+            ("wheel_circumference_m", self.wheel_circumference_m),
+            ("steering_ratio", self.steering_ratio),
+        ];
+        for (k, v) in pos {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(Error::InvalidVehicle(format!("{k} must be a positive number, got {v}")));
+            }
+        }
+        if !self.gnss_lever_arm_m.is_finite() {
+            return Err(Error::InvalidVehicle("gnss_lever_arm_m must be finite".into()));
+        }
+        if self.ticks_per_rev == 0 {
+            return Err(Error::InvalidVehicle("ticks_per_rev must be positive".into()));
+        }
+        let n = &self.noise;
+        for (k, v) in [
+            ("noise.process_xy_m", n.process_xy_m),
+            ("noise.process_yaw_rad", n.process_yaw_rad),
+            ("noise.process_speed_mps", n.process_speed_mps),
+            ("noise.process_yaw_rate_rps", n.process_yaw_rate_rps),
+            ("noise.process_step_s", n.process_step_s),
+            ("noise.gyro_rps", n.gyro_rps),
+            ("noise.speed_mps", n.speed_mps),
+            ("noise.wheel_ticks", n.wheel_ticks),
+            ("noise.wheel_speed_mps", n.wheel_speed_mps),
+            ("noise.steering", n.steering),
+            ("noise.gnss_gate_chi2", n.gnss_gate_chi2),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(Error::InvalidVehicle(format!("{k} must be a positive number, got {v}")));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The six calibrated parameters p of eq. (9), stored as circumferences (the
+/// estimator works on inverse circumferences internally).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Params {
+    /// b_gyro: gyro bias, rad/s (gyro = true yaw rate + bias).
+    pub gyro_bias_rps: f64,
+    /// a_v: CAN speed scale factor (CAN speed = a_v · true speed).
+    pub speed_scale: f64,
+    /// ρ_FL: front-left wheel circumference, m.
+    pub circumference_fl_m: f64,
+    /// ρ_FR: front-right wheel circumference, m.
+    pub circumference_fr_m: f64,
+    /// ρ_RL: rear-left wheel circumference, m.
+    pub circumference_rl_m: f64,
+    /// ρ_RR: rear-right wheel circumference, m.
+    pub circumference_rr_m: f64,
+}
+
+impl Params {
+    /// The nominal parameters of a vehicle: no gyro bias, unit scale, nominal circumferences.
+    pub fn nominal(vehicle: &Vehicle) -> Self {
+        let c = vehicle.wheel_circumference_m;
+        Params {
+            gyro_bias_rps: 0.0,
+            speed_scale: 1.0,
+            circumference_fl_m: c,
+            circumference_fr_m: c,
+            circumference_rl_m: c,
+            circumference_rr_m: c,
+        }
+    }
+
+    /// The four circumferences in the order FL, FR, RL, RR.
+    pub fn circumferences(&self) -> [f64; 4] {
+        [self.circumference_fl_m, self.circumference_fr_m, self.circumference_rl_m, self.circumference_rr_m]
+    }
+
+    /// Sets the four circumferences from the order FL, FR, RL, RR.
+    pub fn set_circumferences(&mut self, c: [f64; 4]) {
+        self.circumference_fl_m = c[0];
+        self.circumference_fr_m = c[1];
+        self.circumference_rl_m = c[2];
+        self.circumference_rr_m = c[3];
+    }
+
+    /// The parameters as an array: bias, scale, FL, FR, RL, RR.
+    pub fn to_array(&self) -> [f64; 6] {
+        let c = self.circumferences();
+        [self.gyro_bias_rps, self.speed_scale, c[0], c[1], c[2], c[3]]
+    }
+
+    /// The inverse of [`Params::to_array`].
+    pub fn from_array(a: [f64; 6]) -> Self {
+        Params {
+            gyro_bias_rps: a[0],
+            speed_scale: a[1],
+            circumference_fl_m: a[2],
+            circumference_fr_m: a[3],
+            circumference_rl_m: a[4],
+            circumference_rr_m: a[5],
+        }
+    }
+
+    /// Names of the parameters in [`Params::to_array`] order (the `params.toml` keys).
+    pub const NAMES: [&'static str; 6] = [
+        "gyro_bias_rps",
+        "speed_scale",
+        "circumference_fl_m",
+        "circumference_fr_m",
+        "circumference_rl_m",
+        "circumference_rr_m",
+    ];
+
+    /// Checks the parameters are usable: finite, positive scale and circumferences.
+    pub fn validate(&self) -> Result<(), Error> {
+        let a = self.to_array();
+        for (i, v) in a.iter().enumerate() {
+            if !v.is_finite() || (i > 0 && *v <= 0.0) {
+                return Err(Error::InvalidParams(format!("{} = {v} is not valid", Params::NAMES[i])));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Calibrated parameters with their standard errors (the `params.toml` contract).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ParamsWithStd {
+    /// The estimates.
+    #[serde(flatten)]
+    pub params: Params,
+    /// One standard error for each estimate (same keys).
+    pub std: Params,
+}
