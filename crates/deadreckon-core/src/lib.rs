@@ -18,7 +18,15 @@
 #![deny(missing_docs)]
 
 pub mod angle;
+pub mod calibrate;
 pub mod drive;
+pub mod ekf;
+pub mod kalman;
+pub mod metrics;
+pub mod model;
+pub mod observation;
+pub mod reference;
+pub mod rts;
 pub mod track;
 pub mod vehicle;
 

@@ -1,0 +1,391 @@
+//! Calibration of the six parameters p of eq. (9): gyro bias, CAN speed scale and
+//! the four wheel circumferences.
+//!
+//! - [`Method::Rts`] (the paper, eq. 23–26): filter with GNSS, smooth with RTS,
+//!   and solve the one-dimensional least-squares problems on the smoothed states;
+//!   repeat (remark 3) until the parameters settle. The plain repetition is a
+//!   slowly converging fixed-point iteration (the filter leans on the wheels with
+//!   their current circumferences, GNSS pulls only part of the way each pass);
+//!   [`Iteration::Anderson`] (default) accelerates it with Anderson mixing over
+//!   the last passes, reaching the same fixed point in a few passes.
+//!   [`Iteration::Plain`] keeps the paper's iteration for comparison.
+//! - [`Method::Zupt`]: gyro bias as the mean gyro reading while the wheels show
+//!   the car stopped; other parameters nominal (standard error 0: not estimated).
+//! - [`Method::Truth`]: the same least squares on `truth.csv` states.
+//!
+//! Epochs slower than `min_speed_mps` (2 m/s, remark 2) are dropped for the
+//! speed-dependent parameters. Standard errors are the least-squares ones,
+//! inflated for the lag-1 autocorrelation of the residuals (effective sample
+//! size `n·(1−ρ₁)/(1+ρ₁)`), because consecutive residuals are not independent.
+
+use nalgebra::{DMatrix, DVector};
+
+use crate::drive::{Drive, Wheels};
+use crate::ekf::{self, FilterOptions, Init};
+use crate::model::{State, V, YAW_RATE};
+use crate::observation::Sensors;
+use crate::reference::Reference;
+use crate::rts;
+use crate::vehicle::{Params, ParamsWithStd};
+use crate::Error;
+
+/// What the calibration compares the sensors with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Method {
+    /// RTS-smoothed states (needs GNSS).
+    Rts,
+    /// Standstill gyro average (bias only).
+    Zupt,
+    /// Ground-truth states (needs truth).
+    Truth,
+}
+
+impl std::str::FromStr for Method {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self, Error> {
+        match s {
+            "rts" => Ok(Method::Rts),
+            "zupt" => Ok(Method::Zupt),
+            "truth" => Ok(Method::Truth),
+            _ => Err(Error::InvalidParams(format!("unknown calibration method `{s}` (rts, zupt, truth)"))),
+        }
+    }
+}
+
+/// How the smoothing–calibration passes are chained.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Iteration {
+    /// p ← LS(smooth(p)), as in the paper (remark 3).
+    Plain,
+    /// Anderson acceleration of the same fixed point (memory of 3 passes).
+    #[default]
+    Anderson,
+}
+
+/// Calibration options.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CalibrationOptions {
+    /// Method.
+    pub method: Method,
+    /// Chaining of passes (RTS only).
+    pub iteration: Iteration,
+    /// Maximum smoothing passes (RTS only).
+    pub max_iterations: usize,
+    /// Convergence: stop when every parameter changed less than this many of its
+    /// tolerance units (bias 1e-6 rad/s, scale 1e-5, circumference 1e-5 relative).
+    pub tolerance: f64,
+    /// Remark 2: epochs slower than this are dropped for speed-dependent parameters, m/s.
+    pub min_speed_mps: f64,
+    /// Filter options of the smoothing passes (the initial state comes from GNSS).
+    pub filter: FilterOptions,
+    /// Starting parameters (nominal by default).
+    pub initial: Option<Params>,
+}
+
+impl Default for CalibrationOptions {
+    fn default() -> Self {
+        CalibrationOptions {
+            method: Method::Rts,
+            iteration: Iteration::Anderson,
+            max_iterations: 60,
+            tolerance: 1.0,
+            min_speed_mps: 2.0,
+            filter: FilterOptions { record_epochs: true, ..Default::default() },
+            initial: None,
+        }
+    }
+}
+
+/// A calibration result.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Calibration {
+    /// Estimates and standard errors.
+    pub estimate: ParamsWithStd,
+    /// Smoothing passes run (0 for ZUPT, 1 for truth).
+    pub iterations: usize,
+    /// The least-squares result of every pass, in order (the last is the estimate).
+    pub history: Vec<Params>,
+    /// True when the passes settled within the tolerance.
+    pub converged: bool,
+    /// Samples used per parameter (in [`Params::to_array`] order).
+    pub samples: [usize; 6],
+}
+
+/// Tolerance units of the parameters, in [`Params::to_array`] order.
+fn units(nominal_circumference: f64) -> [f64; 6] {
+    let c = 1e-5 * nominal_circumference;
+    [1e-6, 1e-5, c, c, c, c]
+}
+
+/// Runs a calibration.
+pub fn calibrate(drive: &Drive, opts: &CalibrationOptions) -> Result<Calibration, Error> {
+    drive.validate()?;
+    let nominal = Params::nominal(&drive.vehicle);
+    let start = opts.initial.unwrap_or(nominal);
+    start.validate()?;
+    match opts.method {
+        Method::Zupt => zupt(drive, &nominal),
+        Method::Truth => {
+            let reference = Reference::from_truth(&drive.truth)
+                .ok_or_else(|| Error::Insufficient("truth calibration needs truth.csv with at least 3 poses".into()))?;
+            let (est, samples) = least_squares(drive, &reference, opts.min_speed_mps, true)?;
+            Ok(Calibration { estimate: est, iterations: 1, history: vec![est.params], converged: true, samples })
+        }
+        Method::Rts => rts_calibration(drive, opts, start),
+    }
+}
+
+/// One pass: filter with `p`, smooth, least squares on the smoothed states.
+pub fn smoothing_pass(drive: &Drive, p: &Params, opts: &CalibrationOptions) -> Result<(ParamsWithStd, [usize; 6]), Error> {
+    let mut fopts = opts.filter.clone();
+    fopts.record_epochs = true;
+    if matches!(fopts.init, Init::Truth) {
+        fopts.init = Init::Gnss;
+    }
+    let out = ekf::run(drive, p, &fopts, &mut ())?;
+    let sm = rts::smooth(&out.epochs)?;
+    let reference = Reference::from_states(sm.iter().map(|s| s.t_s).collect(), sm.iter().map(|s| s.x).collect());
+    least_squares(drive, &reference, opts.min_speed_mps, false)
+}
+
+fn rts_calibration(drive: &Drive, opts: &CalibrationOptions, start: Params) -> Result<Calibration, Error> {
+    if drive.gnss.len() < 2 {
+        return Err(Error::Insufficient("RTS calibration needs GNSS fixes (gnss.csv)".into()));
+    }
+    let u = units(drive.vehicle.wheel_circumference_m);
+    let scale = |p: &Params| -> DVector<f64> { DVector::from_iterator(6, p.to_array().iter().zip(u.iter()).map(|(a, b)| a / b)) };
+    let unscale = |v: &DVector<f64>| -> Params {
+        let mut a = [0.0; 6];
+        for i in 0..6 {
+            a[i] = v[i] * u[i];
+        }
+        Params::from_array(a)
+    };
+    let mut p = start;
+    let mut history = Vec::new();
+    let mut xs: Vec<DVector<f64>> = Vec::new(); // iterates (scaled)
+    let mut gs: Vec<DVector<f64>> = Vec::new(); // G(iterates) (scaled)
+    let mut last = None;
+    let mut converged = false;
+    let memory = 3;
+    for _ in 0..opts.max_iterations.max(1) {
+        let (g, samples) = smoothing_pass(drive, &p, opts)?;
+        history.push(g.params);
+        let x = scale(&p);
+        let gx = scale(&g.params);
+        let change = (&gx - &x).amax();
+        last = Some((g, samples));
+        if change < opts.tolerance {
+            converged = true;
+            break;
+        }
+        xs.push(x);
+        gs.push(gx.clone());
+        if xs.len() > memory + 1 {
+            xs.remove(0);
+            gs.remove(0);
+        }
+        let next = match opts.iteration {
+            Iteration::Plain => gx,
+            Iteration::Anderson => anderson(&xs, &gs),
+        };
+        let candidate = unscale(&next);
+        p = if candidate.validate().is_ok() { candidate } else { g.params };
+    }
+    let (estimate, samples) = last.ok_or_else(|| Error::Insufficient("no calibration pass ran".into()))?;
+    Ok(Calibration { estimate, iterations: history.len(), history, converged, samples })
+}
+
+/// Anderson mixing (type II, no damping): the next iterate from the last iterates
+/// `x_i` and their images `g_i = G(x_i)`, minimising the combined residual.
+fn anderson(xs: &[DVector<f64>], gs: &[DVector<f64>]) -> DVector<f64> {
+    let m = xs.len();
+    let last_g = gs[m - 1].clone();
+    if m < 2 {
+        return last_g;
+    }
+    let f: Vec<DVector<f64>> = xs.iter().zip(gs).map(|(x, g)| g - x).collect();
+    let cols = m - 1;
+    let mut df = DMatrix::zeros(f[0].len(), cols);
+    let mut dg = DMatrix::zeros(f[0].len(), cols);
+    for j in 0..cols {
+        df.set_column(j, &(&f[j + 1] - &f[j]));
+        dg.set_column(j, &(&gs[j + 1] - &gs[j]));
+    }
+    let svd = df.clone().svd(true, true);
+    match svd.solve(&f[m - 1], 1e-10) {
+        Ok(gamma) if gamma.iter().all(|v| v.is_finite()) => last_g - dg * gamma,
+        _ => last_g,
+    }
+}
+
+/// Lag-1 autocorrelation of residuals, clamped to [0, 0.99].
+fn lag1(res: &[f64]) -> f64 {
+    if res.len() < 3 {
+        return 0.0;
+    }
+    let m = res.iter().sum::<f64>() / res.len() as f64;
+    let den: f64 = res.iter().map(|r| (r - m).powi(2)).sum();
+    if den <= 0.0 {
+        return 0.0;
+    }
+    let num: f64 = res.windows(2).map(|w| (w[0] - m) * (w[1] - m)).sum();
+    (num / den).clamp(0.0, 0.99)
+}
+
+/// Effective-sample-size inflation factor sqrt(n / n_eff) = sqrt((1+ρ)/(1−ρ)).
+fn inflation(res: &[f64]) -> f64 {
+    let r = lag1(res);
+    ((1.0 + r) / (1.0 - r)).sqrt()
+}
+
+/// One-dimensional least squares `z ≈ θ·r` (eq. 26): θ, its standard error, n.
+fn ls_1d(pairs: &[(f64, f64)]) -> Option<(f64, f64, usize)> {
+    let n = pairs.len();
+    if n < 3 {
+        return None;
+    }
+    let srr: f64 = pairs.iter().map(|(_, r)| r * r).sum();
+    if srr <= 0.0 {
+        return None;
+    }
+    let theta = pairs.iter().map(|(z, r)| z * r).sum::<f64>() / srr;
+    let res: Vec<f64> = pairs.iter().map(|(z, r)| z - theta * r).collect();
+    let s2 = res.iter().map(|e| e * e).sum::<f64>() / (n - 1) as f64;
+    Some((theta, (s2 / srr).sqrt() * inflation(&res), n))
+}
+
+/// Eq. (23)–(26): the least-squares parameters from reference states (smoothed or
+/// true). `mid_interval` evaluates the state at the middle of each wheel
+/// counting interval (for the truth) instead of at its end (the filter's model).
+pub fn least_squares(drive: &Drive, reference: &Reference, min_speed: f64, mid_interval: bool) -> Result<(ParamsWithStd, [usize; 6]), Error> {
+    let v = &drive.vehicle;
+    let nominal = Params::nominal(v);
+    let mut est = nominal;
+    let mut std = Params::from_array([0.0; 6]);
+    let mut samples = [0usize; 6];
+
+    // Gyro bias, eq. (25): mean of gyro − ψ̇.
+    let res: Vec<f64> = drive
+        .yaw_rate
+        .iter()
+        .filter_map(|s| reference.state_at(s.t_s).map(|x| s.value - x[YAW_RATE]))
+        .collect();
+    if res.len() >= 3 {
+        let n = res.len() as f64;
+        let mean = res.iter().sum::<f64>() / n;
+        let centred: Vec<f64> = res.iter().map(|r| r - mean).collect();
+        let sd = (centred.iter().map(|e| e * e).sum::<f64>() / (n - 1.0)).sqrt();
+        est.gyro_bias_rps = mean;
+        std.gyro_bias_rps = sd / n.sqrt() * inflation(&centred);
+        samples[0] = res.len();
+    }
+
+    // Speed scale, eq. (26).
+    let pairs: Vec<(f64, f64)> = drive
+        .speed
+        .iter()
+        .filter_map(|s| reference.state_at(s.t_s).filter(|x| x[V] >= min_speed).map(|x| (s.value, x[V])))
+        .collect();
+    if let Some((a, sa, n)) = ls_1d(&pairs) {
+        est.speed_scale = a;
+        std.speed_scale = sa;
+        samples[1] = n;
+    }
+
+    // Inverse circumferences: z = (1/ρ)·r with r = N·T·g (ticks) or ρ_nom·g (speeds).
+    let sensors = Sensors::new(v, &nominal);
+    let mut pairs: [Vec<(f64, f64)>; 4] = Default::default();
+    let n_wheel = drive.wheels.len();
+    for k in 1..n_wheel {
+        let (t0, t1) = (drive.wheels.t_s(k - 1), drive.wheels.t_s(k));
+        let t_eval = if mid_interval { 0.5 * (t0 + t1) } else { t1 };
+        let Some(x) = reference.state_at(t_eval) else { continue };
+        if x[V] < min_speed {
+            continue;
+        }
+        let x: State = x;
+        match &drive.wheels {
+            Wheels::Ticks(rows) => {
+                let r = rows[k];
+                let interval = t1 - t0;
+                if interval > 0.5 {
+                    continue;
+                }
+                for (i, z) in [r.fl, r.fr, r.rl, r.rr].into_iter().enumerate() {
+                    let g = sensors.wheel_ground_speed(i, x[V], x[YAW_RATE]).0;
+                    pairs[i].push((z as f64, sensors.ticks_per_rev * interval * g));
+                }
+            }
+            Wheels::Speeds(rows) => {
+                let r = rows[k];
+                for (i, z) in [r.fl_mps, r.fr_mps, r.rl_mps, r.rr_mps].into_iter().enumerate() {
+                    let g = sensors.wheel_ground_speed(i, x[V], x[YAW_RATE]).0;
+                    pairs[i].push((z, sensors.nominal_circumference_m * g));
+                }
+            }
+        }
+    }
+    let mut circ = nominal.circumferences();
+    let mut circ_std = [0.0; 4];
+    for i in 0..4 {
+        if let Some((k, sk, n)) = ls_1d(&pairs[i]) {
+            if k > 0.0 {
+                circ[i] = 1.0 / k;
+                circ_std[i] = sk / (k * k);
+                samples[2 + i] = n;
+            }
+        }
+    }
+    est.set_circumferences(circ);
+    std.set_circumferences(circ_std);
+    Ok((ParamsWithStd { params: est, std }, samples))
+}
+
+/// Zero-velocity update: the gyro bias is the mean gyro reading over standstills
+/// (all four wheels still for at least 1 s; 0.3 s trimmed at each end).
+pub fn zupt(drive: &Drive, nominal: &Params) -> Result<Calibration, Error> {
+    let still: Vec<bool> = match &drive.wheels {
+        Wheels::Ticks(r) => r.iter().map(|w| w.fl == 0 && w.fr == 0 && w.rl == 0 && w.rr == 0).collect(),
+        Wheels::Speeds(r) => r
+            .iter()
+            .map(|w| w.fl_mps.abs() < 0.01 && w.fr_mps.abs() < 0.01 && w.rl_mps.abs() < 0.01 && w.rr_mps.abs() < 0.01)
+            .collect(),
+    };
+    let mut intervals = Vec::new();
+    let mut k = 1;
+    while k < still.len() {
+        if still[k] {
+            let a = k;
+            while k < still.len() && still[k] {
+                k += 1;
+            }
+            // Rows a..k counted nothing over (t_{a-1}, t_{k-1}].
+            let (t0, t1) = (drive.wheels.t_s(a - 1) + 0.3, drive.wheels.t_s(k - 1) - 0.3);
+            if t1 - t0 >= 0.4 {
+                intervals.push((t0, t1));
+            }
+        } else {
+            k += 1;
+        }
+    }
+    let vals: Vec<f64> = drive
+        .yaw_rate
+        .iter()
+        .filter(|s| intervals.iter().any(|&(a, b)| s.t_s >= a && s.t_s <= b))
+        .map(|s| s.value)
+        .collect();
+    if vals.len() < 3 {
+        return Err(Error::Insufficient("ZUPT found no standstill of at least 1 s with gyro readings".into()));
+    }
+    let n = vals.len() as f64;
+    let mean = vals.iter().sum::<f64>() / n;
+    let sd = (vals.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+    let mut p = *nominal;
+    p.gyro_bias_rps = mean;
+    let mut std = Params::from_array([0.0; 6]);
+    std.gyro_bias_rps = sd / n.sqrt();
+    let mut samples = [0; 6];
+    samples[0] = vals.len();
+    Ok(Calibration { estimate: ParamsWithStd { params: p, std }, iterations: 0, history: vec![p], converged: true, samples })
+}

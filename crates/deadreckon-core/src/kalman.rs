@@ -1,0 +1,120 @@
+//! Kalman filter steps, generic over the state dimension: prediction (eq. 11–12)
+//! and update (eq. 13–17), with the Joseph-form covariance update by default.
+//!
+//! These are the only places that touch covariances in the filter, so the
+//! numerical safeguards live here: symmetrisation after every step and an
+//! [`Error::Numerical`] (never a panic) when an innovation covariance is not
+//! positive.
+
+use nalgebra::{SMatrix, SVector};
+
+use crate::Error;
+
+/// How the updated covariance is computed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum CovarianceForm {
+    /// `P = (I − K H) P (I − K H)ᵀ + K R Kᵀ`: stays symmetric positive definite
+    /// under rounding and for non-optimal gains.
+    #[default]
+    Joseph,
+    /// Eq. (17): `P = (I − K H) P`, cheaper, as printed in the paper.
+    Simple,
+}
+
+/// The result of one update, for filter-health diagnostics.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Innovation {
+    /// The innovation ỹ (first component for vector updates).
+    pub y: f64,
+    /// The innovation variance S (first diagonal element for vector updates).
+    pub s: f64,
+    /// The normalised innovation squared ỹᵀ S⁻¹ ỹ.
+    pub nis: f64,
+}
+
+/// Eq. (12): `P⁻ = F P Fᵀ + Q`, symmetrised.
+pub fn predict_covariance<const N: usize>(
+    p: &SMatrix<f64, N, N>,
+    f: &SMatrix<f64, N, N>,
+    q: &SMatrix<f64, N, N>,
+) -> SMatrix<f64, N, N> {
+    let pp = f * p * f.transpose() + q;
+    (pp + pp.transpose()) * 0.5
+}
+
+/// Eq. (13)–(17) for one scalar measurement with innovation `y = z − h(x)`,
+/// Jacobian row `h` and variance `r`. Updates `x` and `p` in place.
+pub fn update_scalar<const N: usize>(
+    x: &mut SVector<f64, N>,
+    p: &mut SMatrix<f64, N, N>,
+    y: f64,
+    h: &SVector<f64, N>,
+    r: f64,
+    form: CovarianceForm,
+    t_s: f64,
+) -> Result<Innovation, Error> {
+    // S = H P Hᵀ + R   (14)
+    let ph = *p * h;
+    let s = h.dot(&ph) + r;
+    if !(s.is_finite() && s > 0.0) || !y.is_finite() {
+        return Err(Error::Numerical { t_s, what: format!("innovation variance {s} or innovation {y} is not usable") });
+    }
+    // K = P Hᵀ S⁻¹   (15)
+    let k = ph / s;
+    // x̂ = x̂⁻ + K ỹ   (16)
+    *x += k * y;
+    *p = match form {
+        CovarianceForm::Joseph => {
+            let a = SMatrix::<f64, N, N>::identity() - k * h.transpose();
+            a * *p * a.transpose() + k * k.transpose() * r
+        }
+        // P = (I − K H) P⁻   (17)
+        CovarianceForm::Simple => *p - k * ph.transpose(),
+    };
+    *p = (*p + p.transpose()) * 0.5;
+    Ok(Innovation { y, s, nis: y * y / s })
+}
+
+/// Innovation statistics of an `M`-dimensional measurement without updating:
+/// returns `(S, S⁻¹, NIS)` so the caller can gate before [`update_vector`].
+pub fn innovation_stats<const N: usize, const M: usize>(
+    p: &SMatrix<f64, N, N>,
+    y: &SVector<f64, M>,
+    h: &SMatrix<f64, M, N>,
+    r: &SMatrix<f64, M, M>,
+    t_s: f64,
+) -> Result<(SMatrix<f64, M, M>, SMatrix<f64, M, M>, f64), Error> {
+    let s = h * p * h.transpose() + r;
+    let s_inv = s
+        .try_inverse()
+        .ok_or_else(|| Error::Numerical { t_s, what: "innovation covariance is singular".into() })?;
+    let nis = (y.transpose() * s_inv * y)[(0, 0)];
+    if !nis.is_finite() || nis < 0.0 {
+        return Err(Error::Numerical { t_s, what: format!("normalised innovation squared {nis} is not usable") });
+    }
+    Ok((s, s_inv, nis))
+}
+
+/// Eq. (13)–(17) for an `M`-dimensional measurement with innovation `y`.
+pub fn update_vector<const N: usize, const M: usize>(
+    x: &mut SVector<f64, N>,
+    p: &mut SMatrix<f64, N, N>,
+    y: &SVector<f64, M>,
+    h: &SMatrix<f64, M, N>,
+    r: &SMatrix<f64, M, M>,
+    form: CovarianceForm,
+    t_s: f64,
+) -> Result<Innovation, Error> {
+    let (s, s_inv, nis) = innovation_stats(p, y, h, r, t_s)?;
+    let k = *p * h.transpose() * s_inv;
+    *x += k * y;
+    *p = match form {
+        CovarianceForm::Joseph => {
+            let a = SMatrix::<f64, N, N>::identity() - k * h;
+            a * *p * a.transpose() + k * r * k.transpose()
+        }
+        CovarianceForm::Simple => (SMatrix::<f64, N, N>::identity() - k * h) * *p,
+    };
+    *p = (*p + p.transpose()) * 0.5;
+    Ok(Innovation { y: y[0], s: s[(0, 0)], nis })
+}

@@ -1,0 +1,109 @@
+//! A state trajectory sampled at known times, interpolated at any time: used for
+//! the truth (with speed and yaw rate derived by finite differences where the
+//! file does not give them) and for smoothed estimates.
+
+use crate::drive::TruthPose;
+use crate::model::{State, V, X, Y, YAW, YAW_RATE};
+
+/// States at increasing times, linearly interpolated between samples.
+#[derive(Debug, Clone, Default)]
+pub struct Reference {
+    /// Sample times, s, strictly increasing.
+    pub t: Vec<f64>,
+    /// States (yaw continuous, not wrapped).
+    pub x: Vec<State>,
+}
+
+impl Reference {
+    /// Builds the reference from `truth.csv` poses: yaw is unwrapped, speed is
+    /// `speed_mps` when every pose has it, else the central difference of position
+    /// projected on the heading; the yaw rate is the central difference of yaw.
+    /// Returns `None` with fewer than 3 poses.
+    pub fn from_truth(truth: &[TruthPose]) -> Option<Reference> {
+        let n = truth.len();
+        if n < 3 {
+            return None;
+        }
+        let yaw = crate::angle::unwrap(&truth.iter().map(|p| p.yaw_rad).collect::<Vec<_>>());
+        let have_speed = truth.iter().all(|p| p.speed_mps.is_some());
+        let mut x = Vec::with_capacity(n);
+        for i in 0..n {
+            let (a, b) = (i.saturating_sub(1), (i + 1).min(n - 1));
+            let dt = truth[b].t_s - truth[a].t_s;
+            let v = if have_speed {
+                truth[i].speed_mps.unwrap_or(0.0)
+            } else {
+                let (de, dn) = (truth[b].east_m - truth[a].east_m, truth[b].north_m - truth[a].north_m);
+                (de * yaw[i].cos() + dn * yaw[i].sin()) / dt
+            };
+            let w = (yaw[b] - yaw[a]) / dt;
+            x.push(State::from([truth[i].east_m, truth[i].north_m, yaw[i], v, w]));
+        }
+        Some(Reference { t: truth.iter().map(|p| p.t_s).collect(), x })
+    }
+
+    /// Builds a reference from states at times (e.g. smoothed epochs).
+    pub fn from_states(t: Vec<f64>, x: Vec<State>) -> Reference {
+        Reference { t, x }
+    }
+
+    /// The interpolated state at `t`, or `None` outside the covered time span.
+    pub fn state_at(&self, t: f64) -> Option<State> {
+        let n = self.t.len();
+        if n == 0 || !(t >= self.t[0] && t <= self.t[n - 1]) {
+            return None;
+        }
+        let i = self.t.partition_point(|&ti| ti <= t);
+        if i >= n {
+            return Some(self.x[n - 1]);
+        }
+        let i = i.max(1);
+        let (t0, t1) = (self.t[i - 1], self.t[i]);
+        let a = if t1 > t0 { (t - t0) / (t1 - t0) } else { 0.0 };
+        Some(self.x[i - 1] * (1.0 - a) + self.x[i] * a)
+    }
+
+    /// Cumulative travelled distance (m) at each sample, from the positions.
+    pub fn distance(&self) -> Vec<f64> {
+        let mut d = Vec::with_capacity(self.x.len());
+        let mut acc = 0.0;
+        for i in 0..self.x.len() {
+            if i > 0 {
+                acc += (self.x[i][X] - self.x[i - 1][X]).hypot(self.x[i][Y] - self.x[i - 1][Y]);
+            }
+            d.push(acc);
+        }
+        d
+    }
+
+    /// Time span covered.
+    pub fn span(&self) -> Option<(f64, f64)> {
+        Some((*self.t.first()?, *self.t.last()?))
+    }
+}
+
+/// Indices of the state, re-exported for readers of this module.
+pub const INDICES: [usize; 5] = [X, Y, YAW, V, YAW_RATE];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    #[test]
+    fn derives_speed_and_yaw_rate_on_a_circle() {
+        let r = 20.0;
+        let v = 5.0;
+        let w = v / r;
+        let truth: Vec<TruthPose> = (0..2000)
+            .map(|i| {
+                let t = i as f64 * 0.01;
+                let a = w * t;
+                TruthPose { t_s: t, east_m: r * a.sin(), north_m: r * (1.0 - a.cos()), yaw_rad: crate::angle::wrap(a), speed_mps: None }
+            })
+            .collect();
+        let rf = Reference::from_truth(&truth).unwrap();
+        let s = rf.state_at(12.345).unwrap();
+        assert!((s[V] - v).abs() < 1e-3, "{}", s[V]);
+        assert!((s[YAW_RATE] - w).abs() < 1e-6);
+        assert!(rf.state_at(-1.0).is_none());
+    }
+}

@@ -1,0 +1,51 @@
+//! The Rauch–Tung–Striebel smoother, eq. (20)–(22) of Welte et al., run backward
+//! over the epochs recorded by the filter, with the very `F` and predicted
+//! covariances the forward pass used.
+
+use nalgebra::Cholesky;
+
+use crate::ekf::Epoch;
+use crate::model::{Mat, State};
+use crate::Error;
+
+/// One smoothed epoch: x̂_{k|N} and P_{k|N}.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Smoothed {
+    /// Timestamp, s.
+    pub t_s: f64,
+    /// x̂_{k|N}.
+    pub x: State,
+    /// P_{k|N}.
+    pub p: Mat,
+}
+
+/// One backward step: from the smoothed epoch k+1 and the filter's epochs k and
+/// k+1, the smoothed epoch k.
+pub fn step(k: &Epoch, k1: &Epoch, s1: &Smoothed) -> Result<Smoothed, Error> {
+    // J_k = P_{k|k} F_{k+1}ᵀ P_{k+1|k}⁻¹   (22)
+    // computed as the solution of P_{k+1|k} J_kᵀ = F_{k+1} P_{k|k} (P symmetric).
+    let chol = Cholesky::new(k1.p_pred)
+        .ok_or_else(|| Error::Numerical { t_s: k1.t_s, what: "predicted covariance is not positive definite".into() })?;
+    let jt = chol.solve(&(k1.f * k.p));
+    let j = jt.transpose();
+    // x̂_{k|N} = x̂_{k|k} + J_k (x̂_{k+1|N} − x̂_{k+1|k})   (20)
+    let x = k.x + j * (s1.x - k1.x_pred);
+    // P_{k|N} = P_{k|k} + J_k (P_{k+1|N} − P_{k+1|k}) J_kᵀ   (21)
+    let p = k.p + j * (s1.p - k1.p_pred) * jt;
+    let p = (p + p.transpose()) * 0.5;
+    Ok(Smoothed { t_s: k.t_s, x, p })
+}
+
+/// Smooths a whole filter run. The last epoch is its own smoothed estimate.
+pub fn smooth(epochs: &[Epoch]) -> Result<Vec<Smoothed>, Error> {
+    let n = epochs.len();
+    if n == 0 {
+        return Ok(Vec::new());
+    }
+    let mut out = vec![Smoothed { t_s: 0.0, x: State::zeros(), p: Mat::zeros() }; n];
+    out[n - 1] = Smoothed { t_s: epochs[n - 1].t_s, x: epochs[n - 1].x, p: epochs[n - 1].p };
+    for k in (0..n - 1).rev() {
+        out[k] = step(&epochs[k], &epochs[k + 1], &out[k + 1])?;
+    }
+    Ok(out)
+}
