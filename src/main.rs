@@ -15,6 +15,16 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
+    /// Simulate a drive with known truth into a drive directory.
+    Simulate(cmd::simulate::SimulateArgs),
+    /// Calibrate gyro bias, speed scale and wheel circumferences (rts, zupt, truth).
+    Calibrate(cmd::calibrate::CalibrateArgs),
+    /// Evaluate dead reckoning: drift per 100 m, distance before 1 m, sliding GNSS outages.
+    Evaluate(cmd::evaluate::EvaluateArgs),
+    /// Write the dead-reckoned (and filtered, smoothed) track with covariances.
+    Run(cmd::run::RunArgs),
+    /// Simulate, calibrate with every method, evaluate, print tables III and IV.
+    Demo(cmd::demo::DemoArgs),
     /// TedriS time-series dead reckoning: train a model, predict through outages.
     #[command(subcommand)]
     Tedris(cmd::tedris::TedrisCommand),
@@ -32,6 +42,11 @@ fn main() {
 
 fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
+        Command::Simulate(a) => cmd::simulate::run(a),
+        Command::Calibrate(a) => cmd::calibrate::run(a),
+        Command::Evaluate(a) => cmd::evaluate::run(a),
+        Command::Run(a) => cmd::run::run(a),
+        Command::Demo(a) => cmd::demo::run(a),
         Command::Tedris(c) => cmd::tedris::run(c),
         Command::Import(a) => cmd::import::run(a),
     }

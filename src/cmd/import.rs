@@ -1,19 +1,168 @@
-//! `deadreckon import ...` (owned by the importers work; placeholder until it lands).
+//! `deadreckon import FORMAT SOURCE --out DIR`: read a log into a drive
+//! directory. Each format is one arm of the `match` in [`run`], returning the
+//! drive and a printable report; the drive is written atomically (into a
+//! temporary sibling directory renamed into place when `--out` is new; file by
+//! file when it exists).
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
 use clap::Args;
+use deadreckon_core::Drive;
+use deadreckon_import::can::{self, Database, Mapping};
+use deadreckon_import::comma2k19::{Comma2k19Options, GyroSource, SpeedSource};
+use deadreckon_import::tricycle::TricycleOptions;
+use deadreckon_import::TimeOrderPolicy;
 
 /// Import arguments.
 #[derive(Args, Debug)]
 pub struct ImportArgs {
-    /// Input format.
+    /// Input format: comma2k19 (segment directory), can (candump log or
+    /// comma2k19 raw_can directory), tricycle (dataset.txt).
     pub format: String,
     /// Source file or directory.
-    pub source: std::path::PathBuf,
+    pub source: PathBuf,
     /// Output drive directory.
     #[arg(long)]
-    pub out: std::path::PathBuf,
+    pub out: PathBuf,
+    /// vehicle.toml to use (default: comma2k19 the built-in RAV4 profile,
+    /// can the built-in RAV4 profile with the built-in DBC, tricycle the log's header).
+    #[arg(long)]
+    pub vehicle: Option<PathBuf>,
+    /// can: DBC file (default: the built-in Toyota RAV4 subset).
+    #[arg(long)]
+    pub dbc: Option<PathBuf>,
+    /// can: signal-to-stream mapping TOML (default: the built-in RAV4 mapping).
+    #[arg(long)]
+    pub map: Option<PathBuf>,
+    /// Drop and count unsorted, duplicate or invalid samples instead of failing.
+    #[arg(long)]
+    pub gate: bool,
+    /// comma2k19: gyro stream, `raw` (gyro_uncalibrated, bias kept) or `calibrated`.
+    #[arg(long, default_value = "raw")]
+    pub gyro: String,
+    /// comma2k19: speed stream, `can` (SPEED message 0xB4) or `processed` (mean of the wheel speeds).
+    #[arg(long, default_value = "can")]
+    pub speed_source: String,
+    /// comma2k19: forward distance from the rear axle to the device, m (default 1.5).
+    #[arg(long)]
+    pub device_forward_m: Option<f64>,
+    /// comma2k19: u-blox fix latency subtracted from its log time, s (default 0.1).
+    #[arg(long)]
+    pub gnss_latency_s: Option<f64>,
+    /// comma2k19: standard deviation given to each u-blox fix, m (default 1.0).
+    #[arg(long)]
+    pub gnss_std_m: Option<f64>,
 }
 
 /// Runs an import.
-pub fn run(_a: ImportArgs) -> anyhow::Result<()> {
-    anyhow::bail!("import is not available yet")
+pub fn run(a: ImportArgs) -> Result<()> {
+    let policy = if a.gate { TimeOrderPolicy::Gate } else { TimeOrderPolicy::Error };
+    let vehicle = match &a.vehicle {
+        Some(p) => Some(deadreckon_io::read_vehicle(p).with_context(|| format!("reading vehicle {}", p.display()))?),
+        None => None,
+    };
+    let comma_only = a.gyro != "raw"
+        || a.speed_source != "can"
+        || a.device_forward_m.is_some()
+        || a.gnss_latency_s.is_some()
+        || a.gnss_std_m.is_some();
+    if a.format != "comma2k19" && comma_only {
+        bail!("--gyro, --speed-source, --device-forward-m, --gnss-latency-s and --gnss-std-m apply to comma2k19 only");
+    }
+    if a.format != "can" && (a.dbc.is_some() || a.map.is_some()) {
+        bail!("--dbc and --map apply to the can format only");
+    }
+    let (drive, report) = match a.format.as_str() {
+        "comma2k19" => {
+            let d = Comma2k19Options::default();
+            let o = Comma2k19Options {
+                vehicle,
+                gyro: match a.gyro.as_str() {
+                    "raw" => GyroSource::Uncalibrated,
+                    "calibrated" => GyroSource::Calibrated,
+                    g => bail!("unknown --gyro `{g}` (raw, calibrated)"),
+                },
+                speed: match a.speed_source.as_str() {
+                    "can" => SpeedSource::CanSpeedMessage,
+                    "processed" => SpeedSource::Processed,
+                    s => bail!("unknown --speed-source `{s}` (can, processed)"),
+                },
+                device_forward_m: a.device_forward_m.unwrap_or(d.device_forward_m),
+                gnss_latency_s: a.gnss_latency_s.unwrap_or(d.gnss_latency_s),
+                gnss_std_m: a.gnss_std_m.unwrap_or(d.gnss_std_m),
+                policy,
+            };
+            let i = deadreckon_import::read_comma2k19_with(&a.source, &o)?;
+            (i.drive, i.report.to_string())
+        }
+        "can" => {
+            let builtin = a.dbc.is_none() && a.map.is_none();
+            let db = match &a.dbc {
+                Some(p) => Database::read(p)?,
+                None => Database::parse(can::TOYOTA_RAV4_DBC, Path::new("<built-in toyota_rav4_subset.dbc>"))?,
+            };
+            let map = match &a.map {
+                Some(p) => Mapping::read(p, &db)?,
+                None => Mapping::parse(can::TOYOTA_RAV4_MAP, &db, Path::new("<built-in toyota_rav4_comma2k19.toml>"))?,
+            };
+            let vehicle = match vehicle {
+                Some(v) => v,
+                None if builtin => deadreckon_import::profiles::toyota_rav4(),
+                None => bail!("--vehicle is required with your own --dbc/--map"),
+            };
+            let frames = if a.source.is_dir() { can::read_raw_can(&a.source)? } else { can::read_candump(&a.source)? };
+            let i = can::decode_frames(&frames, &map, vehicle, policy, &a.source)?;
+            (i.drive, format!("{} frames read\n{}", frames.len(), i.report))
+        }
+        "tricycle" => {
+            let o = TricycleOptions { vehicle, policy, ..Default::default() };
+            let i = deadreckon_import::tricycle::read_tricycle(&a.source, &o)?;
+            (i.drive, i.report.to_string())
+        }
+        other => bail!("unknown import format `{other}` (comma2k19, can, tricycle)"),
+    };
+    write_new_or_update(&a.out, &drive)?;
+    print!("{report}");
+    print_counts(&drive);
+    println!("wrote {}", a.out.display());
+    Ok(())
+}
+
+fn print_counts(d: &Drive) {
+    let span = d.time_span().map_or(0.0, |(a, b)| b - a);
+    println!(
+        "drive: {:.3} s, wheels {}, yaw_rate {}, speed {}, steering {}, gnss {}, truth {}",
+        span,
+        d.wheels.len(),
+        d.yaw_rate.len(),
+        d.speed.len(),
+        d.steering.len(),
+        d.gnss.len(),
+        d.truth.len()
+    );
+}
+
+/// Writes `drive` into `out`: a new directory appears whole (written beside it
+/// under a temporary name, then renamed); an existing one is updated file by
+/// file, each file atomically.
+fn write_new_or_update(out: &Path, drive: &Drive) -> Result<()> {
+    if out.exists() {
+        return deadreckon_io::write_drive(out, drive).with_context(|| format!("writing drive {}", out.display()));
+    }
+    let parent = match out.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    std::fs::create_dir_all(&parent).with_context(|| format!("creating {}", parent.display()))?;
+    let name = out.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "drive".into());
+    let tmp = parent.join(format!(".{name}.import-{}", std::process::id()));
+    std::fs::create_dir(&tmp).with_context(|| format!("creating {}", tmp.display()))?;
+    let result = deadreckon_io::write_drive(&tmp, drive)
+        .with_context(|| format!("writing drive {}", tmp.display()))
+        .and_then(|()| std::fs::rename(&tmp, out).with_context(|| format!("renaming into {}", out.display())));
+    if result.is_err() {
+        let _ = std::fs::remove_dir_all(&tmp);
+    }
+    result
 }

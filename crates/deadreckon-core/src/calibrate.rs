@@ -52,6 +52,21 @@ impl std::str::FromStr for Method {
     }
 }
 
+/// What one smoothing pass carries.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum PassState {
+    /// The paper's 5-state filter with the parameters fixed at the current estimate.
+    /// The filter takes speed errors for white noise, so GNSS hardly corrects a
+    /// scale error and the passes creep towards the fixed point.
+    Paper,
+    /// The car state augmented with the six parameters (weak prior around the
+    /// current estimate): filter and smoother estimate them from GNSS along the
+    /// drive, so the smoothed states are free of the parameter errors and the
+    /// least squares on them lands at the fixed point in one or two passes.
+    #[default]
+    Augmented,
+}
+
 /// How the smoothing–calibration passes are chained.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Iteration {
@@ -67,8 +82,13 @@ pub enum Iteration {
 pub struct CalibrationOptions {
     /// Method.
     pub method: Method,
+    /// What each smoothing pass carries (RTS only).
+    pub state: PassState,
     /// Chaining of passes (RTS only).
     pub iteration: Iteration,
+    /// Prior standard deviations of the parameters in the augmented pass
+    /// (circumferences in metres).
+    pub prior_std: Params,
     /// Maximum smoothing passes (RTS only).
     pub max_iterations: usize,
     /// Convergence: stop when every parameter changed less than this many of its
@@ -86,7 +106,16 @@ impl Default for CalibrationOptions {
     fn default() -> Self {
         CalibrationOptions {
             method: Method::Rts,
+            state: PassState::Augmented,
             iteration: Iteration::Anderson,
+            prior_std: Params {
+                gyro_bias_rps: 0.01,
+                speed_scale: 0.05,
+                circumference_fl_m: 0.05,
+                circumference_fr_m: 0.05,
+                circumference_rl_m: 0.05,
+                circumference_rr_m: 0.05,
+            },
             max_iterations: 60,
             tolerance: 1.0,
             min_speed_mps: 2.0,
@@ -142,9 +171,18 @@ pub fn smoothing_pass(drive: &Drive, p: &Params, opts: &CalibrationOptions) -> R
     if matches!(fopts.init, Init::Truth) {
         fopts.init = Init::Gnss;
     }
-    let out = ekf::run(drive, p, &fopts, &mut ())?;
-    let sm = rts::smooth(&out.epochs)?;
-    let reference = Reference::from_states(sm.iter().map(|s| s.t_s).collect(), sm.iter().map(|s| s.x).collect());
+    let reference = match opts.state {
+        PassState::Paper => {
+            let out = ekf::run(drive, p, &fopts, &mut ())?;
+            let sm = rts::smooth(&out.epochs)?;
+            Reference::from_states(sm.iter().map(|s| s.t_s).collect(), sm.iter().map(|s| s.x).collect())
+        }
+        PassState::Augmented => {
+            let out = ekf::run_augmented(drive, p, &opts.prior_std, &fopts)?;
+            let sm = rts::smooth(&out.epochs)?;
+            Reference::from_states(sm.iter().map(|s| s.t_s).collect(), sm.iter().map(|s| s.x.fixed_rows::<5>(0).into_owned()).collect())
+        }
+    };
     least_squares(drive, &reference, opts.min_speed_mps, false)
 }
 

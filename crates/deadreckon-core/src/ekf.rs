@@ -14,11 +14,11 @@
 //! per-epoch predicted and updated states, covariances and Jacobians are kept
 //! when asked (`record`), for the RTS smoother.
 
-use nalgebra::{Matrix2, Vector2};
+use nalgebra::{Matrix2, SMatrix, SVector, Vector2};
 
 use crate::drive::{Drive, Wheels};
 use crate::kalman::{self, CovarianceForm};
-use crate::model::{self, Mat, State, V, X, Y, YAW, YAW_RATE};
+use crate::model::{self, Mat, State, V};
 use crate::observation::Sensors;
 use crate::vehicle::{Noise, Params};
 use crate::Error;
@@ -101,6 +101,8 @@ pub struct FilterOptions {
     pub record_epochs: bool,
     /// Keep every innovation (for filter-health plots).
     pub record_innovations: bool,
+    /// Stop after the last epoch at or before this time, s.
+    pub end_s: Option<f64>,
 }
 
 impl Default for FilterOptions {
@@ -113,25 +115,27 @@ impl Default for FilterOptions {
             covariance_form: CovarianceForm::Joseph,
             record_epochs: true,
             record_innovations: false,
+            end_s: None,
         }
     }
 }
 
-/// One filter epoch, as the smoother needs it.
+/// One filter epoch, as the smoother needs it. `N` is 5 for the car state and
+/// 11 for the state augmented with the six parameters.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Epoch {
+pub struct Epoch<const N: usize = 5> {
     /// Timestamp, s.
     pub t_s: f64,
     /// x̂_{k|k-1}.
-    pub x_pred: State,
+    pub x_pred: SVector<f64, N>,
     /// P_{k|k-1}.
-    pub p_pred: Mat,
+    pub p_pred: SMatrix<f64, N, N>,
     /// F_k, the Jacobian of the prediction from the previous epoch to this one.
-    pub f: Mat,
+    pub f: SMatrix<f64, N, N>,
     /// x̂_{k|k}.
-    pub x: State,
+    pub x: SVector<f64, N>,
     /// P_{k|k}.
-    pub p: Mat,
+    pub p: SMatrix<f64, N, N>,
 }
 
 /// Which sensor an innovation belongs to.
@@ -223,54 +227,98 @@ pub struct FilterStats {
 }
 
 /// The result of a filter run.
-#[derive(Debug, Clone, Default)]
-pub struct FilterOutput {
+#[derive(Debug, Clone)]
+pub struct FilterOutput<const N: usize = 5> {
     /// Every epoch (empty unless `record_epochs`).
-    pub epochs: Vec<Epoch>,
+    pub epochs: Vec<Epoch<N>>,
     /// Every innovation (empty unless `record_innovations`).
     pub innovations: Vec<InnovationRecord>,
     /// Counters.
     pub stats: FilterStats,
 }
 
+impl<const N: usize> Default for FilterOutput<N> {
+    fn default() -> Self {
+        FilterOutput { epochs: Vec::new(), innovations: Vec::new(), stats: FilterStats::default() }
+    }
+}
+
 /// A hook called after every epoch with the time and the updated state and
 /// covariance, which it may change (e.g. to reset the state to the truth).
-pub trait EpochHook {
+pub trait EpochHook<const N: usize = 5> {
     /// Called after the updates of the epoch at `t_s`.
-    fn after_epoch(&mut self, t_s: f64, x: &mut State, p: &mut Mat);
+    fn after_epoch(&mut self, t_s: f64, x: &mut SVector<f64, N>, p: &mut SMatrix<f64, N, N>);
 }
 
-impl EpochHook for () {
-    fn after_epoch(&mut self, _t_s: f64, _x: &mut State, _p: &mut Mat) {}
+impl<const N: usize> EpochHook<N> for () {
+    fn after_epoch(&mut self, _t_s: f64, _x: &mut SVector<f64, N>, _p: &mut SMatrix<f64, N, N>) {}
 }
 
-/// The filter's running state.
-struct Filter<'a> {
+/// Dimension of the augmented state: the car state then the six parameters
+/// `[b_gyro, a_v, 1/ρ_FL, 1/ρ_FR, 1/ρ_RL, 1/ρ_RR]`.
+pub const N_AUG: usize = 11;
+/// Index of the gyro bias in the augmented state.
+pub const AUG_BIAS: usize = 5;
+/// Index of the speed scale in the augmented state.
+pub const AUG_SCALE: usize = 6;
+/// Index of the first inverse circumference (FL, then FR, RL, RR) in the augmented state.
+pub const AUG_INV_CIRC: usize = 7;
+
+/// The filter's running state. With `N == 5` the parameters are fixed; with
+/// `N == N_AUG` they are states, and the sensor models read them from the state.
+struct Filter<'a, const N: usize> {
     sensors: Sensors,
     noise: Noise,
     form: CovarianceForm,
-    x: State,
-    p: Mat,
+    x: SVector<f64, N>,
+    p: SMatrix<f64, N, N>,
     t: f64,
     opts: &'a FilterOptions,
-    out: FilterOutput,
+    out: FilterOutput<N>,
 }
 
-impl Filter<'_> {
-    fn predict(&mut self, t: f64) -> (State, Mat, Mat) {
+impl<const N: usize> Filter<'_, N> {
+    fn car(&self) -> State {
+        self.x.fixed_rows::<5>(0).into_owned()
+    }
+
+    /// Points the sensor models at the parameters held in the augmented state.
+    fn refresh_params(&mut self) {
+        if N == N_AUG {
+            self.sensors.params.gyro_bias_rps = self.x[AUG_BIAS];
+            self.sensors.params.speed_scale = self.x[AUG_SCALE];
+            for i in 0..4 {
+                self.sensors.inv_circumference[i] = self.x[AUG_INV_CIRC + i];
+            }
+        }
+    }
+
+    fn predict(&mut self, t: f64) -> (SVector<f64, N>, SMatrix<f64, N, N>, SMatrix<f64, N, N>) {
         let dt = (t - self.t).max(0.0);
-        let f = model::jacobian(&self.x, dt);
-        let q = model::process_noise(&self.noise, dt);
-        self.x = model::evolve(&self.x, dt);
+        let car = self.car();
+        let mut f = SMatrix::<f64, N, N>::identity();
+        f.fixed_view_mut::<5, 5>(0, 0).copy_from(&model::jacobian(&car, dt));
+        let mut q = SMatrix::<f64, N, N>::zeros();
+        q.fixed_view_mut::<5, 5>(0, 0).copy_from(&model::process_noise(&self.noise, dt));
+        self.x.fixed_rows_mut::<5>(0).copy_from(&model::evolve(&car, dt));
         self.p = kalman::predict_covariance(&self.p, &f, &q);
         self.t = t;
         (self.x, self.p, f)
     }
 
-    fn scalar(&mut self, sensor: SensorKind, z: f64, pred: (f64, model::Row), r: f64) -> Result<(), Error> {
-        let (h, row) = pred;
+    /// A scalar update from a car-state model `pred = (h, H)`; `param` adds the
+    /// derivative with respect to one parameter (index in the parameter block)
+    /// when the parameters are states.
+    fn scalar(&mut self, sensor: SensorKind, z: f64, pred: (f64, model::Row), r: f64, param: Option<(usize, f64)>) -> Result<(), Error> {
+        let (h, row5) = pred;
+        let mut row = SVector::<f64, N>::zeros();
+        row.fixed_rows_mut::<5>(0).copy_from(&row5);
+        if let (true, Some((j, d))) = (N == N_AUG, param) {
+            row[5 + j] = d;
+        }
         let y = if sensor == SensorKind::Course { crate::angle::diff(z, h) } else { z - h };
         let inn = kalman::update_scalar(&mut self.x, &mut self.p, y, &row, r, self.form, self.t)?;
+        self.refresh_params();
         if self.opts.record_innovations {
             self.out.innovations.push(InnovationRecord {
                 t_s: self.t,
@@ -296,16 +344,19 @@ impl Filter<'_> {
                 let r = rows[k];
                 let r2 = self.noise.wheel_ticks.powi(2);
                 for (i, z) in [r.fl, r.fr, r.rl, r.rr].into_iter().enumerate() {
-                    let pred = self.sensors.wheel_ticks(&self.x, i, interval);
-                    self.scalar(SensorKind::Wheel(i as u8), z as f64, pred, r2)?;
+                    let pred = self.sensors.wheel_ticks(&self.car(), i, interval);
+                    // ∂h/∂(1/ρ_i) = h·ρ_i: the model is linear in the inverse circumference.
+                    let d = pred.0 / self.sensors.inv_circumference[i];
+                    self.scalar(SensorKind::Wheel(i as u8), z as f64, pred, r2, Some((2 + i, d)))?;
                 }
             }
             Wheels::Speeds(rows) => {
                 let r = rows[k];
                 let r2 = self.noise.wheel_speed_mps.powi(2);
                 for (i, z) in [r.fl_mps, r.fr_mps, r.rl_mps, r.rr_mps].into_iter().enumerate() {
-                    let pred = self.sensors.wheel_speed(&self.x, i);
-                    self.scalar(SensorKind::Wheel(i as u8), z, pred, r2)?;
+                    let pred = self.sensors.wheel_speed(&self.car(), i);
+                    let d = pred.0 / self.sensors.inv_circumference[i];
+                    self.scalar(SensorKind::Wheel(i as u8), z, pred, r2, Some((2 + i, d)))?;
                 }
             }
         }
@@ -313,13 +364,16 @@ impl Filter<'_> {
     }
 
     fn gnss(&mut self, fix: &crate::drive::GnssFix) -> Result<(), Error> {
-        let (h, jac) = self.sensors.gnss(&self.x);
+        let (h, jac5) = self.sensors.gnss(&self.car());
+        let mut jac = SMatrix::<f64, 2, N>::zeros();
+        jac.fixed_view_mut::<2, 5>(0, 0).copy_from(&jac5);
         let y = Vector2::new(fix.east_m, fix.north_m) - h;
         let r = Matrix2::identity() * fix.std_m.powi(2);
         let (s, _, nis) = kalman::innovation_stats(&self.p, &y, &jac, &r, self.t)?;
         let accepted = nis <= self.noise.gnss_gate_chi2;
         if accepted {
             kalman::update_vector(&mut self.x, &mut self.p, &y, &jac, &r, self.form, self.t)?;
+            self.refresh_params();
             self.out.stats.gnss_updates += 1;
         } else {
             self.out.stats.gnss_rejected += 1;
@@ -339,8 +393,8 @@ impl Filter<'_> {
                 if speed > 3.0 {
                     // Course noise shrinks with speed: about 0.5 m/s of velocity noise.
                     let sigma = (0.5 / speed).min(0.3);
-                    let pred = self.sensors.yaw(&self.x);
-                    self.scalar(SensorKind::Course, course, pred, sigma * sigma)?;
+                    let pred = self.sensors.yaw(&self.car());
+                    self.scalar(SensorKind::Course, course, pred, sigma * sigma, None)?;
                     self.out.stats.course_updates += 1;
                 }
             }
@@ -348,7 +402,7 @@ impl Filter<'_> {
         Ok(())
     }
 
-    fn record(&mut self, pred: (State, Mat, Mat)) {
+    fn record(&mut self, pred: (SVector<f64, N>, SMatrix<f64, N, N>, SMatrix<f64, N, N>)) {
         self.out.stats.epochs += 1;
         if self.opts.record_epochs {
             self.out.epochs.push(Epoch { t_s: self.t, x_pred: pred.0, p_pred: pred.1, f: pred.2, x: self.x, p: self.p });
@@ -428,20 +482,49 @@ impl Cursor {
 
 /// Runs the EKF over `drive` with the calibration `params`.
 pub fn run(drive: &Drive, params: &Params, opts: &FilterOptions, hook: &mut dyn EpochHook) -> Result<FilterOutput, Error> {
+    run_generic::<5>(drive, params, None, opts, hook)
+}
+
+/// Runs the EKF with the state augmented by the six parameters, which start at
+/// `params` with standard deviations `prior_std` (circumferences in metres) and
+/// are then estimated with the car state. Used by the calibration.
+pub fn run_augmented(drive: &Drive, params: &Params, prior_std: &Params, opts: &FilterOptions) -> Result<FilterOutput<N_AUG>, Error> {
+    run_generic::<N_AUG>(drive, params, Some(prior_std), opts, &mut ())
+}
+
+fn run_generic<const N: usize>(
+    drive: &Drive,
+    params: &Params,
+    prior_std: Option<&Params>,
+    opts: &FilterOptions,
+    hook: &mut dyn EpochHook<N>,
+) -> Result<FilterOutput<N>, Error> {
     drive.validate()?;
     params.validate()?;
     let (t0, x0, p0) = initial_state(drive, opts)?;
     let sensors = Sensors::new(&drive.vehicle, params);
-    let mut f = Filter {
-        sensors,
-        noise: drive.vehicle.noise,
-        form: opts.covariance_form,
-        x: x0,
-        p: p0,
-        t: t0,
-        opts,
-        out: FilterOutput::default(),
-    };
+    let mut x = SVector::<f64, N>::zeros();
+    let mut p = SMatrix::<f64, N, N>::zeros();
+    x.fixed_rows_mut::<5>(0).copy_from(&x0);
+    p.fixed_view_mut::<5, 5>(0, 0).copy_from(&p0);
+    if N == N_AUG {
+        let sd = prior_std.ok_or_else(|| Error::InvalidParams("the augmented filter needs prior standard deviations".into()))?;
+        let c = params.circumferences();
+        let cs = sd.circumferences();
+        x[AUG_BIAS] = params.gyro_bias_rps;
+        x[AUG_SCALE] = params.speed_scale;
+        p[(AUG_BIAS, AUG_BIAS)] = sd.gyro_bias_rps.powi(2);
+        p[(AUG_SCALE, AUG_SCALE)] = sd.speed_scale.powi(2);
+        for i in 0..4 {
+            x[AUG_INV_CIRC + i] = 1.0 / c[i];
+            // σ(1/ρ) = σ(ρ)/ρ².
+            p[(AUG_INV_CIRC + i, AUG_INV_CIRC + i)] = (cs[i] / (c[i] * c[i])).powi(2);
+        }
+        if (0..6).any(|j| !(p[(5 + j, 5 + j)] > 0.0)) {
+            return Err(Error::InvalidParams("prior standard deviations of the parameters must be positive".into()));
+        }
+    }
+    let mut f = Filter { sensors, noise: drive.vehicle.noise, form: opts.covariance_form, x, p, t: t0, opts, out: FilterOutput::default() };
     let wheels = &drive.wheels;
     let max_interval = 5.0 * median_interval(wheels);
     let k0 = (0..wheels.len()).find(|&k| wheels.t_s(k) >= t0).unwrap_or(wheels.len());
@@ -462,6 +545,9 @@ pub fn run(drive: &Drive, params: &Params, opts: &FilterOptions, hook: &mut dyn 
         Timing::WheelEpochs => {
             for k in (k0 + 1)..wheels.len() {
                 let t = wheels.t_s(k);
+                if opts.end_s.is_some_and(|e| t > e) {
+                    break;
+                }
                 let pred = f.predict(t);
                 if use_.wheels {
                     f.wheels(wheels, k, max_interval)?;
@@ -469,23 +555,23 @@ pub fn run(drive: &Drive, params: &Params, opts: &FilterOptions, hook: &mut dyn 
                 let (gi, n) = gyro.advance(|i| drive.yaw_rate[i].t_s, drive.yaw_rate.len(), t);
                 if let (Some(i), true) = (gi, use_.gyro) {
                     f.out.stats.readings_superseded += n - 1;
-                    let pred = f.sensors.gyro(&f.x);
-                    f.scalar(SensorKind::Gyro, drive.yaw_rate[i].value, pred, r_gyro)?;
+                    let pred = f.sensors.gyro(&f.car());
+                    f.scalar(SensorKind::Gyro, drive.yaw_rate[i].value, pred, r_gyro, Some((0, 1.0)))?;
                     f.out.stats.gyro_updates += 1;
                 }
                 let (si, n) = speed.advance(|i| drive.speed[i].t_s, drive.speed.len(), t);
                 if let (Some(i), true) = (si, use_.speed) {
                     f.out.stats.readings_superseded += n - 1;
-                    let pred = f.sensors.can_speed(&f.x);
-                    f.scalar(SensorKind::Speed, drive.speed[i].value, pred, r_speed)?;
+                    let pred = f.sensors.can_speed(&f.car());
+                    f.scalar(SensorKind::Speed, drive.speed[i].value, pred, r_speed, Some((1, f.x[V])))?;
                     f.out.stats.speed_updates += 1;
                 }
                 let (di, n) = steer.advance(|i| drive.steering[i].t_s, drive.steering.len(), t);
                 if let (Some(i), true) = (di, use_.steering) {
                     f.out.stats.readings_superseded += n - 1;
                     let (z, r) = f.sensors.steering_measurement(drive.steering[i].value, f.x[V], beta_steer);
-                    let pred = f.sensors.steering(&f.x);
-                    f.scalar(SensorKind::Steering, z, pred, r)?;
+                    let pred = f.sensors.steering(&f.car());
+                    f.scalar(SensorKind::Steering, z, pred, r, None)?;
                     f.out.stats.steering_updates += 1;
                 }
                 let start = gnss.next;
@@ -513,9 +599,9 @@ pub fn run(drive: &Drive, params: &Params, opts: &FilterOptions, hook: &mut dyn 
                 Gnss(usize),
             }
             let mut evs: Vec<(f64, u8, Ev)> = Vec::new();
-            let t_end = wheels.t_s(wheels.len() - 1);
+            let t_end = wheels.t_s(wheels.len() - 1).min(opts.end_s.unwrap_or(f64::INFINITY));
             if use_.wheels {
-                evs.extend(((k0 + 1)..wheels.len()).map(|k| (wheels.t_s(k), 0, Ev::Wheel(k))));
+                evs.extend(((k0 + 1)..wheels.len()).filter(|&k| wheels.t_s(k) <= t_end).map(|k| (wheels.t_s(k), 0, Ev::Wheel(k))));
             }
             let within = |t: f64| t > t0 && t <= t_end;
             if use_.gyro {
@@ -543,19 +629,19 @@ pub fn run(drive: &Drive, params: &Params, opts: &FilterOptions, hook: &mut dyn 
                 match ev {
                     Ev::Wheel(k) => f.wheels(wheels, k, max_interval)?,
                     Ev::Gyro(i) => {
-                        let pred = f.sensors.gyro(&f.x);
-                        f.scalar(SensorKind::Gyro, drive.yaw_rate[i].value, pred, r_gyro)?;
+                        let pred = f.sensors.gyro(&f.car());
+                        f.scalar(SensorKind::Gyro, drive.yaw_rate[i].value, pred, r_gyro, Some((0, 1.0)))?;
                         f.out.stats.gyro_updates += 1;
                     }
                     Ev::Speed(i) => {
-                        let pred = f.sensors.can_speed(&f.x);
-                        f.scalar(SensorKind::Speed, drive.speed[i].value, pred, r_speed)?;
+                        let pred = f.sensors.can_speed(&f.car());
+                        f.scalar(SensorKind::Speed, drive.speed[i].value, pred, r_speed, Some((1, f.x[V])))?;
                         f.out.stats.speed_updates += 1;
                     }
                     Ev::Steer(i) => {
                         let (z, r) = f.sensors.steering_measurement(drive.steering[i].value, f.x[V], beta_steer);
-                        let pred = f.sensors.steering(&f.x);
-                        f.scalar(SensorKind::Steering, z, pred, r)?;
+                        let pred = f.sensors.steering(&f.car());
+                        f.scalar(SensorKind::Steering, z, pred, r, None)?;
                         f.out.stats.steering_updates += 1;
                     }
                     Ev::Gnss(i) => f.gnss(&drive.gnss[i])?,
@@ -565,6 +651,5 @@ pub fn run(drive: &Drive, params: &Params, opts: &FilterOptions, hook: &mut dyn 
             }
         }
     }
-    let _ = (X, Y, YAW, YAW_RATE);
     Ok(f.out)
 }

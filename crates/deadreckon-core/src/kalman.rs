@@ -63,14 +63,18 @@ pub fn update_scalar<const N: usize>(
     let k = ph / s;
     // x̂ = x̂⁻ + K ỹ   (16)
     *x += k * y;
-    *p = match form {
+    match form {
+        // Joseph form (I − K H) P (I − K H)ᵀ + K R Kᵀ, expanded for a scalar
+        // measurement into rank-one terms (O(N²) instead of O(N³)):
+        // P − K (P H)ᵀ − (P H) Kᵀ + (H P Hᵀ + R) K Kᵀ.
         CovarianceForm::Joseph => {
-            let a = SMatrix::<f64, N, N>::identity() - k * h.transpose();
-            a * *p * a.transpose() + k * k.transpose() * r
+            p.ger(-1.0, &k, &ph, 1.0);
+            p.ger(-1.0, &ph, &k, 1.0);
+            p.ger(s, &k, &k, 1.0);
         }
         // P = (I − K H) P⁻   (17)
-        CovarianceForm::Simple => *p - k * ph.transpose(),
-    };
+        CovarianceForm::Simple => p.ger(-1.0, &k, &ph, 1.0),
+    }
     *p = (*p + p.transpose()) * 0.5;
     Ok(Innovation { y, s, nis: y * y / s })
 }

@@ -25,6 +25,7 @@ pub mod kalman;
 pub mod metrics;
 pub mod model;
 pub mod observation;
+pub mod outage;
 pub mod reference;
 pub mod rts;
 pub mod track;

@@ -4,24 +4,25 @@
 
 use nalgebra::Cholesky;
 
+use nalgebra::{SMatrix, SVector};
+
 use crate::ekf::Epoch;
-use crate::model::{Mat, State};
 use crate::Error;
 
 /// One smoothed epoch: x̂_{k|N} and P_{k|N}.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Smoothed {
+pub struct Smoothed<const N: usize = 5> {
     /// Timestamp, s.
     pub t_s: f64,
     /// x̂_{k|N}.
-    pub x: State,
+    pub x: SVector<f64, N>,
     /// P_{k|N}.
-    pub p: Mat,
+    pub p: SMatrix<f64, N, N>,
 }
 
 /// One backward step: from the smoothed epoch k+1 and the filter's epochs k and
 /// k+1, the smoothed epoch k.
-pub fn step(k: &Epoch, k1: &Epoch, s1: &Smoothed) -> Result<Smoothed, Error> {
+pub fn step<const N: usize>(k: &Epoch<N>, k1: &Epoch<N>, s1: &Smoothed<N>) -> Result<Smoothed<N>, Error> {
     // J_k = P_{k|k} F_{k+1}ᵀ P_{k+1|k}⁻¹   (22)
     // computed as the solution of P_{k+1|k} J_kᵀ = F_{k+1} P_{k|k} (P symmetric).
     let chol = Cholesky::new(k1.p_pred)
@@ -37,12 +38,12 @@ pub fn step(k: &Epoch, k1: &Epoch, s1: &Smoothed) -> Result<Smoothed, Error> {
 }
 
 /// Smooths a whole filter run. The last epoch is its own smoothed estimate.
-pub fn smooth(epochs: &[Epoch]) -> Result<Vec<Smoothed>, Error> {
+pub fn smooth<const N: usize>(epochs: &[Epoch<N>]) -> Result<Vec<Smoothed<N>>, Error> {
     let n = epochs.len();
     if n == 0 {
         return Ok(Vec::new());
     }
-    let mut out = vec![Smoothed { t_s: 0.0, x: State::zeros(), p: Mat::zeros() }; n];
+    let mut out = vec![Smoothed { t_s: 0.0, x: SVector::zeros(), p: SMatrix::zeros() }; n];
     out[n - 1] = Smoothed { t_s: epochs[n - 1].t_s, x: epochs[n - 1].x, p: epochs[n - 1].p };
     for k in (0..n - 1).rev() {
         out[k] = step(&epochs[k], &epochs[k + 1], &out[k + 1])?;

@@ -46,3 +46,38 @@ pub struct Track {
     /// The geodetic origin of the local frame, where known (for map exports).
     pub origin: Option<Origin>,
 }
+
+impl TrackPoint {
+    /// A track point from a state and its covariance (yaw wrapped for output).
+    pub fn from_state(t_s: f64, x: &crate::model::State, p: &crate::model::Mat) -> Self {
+        use crate::model::{V, X, Y, YAW, YAW_RATE};
+        let idx = [X, Y, YAW];
+        let mut cov_pose = [0.0; 9];
+        for (a, &i) in idx.iter().enumerate() {
+            for (b, &j) in idx.iter().enumerate() {
+                cov_pose[3 * a + b] = p[(i, j)];
+            }
+        }
+        TrackPoint {
+            t_s,
+            east_m: x[X],
+            north_m: x[Y],
+            yaw_rad: crate::angle::wrap(x[YAW]),
+            speed_mps: x[V],
+            yaw_rate_rps: x[YAW_RATE],
+            cov_pose,
+        }
+    }
+}
+
+impl Track {
+    /// The filtered states of a filter run.
+    pub fn from_epochs(name: &str, epochs: &[crate::ekf::Epoch], origin: Option<Origin>) -> Track {
+        Track { name: name.into(), points: epochs.iter().map(|e| TrackPoint::from_state(e.t_s, &e.x, &e.p)).collect(), origin }
+    }
+
+    /// The smoothed states of an RTS pass.
+    pub fn from_smoothed(name: &str, smoothed: &[crate::rts::Smoothed], origin: Option<Origin>) -> Track {
+        Track { name: name.into(), points: smoothed.iter().map(|s| TrackPoint::from_state(s.t_s, &s.x, &s.p)).collect(), origin }
+    }
+}

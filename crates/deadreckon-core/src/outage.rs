@@ -1,0 +1,186 @@
+//! Outage evaluation on any drive: GNSS is hidden in sliding windows of a given
+//! length; in each, the vehicle dead-reckons from the GNSS-aided filter state at
+//! the window start, and the error is measured against the truth or, where the
+//! drive has none, against the GNSS fixes that were hidden (compared at the
+//! antenna, through the lever arm).
+//!
+//! Per window: the horizontal error at the end of the window, the drift per
+//! 100 m (end error over the distance travelled in the window), and the distance
+//! travelled before the error first reaches 1 m (the window's distance when it
+//! never does, flagged as censored).
+
+use crate::drive::Drive;
+use crate::ekf::{self, EpochHook, FilterOptions, Init, SensorSet};
+use crate::metrics::Summary;
+use crate::model::{Mat, State, X, Y, YAW};
+use crate::reference::Reference;
+use crate::vehicle::Params;
+use crate::Error;
+
+/// What the errors are measured against.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ReferenceKind {
+    /// `truth.csv`.
+    Truth,
+    /// The hidden GNSS fixes.
+    Gnss,
+}
+
+impl ReferenceKind {
+    /// "truth" or "gnss".
+    pub fn name(&self) -> &'static str {
+        match self {
+            ReferenceKind::Truth => "truth",
+            ReferenceKind::Gnss => "gnss",
+        }
+    }
+}
+
+/// One outage window.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Window {
+    /// Start, s.
+    pub start_s: f64,
+    /// End, s.
+    pub end_s: f64,
+    /// Horizontal error at the end of the window, m.
+    pub final_error_m: f64,
+    /// Largest error in the window, m.
+    pub max_error_m: f64,
+    /// Distance travelled in the window, m.
+    pub distance_m: f64,
+    /// Distance before the error first reached 1 m, m.
+    pub distance_to_1m_m: f64,
+    /// False when the error never reached 1 m (the distance is the window's).
+    pub reached_1m: bool,
+    /// Errors over the window: (time since start s, error m).
+    pub errors: Vec<(f64, f64)>,
+}
+
+/// The result over all windows.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OutageEvaluation {
+    /// Window length, s.
+    pub outage_s: f64,
+    /// Reference used.
+    pub reference: ReferenceKind,
+    /// Every window.
+    pub windows: Vec<Window>,
+}
+
+impl OutageEvaluation {
+    /// Summary of the final errors, m.
+    pub fn final_error(&self) -> Summary {
+        Summary::of(&self.windows.iter().map(|w| w.final_error_m).collect::<Vec<_>>())
+    }
+    /// Summary of the drift per 100 m, % (windows that travelled at least 10 m).
+    pub fn drift_pct(&self) -> Summary {
+        Summary::of(&self.windows.iter().filter(|w| w.distance_m >= 10.0).map(|w| 100.0 * w.final_error_m / w.distance_m).collect::<Vec<_>>())
+    }
+    /// Summary of the distances before 1 m of error, m (censored windows included at their length).
+    pub fn distance_to_1m(&self) -> Summary {
+        Summary::of(&self.windows.iter().map(|w| w.distance_to_1m_m).collect::<Vec<_>>())
+    }
+}
+
+struct Collect(Vec<(f64, State)>);
+
+impl EpochHook for Collect {
+    fn after_epoch(&mut self, t: f64, x: &mut State, _p: &mut Mat) {
+        self.0.push((t, *x));
+    }
+}
+
+/// Runs the sliding-window outage evaluation.
+///
+/// The first window starts `warmup_s` after the filter's start; windows start
+/// every `step_s` and must end before the last GNSS fix (and the truth's end).
+pub fn evaluate(drive: &Drive, params: &Params, outage_s: f64, step_s: f64, warmup_s: f64, base: &FilterOptions) -> Result<OutageEvaluation, Error> {
+    if !(outage_s > 0.0 && step_s > 0.0) {
+        return Err(Error::InvalidParams("outage length and step must be positive".into()));
+    }
+    let truth = Reference::from_truth(&drive.truth);
+    let reference = if truth.is_some() { ReferenceKind::Truth } else { ReferenceKind::Gnss };
+    if reference == ReferenceKind::Gnss && drive.gnss.len() < 2 {
+        return Err(Error::Insufficient("outage evaluation needs truth.csv or GNSS fixes".into()));
+    }
+    // The GNSS-aided filter gives the state at every window start.
+    let aided = ekf::run(drive, params, &FilterOptions { record_epochs: true, ..base.clone() }, &mut ())?;
+    let (Some(first), Some(last_epoch)) = (aided.epochs.first(), aided.epochs.last()) else {
+        return Err(Error::Insufficient("the filter produced no epochs".into()));
+    };
+    let mut end_limit = last_epoch.t_s;
+    if let Some(t) = &truth {
+        end_limit = end_limit.min(t.span().map(|s| s.1).unwrap_or(f64::NEG_INFINITY));
+    } else if let Some(g) = drive.gnss.last() {
+        end_limit = end_limit.min(g.t_s);
+    }
+    let lever = drive.vehicle.gnss_lever_arm_m;
+    let mut windows = Vec::new();
+    let mut start = first.t_s + warmup_s;
+    while start + outage_s <= end_limit {
+        let end = start + outage_s;
+        let i = aided.epochs.partition_point(|e| e.t_s <= start);
+        let e0 = &aided.epochs[i.saturating_sub(1)];
+        let opts = FilterOptions {
+            init: Init::Given { t_s: e0.t_s, x: e0.x, p: e0.p },
+            sensors: SensorSet::dead_reckoning(),
+            record_epochs: false,
+            end_s: Some(end),
+            gnss_outages: Vec::new(),
+            ..base.clone()
+        };
+        let mut hook = Collect(Vec::new());
+        ekf::run(drive, params, &opts, &mut hook)?;
+        let states = hook.0;
+        // Errors at the reference's times.
+        let mut errors = Vec::new();
+        match (&truth, reference) {
+            (Some(t), ReferenceKind::Truth) => {
+                for (ts, x) in &states {
+                    if let Some(r) = t.state_at(*ts) {
+                        errors.push((*ts - e0.t_s, (x[X] - r[X]).hypot(x[Y] - r[Y])));
+                    }
+                }
+            }
+            _ => {
+                let traj = Reference::from_states(states.iter().map(|s| s.0).collect(), states.iter().map(|s| s.1).collect());
+                for g in drive.gnss.iter().filter(|g| g.t_s > e0.t_s && g.t_s <= end) {
+                    if let Some(x) = traj.state_at(g.t_s) {
+                        let (ae, an) = (x[X] + lever * x[YAW].cos(), x[Y] + lever * x[YAW].sin());
+                        errors.push((g.t_s - e0.t_s, (ae - g.east_m).hypot(an - g.north_m)));
+                    }
+                }
+            }
+        }
+        if let Some(&(_, final_error_m)) = errors.last() {
+            // Distance along the dead-reckoned path.
+            let mut dist = vec![0.0];
+            for w in states.windows(2) {
+                let d = dist.last().copied().unwrap_or(0.0) + (w[1].1[X] - w[0].1[X]).hypot(w[1].1[Y] - w[0].1[Y]);
+                dist.push(d);
+            }
+            let distance_m = dist.last().copied().unwrap_or(0.0);
+            let dist_at = |dt: f64| -> f64 {
+                let k = states.partition_point(|s| s.0 - e0.t_s <= dt);
+                dist[k.saturating_sub(1).min(dist.len() - 1)]
+            };
+            let hit = errors.iter().find(|e| e.1 >= 1.0);
+            windows.push(Window {
+                start_s: start,
+                end_s: end,
+                final_error_m,
+                max_error_m: errors.iter().map(|e| e.1).fold(0.0, f64::max),
+                distance_m,
+                distance_to_1m_m: hit.map(|h| dist_at(h.0)).unwrap_or(distance_m),
+                reached_1m: hit.is_some(),
+                errors,
+            });
+        }
+        start += step_s;
+    }
+    if windows.is_empty() {
+        return Err(Error::Insufficient(format!("the drive is too short for a {outage_s} s outage after {warmup_s} s of warm-up")));
+    }
+    Ok(OutageEvaluation { outage_s, reference, windows })
+}

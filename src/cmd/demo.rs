@@ -1,0 +1,155 @@
+//! `deadreckon demo`: the whole four-wheel method on simulated drives: simulate
+//! the calibration and evaluation scenarios, calibrate with nominal, ZUPT, RTS
+//! and truth, evaluate each on the evaluation drive, print the analogues of the
+//! paper's tables III and IV.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use clap::Args;
+use deadreckon_core::calibrate::{self, Calibration, CalibrationOptions, Iteration, Method, PassState};
+use deadreckon_core::ekf::Timing;
+use deadreckon_core::metrics::{self, Summary};
+use deadreckon_core::{Params, ParamsWithStd};
+
+use super::{common, simulate};
+
+/// Arguments of `demo`.
+#[derive(Args, Debug)]
+pub struct DemoArgs {
+    /// Where the simulated drives, parameters and report go.
+    #[arg(long, default_value = "out/demo")]
+    pub out: PathBuf,
+    /// Seed of the calibration drive (the evaluation drive uses seed + 1).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Print JSON instead of tables.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// One calibration method's results.
+pub struct MethodResult {
+    /// Method name.
+    pub name: &'static str,
+    /// Calibration (None for nominal).
+    pub calibration: Option<Calibration>,
+    /// Parameters used.
+    pub params: ParamsWithStd,
+    /// Drift evaluation.
+    pub drift: metrics::DriftResult,
+    /// Reset-on-1 m evaluation.
+    pub reset: metrics::ResetResult,
+}
+
+/// Calibrates with every method on `cal` and evaluates on `eval`.
+pub fn calibrate_and_evaluate(cal: &deadreckon_core::Drive, eval: &deadreckon_core::Drive) -> Result<Vec<MethodResult>> {
+    let nominal = Params::nominal(&cal.vehicle);
+    let mut out = Vec::new();
+    for (name, method) in [("nominal", None), ("ZUPT", Some(Method::Zupt)), ("RTS", Some(Method::Rts)), ("truth", Some(Method::Truth))] {
+        let calibration = match method {
+            None => None,
+            Some(m) => Some(calibrate::calibrate(cal, &CalibrationOptions { method: m, ..Default::default() }).with_context(|| format!("{name} calibration"))?),
+        };
+        let params = calibration.as_ref().map(|c| c.estimate).unwrap_or(ParamsWithStd { params: nominal, std: Params::from_array([0.0; 6]) });
+        let drift = metrics::drift(eval, &params.params, 100.0, Timing::WheelEpochs)?;
+        let reset = metrics::reset_on_error(eval, &params.params, 1.0, Timing::WheelEpochs)?;
+        out.push(MethodResult { name, calibration, params, drift, reset });
+    }
+    Ok(out)
+}
+
+/// Runs `demo`.
+pub fn run(a: DemoArgs) -> Result<()> {
+    let cal_dir = a.out.join("calibration");
+    let eval_dir = a.out.join("evaluation");
+    let sim_cal = simulate::simulate_to("calibration", a.seed, &cal_dir)?;
+    let sim_eval = simulate::simulate_to("evaluation", a.seed + 1, &eval_dir)?;
+    // Read back what was written, as a user's drive would be.
+    let cal = common::load_drive(&cal_dir)?;
+    let eval = common::load_drive(&eval_dir)?;
+    let results = calibrate_and_evaluate(&cal, &eval)?;
+    for r in &results {
+        if let Some(c) = &r.calibration {
+            let file = a.out.join(format!("params_{}.toml", r.name.to_lowercase()));
+            let mut extra = toml::Table::new();
+            extra.insert("iterations".into(), (c.iterations as i64).into());
+            deadreckon_io::write_params(&file, &c.estimate, Some(&extra))?;
+        }
+    }
+    // The paper's scheme (5-state passes, plain iteration), for comparison of convergence.
+    let plain = calibrate::calibrate(&cal, &CalibrationOptions { state: PassState::Paper, iteration: Iteration::Plain, max_iterations: 30, ..Default::default() })?;
+    let truth = sim_cal.truth_params;
+    if a.json {
+        let rows: Vec<serde_json::Value> = results
+            .iter()
+            .map(|r| {
+                let d = Summary::of(&r.drift.errors_pct());
+                let s = Summary::of(&r.reset.distances_m);
+                serde_json::json!({
+                    "method": r.name,
+                    "params": r.params.params.to_array(),
+                    "std": r.params.std.to_array(),
+                    "iterations": r.calibration.as_ref().map(|c| c.iterations),
+                    "drift": {"mean_pct": d.mean, "std_pct": d.std, "n": d.n},
+                    "reset_1m": {"mean_m": s.mean, "median_m": s.median, "min_m": s.min, "max_m": s.max, "n": s.n},
+                })
+            })
+            .collect();
+        let v = serde_json::json!({"truth_params": truth.to_array(), "methods": rows, "plain_iterations": plain.iterations});
+        println!("{}", serde_json::to_string_pretty(&v)?);
+        return Ok(());
+    }
+    println!(
+        "calibration drive: {:.2} km, {:.0} s, mean {:.1} km/h; evaluation drive: {:.2} km, {:.0} s",
+        sim_cal.stats.distance_m / 1000.0,
+        sim_cal.stats.duration_s,
+        sim_cal.stats.mean_speed_mps * 3.6,
+        sim_eval.stats.distance_m / 1000.0,
+        sim_eval.stats.duration_s
+    );
+    println!();
+    println!("Table III: parameter calibration");
+    println!("{}", common::params_header());
+    println!("{}", common::params_row("GT", &ParamsWithStd { params: truth, std: Params::from_array([0.0; 6]) }));
+    for r in &results {
+        println!("{}", common::params_row(r.name, &r.params));
+    }
+    if let Some(rts) = results.iter().find(|r| r.name == "RTS").and_then(|r| r.calibration.as_ref()) {
+        let e = rts.estimate.params.to_array();
+        let t = truth.to_array();
+        println!(
+            "RTS errors: gyro bias {:.2}%, speed scale {:.3}%, circumferences {:.3}% {:.3}% {:.3}% {:.3}%",
+            100.0 * ((e[0] - t[0]) / t[0]).abs(),
+            100.0 * ((e[1] - t[1]) / t[1]).abs(),
+            100.0 * ((e[2] - t[2]) / t[2]).abs(),
+            100.0 * ((e[3] - t[3]) / t[3]).abs(),
+            100.0 * ((e[4] - t[4]) / t[4]).abs(),
+            100.0 * ((e[5] - t[5]) / t[5]).abs()
+        );
+        let worst = |p: &Params| (2..6).map(|i| ((p.to_array()[i] - t[i]) / t[i]).abs()).fold(0.0, f64::max) * 100.0;
+        println!(
+            "RTS smoothing passes: {} (augmented state); the paper's 5-state plain iteration: worst circumference error {:.3}% after 1 pass, {:.3}% after 3, {:.3}% after {}{}",
+            rts.iterations,
+            worst(&plain.history[0]),
+            worst(&plain.history[2.min(plain.history.len() - 1)]),
+            worst(plain.history.last().unwrap_or(&plain.estimate.params)),
+            plain.iterations,
+            if plain.converged { " (converged)" } else { " (not converged)" }
+        );
+    }
+    println!();
+    println!("Table IV: dead-reckoning drift on the evaluation drive (reset to the truth every 100 m)");
+    println!("{:<8} {:>12} {:>12} {:>6}   {:>24}", "method", "mean error", "std", "n", "distance before 1 m error");
+    for r in &results {
+        let d = Summary::of(&r.drift.errors_pct());
+        let s = Summary::of(&r.reset.distances_m);
+        println!(
+            "{:<8} {:>11.3}% {:>11.3}% {:>6}   mean {:>6.1} m, median {:>6.1} m",
+            r.name, d.mean, d.std, d.n, s.mean, s.median
+        );
+    }
+    println!();
+    println!("drives and parameters in {}", a.out.display());
+    Ok(())
+}

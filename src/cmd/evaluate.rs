@@ -1,0 +1,120 @@
+//! `deadreckon evaluate`: dead-reckoning accuracy with the papers' metrics
+//! (drift per 100 m, distance before 1 m) or over sliding GNSS outages.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use clap::Args;
+use deadreckon_core::calibrate::{self, CalibrationOptions};
+use deadreckon_core::ekf::FilterOptions;
+use deadreckon_core::metrics::{self, Summary};
+use deadreckon_core::outage;
+use serde_json::json;
+
+use super::common;
+
+/// Arguments of `evaluate`.
+#[derive(Args, Debug)]
+pub struct EvaluateArgs {
+    /// The drive directory.
+    pub dir: PathBuf,
+    /// `nominal` or a params.toml. Without it, `--outage` calibrates with RTS on the drive itself.
+    #[arg(long)]
+    pub params: Option<String>,
+    /// drift (reset to the truth every 100 m) or reset-1m (reset when the error reaches 1 m).
+    #[arg(long, default_value = "drift")]
+    pub metric: String,
+    /// Segment length of the drift metric, m.
+    #[arg(long, default_value_t = 100.0)]
+    pub segment_m: f64,
+    /// Error threshold of the reset metric, m.
+    #[arg(long, default_value_t = 1.0)]
+    pub threshold_m: f64,
+    /// Evaluate over sliding GNSS outages of this length, s (instead of --metric).
+    #[arg(long)]
+    pub outage: Option<f64>,
+    /// Step between outage windows, s (default: half the outage length).
+    #[arg(long)]
+    pub step: Option<f64>,
+    /// GNSS-aided time before the first outage window, s.
+    #[arg(long, default_value_t = 5.0)]
+    pub warmup: f64,
+    /// Filter timing: wheel or each.
+    #[arg(long, default_value = "wheel")]
+    pub timing: String,
+    /// Print JSON instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+fn summary_json(s: &Summary) -> serde_json::Value {
+    json!({"mean": s.mean, "median": s.median, "p95": s.p95, "min": s.min, "max": s.max, "std": s.std, "n": s.n})
+}
+
+/// Runs `evaluate`.
+pub fn run(a: EvaluateArgs) -> Result<()> {
+    let drive = common::load_drive(&a.dir)?;
+    let timing = common::parse_timing(&a.timing)?;
+    if let Some(len) = a.outage {
+        let (params, source) = match &a.params {
+            Some(p) => (common::load_params(p, &drive)?, p.clone()),
+            None => {
+                let c = calibrate::calibrate(&drive, &CalibrationOptions::default()).context("RTS calibration with GNSS")?;
+                (c.estimate.params, format!("rts ({} passes)", c.iterations))
+            }
+        };
+        let base = FilterOptions { timing, ..Default::default() };
+        let ev = outage::evaluate(&drive, &params, len, a.step.unwrap_or(len / 2.0), a.warmup, &base)?;
+        let (fe, dr, d1) = (ev.final_error(), ev.drift_pct(), ev.distance_to_1m());
+        if a.json {
+            let v = json!({
+                "outage_s": len,
+                "windows": ev.windows.len(),
+                "reference": ev.reference.name(),
+                "params": source,
+                "final_error_m": summary_json(&fe),
+                "drift_pct": summary_json(&dr),
+                "distance_to_1m_m": summary_json(&d1),
+                "windows_reaching_1m": ev.windows.iter().filter(|w| w.reached_1m).count(),
+            });
+            println!("{}", serde_json::to_string_pretty(&v)?);
+        } else {
+            println!("{} outage windows of {len} s against the {} (parameters: {source})", ev.windows.len(), ev.reference.name());
+            println!("{:<28} {:>9} {:>9} {:>9} {:>9}", "", "mean", "median", "p95", "max");
+            for (name, s) in [("final error (m)", fe), ("drift per 100 m (%)", dr), ("distance before 1 m (m)", d1)] {
+                println!("{:<28} {:>9.3} {:>9.3} {:>9.3} {:>9.3}", name, s.mean, s.median, s.p95, s.max);
+            }
+        }
+        return Ok(());
+    }
+    let params = common::load_params(a.params.as_deref().unwrap_or("nominal"), &drive)?;
+    match a.metric.as_str() {
+        "drift" => {
+            let r = metrics::drift(&drive, &params, a.segment_m, timing)?;
+            let s = Summary::of(&r.errors_pct());
+            if a.json {
+                let v = json!({"metric": "drift", "mean_pct": s.mean, "std_pct": s.std, "n": s.n,
+                    "median_pct": s.median, "p95_pct": s.p95, "max_pct": s.max, "segment_m": a.segment_m, "errors_m": r.errors_m});
+                println!("{}", serde_json::to_string_pretty(&v)?);
+            } else {
+                println!("drift per {} m over {} segments: mean {:.3}%, std {:.3}%, median {:.3}%, max {:.3}%", a.segment_m, s.n, s.mean, s.std, s.median, s.max);
+            }
+        }
+        "reset-1m" => {
+            let r = metrics::reset_on_error(&drive, &params, a.threshold_m, timing)?;
+            let s = Summary::of(&r.distances_m);
+            if a.json {
+                let v = json!({"metric": "reset-1m", "mean_m": s.mean, "median_m": s.median, "min_m": s.min, "max_m": s.max, "n": s.n,
+                    "threshold_m": a.threshold_m, "distances_m": r.distances_m});
+                println!("{}", serde_json::to_string_pretty(&v)?);
+            } else {
+                println!(
+                    "distance before {} m of error over {} resets: mean {:.1} m, median {:.1} m, min {:.1} m, max {:.1} m",
+                    a.threshold_m, s.n, s.mean, s.median, s.min, s.max
+                );
+            }
+        }
+        m => anyhow::bail!("unknown metric `{m}` (drift, reset-1m)"),
+    }
+    Ok(())
+}
