@@ -174,13 +174,13 @@ pub fn smoothing_pass(drive: &Drive, p: &Params, opts: &CalibrationOptions) -> R
     let reference = match opts.state {
         PassState::Paper => {
             let out = ekf::run(drive, p, &fopts, &mut ())?;
-            let sm = rts::smooth(&out.epochs)?;
-            Reference::from_states(sm.iter().map(|s| s.t_s).collect(), sm.iter().map(|s| s.x).collect())
+            let sm = rts::smooth_states(&out.epochs)?;
+            Reference::from_states(sm.iter().map(|s| s.0).collect(), sm.iter().map(|s| s.1).collect())
         }
         PassState::Augmented => {
             let out = ekf::run_augmented(drive, p, &opts.prior_std, &fopts)?;
-            let sm = rts::smooth(&out.epochs)?;
-            Reference::from_states(sm.iter().map(|s| s.t_s).collect(), sm.iter().map(|s| s.x.fixed_rows::<5>(0).into_owned()).collect())
+            let sm = rts::smooth_states(&out.epochs)?;
+            Reference::from_states(sm.iter().map(|s| s.0).collect(), sm.iter().map(|s| s.1.fixed_rows::<5>(0).into_owned()).collect())
         }
     };
     least_squares(drive, &reference, opts.min_speed_mps, false)

@@ -296,12 +296,29 @@ impl<const N: usize> Filter<'_, N> {
     fn predict(&mut self, t: f64) -> (SVector<f64, N>, SMatrix<f64, N, N>, SMatrix<f64, N, N>) {
         let dt = (t - self.t).max(0.0);
         let car = self.car();
-        let mut f = SMatrix::<f64, N, N>::identity();
-        f.fixed_view_mut::<5, 5>(0, 0).copy_from(&model::jacobian(&car, dt));
-        let mut q = SMatrix::<f64, N, N>::zeros();
-        q.fixed_view_mut::<5, 5>(0, 0).copy_from(&model::process_noise(&self.noise, dt));
+        let f5 = model::jacobian(&car, dt);
+        let q5 = model::process_noise(&self.noise, dt);
         self.x.fixed_rows_mut::<5>(0).copy_from(&model::evolve(&car, dt));
-        self.p = kalman::predict_covariance(&self.p, &f, &q);
+        let mut f = SMatrix::<f64, N, N>::identity();
+        f.fixed_view_mut::<5, 5>(0, 0).copy_from(&f5);
+        if N == 5 {
+            self.p = kalman::predict_covariance(&self.p, &f, &SMatrix::<f64, N, N>::from_fn(|i, j| q5[(i % 5, j % 5)]));
+        } else {
+            // F = diag(F_car, I) and Q = diag(Q_car, 0): only the car rows and
+            // columns change. P11 ← F P11 Fᵀ + Q, P12 ← F P12, P22 unchanged.
+            let p11 = self.p.fixed_view::<5, 5>(0, 0).into_owned();
+            let n11 = f5 * p11 * f5.transpose() + q5;
+            let n11 = (n11 + n11.transpose()) * 0.5;
+            self.p.fixed_view_mut::<5, 5>(0, 0).copy_from(&n11);
+            for j in 5..N {
+                let col: State = self.p.fixed_view::<5, 1>(0, j).into_owned();
+                let nc = f5 * col;
+                for i in 0..5 {
+                    self.p[(i, j)] = nc[i];
+                    self.p[(j, i)] = nc[i];
+                }
+            }
+        }
         self.t = t;
         (self.x, self.p, f)
     }

@@ -53,8 +53,14 @@ pub fn update_scalar<const N: usize>(
     form: CovarianceForm,
     t_s: f64,
 ) -> Result<Innovation, Error> {
+    // P Hᵀ, using only the non-zero entries of H (observation rows are sparse).
+    let mut ph = SVector::<f64, N>::zeros();
+    for (j, &hj) in h.iter().enumerate() {
+        if hj != 0.0 {
+            ph.axpy(hj, &p.column(j), 1.0);
+        }
+    }
     // S = H P Hᵀ + R   (14)
-    let ph = *p * h;
     let s = h.dot(&ph) + r;
     if !(s.is_finite() && s > 0.0) || !y.is_finite() {
         return Err(Error::Numerical { t_s, what: format!("innovation variance {s} or innovation {y} is not usable") });
@@ -62,20 +68,22 @@ pub fn update_scalar<const N: usize>(
     // K = P Hᵀ S⁻¹   (15)
     let k = ph / s;
     // x̂ = x̂⁻ + K ỹ   (16)
-    *x += k * y;
-    match form {
-        // Joseph form (I − K H) P (I − K H)ᵀ + K R Kᵀ, expanded for a scalar
-        // measurement into rank-one terms (O(N²) instead of O(N³)):
-        // P − K (P H)ᵀ − (P H) Kᵀ + (H P Hᵀ + R) K Kᵀ.
-        CovarianceForm::Joseph => {
-            p.ger(-1.0, &k, &ph, 1.0);
-            p.ger(-1.0, &ph, &k, 1.0);
-            p.ger(s, &k, &k, 1.0);
+    x.axpy(y, &k, 1.0);
+    // Covariance, on the upper triangle then mirrored (exactly symmetric):
+    // Joseph form (I − K H) P (I − K H)ᵀ + K R Kᵀ, expanded for a scalar
+    // measurement into rank-one terms: P − K (P H)ᵀ − (P H) Kᵀ + S K Kᵀ;
+    // or eq. (17), P = (I − K H) P⁻ = P − K (P H)ᵀ.
+    for i in 0..N {
+        for j in i..N {
+            let d = match form {
+                CovarianceForm::Joseph => -k[i] * ph[j] - ph[i] * k[j] + s * k[i] * k[j],
+                CovarianceForm::Simple => -0.5 * (k[i] * ph[j] + ph[i] * k[j]),
+            };
+            let v = p[(i, j)] + d;
+            p[(i, j)] = v;
+            p[(j, i)] = v;
         }
-        // P = (I − K H) P⁻   (17)
-        CovarianceForm::Simple => p.ger(-1.0, &k, &ph, 1.0),
     }
-    *p = (*p + p.transpose()) * 0.5;
     Ok(Innovation { y, s, nis: y * y / s })
 }
 

@@ -230,3 +230,31 @@ fn rts_equals_batch_least_squares_on_a_linear_model() {
     }
     assert!(max_x < 1e-8 && max_p < 1e-8, "state diff {max_x:e}, covariance diff {max_p:e}");
 }
+
+#[test]
+fn state_only_smoothing_equals_the_full_smoother() {
+    let vehicle = Vehicle::paper_car();
+    let mut rng = Pcg64::seed_from_u64(21);
+    let mut drive = Drive::empty(vehicle.clone());
+    let n = 500;
+    drive.wheels = Wheels::Ticks((0..n).map(|k| WheelTicks { t_s: k as f64 * 0.02, fl: 4, fr: 4, rl: 4, rr: 5 }).collect());
+    drive.yaw_rate = (1..n).map(|k| Scalar { t_s: k as f64 * 0.02 - 0.003, value: 0.02 + 0.003 * randn(&mut rng) }).collect();
+    drive.gnss = (1..n / 25).map(|k| deadreckon_core::drive::GnssFix { t_s: k as f64 * 0.5 + 0.001, east_m: 4.0 * k as f64 + 0.5 * randn(&mut rng), north_m: 0.5 * randn(&mut rng), std_m: 0.5, course_deg: None, speed_mps: None }).collect();
+    let p0 = Mat::from_diagonal(&State::from([1.0, 1.0, 0.1, 4.0, 0.25]));
+    let opts = FilterOptions { init: Init::Given { t_s: 0.0, x: State::from([0.0, 0.0, 0.0, 8.0, 0.0]), p: p0 }, ..Default::default() };
+    let params = Params::nominal(&vehicle);
+    let out = ekf::run(&drive, &params, &opts, &mut ()).unwrap();
+    let full = rts::smooth(&out.epochs).unwrap();
+    let states = rts::smooth_states(&out.epochs).unwrap();
+    for (a, b) in full.iter().zip(&states) {
+        assert!((a.x - b.1).amax() < 1e-9, "t={}: {} vs {}", a.t_s, a.x, b.1);
+    }
+    // Same for the augmented state.
+    let prior = deadreckon_core::calibrate::CalibrationOptions::default().prior_std;
+    let aug = ekf::run_augmented(&drive, &params, &prior, &opts).unwrap();
+    let full = rts::smooth(&aug.epochs).unwrap();
+    let states = rts::smooth_states(&aug.epochs).unwrap();
+    for (a, b) in full.iter().zip(&states) {
+        assert!((a.x - b.1).amax() < 1e-9);
+    }
+}

@@ -1,0 +1,14 @@
+//! # deadreckon-bench
+//!
+//! Benchmarks only (`cargo bench -p deadreckon-bench`): one EKF epoch, one RTS
+//! epoch and a whole 1-hour drive calibration, on simulated drives. Kept in its
+//! own crate so that test builds do not compile criterion.
+#![deny(missing_docs)]
+
+use deadreckon_core::Drive;
+
+/// A simulated calibration drive of `duration_s` seconds (seed 1).
+pub fn drive(duration_s: f64) -> Drive {
+    let sc = deadreckon_sim::Scenario::builtin("calibration").expect("built-in scenario").with_duration_s(duration_s);
+    deadreckon_sim::simulate(&sc, 1).expect("simulation").drive
+}
