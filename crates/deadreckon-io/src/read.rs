@@ -1,0 +1,343 @@
+//! Reading a drive directory into a [`Drive`].
+
+use std::fs;
+use std::path::Path;
+
+use deadreckon_core::drive::{GnssFix, Scalar, TruthPose, WheelSpeeds, WheelTicks, Wheels};
+use deadreckon_core::vehicle::Origin;
+use deadreckon_core::Drive;
+
+use crate::table::{Limit, Table};
+use crate::{files, geo, IoError};
+
+/// Which wheel file a drive's wheel stream comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum WheelFile {
+    /// `wheel_ticks.csv`: encoder ticks.
+    Ticks,
+    /// `wheel_speeds.csv`: wheel speeds.
+    Speeds,
+}
+
+impl WheelFile {
+    /// The file name in a drive directory.
+    pub fn file_name(self) -> &'static str {
+        match self {
+            WheelFile::Ticks => files::WHEEL_TICKS,
+            WheelFile::Speeds => files::WHEEL_SPEEDS,
+        }
+    }
+}
+
+/// Options of [`read_drive_with`].
+#[derive(Debug, Clone, Default)]
+#[non_exhaustive]
+pub struct ReadOptions {
+    /// The wheel file to use when a directory has both (`None`: having both is
+    /// an error). When only one exists, that one is used whatever this says.
+    pub prefer_wheels: Option<WheelFile>,
+}
+
+impl ReadOptions {
+    /// Uses `wheels` when both wheel files exist.
+    pub fn prefer_wheels(mut self, wheels: WheelFile) -> Self {
+        self.prefer_wheels = Some(wheels);
+        self
+    }
+}
+
+/// Reads the drive directory `dir` (see `docs/drive-format.md`); having both
+/// wheel files is an error.
+pub fn read_drive(dir: &Path) -> Result<Drive, IoError> {
+    read_drive_with(dir, &ReadOptions::default())
+}
+
+/// Reads the drive directory `dir` with options.
+///
+/// Every CSV field is checked (number, finite, plausible range of its unit,
+/// increasing time), latitude/longitude files are converted to east-north
+/// about `[origin]` of `vehicle.toml` or, when absent, the first fix (recorded
+/// in the returned `vehicle.origin`), and the result passes [`Drive::validate`].
+pub fn read_drive_with(dir: &Path, options: &ReadOptions) -> Result<Drive, IoError> {
+    let vehicle_path = dir.join(files::VEHICLE);
+    if !vehicle_path.exists() {
+        return Err(IoError::MissingFile {
+            path: vehicle_path,
+            note: "every drive needs vehicle.toml".into(),
+        });
+    }
+    let mut vehicle = crate::toml_files::read_vehicle(&vehicle_path)?;
+
+    let ticks = read_optional(&dir.join(files::WHEEL_TICKS))?;
+    let speeds = read_optional(&dir.join(files::WHEEL_SPEEDS))?;
+    let use_file = match (&ticks, &speeds, options.prefer_wheels) {
+        (Some(_), Some(_), None) => {
+            return Err(IoError::AmbiguousWheels {
+                dir: dir.to_path_buf(),
+            })
+        }
+        (Some(_), Some(_), Some(w)) => w,
+        (Some(_), None, _) => WheelFile::Ticks,
+        (None, Some(_), _) => WheelFile::Speeds,
+        (None, None, _) => {
+            return Err(IoError::MissingFile {
+                path: dir.join(files::WHEEL_TICKS),
+                note: "a drive needs wheel_ticks.csv or wheel_speeds.csv".into(),
+            })
+        }
+    };
+    let wheels_path = dir.join(use_file.file_name());
+    let wheels = match (use_file, ticks, speeds) {
+        (WheelFile::Ticks, Some(b), _) => Wheels::Ticks(parse_ticks(&wheels_path, &b)?),
+        (WheelFile::Speeds, _, Some(b)) => Wheels::Speeds(parse_speeds(&wheels_path, &b)?),
+        // Unreachable by the match above; reported rather than panicking.
+        _ => {
+            return Err(IoError::MissingFile {
+                path: wheels_path,
+                note: "the wheel file chosen does not exist".into(),
+            })
+        }
+    };
+    if wheels.len() < 2 {
+        return Err(IoError::TooFewRows {
+            file: wheels_path,
+            found: wheels.len(),
+            min: 2,
+        });
+    }
+
+    let scalar = |name: &str, column: &'static str, limit| -> Result<Vec<Scalar>, IoError> {
+        let path = dir.join(name);
+        match read_optional(&path)? {
+            Some(b) => parse_scalar(&path, &b, column, limit),
+            None => Ok(Vec::new()),
+        }
+    };
+    let yaw_rate = scalar(files::YAW_RATE, "yaw_rate_rps", Limit::YawRate)?;
+    let speed = scalar(files::SPEED, "speed_mps", Limit::Speed)?;
+    let steering = scalar(files::STEERING, "steering_wheel_rad", Limit::SteeringWheel)?;
+
+    let gnss_path = dir.join(files::GNSS);
+    let (mut gnss, gnss_geo) = match read_optional(&gnss_path)? {
+        Some(b) => parse_gnss(&gnss_path, &b)?,
+        None => (Vec::new(), false),
+    };
+    let truth_path = dir.join(files::TRUTH);
+    let (mut truth, truth_geo) = match read_optional(&truth_path)? {
+        Some(b) => parse_truth(&truth_path, &b)?,
+        None => (Vec::new(), false),
+    };
+
+    // Geodetic files: pick the origin, then convert.
+    let gnss_geo = gnss_geo && !gnss.is_empty();
+    let truth_geo = truth_geo && !truth.is_empty();
+    if gnss_geo || truth_geo {
+        let origin = match vehicle.origin {
+            Some(o) => o,
+            None => {
+                // Without [origin], geodetic and east-north files cannot share a frame.
+                if gnss_geo != truth_geo && !gnss.is_empty() && !truth.is_empty() {
+                    let (geo_file, en_file) = if gnss_geo {
+                        (&gnss_path, files::TRUTH)
+                    } else {
+                        (&truth_path, files::GNSS)
+                    };
+                    return Err(IoError::NeedsOrigin {
+                        file: geo_file.clone(),
+                        message: format!(
+                            "latitude/longitude here but east/north in {en_file}: \
+                             vehicle.toml needs an [origin] (lat_deg, lon_deg) to relate them"
+                        ),
+                    });
+                }
+                let first = if gnss_geo {
+                    gnss.first().map(|g| (g.east_m, g.north_m))
+                } else {
+                    truth.first().map(|t| (t.east_m, t.north_m))
+                };
+                let Some((lat_deg, lon_deg)) = first else {
+                    return Err(IoError::NeedsOrigin {
+                        file: dir.to_path_buf(),
+                        message: "no fix to take as the origin".into(),
+                    });
+                };
+                Origin { lat_deg, lon_deg }
+            }
+        };
+        if gnss_geo {
+            for g in &mut gnss {
+                (g.east_m, g.north_m) = geo::geodetic_to_en(&origin, g.east_m, g.north_m);
+            }
+        }
+        if truth_geo {
+            for t in &mut truth {
+                (t.east_m, t.north_m) = geo::geodetic_to_en(&origin, t.east_m, t.north_m);
+            }
+        }
+        vehicle.origin = Some(origin);
+    }
+
+    let drive = Drive {
+        vehicle,
+        wheels,
+        yaw_rate,
+        speed,
+        steering,
+        gnss,
+        truth,
+    };
+    drive.validate().map_err(|source| IoError::Invalid {
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    Ok(drive)
+}
+
+/// The content of `path`, or `None` when it does not exist.
+fn read_optional(path: &Path) -> Result<Option<Vec<u8>>, IoError> {
+    match fs::read(path) {
+        Ok(b) => Ok(Some(b)),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+        Err(e) => Err(IoError::io(path, e)),
+    }
+}
+
+/// Parses `wheel_ticks.csv`.
+pub(crate) fn parse_ticks(file: &Path, bytes: &[u8]) -> Result<Vec<WheelTicks>, IoError> {
+    let t = Table::new(file, bytes)?;
+    let (ts, fl, fr, rl, rr) = (
+        t.col("t_s")?,
+        t.col("fl")?,
+        t.col("fr")?,
+        t.col("rl")?,
+        t.col("rr")?,
+    );
+    t.rows(|r| {
+        Ok(WheelTicks {
+            t_s: r.f64(ts)?,
+            fl: r.i64(fl)?,
+            fr: r.i64(fr)?,
+            rl: r.i64(rl)?,
+            rr: r.i64(rr)?,
+        })
+    })
+}
+
+/// Parses `wheel_speeds.csv`.
+pub(crate) fn parse_speeds(file: &Path, bytes: &[u8]) -> Result<Vec<WheelSpeeds>, IoError> {
+    let t = Table::new(file, bytes)?;
+    let ts = t.col("t_s")?;
+    let (fl, fr) = (t.col("fl_mps")?, t.col("fr_mps")?);
+    let (rl, rr) = (t.col("rl_mps")?, t.col("rr_mps")?);
+    t.rows(|r| {
+        Ok(WheelSpeeds {
+            t_s: r.f64(ts)?,
+            fl_mps: r.checked(fl, Limit::Speed)?,
+            fr_mps: r.checked(fr, Limit::Speed)?,
+            rl_mps: r.checked(rl, Limit::Speed)?,
+            rr_mps: r.checked(rr, Limit::Speed)?,
+        })
+    })
+}
+
+/// Parses a `t_s,<column>` stream.
+pub(crate) fn parse_scalar(
+    file: &Path,
+    bytes: &[u8],
+    column: &'static str,
+    limit: Limit,
+) -> Result<Vec<Scalar>, IoError> {
+    let t = Table::new(file, bytes)?;
+    let (ts, v) = (t.col("t_s")?, t.col(column)?);
+    t.rows(|r| {
+        Ok(Scalar {
+            t_s: r.f64(ts)?,
+            value: r.checked(v, limit)?,
+        })
+    })
+}
+
+/// Whether a position file is in east/north (preferred when both are present)
+/// or latitude/longitude; `MissingColumn` names what east/north needs.
+fn position_columns(t: &Table<'_>) -> Result<bool, IoError> {
+    if t.has("east_m") || t.has("north_m") || !(t.has("lat_deg") || t.has("lon_deg")) {
+        t.col("east_m")?;
+        t.col("north_m")?;
+        Ok(false)
+    } else {
+        t.col("lat_deg")?;
+        t.col("lon_deg")?;
+        Ok(true)
+    }
+}
+
+/// Parses `gnss.csv`; with latitude/longitude (flag `true`) the fixes carry
+/// latitude in `east_m` and longitude in `north_m` until converted.
+pub(crate) fn parse_gnss(file: &Path, bytes: &[u8]) -> Result<(Vec<GnssFix>, bool), IoError> {
+    let t = Table::new(file, bytes)?;
+    let geodetic = position_columns(&t)?;
+    let ts = t.col("t_s")?;
+    let std = t.col("std_m")?;
+    let (a, b, la, lb) = if geodetic {
+        (
+            t.col("lat_deg")?,
+            t.col("lon_deg")?,
+            Some(Limit::Lat),
+            Some(Limit::Lon),
+        )
+    } else {
+        (t.col("east_m")?, t.col("north_m")?, None, None)
+    };
+    let (course, speed) = (t.opt_col("course_deg"), t.opt_col("speed_mps"));
+    let fixes = t.rows(|r| {
+        Ok(GnssFix {
+            t_s: r.f64(ts)?,
+            east_m: position(r, a, la)?,
+            north_m: position(r, b, lb)?,
+            std_m: r.checked(std, Limit::Std)?,
+            course_deg: r.opt_checked(course, Limit::Course)?,
+            speed_mps: r.opt_checked(speed, Limit::Speed)?,
+        })
+    })?;
+    Ok((fixes, geodetic))
+}
+
+/// Parses `truth.csv`, like [`parse_gnss`].
+pub(crate) fn parse_truth(file: &Path, bytes: &[u8]) -> Result<(Vec<TruthPose>, bool), IoError> {
+    let t = Table::new(file, bytes)?;
+    let geodetic = position_columns(&t)?;
+    let ts = t.col("t_s")?;
+    let yaw = t.col("yaw_rad")?;
+    let (a, b, la, lb) = if geodetic {
+        (
+            t.col("lat_deg")?,
+            t.col("lon_deg")?,
+            Some(Limit::Lat),
+            Some(Limit::Lon),
+        )
+    } else {
+        (t.col("east_m")?, t.col("north_m")?, None, None)
+    };
+    let speed = t.opt_col("speed_mps");
+    let poses = t.rows(|r| {
+        Ok(TruthPose {
+            t_s: r.f64(ts)?,
+            east_m: position(r, a, la)?,
+            north_m: position(r, b, lb)?,
+            yaw_rad: r.checked(yaw, Limit::Yaw)?,
+            speed_mps: r.opt_checked(speed, Limit::Speed)?,
+        })
+    })?;
+    Ok((poses, geodetic))
+}
+
+fn position(
+    r: &crate::table::Row<'_>,
+    col: crate::table::Col,
+    limit: Option<Limit>,
+) -> Result<f64, IoError> {
+    match limit {
+        Some(l) => r.checked(col, l),
+        None => r.f64(col),
+    }
+}
