@@ -57,9 +57,16 @@ pub struct ImportArgs {
 
 /// Runs an import.
 pub fn run(a: ImportArgs) -> Result<()> {
-    let policy = if a.gate { TimeOrderPolicy::Gate } else { TimeOrderPolicy::Error };
+    let policy = if a.gate {
+        TimeOrderPolicy::Gate
+    } else {
+        TimeOrderPolicy::Error
+    };
     let vehicle = match &a.vehicle {
-        Some(p) => Some(deadreckon_io::read_vehicle(p).with_context(|| format!("reading vehicle {}", p.display()))?),
+        Some(p) => Some(
+            deadreckon_io::read_vehicle(p)
+                .with_context(|| format!("reading vehicle {}", p.display()))?,
+        ),
         None => None,
     };
     let comma_only = a.gyro != "raw"
@@ -100,23 +107,41 @@ pub fn run(a: ImportArgs) -> Result<()> {
             let builtin = a.dbc.is_none() && a.map.is_none();
             let db = match &a.dbc {
                 Some(p) => Database::read(p)?,
-                None => Database::parse(can::TOYOTA_RAV4_DBC, Path::new("<built-in toyota_rav4_subset.dbc>"))?,
+                None => Database::parse(
+                    can::TOYOTA_RAV4_DBC,
+                    Path::new("<built-in toyota_rav4_subset.dbc>"),
+                )?,
             };
             let map = match &a.map {
                 Some(p) => Mapping::read(p, &db)?,
-                None => Mapping::parse(can::TOYOTA_RAV4_MAP, &db, Path::new("<built-in toyota_rav4_comma2k19.toml>"))?,
+                None => Mapping::parse(
+                    can::TOYOTA_RAV4_MAP,
+                    &db,
+                    Path::new("<built-in toyota_rav4_comma2k19.toml>"),
+                )?,
             };
             let vehicle = match vehicle {
                 Some(v) => v,
                 None if builtin => deadreckon_import::profiles::toyota_rav4(),
                 None => bail!("--vehicle is required with your own --dbc/--map"),
             };
-            let frames = if a.source.is_dir() { can::read_raw_can(&a.source)? } else { can::read_candump(&a.source)? };
+            let frames = if a.source.is_dir() {
+                can::read_raw_can(&a.source)?
+            } else {
+                can::read_candump(&a.source)?
+            };
             let i = can::decode_frames(&frames, &map, vehicle, policy, &a.source)?;
-            (i.drive, format!("{} frames read\n{}", frames.len(), i.report))
+            (
+                i.drive,
+                format!("{} frames read\n{}", frames.len(), i.report),
+            )
         }
         "tricycle" => {
-            let o = TricycleOptions { vehicle, policy, ..Default::default() };
+            let o = TricycleOptions {
+                vehicle,
+                policy,
+                ..Default::default()
+            };
             let i = deadreckon_import::tricycle::read_tricycle(&a.source, &o)?;
             (i.drive, i.report.to_string())
         }
@@ -148,19 +173,25 @@ fn print_counts(d: &Drive) {
 /// file, each file atomically.
 fn write_new_or_update(out: &Path, drive: &Drive) -> Result<()> {
     if out.exists() {
-        return deadreckon_io::write_drive(out, drive).with_context(|| format!("writing drive {}", out.display()));
+        return deadreckon_io::write_drive(out, drive)
+            .with_context(|| format!("writing drive {}", out.display()));
     }
     let parent = match out.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
     };
     std::fs::create_dir_all(&parent).with_context(|| format!("creating {}", parent.display()))?;
-    let name = out.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "drive".into());
+    let name = out
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "drive".into());
     let tmp = parent.join(format!(".{name}.import-{}", std::process::id()));
     std::fs::create_dir(&tmp).with_context(|| format!("creating {}", tmp.display()))?;
     let result = deadreckon_io::write_drive(&tmp, drive)
         .with_context(|| format!("writing drive {}", tmp.display()))
-        .and_then(|()| std::fs::rename(&tmp, out).with_context(|| format!("renaming into {}", out.display())));
+        .and_then(|()| {
+            std::fs::rename(&tmp, out).with_context(|| format!("renaming into {}", out.display()))
+        });
     if result.is_err() {
         let _ = std::fs::remove_dir_all(&tmp);
     }

@@ -1,0 +1,147 @@
+//! End-to-end tests of the `deadreckon` binary in temporary directories: the
+//! slow cases (whole simulated drives through every command) live here.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_deadreckon"))
+}
+
+fn run_ok(args: &[&str]) -> String {
+    let out = bin().args(args).output().expect("binary runs");
+    assert!(out.status.success(), "deadreckon {args:?} failed:\n{}", String::from_utf8_lossy(&out.stderr));
+    String::from_utf8(out.stdout).expect("utf-8 output")
+}
+
+fn run_err(args: &[&str]) -> Output {
+    let out = bin().args(args).output().expect("binary runs");
+    assert!(!out.status.success(), "deadreckon {args:?} should have failed");
+    out
+}
+
+fn json(s: &str) -> serde_json::Value {
+    serde_json::from_str(s).unwrap_or_else(|e| panic!("not JSON ({e}):\n{s}"))
+}
+
+fn simulate(dir: &Path, scenario: &str, seed: u64) {
+    run_ok(&["simulate", "--scenario", scenario, "--seed", &seed.to_string(), "--out", dir.to_str().unwrap()]);
+}
+
+#[test]
+fn simulate_calibrate_evaluate_run() {
+    let tmp = tempfile::tempdir().unwrap();
+    let cal = tmp.path().join("cal");
+    let eval = tmp.path().join("eval");
+    simulate(&cal, "calibration", 11);
+    simulate(&eval, "evaluation", 12);
+    let truth = deadreckon_io::read_truth_params(&cal.join("truth_params.toml")).unwrap().to_array();
+
+    // calibrate --json: the contract keys, close to the truth.
+    let params = tmp.path().join("params.toml");
+    let v = json(&run_ok(&["calibrate", cal.to_str().unwrap(), "--method", "rts", "--json", "--out", params.to_str().unwrap()]));
+    for (i, k) in deadreckon_core::Params::NAMES.iter().enumerate() {
+        let est = v[k].as_f64().unwrap_or_else(|| panic!("missing {k}"));
+        let tol = if i == 0 { 0.05 } else { 0.003 };
+        assert!(((est - truth[i]) / truth[i]).abs() < tol, "{k}: {est} vs {}", truth[i]);
+        assert!(v["std"][k].as_f64().unwrap() > 0.0, "std of {k}");
+    }
+    assert!(v["iterations"].as_u64().unwrap() >= 1);
+    // params.toml: the same keys and a [std] table.
+    let p = deadreckon_io::read_params(&params).unwrap();
+    assert_eq!(p.params.to_array()[0], v["gyro_bias_rps"].as_f64().unwrap());
+    let text = std::fs::read_to_string(&params).unwrap();
+    assert!(text.contains("[std]") && text.contains("circumference_rr_m"), "{text}");
+
+    // evaluate: drift and reset-1m JSON contracts, calibrated beats nominal.
+    let d_cal = json(&run_ok(&["evaluate", eval.to_str().unwrap(), "--params", params.to_str().unwrap(), "--metric", "drift", "--json"]));
+    let d_nom = json(&run_ok(&["evaluate", eval.to_str().unwrap(), "--params", "nominal", "--metric", "drift", "--json"]));
+    assert_eq!(d_cal["metric"], "drift");
+    assert!(d_cal["n"].as_u64().unwrap() >= 40, "{d_cal}");
+    let (c, n) = (d_cal["mean_pct"].as_f64().unwrap(), d_nom["mean_pct"].as_f64().unwrap());
+    assert!(c < 0.5 && c < n / 3.0, "calibrated drift {c}% vs nominal {n}%");
+    assert!(d_cal["std_pct"].as_f64().unwrap() > 0.0);
+    let r = json(&run_ok(&["evaluate", eval.to_str().unwrap(), "--params", params.to_str().unwrap(), "--metric", "reset-1m", "--json"]));
+    assert_eq!(r["metric"], "reset-1m");
+    for k in ["mean_m", "median_m", "min_m", "max_m"] {
+        assert!(r[k].as_f64().unwrap() > 50.0, "{k}: {r}");
+    }
+
+    // Sliding-window outages against the truth.
+    let o = json(&run_ok(&["evaluate", eval.to_str().unwrap(), "--params", params.to_str().unwrap(), "--outage", "20", "--step", "30", "--json"]));
+    assert_eq!(o["reference"], "truth");
+    assert!(o["windows"].as_u64().unwrap() >= 15, "{o}");
+    let fe = &o["final_error_m"];
+    assert!(fe["mean"].as_f64().unwrap() < 2.0 && fe["max"].as_f64().unwrap() >= fe["p95"].as_f64().unwrap(), "{o}");
+
+    // run: tracks with covariances.
+    let track = tmp.path().join("track.csv");
+    run_ok(&["run", eval.to_str().unwrap(), "--params", params.to_str().unwrap(), "--out", track.to_str().unwrap()]);
+    let text = std::fs::read_to_string(&track).unwrap();
+    let header = text.lines().next().unwrap();
+    assert!(header.starts_with("t_s,track,east_m,north_m,yaw_rad"), "{header}");
+    for name in ["dead-reckoned", "filtered", "smoothed"] {
+        assert!(text.contains(&format!(",{name},")), "track {name} missing");
+    }
+    // GeoJSON needs a geodetic origin: a clear error and no file left behind.
+    let gj = tmp.path().join("track.geojson");
+    let e = run_err(&["run", eval.to_str().unwrap(), "--out", gj.to_str().unwrap()]);
+    assert!(String::from_utf8_lossy(&e.stderr).contains("origin"), "{}", String::from_utf8_lossy(&e.stderr));
+    assert!(!gj.exists());
+}
+
+#[test]
+fn malformed_drives_are_reported_with_file_line_and_column() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("d");
+    simulate(&dir, "evaluation", 3);
+    let yaw = dir.join("yaw_rate.csv");
+    let original = std::fs::read_to_string(&yaw).unwrap();
+    let cases: [(&str, Box<dyn Fn(&str) -> String>); 4] = [
+        ("bad number", Box::new(|s: &str| s.replacen("\n0.", "\nzero.", 1))),
+        ("NaN", Box::new(|s: &str| {
+            let mut l: Vec<String> = s.lines().map(String::from).collect();
+            l[5] = format!("{},NaN", l[5].split(',').next().unwrap());
+            l.join("\n") + "\n"
+        })),
+        ("duplicate time", Box::new(|s: &str| {
+            let mut l: Vec<String> = s.lines().map(String::from).collect();
+            l[6] = l[5].clone();
+            l.join("\n") + "\n"
+        })),
+        ("degrees", Box::new(|s: &str| {
+            let mut l: Vec<String> = s.lines().map(String::from).collect();
+            l[5] = format!("{},45.0", l[5].split(',').next().unwrap());
+            l.join("\n") + "\n"
+        })),
+    ];
+    for (what, corrupt) in cases {
+        std::fs::write(&yaw, corrupt(&original)).unwrap();
+        let e = run_err(&["calibrate", dir.to_str().unwrap(), "--method", "zupt"]);
+        let msg = String::from_utf8_lossy(&e.stderr);
+        assert!(msg.contains("yaw_rate.csv") && msg.contains("line") && (msg.contains("yaw_rate_rps") || msg.contains("t_s")), "{what}: {msg}");
+        eprintln!("{what}: {msg}");
+        assert!(!msg.contains("panicked"), "{what}: {msg}");
+    }
+    std::fs::write(&yaw, &original).unwrap();
+    // A missing required file.
+    std::fs::remove_file(dir.join("wheel_ticks.csv")).unwrap();
+    let e = run_err(&["calibrate", dir.to_str().unwrap(), "--method", "zupt"]);
+    let msg = String::from_utf8_lossy(&e.stderr);
+    assert!(msg.contains("wheel_ticks.csv") && msg.contains("wheel_speeds.csv"), "{msg}");
+    // A missing drive.
+    let e = run_err(&["calibrate", tmp.path().join("nope").to_str().unwrap()]);
+    assert!(!String::from_utf8_lossy(&e.stderr).contains("panicked"));
+}
+
+#[test]
+fn demo_reproduces_the_papers_ordering() {
+    let tmp = tempfile::tempdir().unwrap();
+    let v = json(&run_ok(&["demo", "--out", tmp.path().to_str().unwrap(), "--json"]));
+    let methods = v["methods"].as_array().unwrap();
+    let drift = |name: &str| methods.iter().find(|m| m["method"] == name).unwrap()["drift"]["mean_pct"].as_f64().unwrap();
+    let (nom, zupt, rts, truth) = (drift("nominal"), drift("ZUPT"), drift("RTS"), drift("truth"));
+    assert!(rts < zupt && zupt < nom, "nominal {nom} ZUPT {zupt} RTS {rts}");
+    assert!(rts <= 1.1 * truth, "RTS {rts} truth {truth}");
+    assert!(tmp.path().join("params_rts.toml").exists());
+}
