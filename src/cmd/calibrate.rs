@@ -85,6 +85,9 @@ pub fn run(a: CalibrateArgs) -> Result<()> {
                 if c.converged { "converged" } else { "NOT converged: raise --max-iterations" }
             );
         }
+        if let Some(st) = &c.filter_stats {
+            println!("{}", common::stats_line(st));
+        }
         if let Some(out) = &a.out {
             println!("wrote {}", out.display());
         }

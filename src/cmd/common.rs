@@ -81,5 +81,20 @@ pub fn calibration_json(method: &str, c: &Calibration) -> serde_json::Value {
         "history".into(),
         c.history.iter().map(|p| serde_json::json!(p.to_array())).collect::<Vec<_>>().into(),
     );
+    if let Some(st) = &c.filter_stats {
+        m.insert(
+            "gnss".into(),
+            serde_json::json!({"used": st.gnss_updates, "rejected": st.gnss_rejected, "hidden": st.gnss_hidden}),
+        );
+        m.insert("wheel_gaps".into(), st.wheel_gaps.into());
+    }
     serde_json::Value::Object(m)
+}
+
+/// A one-line account of what the filter used and gated.
+pub fn stats_line(st: &deadreckon_core::ekf::FilterStats) -> String {
+    format!(
+        "filter: {} epochs, GNSS {} used / {} rejected by the gate / {} hidden, {} wheel gaps skipped",
+        st.epochs, st.gnss_updates, st.gnss_rejected, st.gnss_hidden, st.wheel_gaps
+    )
 }

@@ -18,22 +18,75 @@ pub struct SimulateArgs {
     /// Output drive directory (created).
     #[arg(long)]
     pub out: PathBuf,
+    /// Vehicle geometry and noise from a vehicle.toml instead of the scenario's.
+    #[arg(long)]
+    pub vehicle: Option<PathBuf>,
+    /// True gyro bias, rad/s.
+    #[arg(long, allow_hyphen_values = true)]
+    pub gyro_bias: Option<f64>,
+    /// True CAN speed scale factor.
+    #[arg(long)]
+    pub speed_scale: Option<f64>,
+    /// True wheel circumferences FL,FR,RL,RR in metres.
+    #[arg(long, value_delimiter = ',')]
+    pub circumferences: Option<Vec<f64>>,
+    /// GNSS noise standard deviation, m.
+    #[arg(long)]
+    pub gnss_std: Option<f64>,
+    /// Number of laps of the route.
+    #[arg(long)]
+    pub laps: Option<u32>,
+    /// Drive duration, s (laps repeat until then).
+    #[arg(long)]
+    pub duration: Option<f64>,
+}
+
+/// Applies the command-line overrides to a scenario.
+fn with_overrides(mut sc: Scenario, a: &SimulateArgs) -> Result<Scenario> {
+    if let Some(v) = &a.vehicle {
+        sc = sc.with_vehicle(deadreckon_io::read_vehicle(v)?);
+    }
+    let mut e = sc.true_params();
+    if let Some(b) = a.gyro_bias {
+        e.gyro_bias_rps = b;
+    }
+    if let Some(s) = a.speed_scale {
+        e.speed_scale = s;
+    }
+    if let Some(c) = &a.circumferences {
+        anyhow::ensure!(c.len() == 4, "--circumferences takes four values FL,FR,RL,RR (m), got {}", c.len());
+        e.set_circumferences([c[0], c[1], c[2], c[3]]);
+    }
+    e.validate()?;
+    sc = sc.with_errors(e);
+    if let Some(g) = a.gnss_std {
+        sc = sc.with_gnss_std_m(g);
+    }
+    if let Some(l) = a.laps {
+        sc = sc.with_laps(l);
+    }
+    if let Some(d) = a.duration {
+        sc = sc.with_duration_s(d);
+    }
+    sc.validate()?;
+    Ok(sc)
 }
 
 /// Resolves a scenario name or file.
 pub fn scenario(spec: &str) -> Result<Scenario> {
     let path = std::path::Path::new(spec);
     if path.extension().is_some_and(|e| e == "toml") || path.is_file() {
-        let text = std::fs::read_to_string(path).with_context(|| format!("reading scenario {spec}"))?;
-        let s: Scenario = toml::from_str(&text).with_context(|| format!("parsing scenario {spec}"))?;
-        return Ok(s);
+        return Ok(Scenario::load(path)?);
     }
-    Scenario::builtin(spec).map_err(|e| anyhow::anyhow!("{e} (built-in scenarios: {})", Scenario::names().join(", ")))
+    Ok(Scenario::builtin(spec)?)
 }
 
 /// Simulates and writes `drive` + `truth_params.toml` into `dir`.
 pub fn simulate_to(spec: &str, seed: u64, dir: &std::path::Path) -> Result<deadreckon_sim::SimOutput> {
-    let sc = scenario(spec)?;
+    write_scenario(scenario(spec)?, spec, seed, dir)
+}
+
+fn write_scenario(sc: Scenario, spec: &str, seed: u64, dir: &std::path::Path) -> Result<deadreckon_sim::SimOutput> {
     let out = deadreckon_sim::simulate(&sc, seed).with_context(|| format!("simulating {spec}"))?;
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     deadreckon_io::write_drive(dir, &out.drive).with_context(|| format!("writing {}", dir.display()))?;
@@ -43,7 +96,8 @@ pub fn simulate_to(spec: &str, seed: u64, dir: &std::path::Path) -> Result<deadr
 
 /// Runs `simulate`.
 pub fn run(a: SimulateArgs) -> Result<()> {
-    let out = simulate_to(&a.scenario, a.seed, &a.out)?;
+    let sc = with_overrides(scenario(&a.scenario)?, &a)?;
+    let out = write_scenario(sc, &a.scenario, a.seed, &a.out)?;
     let s = &out.stats;
     println!(
         "simulated {} (seed {}): {:.2} km in {:.0} s, mean {:.1} km/h, max {:.1} km/h, {} stops -> {}",

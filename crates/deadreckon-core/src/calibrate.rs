@@ -138,6 +138,8 @@ pub struct Calibration {
     pub converged: bool,
     /// Samples used per parameter (in [`Params::to_array`] order).
     pub samples: [usize; 6],
+    /// The filter's counters in the last smoothing pass (GNSS used, gated, ...).
+    pub filter_stats: Option<ekf::FilterStats>,
 }
 
 /// Tolerance units of the parameters, in [`Params::to_array`] order.
@@ -158,32 +160,34 @@ pub fn calibrate(drive: &Drive, opts: &CalibrationOptions) -> Result<Calibration
             let reference = Reference::from_truth(&drive.truth)
                 .ok_or_else(|| Error::Insufficient("truth calibration needs truth.csv with at least 3 poses".into()))?;
             let (est, samples) = least_squares(drive, &reference, opts.min_speed_mps, true)?;
-            Ok(Calibration { estimate: est, iterations: 1, history: vec![est.params], converged: true, samples })
+            Ok(Calibration { estimate: est, iterations: 1, history: vec![est.params], converged: true, samples, filter_stats: None })
         }
         Method::Rts => rts_calibration(drive, opts, start),
     }
 }
 
 /// One pass: filter with `p`, smooth, least squares on the smoothed states.
-pub fn smoothing_pass(drive: &Drive, p: &Params, opts: &CalibrationOptions) -> Result<(ParamsWithStd, [usize; 6]), Error> {
+pub fn smoothing_pass(drive: &Drive, p: &Params, opts: &CalibrationOptions) -> Result<(ParamsWithStd, [usize; 6], ekf::FilterStats), Error> {
     let mut fopts = opts.filter.clone();
     fopts.record_epochs = true;
     if matches!(fopts.init, Init::Truth) {
         fopts.init = Init::Gnss;
     }
-    let reference = match opts.state {
+    let (reference, stats) = match opts.state {
         PassState::Paper => {
             let out = ekf::run(drive, p, &fopts, &mut ())?;
             let sm = rts::smooth_states(&out.epochs)?;
-            Reference::from_states(sm.iter().map(|s| s.0).collect(), sm.iter().map(|s| s.1).collect())
+            (Reference::from_states(sm.iter().map(|s| s.0).collect(), sm.iter().map(|s| s.1).collect()), out.stats)
         }
         PassState::Augmented => {
             let out = ekf::run_augmented(drive, p, &opts.prior_std, &fopts)?;
             let sm = rts::smooth_states(&out.epochs)?;
-            Reference::from_states(sm.iter().map(|s| s.0).collect(), sm.iter().map(|s| s.1.fixed_rows::<5>(0).into_owned()).collect())
+            let states = sm.iter().map(|s| s.1.fixed_rows::<5>(0).into_owned()).collect();
+            (Reference::from_states(sm.iter().map(|s| s.0).collect(), states), out.stats)
         }
     };
-    least_squares(drive, &reference, opts.min_speed_mps, false)
+    let (est, samples) = least_squares(drive, &reference, opts.min_speed_mps, false)?;
+    Ok((est, samples, stats))
 }
 
 fn rts_calibration(drive: &Drive, opts: &CalibrationOptions, start: Params) -> Result<Calibration, Error> {
@@ -207,12 +211,12 @@ fn rts_calibration(drive: &Drive, opts: &CalibrationOptions, start: Params) -> R
     let mut converged = false;
     let memory = 3;
     for _ in 0..opts.max_iterations.max(1) {
-        let (g, samples) = smoothing_pass(drive, &p, opts)?;
+        let (g, samples, stats) = smoothing_pass(drive, &p, opts)?;
         history.push(g.params);
         let x = scale(&p);
         let gx = scale(&g.params);
         let change = (&gx - &x).amax();
-        last = Some((g, samples));
+        last = Some((g, samples, stats));
         if change < opts.tolerance {
             converged = true;
             break;
@@ -230,8 +234,8 @@ fn rts_calibration(drive: &Drive, opts: &CalibrationOptions, start: Params) -> R
         let candidate = unscale(&next);
         p = if candidate.validate().is_ok() { candidate } else { g.params };
     }
-    let (estimate, samples) = last.ok_or_else(|| Error::Insufficient("no calibration pass ran".into()))?;
-    Ok(Calibration { estimate, iterations: history.len(), history, converged, samples })
+    let (estimate, samples, stats) = last.ok_or_else(|| Error::Insufficient("no calibration pass ran".into()))?;
+    Ok(Calibration { estimate, iterations: history.len(), history, converged, samples, filter_stats: Some(stats) })
 }
 
 /// Anderson mixing (type II, no damping): the next iterate from the last iterates
@@ -425,5 +429,5 @@ pub fn zupt(drive: &Drive, nominal: &Params) -> Result<Calibration, Error> {
     std.gyro_bias_rps = sd / n.sqrt();
     let mut samples = [0; 6];
     samples[0] = vals.len();
-    Ok(Calibration { estimate: ParamsWithStd { params: p, std }, iterations: 0, history: vec![p], converged: true, samples })
+    Ok(Calibration { estimate: ParamsWithStd { params: p, std }, iterations: 0, history: vec![p], converged: true, samples, filter_stats: None })
 }

@@ -1,0 +1,473 @@
+//! Sensor models: what each stream reports from the truth, when, and with what
+//! errors (the `[sensors]` table of a scenario).
+//!
+//! Every stream samples at `offset_s + i / rate_hz`, so streams with different
+//! offsets are not synchronised. The true systematic errors are the scenario's
+//! `errors` (a [`Params`]); the white noises are drawn from one PCG-64
+//! generator per stream, seeded from the simulation seed and the stream, so
+//! adding a stream does not change the noise of the others.
+
+use deadreckon_core::drive::{GnssFix, Scalar, TruthPose, WheelSpeeds, WheelTicks, Wheels};
+use deadreckon_core::{angle, drive::yaw_rad_to_course_deg, Drive, Params, Vehicle};
+use rand::SeedableRng;
+use rand_distr::{Distribution, StandardNormal};
+use rand_pcg::Pcg64;
+use serde::{Deserialize, Serialize};
+
+use crate::truth::{Kinematics, State};
+
+/// What the wheel stream reports.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+#[non_exhaustive]
+pub enum WheelKind {
+    /// Encoder ticks per interval (`Wheels::Ticks`), quantised exactly.
+    Ticks,
+    /// Wheel speeds computed with the nominal circumference (`Wheels::Speeds`).
+    Speeds,
+}
+
+/// The wheel stream (`[sensors.wheels]`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WheelsSpec {
+    /// Ticks or speeds.
+    pub kind: WheelKind,
+    /// Sample rate, Hz.
+    pub rate_hz: f64,
+    /// Time of the first sample, s.
+    #[serde(default)]
+    pub offset_s: f64,
+    /// Speeds only: white noise on each wheel speed, m/s (default 0.02).
+    #[serde(default = "default_wheel_speed_noise")]
+    pub noise_std_mps: f64,
+    /// Speeds only: quantisation step of the reported speeds, m/s (default 0.01; 0: none).
+    #[serde(default = "default_wheel_speed_resolution")]
+    pub resolution_mps: f64,
+}
+
+fn default_wheel_speed_noise() -> f64 {
+    0.02
+}
+fn default_wheel_speed_resolution() -> f64 {
+    0.01
+}
+
+/// A scalar stream: the gyro (`[sensors.gyro]`, noise in rad/s) or the CAN
+/// speed (`[sensors.speed]`, noise in m/s).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScalarSpec {
+    /// Sample rate, Hz.
+    pub rate_hz: f64,
+    /// Time of the first sample, s.
+    #[serde(default)]
+    pub offset_s: f64,
+    /// White-noise standard deviation in the stream's unit: rad/s for the gyro
+    /// (table II: 0.003), m/s for the CAN speed (table II: 0.1).
+    pub noise_std: f64,
+}
+
+/// The steering-wheel stream (`[sensors.steering]`).
+///
+/// The reading is δ = r_s · atan(l_RF·κ + β) with β white of std `noise_std`:
+/// exactly the noise model of eq. 7 of the paper, where β is the error on
+/// tan(δ/r_s). For small angles this is a steering-wheel noise of about
+/// `noise_std · r_s` rad.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SteeringSpec {
+    /// Sample rate, Hz.
+    pub rate_hz: f64,
+    /// Time of the first sample, s.
+    #[serde(default)]
+    pub offset_s: f64,
+    /// Standard deviation of the error on tan(δ/r_s), unitless (table II: 0.02).
+    pub noise_std: f64,
+}
+
+/// The GNSS receiver (`[sensors.gnss]`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GnssSpec {
+    /// Fix rate, Hz.
+    pub rate_hz: f64,
+    /// Time of the first fix, s.
+    #[serde(default)]
+    pub offset_s: f64,
+    /// White noise on each coordinate of the antenna position, m (written as `std_m`).
+    pub std_m: f64,
+    /// White noise on each component of the antenna velocity, m/s; when given,
+    /// fixes carry `course_deg` and `speed_mps` computed from the noisy
+    /// velocity, so the course noise grows as the speed falls (≈ std / v rad).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub velocity_std_mps: Option<f64>,
+    /// Below this measured speed the course is not reported, m/s (default 0.5).
+    #[serde(default = "default_min_course_speed")]
+    pub min_course_speed_mps: f64,
+}
+
+fn default_min_course_speed() -> f64 {
+    0.5
+}
+
+/// All the streams of a scenario (the `[sensors]` table). Absent tables are
+/// streams the vehicle does not have.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SensorsSpec {
+    /// Wheel encoders or wheel speeds (required).
+    pub wheels: WheelsSpec,
+    /// Gyro yaw rate.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gyro: Option<ScalarSpec>,
+    /// CAN vehicle speed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub speed: Option<ScalarSpec>,
+    /// Steering wheel angle.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub steering: Option<SteeringSpec>,
+    /// GNSS fixes.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gnss: Option<GnssSpec>,
+    /// Rate of the written truth, Hz (default 100).
+    #[serde(default = "default_truth_rate")]
+    pub truth_rate_hz: f64,
+}
+
+fn default_truth_rate() -> f64 {
+    100.0
+}
+
+impl SensorsSpec {
+    /// The rates and offsets of every stream, with their keys, for validation.
+    pub(crate) fn clocks(&self) -> Vec<(&'static str, f64, f64)> {
+        let mut v = vec![("sensors.wheels", self.wheels.rate_hz, self.wheels.offset_s)];
+        if let Some(g) = &self.gyro {
+            v.push(("sensors.gyro", g.rate_hz, g.offset_s));
+        }
+        if let Some(g) = &self.speed {
+            v.push(("sensors.speed", g.rate_hz, g.offset_s));
+        }
+        if let Some(g) = &self.steering {
+            v.push(("sensors.steering", g.rate_hz, g.offset_s));
+        }
+        if let Some(g) = &self.gnss {
+            v.push(("sensors.gnss", g.rate_hz, g.offset_s));
+        }
+        v.push(("sensors.truth", self.truth_rate_hz, 0.0));
+        v
+    }
+
+    /// The noise values with their keys, for validation (all must be ≥ 0).
+    pub(crate) fn noises(&self) -> Vec<(&'static str, f64)> {
+        let mut v = vec![
+            ("sensors.wheels.noise_std_mps", self.wheels.noise_std_mps),
+            ("sensors.wheels.resolution_mps", self.wheels.resolution_mps),
+        ];
+        if let Some(g) = &self.gyro {
+            v.push(("sensors.gyro.noise_std", g.noise_std));
+        }
+        if let Some(g) = &self.speed {
+            v.push(("sensors.speed.noise_std", g.noise_std));
+        }
+        if let Some(g) = &self.steering {
+            v.push(("sensors.steering.noise_std", g.noise_std));
+        }
+        if let Some(g) = &self.gnss {
+            v.push(("sensors.gnss.std_m", g.std_m));
+            v.push((
+                "sensors.gnss.velocity_std_mps",
+                g.velocity_std_mps.unwrap_or(0.0),
+            ));
+            v.push(("sensors.gnss.min_course_speed_mps", g.min_course_speed_mps));
+        }
+        v
+    }
+}
+
+/// Sample times `offset + i / rate`.
+#[derive(Debug)]
+struct Clock {
+    rate: f64,
+    offset: f64,
+    i: u64,
+}
+
+impl Clock {
+    fn new(rate: f64, offset: f64) -> Self {
+        Clock { rate, offset, i: 0 }
+    }
+    fn t(&self) -> f64 {
+        self.offset + self.i as f64 / self.rate
+    }
+}
+
+/// SplitMix64 finaliser: decorrelates the per-stream seeds.
+fn mix(mut z: u64) -> u64 {
+    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// A seeded Gaussian source for one stream.
+#[derive(Debug)]
+struct Noise(Pcg64);
+
+impl Noise {
+    fn new(seed: u64, stream: u64) -> Self {
+        Noise(Pcg64::seed_from_u64(mix(seed ^ mix(stream))))
+    }
+    fn gauss(&mut self, std: f64) -> f64 {
+        let z: f64 = StandardNormal.sample(&mut self.0);
+        std * z
+    }
+}
+
+#[derive(Debug)]
+enum WheelState {
+    Ticks {
+        out: Vec<WheelTicks>,
+        emitted: [i64; 4],
+    },
+    Speeds {
+        out: Vec<WheelSpeeds>,
+        last_rot: [f64; 4],
+        last_t: Option<f64>,
+    },
+}
+
+/// Every stream being simulated.
+#[derive(Debug)]
+pub(crate) struct Suite {
+    spec: SensorsSpec,
+    t_end: f64,
+    circ: [f64; 4],
+    nominal_circ: f64,
+    ticks_per_rev: f64,
+    params: Params,
+    steering_ratio: f64,
+    wheelbase: f64,
+    lever_arm: f64,
+    clocks: [Option<Clock>; 6],
+    noise: [Noise; 5],
+    wheels: WheelState,
+    yaw_rate: Vec<Scalar>,
+    speed: Vec<Scalar>,
+    steering: Vec<Scalar>,
+    gnss: Vec<GnssFix>,
+    truth: Vec<TruthPose>,
+}
+
+const WHEELS: usize = 0;
+const GYRO: usize = 1;
+const SPEED: usize = 2;
+const STEERING: usize = 3;
+const GNSS: usize = 4;
+const TRUTH: usize = 5;
+
+impl Suite {
+    pub fn new(
+        spec: &SensorsSpec,
+        vehicle: &Vehicle,
+        params: &Params,
+        seed: u64,
+        t_end: f64,
+    ) -> Self {
+        let clocks = [
+            Some(Clock::new(spec.wheels.rate_hz, spec.wheels.offset_s)),
+            spec.gyro
+                .as_ref()
+                .map(|g| Clock::new(g.rate_hz, g.offset_s)),
+            spec.speed
+                .as_ref()
+                .map(|g| Clock::new(g.rate_hz, g.offset_s)),
+            spec.steering
+                .as_ref()
+                .map(|g| Clock::new(g.rate_hz, g.offset_s)),
+            spec.gnss
+                .as_ref()
+                .map(|g| Clock::new(g.rate_hz, g.offset_s)),
+            Some(Clock::new(spec.truth_rate_hz, 0.0)),
+        ];
+        let noise = [1, 2, 3, 4, 5].map(|k| Noise::new(seed, k));
+        let wheels = match spec.wheels.kind {
+            WheelKind::Ticks => WheelState::Ticks {
+                out: Vec::new(),
+                emitted: [0; 4],
+            },
+            WheelKind::Speeds => WheelState::Speeds {
+                out: Vec::new(),
+                last_rot: [0.0; 4],
+                last_t: None,
+            },
+        };
+        Suite {
+            spec: spec.clone(),
+            t_end,
+            circ: params.circumferences(),
+            nominal_circ: vehicle.wheel_circumference_m,
+            ticks_per_rev: f64::from(vehicle.ticks_per_rev),
+            params: *params,
+            steering_ratio: vehicle.steering_ratio,
+            wheelbase: vehicle.wheelbase_m,
+            lever_arm: vehicle.gnss_lever_arm_m,
+            clocks,
+            noise,
+            wheels,
+            yaw_rate: Vec::new(),
+            speed: Vec::new(),
+            steering: Vec::new(),
+            gnss: Vec::new(),
+            truth: Vec::new(),
+        }
+    }
+
+    /// Emits every sample due in (`a.t`, `b.t`] (and at or before `b.t` on the first call).
+    pub fn sample(&mut self, kin: &Kinematics<'_>, a: &State, b: &State) {
+        for stream in 0..self.clocks.len() {
+            while let Some(t) = self.clocks[stream].as_ref().map(Clock::t) {
+                if t > b.t || t > self.t_end {
+                    break;
+                }
+                let st = kin.between(t, a, b);
+                self.emit(stream, &st);
+                if let Some(c) = &mut self.clocks[stream] {
+                    c.i += 1;
+                }
+            }
+        }
+    }
+
+    fn emit(&mut self, stream: usize, st: &State) {
+        let t_s = st.t;
+        match stream {
+            WHEELS => self.emit_wheels(st),
+            GYRO => {
+                let std = self.spec.gyro.as_ref().map_or(0.0, |g| g.noise_std);
+                let value = st.yaw_rate + self.params.gyro_bias_rps + self.noise[GYRO].gauss(std);
+                self.yaw_rate.push(Scalar { t_s, value });
+            }
+            SPEED => {
+                let std = self.spec.speed.as_ref().map_or(0.0, |g| g.noise_std);
+                let value = self.params.speed_scale * st.v + self.noise[SPEED].gauss(std);
+                self.speed.push(Scalar { t_s, value });
+            }
+            STEERING => {
+                let std = self.spec.steering.as_ref().map_or(0.0, |g| g.noise_std);
+                let tan = self.wheelbase * st.kappa + self.noise[STEERING].gauss(std);
+                self.steering.push(Scalar {
+                    t_s,
+                    value: self.steering_ratio * tan.atan(),
+                });
+            }
+            GNSS => self.emit_gnss(st),
+            TRUTH => self.truth.push(TruthPose {
+                t_s,
+                east_m: st.x,
+                north_m: st.y,
+                yaw_rad: angle::wrap(st.psi),
+                speed_mps: Some(st.v),
+            }),
+            _ => {}
+        }
+    }
+
+    fn emit_wheels(&mut self, st: &State) {
+        let rot = [0, 1, 2, 3].map(|i| st.wheel_m[i] / self.circ[i]);
+        match &mut self.wheels {
+            WheelState::Ticks { out, emitted } => {
+                let mut d = [0i64; 4];
+                for i in 0..4 {
+                    // Cumulative ticks, floored: fractions of a tick carry over.
+                    let cum = (rot[i] * self.ticks_per_rev).floor() as i64;
+                    d[i] = cum - emitted[i];
+                    emitted[i] = cum;
+                }
+                out.push(WheelTicks {
+                    t_s: st.t,
+                    fl: d[0],
+                    fr: d[1],
+                    rl: d[2],
+                    rr: d[3],
+                });
+            }
+            WheelState::Speeds {
+                out,
+                last_rot,
+                last_t,
+            } => {
+                let period = 1.0 / self.spec.wheels.rate_hz;
+                let dt = last_t.map_or(period, |t0| st.t - t0);
+                let (std, q) = (
+                    self.spec.wheels.noise_std_mps,
+                    self.spec.wheels.resolution_mps,
+                );
+                let mut v = [0.0; 4];
+                for i in 0..4 {
+                    // The ECU's speed: rotation over the last period times the nominal circumference.
+                    let raw = (rot[i] - last_rot[i]) * self.nominal_circ / dt
+                        + self.noise[WHEELS].gauss(std);
+                    v[i] = if q > 0.0 { (raw / q).round() * q } else { raw };
+                }
+                *last_rot = rot;
+                *last_t = Some(st.t);
+                out.push(WheelSpeeds {
+                    t_s: st.t,
+                    fl_mps: v[0],
+                    fr_mps: v[1],
+                    rl_mps: v[2],
+                    rr_mps: v[3],
+                });
+            }
+        }
+    }
+
+    fn emit_gnss(&mut self, st: &State) {
+        let Some(spec) = self.spec.gnss.clone() else {
+            return;
+        };
+        let (sin, cos) = st.psi.sin_cos();
+        let l = self.lever_arm;
+        let n = &mut self.noise[GNSS];
+        let east_m = st.x + l * cos + n.gauss(spec.std_m);
+        let north_m = st.y + l * sin + n.gauss(spec.std_m);
+        let (mut course_deg, mut speed_mps) = (None, None);
+        if let Some(vstd) = spec.velocity_std_mps {
+            // Antenna velocity: v·(cos ψ, sin ψ) + l·ψ̇·(−sin ψ, cos ψ).
+            let ve = st.v * cos - l * st.yaw_rate * sin + n.gauss(vstd);
+            let vn = st.v * sin + l * st.yaw_rate * cos + n.gauss(vstd);
+            let sp = ve.hypot(vn);
+            speed_mps = Some(sp);
+            if sp >= spec.min_course_speed_mps {
+                course_deg = Some(yaw_rad_to_course_deg(vn.atan2(ve)));
+            }
+        }
+        self.gnss.push(GnssFix {
+            t_s: st.t,
+            east_m,
+            north_m,
+            std_m: spec.std_m,
+            course_deg,
+            speed_mps,
+        });
+    }
+
+    /// The drive with every stream.
+    pub fn finish(self, vehicle: Vehicle) -> Drive {
+        let wheels = match self.wheels {
+            WheelState::Ticks { out, .. } => Wheels::Ticks(out),
+            WheelState::Speeds { out, .. } => Wheels::Speeds(out),
+        };
+        Drive {
+            vehicle,
+            wheels,
+            yaw_rate: self.yaw_rate,
+            speed: self.speed,
+            steering: self.steering,
+            gnss: self.gnss,
+            truth: self.truth,
+        }
+    }
+}
