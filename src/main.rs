@@ -9,6 +9,9 @@ use clap::{Parser, Subcommand};
 #[derive(Parser, Debug)]
 #[command(name = "deadreckon", version, about, long_about = None)]
 struct Cli {
+    /// No progress display.
+    #[arg(long, global = true)]
+    quiet: bool,
     #[command(subcommand)]
     command: Command,
 }
@@ -23,8 +26,10 @@ enum Command {
     Evaluate(cmd::evaluate::EvaluateArgs),
     /// Write the dead-reckoned (and filtered, smoothed) track with covariances.
     Run(cmd::run::RunArgs),
-    /// Simulate, calibrate with every method, evaluate, print tables III and IV.
+    /// Simulate, calibrate with every method, evaluate, print tables III and IV, write the report.
     Demo(cmd::demo::DemoArgs),
+    /// Write one self-contained HTML report with the papers' tables and figures for a drive.
+    Report(cmd::report::ReportArgs),
     /// TedriS time-series dead reckoning: train a model, predict through outages.
     #[command(subcommand)]
     Tedris(cmd::tedris::TedrisCommand),
@@ -46,7 +51,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Calibrate(a) => cmd::calibrate::run(a),
         Command::Evaluate(a) => cmd::evaluate::run(a),
         Command::Run(a) => cmd::run::run(a),
-        Command::Demo(a) => cmd::demo::run(a),
+        Command::Demo(a) => cmd::demo::run(a, cli.quiet),
+        Command::Report(a) => cmd::report::run(a, cli.quiet),
         Command::Tedris(c) => cmd::tedris::run(c),
         Command::Import(a) => cmd::import::run(a),
     }

@@ -21,26 +21,84 @@ fn check_seed(seed: u64) {
 
     let rts = calibrate::calibrate(&cal.drive, &CalibrationOptions::default()).unwrap();
     let e = rts.estimate.params.to_array();
-    assert!(rts.converged, "seed {seed}: RTS did not converge in {} passes", rts.iterations);
-    assert!(rel(e[0], truth[0]) < 0.05, "seed {seed}: gyro bias {} vs {}", e[0], truth[0]);
-    assert!(rel(e[1], truth[1]) < 0.003, "seed {seed}: speed scale {} vs {}", e[1], truth[1]);
+    assert!(
+        rts.converged,
+        "seed {seed}: RTS did not converge in {} passes",
+        rts.iterations
+    );
+    assert!(
+        rel(e[0], truth[0]) < 0.05,
+        "seed {seed}: gyro bias {} vs {}",
+        e[0],
+        truth[0]
+    );
+    assert!(
+        rel(e[1], truth[1]) < 0.003,
+        "seed {seed}: speed scale {} vs {}",
+        e[1],
+        truth[1]
+    );
     for i in 2..6 {
-        assert!(rel(e[i], truth[i]) < 0.001, "seed {seed}: {} {} vs {}", Params::NAMES[i], e[i], truth[i]);
+        assert!(
+            rel(e[i], truth[i]) < 0.001,
+            "seed {seed}: {} {} vs {}",
+            Params::NAMES[i],
+            e[i],
+            truth[i]
+        );
     }
     // The standard errors are meaningful: the truth lies within 5 of them.
     let s = rts.estimate.std.to_array();
     for i in 0..6 {
-        assert!(s[i] > 0.0 && (e[i] - truth[i]).abs() < 5.0 * s[i] + 1e-9, "seed {seed}: {} error {} vs std {}", Params::NAMES[i], e[i] - truth[i], s[i]);
+        assert!(
+            s[i] > 0.0 && (e[i] - truth[i]).abs() < 5.0 * s[i] + 1e-9,
+            "seed {seed}: {} error {} vs std {}",
+            Params::NAMES[i],
+            e[i] - truth[i],
+            s[i]
+        );
     }
 
-    let zupt = calibrate::calibrate(&cal.drive, &CalibrationOptions { method: Method::Zupt, ..Default::default() }).unwrap();
-    let tru = calibrate::calibrate(&cal.drive, &CalibrationOptions { method: Method::Truth, ..Default::default() }).unwrap();
+    let zupt = calibrate::calibrate(
+        &cal.drive,
+        &CalibrationOptions {
+            method: Method::Zupt,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let tru = calibrate::calibrate(
+        &cal.drive,
+        &CalibrationOptions {
+            method: Method::Truth,
+            ..Default::default()
+        },
+    )
+    .unwrap();
     let nominal = Params::nominal(&cal.drive.vehicle);
-    let drift = |p: &Params| Summary::of(&metrics::drift(&eval.drive, p, 100.0, Timing::WheelEpochs).unwrap().errors_pct()).mean;
-    let (d_nom, d_zupt, d_rts, d_truth) = (drift(&nominal), drift(&zupt.estimate.params), drift(&rts.estimate.params), drift(&tru.estimate.params));
+    let drift = |p: &Params| {
+        Summary::of(
+            &metrics::drift(&eval.drive, p, 100.0, Timing::WheelEpochs)
+                .unwrap()
+                .errors_pct(),
+        )
+        .mean
+    };
+    let (d_nom, d_zupt, d_rts, d_truth) = (
+        drift(&nominal),
+        drift(&zupt.estimate.params),
+        drift(&rts.estimate.params),
+        drift(&tru.estimate.params),
+    );
     eprintln!("seed {seed}: drift nominal {d_nom:.3}% zupt {d_zupt:.3}% rts {d_rts:.3}% truth {d_truth:.3}%, {} passes", rts.iterations);
-    assert!(d_rts < d_zupt && d_zupt < d_nom, "seed {seed}: drift order nominal {d_nom} zupt {d_zupt} rts {d_rts}");
-    assert!(d_rts <= 1.1 * d_truth, "seed {seed}: RTS drift {d_rts} vs truth-calibrated {d_truth}");
+    assert!(
+        d_rts < d_zupt && d_zupt < d_nom,
+        "seed {seed}: drift order nominal {d_nom} zupt {d_zupt} rts {d_rts}"
+    );
+    assert!(
+        d_rts <= 1.1 * d_truth,
+        "seed {seed}: RTS drift {d_rts} vs truth-calibrated {d_truth}"
+    );
 }
 
 #[test]
@@ -74,36 +132,88 @@ fn accelerated_iteration_beats_the_plain_one_on_a_one_percent_error() {
     errors.set_circumferences([c, c * 1.0002, c * 0.9998, c]);
     let sim = simulate(&sc.with_errors(errors), 9).unwrap();
     let truth = sim.truth_params.to_array();
-    let worst = |p: &Params| (2..6).map(|i| rel(p.to_array()[i], truth[i])).fold(0.0, f64::max);
+    let worst = |p: &Params| {
+        (2..6)
+            .map(|i| rel(p.to_array()[i], truth[i]))
+            .fold(0.0, f64::max)
+    };
 
     let fast = calibrate::calibrate(&sim.drive, &CalibrationOptions::default()).unwrap();
-    assert!(worst(&fast.estimate.params) < 0.001, "accelerated: {}", worst(&fast.estimate.params));
-    assert!(fast.iterations <= 10, "accelerated took {} passes", fast.iterations);
+    assert!(
+        worst(&fast.estimate.params) < 0.001,
+        "accelerated: {}",
+        worst(&fast.estimate.params)
+    );
+    assert!(
+        fast.iterations <= 10,
+        "accelerated took {} passes",
+        fast.iterations
+    );
 
-    let plain = calibrate::calibrate(&sim.drive, &CalibrationOptions { state: PassState::Paper, iteration: Iteration::Plain, max_iterations: 3, ..Default::default() }).unwrap();
+    let plain = calibrate::calibrate(
+        &sim.drive,
+        &CalibrationOptions {
+            state: PassState::Paper,
+            iteration: Iteration::Plain,
+            max_iterations: 3,
+            ..Default::default()
+        },
+    )
+    .unwrap();
     let after3 = worst(&plain.history[2]);
-    eprintln!("1% circumference error: accelerated {} passes -> {:.4}%, plain after 3 passes {:.3}%", fast.iterations, 100.0 * worst(&fast.estimate.params), 100.0 * after3);
-    assert!(after3 > 0.001, "plain iteration after 3 passes already within 0.1%: {after3}");
+    eprintln!(
+        "1% circumference error: accelerated {} passes -> {:.4}%, plain after 3 passes {:.3}%",
+        fast.iterations,
+        100.0 * worst(&fast.estimate.params),
+        100.0 * after3
+    );
+    assert!(
+        after3 > 0.001,
+        "plain iteration after 3 passes already within 0.1%: {after3}"
+    );
 }
 
 /// Over a 2-hour drive every filtered and smoothed covariance stays symmetric
 /// positive definite, and no smoothed covariance exceeds the filtered one.
 #[test]
 fn covariances_stay_symmetric_positive_definite_over_two_hours() {
-    let sc = Scenario::builtin("calibration").unwrap().with_duration_s(7200.0);
+    let sc = Scenario::builtin("calibration")
+        .unwrap()
+        .with_duration_s(7200.0);
     let sim = simulate(&sc, 4).unwrap();
     let span = sim.drive.time_span().unwrap();
-    assert!(span.1 - span.0 >= 7100.0, "drive lasts {} s", span.1 - span.0);
+    assert!(
+        span.1 - span.0 >= 7100.0,
+        "drive lasts {} s",
+        span.1 - span.0
+    );
     for timing in [Timing::WheelEpochs, Timing::EachMeasurement] {
-        let out = ekf::run(&sim.drive, &sim.truth_params, &FilterOptions { timing, ..Default::default() }, &mut ()).unwrap();
+        let out = ekf::run(
+            &sim.drive,
+            &sim.truth_params,
+            &FilterOptions {
+                timing,
+                ..Default::default()
+            },
+            &mut (),
+        )
+        .unwrap();
         let sm = rts::smooth(&out.epochs).unwrap();
         for (e, s) in out.epochs.iter().zip(&sm) {
             for p in [&e.p, &e.p_pred, &s.p] {
                 assert_eq!(*p, p.transpose(), "asymmetric covariance at t={}", e.t_s);
-                assert!(p.cholesky().is_some(), "covariance not positive definite at t={}", e.t_s);
+                assert!(
+                    p.cholesky().is_some(),
+                    "covariance not positive definite at t={}",
+                    e.t_s
+                );
             }
             let min_eig = (e.p - s.p).symmetric_eigen().eigenvalues.min();
-            assert!(min_eig > -1e-9 * e.p.amax(), "smoothed exceeds filtered at t={}: {min_eig:e}", e.t_s);
+            assert!(
+                min_eig > -1e-9 * e.p.amax(),
+                "smoothed exceeds filtered at t={}: {min_eig:e}",
+                e.t_s
+            );
         }
     }
 }

@@ -60,19 +60,27 @@ pub fn run(a: CalibrateArgs) -> Result<()> {
         iteration,
         max_iterations: a.max_iterations,
         min_speed_mps: a.min_speed,
-        filter: FilterOptions { timing: common::parse_timing(&a.timing)?, ..Default::default() },
+        filter: FilterOptions {
+            timing: common::parse_timing(&a.timing)?,
+            ..Default::default()
+        },
         ..Default::default()
     };
-    let c = calibrate::calibrate(&drive, &opts).with_context(|| format!("calibrating {}", a.dir.display()))?;
+    let c = calibrate::calibrate(&drive, &opts)
+        .with_context(|| format!("calibrating {}", a.dir.display()))?;
     if let Some(out) = &a.out {
         let mut extra = toml::Table::new();
         extra.insert("method".into(), a.method.clone().into());
         extra.insert("iterations".into(), (c.iterations as i64).into());
         extra.insert("converged".into(), c.converged.into());
-        deadreckon_io::write_params(out, &c.estimate, Some(&extra)).with_context(|| format!("writing {}", out.display()))?;
+        deadreckon_io::write_params(out, &c.estimate, Some(&extra))
+            .with_context(|| format!("writing {}", out.display()))?;
     }
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&common::calibration_json(&a.method, &c))?);
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&common::calibration_json(&a.method, &c))?
+        );
     } else {
         println!("{}", common::params_header());
         println!("{}", common::params_row(&a.method, &c.estimate));
@@ -82,7 +90,11 @@ pub fn run(a: CalibrateArgs) -> Result<()> {
                 c.iterations,
                 a.state,
                 a.iteration,
-                if c.converged { "converged" } else { "NOT converged: raise --max-iterations" }
+                if c.converged {
+                    "converged"
+                } else {
+                    "NOT converged: raise --max-iterations"
+                }
             );
         }
         if let Some(st) = &c.filter_stats {

@@ -17,8 +17,11 @@ pub fn load_params(spec: &str, drive: &Drive) -> Result<Params> {
     if spec == "nominal" {
         return Ok(Params::nominal(&drive.vehicle));
     }
-    let p = deadreckon_io::read_params(Path::new(spec)).with_context(|| format!("reading parameters {spec}"))?;
-    p.params.validate().with_context(|| format!("parameters in {spec}"))?;
+    let p = deadreckon_io::read_params(Path::new(spec))
+        .with_context(|| format!("reading parameters {spec}"))?;
+    p.params
+        .validate()
+        .with_context(|| format!("parameters in {spec}"))?;
     Ok(p.params)
 }
 
@@ -79,7 +82,11 @@ pub fn calibration_json(method: &str, c: &Calibration) -> serde_json::Value {
     m.insert("samples".into(), serde_json::json!(c.samples));
     m.insert(
         "history".into(),
-        c.history.iter().map(|p| serde_json::json!(p.to_array())).collect::<Vec<_>>().into(),
+        c.history
+            .iter()
+            .map(|p| serde_json::json!(p.to_array()))
+            .collect::<Vec<_>>()
+            .into(),
     );
     if let Some(st) = &c.filter_stats {
         m.insert(

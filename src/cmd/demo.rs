@@ -7,12 +7,14 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use clap::Args;
-use deadreckon_core::calibrate::{self, Calibration, CalibrationOptions, Iteration, Method, PassState};
+use deadreckon_core::calibrate::{
+    self, Calibration, CalibrationOptions, Iteration, Method, PassState,
+};
 use deadreckon_core::ekf::Timing;
 use deadreckon_core::metrics::{self, Summary};
 use deadreckon_core::{Params, ParamsWithStd};
 
-use super::{common, simulate};
+use super::{common, report, simulate};
 
 /// Arguments of `demo`.
 #[derive(Args, Debug)]
@@ -43,24 +45,55 @@ pub struct MethodResult {
 }
 
 /// Calibrates with every method on `cal` and evaluates on `eval`.
-pub fn calibrate_and_evaluate(cal: &deadreckon_core::Drive, eval: &deadreckon_core::Drive) -> Result<Vec<MethodResult>> {
+pub fn calibrate_and_evaluate(
+    cal: &deadreckon_core::Drive,
+    eval: &deadreckon_core::Drive,
+) -> Result<Vec<MethodResult>> {
     let nominal = Params::nominal(&cal.vehicle);
     let mut out = Vec::new();
-    for (name, method) in [("nominal", None), ("ZUPT", Some(Method::Zupt)), ("RTS", Some(Method::Rts)), ("truth", Some(Method::Truth))] {
+    for (name, method) in [
+        ("nominal", None),
+        ("ZUPT", Some(Method::Zupt)),
+        ("RTS", Some(Method::Rts)),
+        ("truth", Some(Method::Truth)),
+    ] {
         let calibration = match method {
             None => None,
-            Some(m) => Some(calibrate::calibrate(cal, &CalibrationOptions { method: m, ..Default::default() }).with_context(|| format!("{name} calibration"))?),
+            Some(m) => Some(
+                calibrate::calibrate(
+                    cal,
+                    &CalibrationOptions {
+                        method: m,
+                        ..Default::default()
+                    },
+                )
+                .with_context(|| format!("{name} calibration"))?,
+            ),
         };
-        let params = calibration.as_ref().map(|c| c.estimate).unwrap_or(ParamsWithStd { params: nominal, std: Params::from_array([0.0; 6]) });
+        let params = calibration
+            .as_ref()
+            .map(|c| c.estimate)
+            .unwrap_or(ParamsWithStd {
+                params: nominal,
+                std: Params::from_array([0.0; 6]),
+            });
         let drift = metrics::drift(eval, &params.params, 100.0, Timing::WheelEpochs)?;
         let reset = metrics::reset_on_error(eval, &params.params, 1.0, Timing::WheelEpochs)?;
-        out.push(MethodResult { name, calibration, params, drift, reset });
+        out.push(MethodResult {
+            name,
+            calibration,
+            params,
+            drift,
+            reset,
+        });
     }
     Ok(out)
 }
 
 /// Runs `demo`.
-pub fn run(a: DemoArgs) -> Result<()> {
+pub fn run(a: DemoArgs, quiet: bool) -> Result<()> {
+    let steps = super::progress::Steps::new(16, quiet);
+    steps.step("simulating");
     let cal_dir = a.out.join("calibration");
     let eval_dir = a.out.join("evaluation");
     let sim_cal = simulate::simulate_to("calibration", a.seed, &cal_dir)?;
@@ -68,6 +101,7 @@ pub fn run(a: DemoArgs) -> Result<()> {
     // Read back what was written, as a user's drive would be.
     let cal = common::load_drive(&cal_dir)?;
     let eval = common::load_drive(&eval_dir)?;
+    steps.step("calibrating and evaluating");
     let results = calibrate_and_evaluate(&cal, &eval)?;
     for r in &results {
         if let Some(c) = &r.calibration {
@@ -77,9 +111,40 @@ pub fn run(a: DemoArgs) -> Result<()> {
             deadreckon_io::write_params(&file, &c.estimate, Some(&extra))?;
         }
     }
+    // The report of the evaluation drive with the calibrations made on the calibration drive.
+    let methods: Vec<report::Method_> = results
+        .iter()
+        .map(|r| report::Method_ {
+            name: r.name.into(),
+            params: r.params,
+            calibration: r.calibration.clone(),
+        })
+        .collect();
+    let mut input = report::four_wheel_input(&eval, &methods, Some(20.0), &steps)?;
+    input.header = report::header(
+        &eval,
+        "demo: evaluation drive",
+        vec![
+            ("calibration drive".into(), cal_dir.display().to_string()),
+            ("evaluation drive".into(), eval_dir.display().to_string()),
+        ],
+    );
+    input.footer = report::footer();
+    let report_path = a.out.join("report.html");
+    deadreckon_report::write_report(&report_path, &input)?;
+    steps.step("paper's plain iteration");
     // The paper's scheme (5-state passes, plain iteration), for comparison of convergence.
-    let plain = calibrate::calibrate(&cal, &CalibrationOptions { state: PassState::Paper, iteration: Iteration::Plain, max_iterations: 30, ..Default::default() })?;
+    let plain = calibrate::calibrate(
+        &cal,
+        &CalibrationOptions {
+            state: PassState::Paper,
+            iteration: Iteration::Plain,
+            max_iterations: 30,
+            ..Default::default()
+        },
+    )?;
     let truth = sim_cal.truth_params;
+    steps.finish();
     if a.json {
         let rows: Vec<serde_json::Value> = results
             .iter()
@@ -111,11 +176,24 @@ pub fn run(a: DemoArgs) -> Result<()> {
     println!();
     println!("Table III: parameter calibration");
     println!("{}", common::params_header());
-    println!("{}", common::params_row("GT", &ParamsWithStd { params: truth, std: Params::from_array([0.0; 6]) }));
+    println!(
+        "{}",
+        common::params_row(
+            "GT",
+            &ParamsWithStd {
+                params: truth,
+                std: Params::from_array([0.0; 6])
+            }
+        )
+    );
     for r in &results {
         println!("{}", common::params_row(r.name, &r.params));
     }
-    if let Some(rts) = results.iter().find(|r| r.name == "RTS").and_then(|r| r.calibration.as_ref()) {
+    if let Some(rts) = results
+        .iter()
+        .find(|r| r.name == "RTS")
+        .and_then(|r| r.calibration.as_ref())
+    {
         let e = rts.estimate.params.to_array();
         let t = truth.to_array();
         println!(
@@ -127,7 +205,12 @@ pub fn run(a: DemoArgs) -> Result<()> {
             100.0 * ((e[4] - t[4]) / t[4]).abs(),
             100.0 * ((e[5] - t[5]) / t[5]).abs()
         );
-        let worst = |p: &Params| (2..6).map(|i| ((p.to_array()[i] - t[i]) / t[i]).abs()).fold(0.0, f64::max) * 100.0;
+        let worst = |p: &Params| {
+            (2..6)
+                .map(|i| ((p.to_array()[i] - t[i]) / t[i]).abs())
+                .fold(0.0, f64::max)
+                * 100.0
+        };
         println!(
             "RTS smoothing passes: {} (augmented state); the paper's 5-state plain iteration: worst circumference error {:.3}% after 1 pass, {:.3}% after 3, {:.3}% after {}{}",
             rts.iterations,
@@ -139,8 +222,13 @@ pub fn run(a: DemoArgs) -> Result<()> {
         );
     }
     println!();
-    println!("Table IV: dead-reckoning drift on the evaluation drive (reset to the truth every 100 m)");
-    println!("{:<8} {:>12} {:>12} {:>6}   {:>24}", "method", "mean error", "std", "n", "distance before 1 m error");
+    println!(
+        "Table IV: dead-reckoning drift on the evaluation drive (reset to the truth every 100 m)"
+    );
+    println!(
+        "{:<8} {:>12} {:>12} {:>6}   {:>24}",
+        "method", "mean error", "std", "n", "distance before 1 m error"
+    );
     for r in &results {
         let d = Summary::of(&r.drift.errors_pct());
         let s = Summary::of(&r.reset.distances_m);
@@ -150,6 +238,10 @@ pub fn run(a: DemoArgs) -> Result<()> {
         );
     }
     println!();
-    println!("drives and parameters in {}", a.out.display());
+    println!(
+        "drives and parameters in {}, report in {}",
+        a.out.display(),
+        report_path.display()
+    );
     Ok(())
 }

@@ -59,12 +59,23 @@ pub fn run(a: EvaluateArgs) -> Result<()> {
         let (params, source) = match &a.params {
             Some(p) => (common::load_params(p, &drive)?, p.clone()),
             None => {
-                let c = calibrate::calibrate(&drive, &CalibrationOptions::default()).context("RTS calibration with GNSS")?;
+                let c = calibrate::calibrate(&drive, &CalibrationOptions::default())
+                    .context("RTS calibration with GNSS")?;
                 (c.estimate.params, format!("rts ({} passes)", c.iterations))
             }
         };
-        let base = FilterOptions { timing, ..Default::default() };
-        let ev = outage::evaluate(&drive, &params, len, a.step.unwrap_or(len / 2.0), a.warmup, &base)?;
+        let base = FilterOptions {
+            timing,
+            ..Default::default()
+        };
+        let ev = outage::evaluate(
+            &drive,
+            &params,
+            len,
+            a.step.unwrap_or(len / 2.0),
+            a.warmup,
+            &base,
+        )?;
         let (fe, dr, d1) = (ev.final_error(), ev.drift_pct(), ev.distance_to_1m());
         if a.json {
             let v = json!({
@@ -79,10 +90,24 @@ pub fn run(a: EvaluateArgs) -> Result<()> {
             });
             println!("{}", serde_json::to_string_pretty(&v)?);
         } else {
-            println!("{} outage windows of {len} s against the {} (parameters: {source})", ev.windows.len(), ev.reference.name());
-            println!("{:<28} {:>9} {:>9} {:>9} {:>9}", "", "mean", "median", "p95", "max");
-            for (name, s) in [("final error (m)", fe), ("drift per 100 m (%)", dr), ("distance before 1 m (m)", d1)] {
-                println!("{:<28} {:>9.3} {:>9.3} {:>9.3} {:>9.3}", name, s.mean, s.median, s.p95, s.max);
+            println!(
+                "{} outage windows of {len} s against the {} (parameters: {source})",
+                ev.windows.len(),
+                ev.reference.name()
+            );
+            println!(
+                "{:<28} {:>9} {:>9} {:>9} {:>9}",
+                "", "mean", "median", "p95", "max"
+            );
+            for (name, s) in [
+                ("final error (m)", fe),
+                ("drift per 100 m (%)", dr),
+                ("distance before 1 m (m)", d1),
+            ] {
+                println!(
+                    "{:<28} {:>9.3} {:>9.3} {:>9.3} {:>9.3}",
+                    name, s.mean, s.median, s.p95, s.max
+                );
             }
         }
         return Ok(());

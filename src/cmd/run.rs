@@ -31,12 +31,25 @@ pub struct RunArgs {
 }
 
 /// The tracks of a drive: dead-reckoned, and with GNSS the filtered and smoothed.
-pub fn tracks(drive: &Drive, params: &Params, opts: &FilterOptions, init_pose: Option<(f64, f64, f64)>) -> Result<Vec<Track>> {
+pub fn tracks(
+    drive: &Drive,
+    params: &Params,
+    opts: &FilterOptions,
+    init_pose: Option<(f64, f64, f64)>,
+) -> Result<Vec<Track>> {
     let origin = drive.vehicle.origin;
     let mut out = Vec::new();
     let mut smoothed_start = None;
     if drive.gnss.len() >= 2 {
-        let f = ekf::run(drive, params, &FilterOptions { record_epochs: true, ..opts.clone() }, &mut ())?;
+        let f = ekf::run(
+            drive,
+            params,
+            &FilterOptions {
+                record_epochs: true,
+                ..opts.clone()
+            },
+            &mut (),
+        )?;
         let s = rts::smooth(&f.epochs)?;
         smoothed_start = s.first().map(|s| (s.t_s, s.x, s.p));
         out.push(Track::from_epochs("filtered", &f.epochs, origin));
@@ -44,7 +57,11 @@ pub fn tracks(drive: &Drive, params: &Params, opts: &FilterOptions, init_pose: O
     }
     let init = if let Some((e, n, y)) = init_pose {
         let t0 = drive.wheels.t_s(0);
-        Init::Given { t_s: t0, x: State::from([e, n, y, 0.0, 0.0]), p: Mat::from_diagonal(&State::from([1e-4, 1e-4, 1e-6, 4.0, 0.25])) }
+        Init::Given {
+            t_s: t0,
+            x: State::from([e, n, y, 0.0, 0.0]),
+            p: Mat::from_diagonal(&State::from([1e-4, 1e-4, 1e-6, 4.0, 0.25])),
+        }
     } else if !drive.truth.is_empty() {
         Init::Truth
     } else if let Some((t_s, x, p)) = smoothed_start {
@@ -52,7 +69,17 @@ pub fn tracks(drive: &Drive, params: &Params, opts: &FilterOptions, init_pose: O
     } else {
         anyhow::bail!("dead reckoning needs an initial pose: truth.csv, gnss.csv or --init-pose");
     };
-    let dr = ekf::run(drive, params, &FilterOptions { init, sensors: SensorSet::dead_reckoning(), record_epochs: true, ..opts.clone() }, &mut ())?;
+    let dr = ekf::run(
+        drive,
+        params,
+        &FilterOptions {
+            init,
+            sensors: SensorSet::dead_reckoning(),
+            record_epochs: true,
+            ..opts.clone()
+        },
+        &mut (),
+    )?;
     out.insert(0, Track::from_epochs("dead-reckoned", &dr.epochs, origin));
     Ok(out)
 }
@@ -63,7 +90,10 @@ pub fn write_tracks(path: &Path, tracks: &[Track]) -> Result<()> {
         Some("csv") => deadreckon_io::write_track_csv(path, tracks)?,
         Some("geojson") | Some("json") => deadreckon_io::write_track_geojson(path, tracks)?,
         Some("mcap") => super::write_mcap(path, tracks)?,
-        _ => anyhow::bail!("unknown output format for {} (use .csv, .geojson or .mcap)", path.display()),
+        _ => anyhow::bail!(
+            "unknown output format for {} (use .csv, .geojson or .mcap)",
+            path.display()
+        ),
     }
     Ok(())
 }
@@ -74,13 +104,23 @@ pub fn run(a: RunArgs) -> Result<()> {
     let params = common::load_params(&a.params, &drive)?;
     let init_pose = match &a.init_pose {
         Some(s) => {
-            let v: Vec<f64> = s.split(',').map(|x| x.trim().parse::<f64>()).collect::<Result<_, _>>().context("--init-pose EAST_M,NORTH_M,YAW_RAD")?;
-            anyhow::ensure!(v.len() == 3 && v.iter().all(|x| x.is_finite()), "--init-pose needs three finite numbers EAST_M,NORTH_M,YAW_RAD");
+            let v: Vec<f64> = s
+                .split(',')
+                .map(|x| x.trim().parse::<f64>())
+                .collect::<Result<_, _>>()
+                .context("--init-pose EAST_M,NORTH_M,YAW_RAD")?;
+            anyhow::ensure!(
+                v.len() == 3 && v.iter().all(|x| x.is_finite()),
+                "--init-pose needs three finite numbers EAST_M,NORTH_M,YAW_RAD"
+            );
             Some((v[0], v[1], v[2]))
         }
         None => None,
     };
-    let opts = FilterOptions { timing: common::parse_timing(&a.timing)?, ..Default::default() };
+    let opts = FilterOptions {
+        timing: common::parse_timing(&a.timing)?,
+        ..Default::default()
+    };
     let t = tracks(&drive, &params, &opts, init_pose)?;
     write_tracks(&a.out, &t).with_context(|| format!("writing {}", a.out.display()))?;
     for tr in &t {

@@ -54,7 +54,11 @@ fn with_overrides(mut sc: Scenario, a: &SimulateArgs) -> Result<Scenario> {
         e.speed_scale = s;
     }
     if let Some(c) = &a.circumferences {
-        anyhow::ensure!(c.len() == 4, "--circumferences takes four values FL,FR,RL,RR (m), got {}", c.len());
+        anyhow::ensure!(
+            c.len() == 4,
+            "--circumferences takes four values FL,FR,RL,RR (m), got {}",
+            c.len()
+        );
         e.set_circumferences([c[0], c[1], c[2], c[3]]);
     }
     e.validate()?;
@@ -82,14 +86,24 @@ pub fn scenario(spec: &str) -> Result<Scenario> {
 }
 
 /// Simulates and writes `drive` + `truth_params.toml` into `dir`.
-pub fn simulate_to(spec: &str, seed: u64, dir: &std::path::Path) -> Result<deadreckon_sim::SimOutput> {
+pub fn simulate_to(
+    spec: &str,
+    seed: u64,
+    dir: &std::path::Path,
+) -> Result<deadreckon_sim::SimOutput> {
     write_scenario(scenario(spec)?, spec, seed, dir)
 }
 
-fn write_scenario(sc: Scenario, spec: &str, seed: u64, dir: &std::path::Path) -> Result<deadreckon_sim::SimOutput> {
+fn write_scenario(
+    sc: Scenario,
+    spec: &str,
+    seed: u64,
+    dir: &std::path::Path,
+) -> Result<deadreckon_sim::SimOutput> {
     let out = deadreckon_sim::simulate(&sc, seed).with_context(|| format!("simulating {spec}"))?;
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    deadreckon_io::write_drive(dir, &out.drive).with_context(|| format!("writing {}", dir.display()))?;
+    deadreckon_io::write_drive(dir, &out.drive)
+        .with_context(|| format!("writing {}", dir.display()))?;
     deadreckon_io::write_truth_params(&dir.join("truth_params.toml"), &out.truth_params)?;
     Ok(out)
 }

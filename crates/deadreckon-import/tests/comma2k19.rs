@@ -1,0 +1,241 @@
+//! The comma2k19 RAV4 segment, read end to end.
+
+mod common;
+
+use deadreckon_core::drive::Wheels;
+use deadreckon_import::comma2k19::{
+    read_comma2k19_with, Comma2k19Options, GyroSource, SpeedSource,
+};
+use deadreckon_import::npy::read_npy;
+use deadreckon_import::read_comma2k19;
+
+fn interp(ts: &[f64], vs: &[f64], t: f64) -> Option<f64> {
+    let i = ts.partition_point(|&x| x < t);
+    if i == 0 || i >= ts.len() {
+        return None;
+    }
+    let w = (t - ts[i - 1]) / (ts[i] - ts[i - 1]);
+    Some(vs[i - 1] * (1.0 - w) + vs[i] * w)
+}
+
+#[test]
+fn segment_reads_with_plausible_streams() {
+    let dir = common::data("comma2k19-rav4");
+    let imp = read_comma2k19_with(&dir, &Comma2k19Options::default()).unwrap();
+    let d = &imp.drive;
+    println!("{}", imp.report);
+    let (t0, t1) = d.time_span().unwrap();
+    assert!((t1 - t0 - 60.0).abs() < 1.0, "duration {}", t1 - t0);
+    let Wheels::Speeds(ws) = &d.wheels else {
+        panic!("wheel speeds expected")
+    };
+    assert_eq!(ws.len(), 4974);
+    for w in ws {
+        for v in [w.fl_mps, w.fr_mps, w.rl_mps, w.rr_mps] {
+            assert!((7.0..21.0).contains(&v), "wheel speed {v}");
+        }
+    }
+    assert_eq!(
+        d.speed.len(),
+        2487,
+        "SPEED 0xB4 runs at half the wheel-speed rate"
+    );
+    assert!(d.speed.iter().all(|s| (7.0..21.0).contains(&s.value)));
+    // The car's speed reads about 2 % above the wheel speeds (speedometer over-read).
+    let wt: Vec<f64> = ws.iter().map(|w| w.t_s).collect();
+    let wm: Vec<f64> = ws.iter().map(|w| (w.rl_mps + w.rr_mps) / 2.0).collect();
+    let ratios: Vec<f64> = d
+        .speed
+        .iter()
+        .filter_map(|s| interp(&wt, &wm, s.t_s).map(|m| s.value / m))
+        .collect();
+    let mean = ratios.iter().sum::<f64>() / ratios.len() as f64;
+    assert!(
+        (1.0..1.04).contains(&mean),
+        "SPEED / rear wheel speed = {mean}"
+    );
+
+    // Raw gyro: the bias (about 0.07 rad/s) is still in it; yaw rate otherwise near 0.
+    let yr = d.yaw_rate.iter().map(|s| s.value).sum::<f64>() / d.yaw_rate.len() as f64;
+    assert!((-0.09..-0.05).contains(&yr), "mean raw yaw rate {yr}");
+    let cal = read_comma2k19_with(
+        &dir,
+        &Comma2k19Options {
+            gyro: GyroSource::Calibrated,
+            ..Default::default()
+        },
+    )
+    .unwrap()
+    .drive;
+    let yc = cal.yaw_rate.iter().map(|s| s.value).sum::<f64>() / cal.yaw_rate.len() as f64;
+    assert!(yc.abs() < 0.01, "mean bias-removed yaw rate {yc}");
+
+    // Steering in radians, small on a highway.
+    assert!(d.steering.iter().all(|s| s.value.abs() < 0.2));
+
+    // Truth: about 1 km, heading changes by less than a degree.
+    let dist: f64 = d
+        .truth
+        .windows(2)
+        .map(|w| (w[1].east_m - w[0].east_m).hypot(w[1].north_m - w[0].north_m))
+        .sum();
+    assert!((950.0..1070.0).contains(&dist), "truth distance {dist}");
+    let yaws: Vec<f64> = d.truth.iter().map(|p| p.yaw_rad).collect();
+    let (lo, hi) = yaws
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(a, b), &y| (a.min(y), b.max(y)));
+    assert!(
+        (hi - lo).to_degrees() < 2.0,
+        "yaw span {} deg",
+        (hi - lo).to_degrees()
+    );
+    assert!(d
+        .truth
+        .iter()
+        .all(|p| p.speed_mps.is_some_and(|v| (7.0..21.0).contains(&v))));
+    // Driving north (course about 2 degrees): yaw about 88 degrees.
+    assert!(
+        (yaws[0].to_degrees() - 88.5).abs() < 2.0,
+        "{}",
+        yaws[0].to_degrees()
+    );
+    assert!(d.vehicle.origin.is_some());
+    assert_eq!(imp.report.total_gated(), 0);
+}
+
+#[test]
+fn gnss_agrees_with_truth_plus_lever_arm() {
+    let dir = common::data("comma2k19-rav4");
+    let d = read_comma2k19(&dir, None).unwrap();
+    let t: Vec<f64> = d.truth.iter().map(|p| p.t_s).collect();
+    let e: Vec<f64> = d
+        .truth
+        .iter()
+        .map(|p| p.east_m + d.vehicle.gnss_lever_arm_m * p.yaw_rad.cos())
+        .collect();
+    let n: Vec<f64> = d
+        .truth
+        .iter()
+        .map(|p| p.north_m + d.vehicle.gnss_lever_arm_m * p.yaw_rad.sin())
+        .collect();
+    let mut sq = 0.0;
+    let mut count = 0;
+    let mut worst: f64 = 0.0;
+    for g in &d.gnss {
+        let (Some(te), Some(tn)) = (interp(&t, &e, g.t_s), interp(&t, &n, g.t_s)) else {
+            continue;
+        };
+        let err = (g.east_m - te).hypot(g.north_m - tn);
+        sq += err * err;
+        count += 1;
+        worst = worst.max(err);
+    }
+    let rms = (sq / count as f64).sqrt();
+    println!("gnss vs truth: {count} fixes, rms {rms:.3} m, max {worst:.3} m");
+    assert!(count > 550);
+    assert!(rms < 1.0 && worst < 2.0, "rms {rms} max {worst}");
+    // The first fix is the origin (its latency-shifted time is before the first truth pose).
+    assert!(d.gnss[0].east_m.abs() < 1e-6 && d.gnss[0].north_m.abs() < 1e-6);
+    // GNSS course: about 2 degrees (north, slightly east).
+    assert!(d
+        .gnss
+        .iter()
+        .all(|g| g.course_deg.is_some_and(|c| !(5.0..=355.0).contains(&c))));
+}
+
+#[test]
+fn processed_speed_is_the_mean_of_the_wheel_speeds() {
+    // Pins the reason the default speed source is the SPEED message.
+    let dir = common::data("comma2k19-rav4");
+    let o = Comma2k19Options {
+        speed: SpeedSource::Processed,
+        ..Default::default()
+    };
+    let d = read_comma2k19_with(&dir, &o).unwrap().drive;
+    let Wheels::Speeds(ws) = &d.wheels else {
+        panic!()
+    };
+    assert_eq!(d.speed.len(), ws.len());
+    for (s, w) in d.speed.iter().zip(ws) {
+        assert_eq!(s.t_s, w.t_s);
+        assert!((s.value - (w.fl_mps + w.fr_mps + w.rl_mps + w.rr_mps) / 4.0).abs() < 1e-9);
+    }
+}
+
+#[test]
+fn fortran_ordered_imu_arrays_are_read_in_row_order() {
+    // IMU values are stored in Fortran order; gyro = gyro_uncalibrated - gyro_bias row by row.
+    let imu = common::data("comma2k19-rav4/processed_log/IMU");
+    let rows = |name: &str| {
+        let p = imu.join(name).join("value");
+        read_npy(&p).unwrap().f64_rows::<3>(&p).unwrap()
+    };
+    let (g, u, b) = (rows("gyro"), rows("gyro_uncalibrated"), rows("gyro_bias"));
+    assert_eq!(g.len(), 6256);
+    for ((g, u), b) in g.iter().zip(&u).zip(&b) {
+        for k in 0..3 {
+            assert!((g[k] - (u[k] - b[k])).abs() < 1e-6, "{g:?} {u:?} {b:?}");
+        }
+    }
+}
+
+#[test]
+fn missing_segment_names_the_file() {
+    let e = read_comma2k19(std::path::Path::new("/nonexistent-segment"), None).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("/nonexistent-segment/processed_log/CAN/wheel_speed/t"),
+        "{e}"
+    );
+}
+
+/// Means of `(t, v)` samples in 1-second bins.
+fn bins(samples: impl Iterator<Item = (f64, f64)>) -> std::collections::BTreeMap<i64, f64> {
+    let mut acc: std::collections::BTreeMap<i64, (f64, usize)> = Default::default();
+    for (t, v) in samples {
+        let e = acc.entry(t.floor() as i64).or_default();
+        e.0 += v;
+        e.1 += 1;
+    }
+    acc.into_iter()
+        .map(|(k, (s, n))| (k, s / n as f64))
+        .collect()
+}
+
+fn correlation(x: &[f64], y: &[f64]) -> f64 {
+    let (mx, my) = (
+        x.iter().sum::<f64>() / x.len() as f64,
+        y.iter().sum::<f64>() / y.len() as f64,
+    );
+    let sxy: f64 = x.iter().zip(y).map(|(a, b)| (a - mx) * (b - my)).sum();
+    let sxx: f64 = x.iter().map(|a| (a - mx).powi(2)).sum();
+    let syy: f64 = y.iter().map(|b| (b - my).powi(2)).sum();
+    sxy / (sxx * syy).sqrt()
+}
+
+#[test]
+fn gyro_and_steering_signs_agree_with_the_truth_yaw_rate() {
+    // Counter-clockwise yaw rate and left-positive steering: both follow the
+    // reference's yaw rate (1 s means; the segment turns by less than a degree,
+    // so this checks signs, not scales).
+    let d = read_comma2k19(&common::data("comma2k19-rav4"), None).unwrap();
+    let truth_rate = bins(d.truth.windows(2).map(|w| {
+        let dy = deadreckon_core::angle::wrap(w[1].yaw_rad - w[0].yaw_rad);
+        (w[0].t_s, dy / (w[1].t_s - w[0].t_s))
+    }));
+    let gyro = bins(d.yaw_rate.iter().map(|s| (s.t_s, s.value)));
+    let steer = bins(d.steering.iter().map(|s| (s.t_s, s.value)));
+    let keys: Vec<i64> = truth_rate
+        .keys()
+        .copied()
+        .filter(|k| gyro.contains_key(k) && steer.contains_key(k))
+        .collect();
+    let keys = &keys[1..keys.len() - 1]; // drop partial bins
+    let tr: Vec<f64> = keys.iter().map(|k| truth_rate[k]).collect();
+    let g: Vec<f64> = keys.iter().map(|k| gyro[k]).collect();
+    let s: Vec<f64> = keys.iter().map(|k| steer[k]).collect();
+    let (cg, cs) = (correlation(&g, &tr), correlation(&s, &tr));
+    println!("correlation with the truth yaw rate: gyro {cg:.3}, steering {cs:.3}");
+    assert!(cg > 0.9, "gyro {cg}");
+    assert!(cs > 0.7, "steering {cs}");
+}

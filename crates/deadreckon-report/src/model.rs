@@ -1,0 +1,425 @@
+//! The input of the report: plain, serialisable data, filled by the command line
+//! from the estimators' results.
+//!
+//! Every section is optional, and inside a section every series may be empty: the
+//! report renders a section (and a figure inside it) only when it has data. Units are
+//! SI (m, s, rad, rad/s) and named in the field names; the report converts for
+//! display (headings to degrees, drift to %). Methods (calibrations, estimators) are
+//! plain strings: the same string gets the same colour in every figure, and the
+//! well-known names `truth`/`GT`, `nominal`, `ZUPT`, `RTS`/`ours`, `filtered`,
+//! `smoothed`, `GNSS` and `TedriS` get fixed colours (case-insensitive).
+
+use serde::{Deserialize, Serialize};
+
+/// Everything the report can show. `Default` gives an empty report (header and
+/// footer only).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct ReportInput {
+    /// The drive: name, duration, distance, streams.
+    pub header: Header,
+    /// Version and command line.
+    pub footer: Footer,
+    /// Trajectories in the east-north plane (figure 6 of the four-wheel paper).
+    pub trajectories: Option<Trajectories>,
+    /// Calibrated parameters by method and their path over the iterations (table III).
+    pub calibration: Option<Calibration>,
+    /// Dead-reckoning drift per segment and distance to the error threshold (table IV, figures 4–5).
+    pub drift: Option<Drift>,
+    /// Innovations and normalised innovation squared of the filter.
+    pub health: Option<FilterHealth>,
+    /// TedriS training and dead reckoning (figures 5–8 and table 1 of the TedriS paper).
+    pub tedris: Option<Tedris>,
+    /// Final errors of sliding simulated GNSS outages.
+    pub outages: Option<OutageEvaluation>,
+}
+
+/// The report header: what was driven and which sensor streams the drive has.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Header {
+    /// Name of the drive (usually its directory name).
+    pub drive_name: String,
+    /// Duration of the drive, s.
+    pub duration_s: Option<f64>,
+    /// Distance driven, m.
+    pub distance_m: Option<f64>,
+    /// Timestamp subtracted from every time axis, s (usually the first wheel epoch);
+    /// `None` plots the timestamps as they are.
+    pub start_t_s: Option<f64>,
+    /// The sensor streams present.
+    pub streams: Vec<StreamInfo>,
+    /// Input files other than the drive (e.g. `params.toml`, the TedriS model), as given.
+    pub inputs: Vec<NamedText>,
+}
+
+/// One sensor stream of the drive.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct StreamInfo {
+    /// Stream name, e.g. `wheel_ticks`, `yaw_rate`, `gnss`.
+    pub name: String,
+    /// Number of samples.
+    pub samples: usize,
+    /// Mean sample rate, Hz, where known.
+    pub rate_hz: Option<f64>,
+}
+
+/// A label with a free-text value.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct NamedText {
+    /// The label.
+    pub name: String,
+    /// The value.
+    pub value: String,
+}
+
+/// The report footer.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Footer {
+    /// The deadreckon version that wrote the report.
+    pub version: String,
+    /// The command line that produced the report, as typed.
+    pub command_line: String,
+}
+
+/// A path in the local east-north frame; `east_m` and `north_m` have equal lengths.
+/// Non-finite values break the line.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct EnPath {
+    /// East of the origin, m.
+    pub east_m: Vec<f64>,
+    /// North of the origin, m.
+    pub north_m: Vec<f64>,
+}
+
+/// A path produced by one method (e.g. dead reckoning with one calibration).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct MethodPath {
+    /// The method, e.g. `nominal`, `ZUPT`, `RTS`, `truth`.
+    pub method: String,
+    /// The path.
+    pub path: EnPath,
+}
+
+/// The trajectories figure (figure 6 of the four-wheel paper).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Trajectories {
+    /// The reference trajectory.
+    pub truth: Option<EnPath>,
+    /// GNSS fixes used by the filter (drawn as points).
+    pub gnss: Option<EnPath>,
+    /// GNSS fixes rejected by the Mahalanobis gate (drawn as crosses).
+    pub gnss_gated: Option<EnPath>,
+    /// The filtered (EKF) trajectory.
+    pub filtered: Option<EnPath>,
+    /// The smoothed (RTS) trajectory.
+    pub smoothed: Option<EnPath>,
+    /// Dead reckoning from the start with each calibration.
+    pub dead_reckoned: Vec<MethodPath>,
+}
+
+/// The six calibrated parameters (the `params.toml` keys of deadreckon-core).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct ParamSet {
+    /// Gyro bias, rad/s.
+    pub gyro_bias_rps: f64,
+    /// CAN speed scale factor.
+    pub speed_scale: f64,
+    /// Front-left wheel circumference, m.
+    pub circumference_fl_m: f64,
+    /// Front-right wheel circumference, m.
+    pub circumference_fr_m: f64,
+    /// Rear-left wheel circumference, m.
+    pub circumference_rl_m: f64,
+    /// Rear-right wheel circumference, m.
+    pub circumference_rr_m: f64,
+}
+
+impl ParamSet {
+    /// The parameters in the order of [`ParamSet::LABELS`].
+    pub fn to_array(&self) -> [f64; 6] {
+        [
+            self.gyro_bias_rps,
+            self.speed_scale,
+            self.circumference_fl_m,
+            self.circumference_fr_m,
+            self.circumference_rl_m,
+            self.circumference_rr_m,
+        ]
+    }
+
+    /// Display names with units, in [`ParamSet::to_array`] order.
+    pub const LABELS: [&'static str; 6] = [
+        "gyro bias (rad/s)",
+        "speed scale",
+        "circumference FL (m)",
+        "circumference FR (m)",
+        "circumference RL (m)",
+        "circumference RR (m)",
+    ];
+}
+
+/// One row of the calibration table.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct CalibrationRow {
+    /// The method, e.g. `truth`, `RTS`, `ZUPT`, `nominal`.
+    pub method: String,
+    /// The estimates.
+    pub values: ParamSet,
+    /// One standard error for each estimate, where the method gives one.
+    pub std: Option<ParamSet>,
+}
+
+/// The calibration table (table III) and the path of the iterated calibration.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Calibration {
+    /// One row per method.
+    pub rows: Vec<CalibrationRow>,
+    /// The method whose iterations are given (its colour in the iteration plots), e.g. `RTS`.
+    pub iterated_method: String,
+    /// The parameters after each smoothing–calibration iteration; index 0 is the start.
+    pub iterations: Vec<ParamSet>,
+    /// Standard errors after each iteration: empty, or as long as `iterations`.
+    pub iteration_std: Vec<ParamSet>,
+}
+
+/// The drift evaluation of one method.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct DriftMethod {
+    /// The method (calibration), e.g. `RTS`.
+    pub method: String,
+    /// Horizontal error at the end of each dead-reckoned segment of `segment_m`, m.
+    pub error_after_segment_m: Vec<f64>,
+    /// Distance dead-reckoned before the error first reached `threshold_m`, m, one per run.
+    pub distance_to_threshold_m: Vec<f64>,
+}
+
+/// The drift table (table IV) and figures 4–5 of the four-wheel paper.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Drift {
+    /// Length of each dead-reckoned segment, m (the paper: 100).
+    pub segment_m: f64,
+    /// Error threshold of the distance test, m (the paper: 1).
+    pub threshold_m: f64,
+    /// One entry per method.
+    pub methods: Vec<DriftMethod>,
+}
+
+impl Default for Drift {
+    fn default() -> Self {
+        Drift {
+            segment_m: 100.0,
+            threshold_m: 1.0,
+            methods: Vec::new(),
+        }
+    }
+}
+
+/// The innovations of one scalar observation (one component of a sensor).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct InnovationSeries {
+    /// Sensor and component, e.g. `gyro`, `GNSS east`.
+    pub sensor: String,
+    /// Unit of the innovation, e.g. `rad/s`, `m`.
+    pub unit: String,
+    /// Timestamps, s.
+    pub t_s: Vec<f64>,
+    /// Innovation y = z − h(x), in `unit`.
+    pub innovation: Vec<f64>,
+    /// Predicted standard deviation √S, in `unit`: empty, or as long as `t_s`.
+    pub std: Vec<f64>,
+    /// True where the observation was rejected by the gate: empty, or as long as `t_s`.
+    pub gated: Vec<bool>,
+}
+
+/// The normalised innovation squared yᵀS⁻¹y of one sensor.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct NisSeries {
+    /// Sensor, e.g. `GNSS`, `wheels`.
+    pub sensor: String,
+    /// Degrees of freedom (dimension of the observation).
+    pub dof: u32,
+    /// Timestamps, s.
+    pub t_s: Vec<f64>,
+    /// NIS values.
+    pub nis: Vec<f64>,
+    /// True where the observation was rejected by the gate: empty, or as long as `t_s`.
+    pub gated: Vec<bool>,
+    /// The gate (chi-square value above which observations are rejected), if any.
+    pub gate_chi2: Option<f64>,
+}
+
+/// Filter health: innovations and NIS over time.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct FilterHealth {
+    /// One series per sensor component.
+    pub innovations: Vec<InnovationSeries>,
+    /// One series per sensor.
+    pub nis: Vec<NisSeries>,
+    /// Two-sided probability of the NIS bounds drawn (default 0.95).
+    pub nis_bound_probability: Option<f64>,
+}
+
+/// A scalar time series.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct TimeSeries {
+    /// Timestamps, s.
+    pub t_s: Vec<f64>,
+    /// Values, in the unit the field that holds the series names.
+    pub value: Vec<f64>,
+}
+
+/// Cross-correlation between GNSS yaw rate and the wheel/gyro yaw rate by lag (figure 8).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct CrossCorrelation {
+    /// Lags, samples.
+    pub lag: Vec<i64>,
+    /// Correlation coefficient at each lag.
+    pub correlation: Vec<f64>,
+    /// The lag the model uses, if any (marked; otherwise the peak is marked).
+    pub chosen_lag: Option<i64>,
+}
+
+/// One coefficient of a regression model.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Coefficient {
+    /// Name, e.g. `α0`, `α1`, `MA2`.
+    pub name: String,
+    /// Estimate.
+    pub estimate: f64,
+    /// Standard error.
+    pub std_error: f64,
+    /// t value.
+    pub t_value: f64,
+    /// Two-sided p value.
+    pub p_value: f64,
+}
+
+/// A fitted regression model (table 1 of the TedriS paper).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct RegressionModel {
+    /// The model option, e.g. `lag −2`, `lag −2 + MA(2)`.
+    pub name: String,
+    /// The coefficients.
+    pub coefficients: Vec<Coefficient>,
+    /// Goodness-of-fit figures, e.g. R², residual σ, Box–Pierce p.
+    pub statistics: Vec<NamedValue>,
+}
+
+/// A label with a number.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct NamedValue {
+    /// The label, with its unit.
+    pub name: String,
+    /// The value.
+    pub value: f64,
+}
+
+/// The fill of the TedriS repositories.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Repositories {
+    /// Repository index n (R_n), may be negative.
+    pub index: Vec<i64>,
+    /// Tuples stored in each repository.
+    pub fill: Vec<u64>,
+    /// The minimum fill that ends training, if set.
+    pub min_fill: Option<u64>,
+    /// The maximum fill of a repository, if set.
+    pub max_fill: Option<u64>,
+}
+
+/// One method's error through one outage.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct MethodSeries {
+    /// The method, e.g. `TedriS`, `RTS`.
+    pub method: String,
+    /// Timestamps, s.
+    pub t_s: Vec<f64>,
+    /// Horizontal dead-reckoning error, m.
+    pub error_m: Vec<f64>,
+}
+
+/// The dead-reckoning error through one GNSS outage (figures 6–7 of the TedriS paper).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct OutageRun {
+    /// Name of the outage, e.g. `DR update`, `outage 2 (812–893 s)`.
+    pub name: String,
+    /// One series per method; time axes start at the outage start.
+    pub series: Vec<MethodSeries>,
+}
+
+/// The TedriS section.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Tedris {
+    /// Cross-correlation by lag.
+    pub cross_correlation: Option<CrossCorrelation>,
+    /// Regression models, shown side by side.
+    pub models: Vec<RegressionModel>,
+    /// GNSS heading during training, rad (yaw or course: drawn unwrapped, in degrees).
+    pub gnss_heading_rad: Option<TimeSeries>,
+    /// Heading reconstructed by the training phase, rad, same convention.
+    pub training_heading_rad: Option<TimeSeries>,
+    /// Repository fill.
+    pub repositories: Option<Repositories>,
+    /// Error through each outage.
+    pub outages: Vec<OutageRun>,
+    /// The error threshold line, m (the paper: 1).
+    pub threshold_m: f64,
+}
+
+impl Default for Tedris {
+    fn default() -> Self {
+        Tedris {
+            cross_correlation: None,
+            models: Vec::new(),
+            gnss_heading_rad: None,
+            training_heading_rad: None,
+            repositories: None,
+            outages: Vec::new(),
+            threshold_m: 1.0,
+        }
+    }
+}
+
+/// Final errors of one method over sliding outage windows.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct MethodSample {
+    /// The method.
+    pub method: String,
+    /// One value per window, m.
+    pub final_error_m: Vec<f64>,
+}
+
+/// The outage evaluation: errors at the end of sliding simulated outages.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct OutageEvaluation {
+    /// Length of each simulated outage, s, if fixed.
+    pub window_s: Option<f64>,
+    /// One entry per method.
+    pub methods: Vec<MethodSample>,
+}

@@ -1,0 +1,292 @@
+//! Filter health: the innovations of each sensor over time with their predicted
+//! ±2σ, and the normalised innovation squared (NIS) with its two-sided chi-square
+//! bounds and the gate, observations rejected by the gate marked and counted.
+
+use plotters::prelude::*;
+
+use super::{rel_time, time_desc};
+use crate::model::{FilterHealth, InnovationSeries, NisSeries};
+use crate::page::{Block, FigureView, SectionView};
+use crate::plot::{
+    data_begin, data_end, draw_hline, draw_line, fmt_sig, padded_range, render_chart, segments,
+    Frame, Legend, OrPlot, Swatch, GATED, REFERENCE, WIDTH,
+};
+use crate::stats::{chi2_quantile, minmax_indices, quantile_sorted, sorted_finite, stride_indices};
+use crate::{check_len, check_optional_len, ReportError, MAX_POINTS, MAX_SCATTER_POINTS};
+
+const LINE: RGBColor = RGBColor(0, 114, 178);
+const BAND: RGBColor = RGBColor(60, 60, 60);
+
+/// Renders the section, or `None` without series.
+pub(crate) fn section(
+    h: &FilterHealth,
+    start: Option<f64>,
+) -> Result<Option<SectionView>, ReportError> {
+    let mut blocks = Vec::new();
+    for (i, s) in h.innovations.iter().enumerate() {
+        if let Some(f) = innovation_figure(i, s, start)? {
+            blocks.push(Block::Figure(f));
+        }
+    }
+    let p = h
+        .nis_bound_probability
+        .unwrap_or(0.95)
+        .clamp(0.5, 0.999_999);
+    for (i, s) in h.nis.iter().enumerate() {
+        if let Some(f) = nis_figure(i, s, p, start)? {
+            blocks.push(Block::Figure(f));
+        }
+    }
+    if blocks.is_empty() {
+        return Ok(None);
+    }
+    Ok(Some(SectionView {
+        id: "health",
+        title: "Filter health",
+        blocks,
+    }))
+}
+
+fn gated_points(t: &[f64], v: &[f64], gated: &[bool]) -> Vec<(f64, f64)> {
+    let idx: Vec<usize> = (0..t.len())
+        .filter(|&i| gated.get(i).copied().unwrap_or(false))
+        .collect();
+    let keep = stride_indices(idx.len(), MAX_POINTS);
+    keep.into_iter()
+        .map(|k| idx[k])
+        .filter(|&i| t[i].is_finite() && v[i].is_finite())
+        .map(|i| (t[i], v[i]))
+        .collect()
+}
+
+fn innovation_figure(
+    i: usize,
+    s: &InnovationSeries,
+    start: Option<f64>,
+) -> Result<Option<FigureView>, ReportError> {
+    let n = s.t_s.len();
+    check_len("health", &s.sensor, n, s.innovation.len())?;
+    check_optional_len("health", &format!("{} std", s.sensor), n, s.std.len())?;
+    check_optional_len("health", &format!("{} gated", s.sensor), n, s.gated.len())?;
+    let t = rel_time(&s.t_s, start);
+    let accepted: Vec<f64> = s
+        .innovation
+        .iter()
+        .enumerate()
+        .map(|(k, v)| {
+            if s.gated.get(k).copied().unwrap_or(false) {
+                f64::NAN
+            } else {
+                *v
+            }
+        })
+        .collect();
+    let Some(xr) = padded_range(t.iter(), 0.0) else {
+        return Ok(None);
+    };
+    let upper: Vec<f64> = s.std.iter().map(|x| 2.0 * x).collect();
+    let lower: Vec<f64> = upper.iter().map(|x| -x).collect();
+    // The y range covers the accepted innovations and the band; gated outliers are
+    // drawn clamped to the edge so they do not squash the rest.
+    let sorted = sorted_finite(&accepted);
+    let lim = if sorted.is_empty() {
+        sorted_finite(&s.innovation)
+            .iter()
+            .fold(0.0f64, |a, b| a.max(b.abs()))
+    } else {
+        quantile_sorted(&sorted, 0.999)
+            .abs()
+            .max(quantile_sorted(&sorted, 0.001).abs())
+    };
+    let band = sorted_finite(&upper);
+    let lim = lim.max(if band.is_empty() {
+        0.0
+    } else {
+        quantile_sorted(&band, 0.99)
+    });
+    let lim = if lim > 0.0 { 1.15 * lim } else { 1.0 };
+    let yr = -lim..lim;
+    let gated = gated_points(&t, &s.innovation, &s.gated);
+    let n_gated = s.gated.iter().filter(|g| **g).count();
+    let unit = if s.unit.is_empty() {
+        String::new()
+    } else {
+        format!(" ({})", s.unit)
+    };
+    let frame = Frame::new(
+        xr,
+        yr.clone(),
+        time_desc(start),
+        format!("innovation{unit}"),
+    )
+    .size(WIDTH, 250)
+    .legend(Legend::Right);
+    let name = format!("health-innovation-{i}");
+    let svg = render_chart(&name, &frame, |chart, keys| {
+        data_begin(chart)?;
+        // Points, thinned evenly so the cloud keeps its shape (a min–max envelope
+        // would paint noise as a solid block).
+        let idx = stride_indices(accepted.len(), MAX_SCATTER_POINTS);
+        let pts: Vec<(f64, f64)> = segments(&t, &accepted, &idx).concat();
+        chart
+            .draw_series(
+                pts.into_iter()
+                    .map(|q| Circle::new(q, 1, LINE.mix(0.8).filled())),
+            )
+            .or_plot()?;
+        keys.add(s.sensor.clone(), Swatch::Dot(LINE));
+        if !gated.is_empty() {
+            let clamp = |v: f64| v.clamp(yr.start, yr.end);
+            chart
+                .draw_series(
+                    gated
+                        .iter()
+                        .map(|&(x, v)| Cross::new((x, clamp(v)), 4, GATED.stroke_width(2))),
+                )
+                .or_plot()?;
+            keys.add("gated", Swatch::Cross(GATED));
+        }
+        data_end(chart)?;
+        if !upper.is_empty() {
+            let iu = minmax_indices(&upper, MAX_POINTS);
+            draw_line(
+                chart,
+                keys,
+                segments(&t, &upper, &iu),
+                BAND,
+                2,
+                Some("±2σ predicted"),
+            )?;
+            draw_line(chart, keys, segments(&t, &lower, &iu), BAND, 2, None)?;
+        }
+        Ok(())
+    })?;
+    let outside = (0..n)
+        .filter(|&k| !s.gated.get(k).copied().unwrap_or(false))
+        .filter(|&k| {
+            s.std
+                .get(k)
+                .is_some_and(|sd| s.innovation[k].abs() > 2.0 * sd)
+        })
+        .count();
+    let mut caption = format!("Innovations of {}{unit}: {n} observations", s.sensor);
+    if !s.std.is_empty() {
+        caption.push_str(&format!(
+            ", {outside} ({:.1}%) of the accepted outside ±2σ (expected about 4.6%)",
+            100.0 * outside as f64 / (n - s.gated.iter().filter(|g| **g).count()).max(1) as f64
+        ));
+    }
+    if !s.gated.is_empty() {
+        caption.push_str(&format!(
+            ", {n_gated} rejected by the gate (crosses, clamped to the frame)"
+        ));
+    }
+    caption.push('.');
+    Ok(Some(FigureView { name, caption, svg }))
+}
+
+fn nis_figure(
+    i: usize,
+    s: &NisSeries,
+    p: f64,
+    start: Option<f64>,
+) -> Result<Option<FigureView>, ReportError> {
+    let n = s.t_s.len();
+    check_len("health", &format!("{} NIS", s.sensor), n, s.nis.len())?;
+    check_optional_len(
+        "health",
+        &format!("{} NIS gated", s.sensor),
+        n,
+        s.gated.len(),
+    )?;
+    let t = rel_time(&s.t_s, start);
+    let Some(xr) = padded_range(t.iter(), 0.0) else {
+        return Ok(None);
+    };
+    let dof = s.dof.max(1);
+    let lo = chi2_quantile(0.5 * (1.0 - p), dof);
+    let hi = chi2_quantile(0.5 * (1.0 + p), dof);
+    let is_gated = |k: usize| s.gated.get(k).copied().unwrap_or(false);
+    let accepted: Vec<f64> = s
+        .nis
+        .iter()
+        .enumerate()
+        .map(|(k, v)| if is_gated(k) { f64::NAN } else { *v })
+        .collect();
+    let acc_sorted = sorted_finite(&accepted);
+    if acc_sorted.is_empty() && !s.nis.iter().any(|v| v.is_finite()) {
+        return Ok(None);
+    }
+    let inside = acc_sorted.iter().filter(|v| **v >= lo && **v <= hi).count();
+    let mean = if acc_sorted.is_empty() {
+        f64::NAN
+    } else {
+        acc_sorted.iter().sum::<f64>() / acc_sorted.len() as f64
+    };
+    let n_gated = (0..n).filter(|&k| is_gated(k)).count();
+    // y from 0 to above the upper bound and gate, and most accepted values; larger
+    // values are clamped to the top edge.
+    let p99 = if acc_sorted.is_empty() {
+        0.0
+    } else {
+        quantile_sorted(&acc_sorted, 0.99)
+    };
+    let top = hi.max(s.gate_chi2.unwrap_or(0.0)).max(p99) * 1.15;
+    let yr = 0.0..top;
+    let clamped: Vec<f64> = accepted.iter().map(|v| v.min(top)).collect();
+    let gated = gated_points(&t, &s.nis, &s.gated);
+    let frame = Frame::new(xr, yr, time_desc(start), format!("NIS ({dof} dof)"))
+        .size(WIDTH, 260)
+        .legend(Legend::Right);
+    let name = format!("health-nis-{i}");
+    let pc = format!("{:.0}", 100.0 * p);
+    let svg = render_chart(&name, &frame, |chart, keys| {
+        draw_hline(
+            chart,
+            keys,
+            hi,
+            BAND,
+            Some(&format!("{pc}% bounds χ²({dof})")),
+        )?;
+        draw_hline(chart, keys, lo, BAND, None)?;
+        if let Some(g) = s.gate_chi2 {
+            draw_hline(chart, keys, g, REFERENCE, Some("gate"))?;
+        }
+        data_begin(chart)?;
+        let idx = stride_indices(clamped.len(), MAX_SCATTER_POINTS);
+        let pts: Vec<(f64, f64)> = segments(&t, &clamped, &idx).concat();
+        chart
+            .draw_series(
+                pts.into_iter()
+                    .map(|q| Circle::new(q, 1, LINE.mix(0.8).filled())),
+            )
+            .or_plot()?;
+        keys.add(format!("NIS {}", s.sensor), Swatch::Dot(LINE));
+        if !gated.is_empty() {
+            chart
+                .draw_series(
+                    gated
+                        .iter()
+                        .map(|&(x, v)| Cross::new((x, v.min(top)), 4, GATED.stroke_width(2))),
+                )
+                .or_plot()?;
+            keys.add("gated", Swatch::Cross(GATED));
+        }
+        data_end(chart)
+    })?;
+    let mut caption = format!(
+        "NIS of {} ({dof} degrees of freedom): {n} observations; of the {} accepted, {inside} ({:.1}%) inside the \
+         two-sided {pc}% chi-square bounds [{}, {}]; mean {} (expected {dof})",
+        s.sensor,
+        acc_sorted.len(),
+        100.0 * inside as f64 / acc_sorted.len().max(1) as f64,
+        fmt_sig(lo, 3),
+        fmt_sig(hi, 3),
+        fmt_sig(mean, 3)
+    );
+    if !s.gated.is_empty() {
+        caption.push_str(&format!("; {n_gated} rejected by the gate (crosses)"));
+    }
+    caption.push_str(". Values above the frame are drawn at its top edge.");
+    Ok(Some(FigureView { name, caption, svg }))
+}

@@ -1,0 +1,465 @@
+//! End-to-end tests of the HTML report on synthetic input: every section draws
+//! data, empty sections are left out, the page is self-contained, and it stays
+//! small for an hour-long drive.
+
+use deadreckon_report::sample::sample_input;
+use deadreckon_report::*;
+
+/// The figures of a page: (name, inner HTML).
+fn figures(html: &str) -> Vec<(String, String)> {
+    let mut out = Vec::new();
+    let mut rest = html;
+    while let Some(p) = rest.find("<figure ") {
+        rest = &rest[p..];
+        let end = rest.find("</figure>").expect("figure closed");
+        let body = &rest[..end];
+        let name = body
+            .split("data-figure=\"")
+            .nth(1)
+            .and_then(|s| s.split('"').next())
+            .expect("figure has data-figure")
+            .to_string();
+        out.push((name, body.to_string()));
+        rest = &rest[end..];
+    }
+    out
+}
+
+/// The value of attribute `a` in the tag `tag`.
+fn attr<'a>(tag: &'a str, a: &str) -> Option<&'a str> {
+    tag.split(&format!(" {a}=\""))
+        .nth(1)
+        .and_then(|s| s.split('"').next())
+}
+
+/// Counts the data elements inside the figure's `<g class="data">` that draw
+/// something: polylines with two distinct points, circles with a radius, rectangles
+/// with an area.
+fn drawn_elements(figure: &str) -> usize {
+    let mut n = 0;
+    for group in figure.split("<g class=\"data\">").skip(1) {
+        let group = group.split("</g>").next().unwrap_or("");
+        for tag in group.split('<').skip(1) {
+            let drawn = if tag.starts_with("polyline") || tag.starts_with("polygon") {
+                let pts: Vec<&str> = attr(tag, "points")
+                    .unwrap_or("")
+                    .split_whitespace()
+                    .collect();
+                pts.iter().any(|p| *p != pts[0])
+            } else if tag.starts_with("circle") {
+                attr(tag, "r")
+                    .and_then(|r| r.parse::<f64>().ok())
+                    .is_some_and(|r| r > 0.0)
+            } else if tag.starts_with("rect") {
+                let w = attr(tag, "width")
+                    .and_then(|r| r.parse::<f64>().ok())
+                    .unwrap_or(0.0);
+                let h = attr(tag, "height")
+                    .and_then(|r| r.parse::<f64>().ok())
+                    .unwrap_or(0.0);
+                w > 0.0 && h > 0.0
+            } else {
+                tag.starts_with("line ")
+            };
+            n += usize::from(drawn);
+        }
+    }
+    n
+}
+
+fn section_ids(html: &str) -> Vec<String> {
+    html.split("<section id=\"")
+        .skip(1)
+        .map(|s| s.split('"').next().unwrap_or("").to_string())
+        .collect()
+}
+
+#[test]
+fn every_section_and_figure_of_a_full_report_draws_data() {
+    let html = render_html(&sample_input(300.0)).unwrap();
+    assert_eq!(
+        section_ids(&html),
+        [
+            "trajectories",
+            "calibration",
+            "drift",
+            "health",
+            "tedris",
+            "outages"
+        ]
+    );
+    let figs = figures(&html);
+    // 1 trajectory + 6 iteration plots + 2 drift + 3 innovations + 2 NIS
+    // + cross-correlation, heading, repositories, 3 outages + 1 outage evaluation.
+    assert_eq!(
+        figs.len(),
+        21,
+        "{:?}",
+        figs.iter().map(|f| &f.0).collect::<Vec<_>>()
+    );
+    for (name, body) in &figs {
+        assert!(body.contains("<svg"), "{name}: no svg");
+        let n = drawn_elements(body);
+        let want = match name.as_str() {
+            "trajectories" => 50, // 8 lines + GNSS points + gated crosses
+            n if n.starts_with("calibration-iterations") => 7,
+            "tedris-repositories" => 17,
+            "tedris-cross-correlation" => 61,
+            _ => 2,
+        };
+        assert!(
+            n >= want,
+            "{name}: {n} drawn data elements, want at least {want}"
+        );
+        // Axis descriptions with units are drawn as SVG text.
+        assert!(
+            body.matches("<text").count() >= 4,
+            "{name}: axis text missing"
+        );
+    }
+    for table in [
+        "Calibrated parameters",
+        "Dead-reckoning drift",
+        "Regression model",
+        "simulated outage",
+    ] {
+        assert!(html.contains(table), "table {table} missing");
+    }
+}
+
+#[test]
+fn the_page_is_self_contained() {
+    let html = render_html(&sample_input(120.0)).unwrap();
+    assert!(
+        !html.contains("http://") && !html.contains("https://"),
+        "URL in the page"
+    );
+    assert!(!html.contains("src="), "external resource");
+    for href in html.split("href=\"").skip(1) {
+        assert!(
+            href.starts_with('#'),
+            "link outside the page: {}",
+            &href[..20.min(href.len())]
+        );
+    }
+    assert!(html.contains("id=\"selfcheck\""));
+    assert!(html.contains("Content-Security-Policy"));
+}
+
+#[test]
+fn an_hour_long_drive_gives_a_small_page_with_decimated_series() {
+    let mut input = sample_input(3600.0);
+    // As many health series as a drive with every sensor: 9 innovations, 5 NIS.
+    let health = input.health.as_mut().unwrap();
+    let (gyro, wheels) = (health.innovations[0].clone(), health.nis[1].clone());
+    for k in 0..6 {
+        health.innovations.push(InnovationSeries {
+            sensor: format!("wheel {k}"),
+            ..gyro.clone()
+        });
+    }
+    for k in 0..3 {
+        health.nis.push(NisSeries {
+            sensor: format!("sensor {k}"),
+            ..wheels.clone()
+        });
+    }
+    let html = render_html(&input).unwrap();
+    eprintln!("one-hour page with 14 health series: {} bytes", html.len());
+    assert!(html.len() < 5_000_000, "{} bytes", html.len());
+    for tag in html.split("<polyline").skip(1) {
+        let n = attr(tag, "points").unwrap_or("").split_whitespace().count();
+        assert!(n <= MAX_POINTS + MAX_POINTS / 2, "polyline with {n} points");
+    }
+    for (name, body) in figures(&html) {
+        let circles = body.matches("<circle").count();
+        assert!(circles <= 2 * MAX_POINTS + 100, "{name}: {circles} circles");
+    }
+}
+
+#[test]
+fn empty_sections_are_left_out() {
+    let input = ReportInput {
+        trajectories: Some(Trajectories::default()),
+        calibration: Some(Calibration::default()),
+        drift: Some(Drift::default()),
+        health: Some(FilterHealth {
+            innovations: vec![InnovationSeries::default()],
+            nis: vec![NisSeries {
+                dof: 2,
+                ..Default::default()
+            }],
+            ..Default::default()
+        }),
+        tedris: Some(Tedris::default()),
+        outages: Some(OutageEvaluation {
+            window_s: Some(30.0),
+            methods: vec![MethodSample {
+                method: "RTS".into(),
+                final_error_m: vec![f64::NAN],
+            }],
+        }),
+        ..Default::default()
+    };
+    let html = render_html(&input).unwrap();
+    assert!(section_ids(&html).is_empty(), "{:?}", section_ids(&html));
+    assert!(figures(&html).is_empty());
+    assert!(!html.contains("<nav>"));
+
+    let html = render_html(&ReportInput::default()).unwrap();
+    assert!(html.contains("(unnamed drive)"));
+    assert!(figures(&html).is_empty());
+}
+
+#[test]
+fn each_section_renders_alone() {
+    let full = sample_input(120.0);
+    let cases: Vec<(&str, ReportInput)> = vec![
+        (
+            "trajectories",
+            ReportInput {
+                trajectories: full.trajectories.clone(),
+                ..Default::default()
+            },
+        ),
+        (
+            "calibration",
+            ReportInput {
+                calibration: full.calibration.clone(),
+                ..Default::default()
+            },
+        ),
+        (
+            "drift",
+            ReportInput {
+                drift: full.drift.clone(),
+                ..Default::default()
+            },
+        ),
+        (
+            "health",
+            ReportInput {
+                health: full.health.clone(),
+                ..Default::default()
+            },
+        ),
+        (
+            "tedris",
+            ReportInput {
+                tedris: full.tedris.clone(),
+                ..Default::default()
+            },
+        ),
+        (
+            "outages",
+            ReportInput {
+                outages: full.outages.clone(),
+                ..Default::default()
+            },
+        ),
+    ];
+    for (id, input) in cases {
+        let html = render_html(&input).unwrap();
+        assert_eq!(section_ids(&html), [id]);
+        assert!(
+            figures(&html).iter().all(|(_, b)| drawn_elements(b) > 0),
+            "{id}"
+        );
+    }
+}
+
+#[test]
+fn a_section_with_only_some_data_shows_only_that() {
+    let input = ReportInput {
+        trajectories: Some(Trajectories {
+            gnss: Some(EnPath {
+                east_m: vec![0.0, 1.0, 2.0],
+                north_m: vec![0.0, 1.0, f64::NAN],
+            }),
+            ..Default::default()
+        }),
+        calibration: Some(Calibration {
+            rows: vec![CalibrationRow {
+                method: "ZUPT".into(),
+                values: ParamSet {
+                    gyro_bias_rps: -0.002,
+                    speed_scale: 1.0,
+                    ..Default::default()
+                },
+                std: None,
+            }],
+            ..Default::default()
+        }),
+        ..Default::default()
+    };
+    let html = render_html(&input).unwrap();
+    assert_eq!(section_ids(&html), ["trajectories", "calibration"]);
+    let figs = figures(&html);
+    assert_eq!(
+        figs.len(),
+        1,
+        "the calibration has a table but no iteration plots"
+    );
+    assert_eq!(drawn_elements(&figs[0].1), 2, "two finite GNSS fixes");
+}
+
+#[test]
+fn mismatched_lengths_are_an_error_naming_the_series() {
+    let input = ReportInput {
+        drift: None,
+        tedris: Some(Tedris {
+            repositories: Some(Repositories {
+                index: vec![-1, 0, 1],
+                fill: vec![3, 4],
+                ..Default::default()
+            }),
+            ..Default::default()
+        }),
+        ..Default::default()
+    };
+    match render_html(&input) {
+        Err(ReportError::LengthMismatch {
+            section,
+            series,
+            left,
+            right,
+        }) => {
+            assert_eq!(
+                (section, series.as_str(), left, right),
+                ("tedris", "repositories", 3, 2)
+            );
+        }
+        other => panic!("expected a length mismatch, got {other:?}"),
+    }
+}
+
+#[test]
+fn a_method_has_the_same_colour_in_every_figure() {
+    let html = render_html(&sample_input(120.0)).unwrap();
+    // RTS has the fixed colour #0072B2: in the trajectories, the iterations, the
+    // drift histogram and the outage evaluation.
+    let figs = figures(&html);
+    for name in [
+        "trajectories",
+        "calibration-iterations-0",
+        "drift-error-histogram",
+        "outage-final-error",
+    ] {
+        let body = &figs.iter().find(|f| f.0 == name).unwrap().1;
+        assert!(body.to_uppercase().contains("#0072B2"), "{name}");
+    }
+    assert!(html.contains("background:#0072b2"), "table swatch");
+}
+
+#[test]
+fn text_from_the_input_is_escaped() {
+    let mut input = ReportInput::default();
+    input.header.drive_name = "<script>alert(1)</script>".into();
+    input.footer.command_line = "deadreckon report \"a&b\"".into();
+    let html = render_html(&input).unwrap();
+    assert!(!html.contains("<script>alert"));
+    assert!(html.contains("&lt;script&gt;"));
+}
+
+#[test]
+fn write_report_replaces_the_file_atomically() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("report.html");
+    std::fs::write(&path, "old").unwrap();
+    write_report(&path, &sample_input(60.0)).unwrap();
+    let html = std::fs::read_to_string(&path).unwrap();
+    assert!(html.starts_with("<!DOCTYPE html>") && html.trim_end().ends_with("</html>"));
+    let names: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(names, ["report.html"], "no temporary file left");
+    let missing = dir.path().join("no/such/dir/report.html");
+    assert!(matches!(
+        write_report(&missing, &ReportInput::default()),
+        Err(ReportError::Io { .. })
+    ));
+}
+
+#[test]
+fn the_input_round_trips_through_json() {
+    let input = sample_input(30.0);
+    let json = serde_json::to_string(&input).unwrap();
+    let back: ReportInput = serde_json::from_str(&json).unwrap();
+    // serde_json (without `float_roundtrip`) parses floats to within an ulp:
+    // compare the structure, and the numbers to a relative 1e-12.
+    assert_eq!(back.header, input.header);
+    let (a, b) = (back.drift.as_ref().unwrap(), input.drift.as_ref().unwrap());
+    for (x, y) in a.methods[0]
+        .error_after_segment_m
+        .iter()
+        .zip(&b.methods[0].error_after_segment_m)
+    {
+        assert!((x - y).abs() <= 1e-12 * y.abs());
+    }
+    assert_eq!(
+        back.health.unwrap().nis[0].nis.len(),
+        input.health.unwrap().nis[0].nis.len()
+    );
+    // Sections and fields may be left out.
+    let partial: ReportInput =
+        serde_json::from_str(r#"{"header": {"drive_name": "x"}, "drift": {"methods": []}}"#)
+            .unwrap();
+    assert_eq!(partial.drift.unwrap().segment_m, 100.0);
+}
+
+#[test]
+fn series_without_finite_values_give_no_empty_frames() {
+    let nan = f64::NAN;
+    let input = ReportInput {
+        trajectories: Some(Trajectories {
+            truth: Some(EnPath {
+                east_m: vec![nan; 3],
+                north_m: vec![1.0; 3],
+            }),
+            ..Default::default()
+        }),
+        calibration: Some(Calibration {
+            iterated_method: "RTS".into(),
+            iterations: vec![
+                ParamSet {
+                    gyro_bias_rps: nan,
+                    speed_scale: nan,
+                    ..Default::default()
+                };
+                3
+            ],
+            ..Default::default()
+        }),
+        health: Some(FilterHealth {
+            nis: vec![NisSeries {
+                sensor: "GNSS".into(),
+                dof: 2,
+                t_s: vec![0.0, 1.0],
+                nis: vec![nan, nan],
+                gated: vec![false, false],
+                gate_chi2: Some(13.8),
+            }],
+            ..Default::default()
+        }),
+        tedris: Some(Tedris {
+            outages: vec![OutageRun {
+                name: "o".into(),
+                series: vec![MethodSeries {
+                    method: "TedriS".into(),
+                    t_s: vec![0.0, 1.0],
+                    error_m: vec![nan, nan],
+                }],
+            }],
+            ..Default::default()
+        }),
+        ..Default::default()
+    };
+    let html = render_html(&input).unwrap();
+    for (name, body) in figures(&html) {
+        assert!(drawn_elements(&body) > 0, "{name} is an empty frame");
+    }
+    // Circumferences are 0 (finite), so only those four iteration plots remain.
+    assert_eq!(section_ids(&html), ["calibration"]);
+    assert_eq!(figures(&html).len(), 4);
+}

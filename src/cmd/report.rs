@@ -1,0 +1,412 @@
+//! `deadreckon report`: one self-contained HTML page with the papers' tables and
+//! figures for a drive. This module turns estimator results into the report's
+//! plain data model (`deadreckon_report::ReportInput`).
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use clap::Args;
+use deadreckon_core::calibrate::{self, Calibration, CalibrationOptions, Method};
+use deadreckon_core::ekf::{self, FilterOptions, FilterStats, SensorKind};
+use deadreckon_core::metrics;
+use deadreckon_core::{outage, Drive, Params, ParamsWithStd, Track};
+use deadreckon_report as rp;
+
+use super::{common, progress::Steps, run as runcmd};
+
+/// Arguments of `report`.
+#[derive(Args, Debug)]
+pub struct ReportArgs {
+    /// The drive directory.
+    pub dir: PathBuf,
+    /// Extra parameters to show and dead-reckon with (a params.toml), beside the calibrations made on the drive.
+    #[arg(long)]
+    pub params: Option<String>,
+    /// A TedriS model.json: adds the TedriS sections.
+    #[arg(long)]
+    pub model: Option<PathBuf>,
+    /// Also run the sliding-window outage evaluation with windows of this length, s.
+    #[arg(long)]
+    pub outage: Option<f64>,
+    /// Output HTML file.
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+/// A named parameter set for the report.
+pub struct Method_ {
+    /// Display name.
+    pub name: String,
+    /// Parameters.
+    pub params: ParamsWithStd,
+    /// The calibration that produced them, if any.
+    pub calibration: Option<Calibration>,
+}
+
+fn param_set(p: &Params) -> rp::ParamSet {
+    rp::ParamSet {
+        gyro_bias_rps: p.gyro_bias_rps,
+        speed_scale: p.speed_scale,
+        circumference_fl_m: p.circumference_fl_m,
+        circumference_fr_m: p.circumference_fr_m,
+        circumference_rl_m: p.circumference_rl_m,
+        circumference_rr_m: p.circumference_rr_m,
+    }
+}
+
+fn path_of(t: &Track) -> rp::EnPath {
+    rp::EnPath {
+        east_m: t.points.iter().map(|p| p.east_m).collect(),
+        north_m: t.points.iter().map(|p| p.north_m).collect(),
+    }
+}
+
+fn stream(name: &str, t: &[f64]) -> Option<rp::StreamInfo> {
+    if t.is_empty() {
+        return None;
+    }
+    let span = t[t.len() - 1] - t[0];
+    Some(rp::StreamInfo {
+        name: name.into(),
+        samples: t.len(),
+        rate_hz: (span > 0.0).then(|| (t.len() - 1) as f64 / span),
+    })
+}
+
+/// The header: drive name, duration, distance, streams.
+pub fn header(drive: &Drive, name: &str, inputs: Vec<(String, String)>) -> rp::Header {
+    let wheels: Vec<f64> = (0..drive.wheels.len())
+        .map(|k| drive.wheels.t_s(k))
+        .collect();
+    let wheel_name = match drive.wheels {
+        deadreckon_core::drive::Wheels::Ticks(_) => "wheel_ticks",
+        deadreckon_core::drive::Wheels::Speeds(_) => "wheel_speeds",
+    };
+    let streams = [
+        stream(wheel_name, &wheels),
+        stream(
+            "yaw_rate",
+            &drive.yaw_rate.iter().map(|s| s.t_s).collect::<Vec<_>>(),
+        ),
+        stream(
+            "speed",
+            &drive.speed.iter().map(|s| s.t_s).collect::<Vec<_>>(),
+        ),
+        stream(
+            "steering",
+            &drive.steering.iter().map(|s| s.t_s).collect::<Vec<_>>(),
+        ),
+        stream(
+            "gnss",
+            &drive.gnss.iter().map(|s| s.t_s).collect::<Vec<_>>(),
+        ),
+        stream(
+            "truth",
+            &drive.truth.iter().map(|s| s.t_s).collect::<Vec<_>>(),
+        ),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    let distance_m = deadreckon_core::reference::Reference::from_truth(&drive.truth)
+        .and_then(|r| r.distance().last().copied());
+    rp::Header {
+        drive_name: name.into(),
+        duration_s: drive.time_span().map(|(a, b)| b - a),
+        distance_m,
+        start_t_s: drive.time_span().map(|s| s.0),
+        streams,
+        inputs: inputs
+            .into_iter()
+            .map(|(name, value)| rp::NamedText { name, value })
+            .collect(),
+    }
+}
+
+/// The calibrations a drive supports: nominal always, ZUPT with a standstill,
+/// RTS with GNSS, truth with a reference.
+pub fn calibrations(drive: &Drive, steps: &Steps) -> Vec<Method_> {
+    let nominal = Params::nominal(&drive.vehicle);
+    let mut out = vec![Method_ {
+        name: "nominal".into(),
+        params: ParamsWithStd {
+            params: nominal,
+            std: Params::from_array([0.0; 6]),
+        },
+        calibration: None,
+    }];
+    for (name, method) in [
+        ("ZUPT", Method::Zupt),
+        ("RTS", Method::Rts),
+        ("truth", Method::Truth),
+    ] {
+        steps.step(&format!("{name} calibration"));
+        if let Ok(c) = calibrate::calibrate(
+            drive,
+            &CalibrationOptions {
+                method,
+                ..Default::default()
+            },
+        ) {
+            out.push(Method_ {
+                name: name.into(),
+                params: c.estimate,
+                calibration: Some(c),
+            });
+        }
+    }
+    out
+}
+
+fn sensor_unit(k: SensorKind, ticks: bool) -> &'static str {
+    match k {
+        SensorKind::Wheel(_) if ticks => "ticks",
+        SensorKind::Wheel(_) | SensorKind::Speed => "m/s",
+        SensorKind::Gyro => "rad/s",
+        SensorKind::Steering => "m/s",
+        SensorKind::Gnss => "m",
+        SensorKind::Course => "rad",
+    }
+}
+
+/// Filter health from a GNSS-aided run with innovations recorded.
+pub fn health(
+    drive: &Drive,
+    params: &Params,
+) -> Result<(rp::FilterHealth, FilterStats, Vec<Track>)> {
+    let opts = FilterOptions {
+        record_innovations: true,
+        record_epochs: true,
+        ..Default::default()
+    };
+    let out = ekf::run(drive, params, &opts, &mut ())?;
+    let sm = deadreckon_core::rts::smooth(&out.epochs)?;
+    let origin = drive.vehicle.origin;
+    let tracks = vec![
+        Track::from_epochs("filtered", &out.epochs, origin),
+        Track::from_smoothed("smoothed", &sm, origin),
+    ];
+    let ticks = matches!(drive.wheels, deadreckon_core::drive::Wheels::Ticks(_));
+    let mut kinds: Vec<SensorKind> = out.innovations.iter().map(|i| i.sensor).collect();
+    kinds.sort();
+    kinds.dedup();
+    let mut h = rp::FilterHealth {
+        nis_bound_probability: Some(0.95),
+        ..Default::default()
+    };
+    for k in kinds {
+        let recs: Vec<_> = out.innovations.iter().filter(|i| i.sensor == k).collect();
+        h.innovations.push(rp::InnovationSeries {
+            sensor: k.name().into(),
+            unit: sensor_unit(k, ticks).into(),
+            t_s: recs.iter().map(|r| r.t_s).collect(),
+            innovation: recs.iter().map(|r| r.y).collect(),
+            std: recs.iter().map(|r| r.s.sqrt()).collect(),
+            gated: recs.iter().map(|r| !r.accepted).collect(),
+        });
+        h.nis.push(rp::NisSeries {
+            sensor: k.name().into(),
+            dof: k.dof() as u32,
+            t_s: recs.iter().map(|r| r.t_s).collect(),
+            nis: recs.iter().map(|r| r.nis).collect(),
+            gated: recs.iter().map(|r| !r.accepted).collect(),
+            gate_chi2: (k == SensorKind::Gnss).then_some(drive.vehicle.noise.gnss_gate_chi2),
+        });
+    }
+    Ok((h, out.stats, tracks))
+}
+
+/// Builds the four-wheel part of a report for `drive` with the given parameter sets.
+pub fn four_wheel_input(
+    drive: &Drive,
+    methods: &[Method_],
+    outage_s: Option<f64>,
+    steps: &Steps,
+) -> Result<rp::ReportInput> {
+    let mut input = rp::ReportInput::default();
+    let mut traj = rp::Trajectories::default();
+    if let Some(r) = deadreckon_core::reference::Reference::from_truth(&drive.truth) {
+        traj.truth = Some(rp::EnPath {
+            east_m: r.x.iter().map(|x| x[0]).collect(),
+            north_m: r.x.iter().map(|x| x[1]).collect(),
+        });
+    }
+    // Filter health and the aided tracks with the best parameters available.
+    let best = methods
+        .iter()
+        .find(|m| m.name == "RTS")
+        .or_else(|| methods.last())
+        .map(|m| m.params.params);
+    if let (Some(best), true) = (best, drive.gnss.len() >= 2) {
+        steps.step("filter health");
+        if let Ok((h, st, tracks)) = health(drive, &best) {
+            let gated: Vec<f64> = h
+                .innovations
+                .iter()
+                .filter(|s| s.sensor == "gnss")
+                .flat_map(|s| {
+                    s.t_s
+                        .iter()
+                        .zip(&s.gated)
+                        .filter(|(_, g)| **g)
+                        .map(|(t, _)| *t)
+                })
+                .collect();
+            let is_gated = |t: f64| gated.iter().any(|g| (g - t).abs() < 0.011);
+            traj.gnss = Some(rp::EnPath {
+                east_m: drive.gnss.iter().map(|g| g.east_m).collect(),
+                north_m: drive.gnss.iter().map(|g| g.north_m).collect(),
+            });
+            if st.gnss_rejected > 0 {
+                let gg: Vec<_> = drive.gnss.iter().filter(|g| is_gated(g.t_s)).collect();
+                traj.gnss_gated = Some(rp::EnPath {
+                    east_m: gg.iter().map(|g| g.east_m).collect(),
+                    north_m: gg.iter().map(|g| g.north_m).collect(),
+                });
+            }
+            traj.filtered = tracks.first().map(path_of);
+            traj.smoothed = tracks.get(1).map(path_of);
+            input.health = Some(h);
+        }
+    }
+    // Dead reckoning with each parameter set.
+    let opts = FilterOptions::default();
+    for m in methods {
+        steps.step(&format!("dead reckoning with {}", m.name));
+        if let Ok(tr) = runcmd::tracks(
+            &Drive {
+                gnss: Vec::new(),
+                ..drive.clone()
+            },
+            &m.params.params,
+            &opts,
+            None,
+        ) {
+            if let Some(dr) = tr.iter().find(|t| t.name == "dead-reckoned") {
+                traj.dead_reckoned.push(rp::MethodPath {
+                    method: m.name.clone(),
+                    path: path_of(dr),
+                });
+            }
+        }
+    }
+    input.trajectories = Some(traj);
+    // Calibration table and the iterations of the RTS calibration.
+    let mut cal = rp::Calibration::default();
+    for m in methods {
+        let has_std = m.params.std.to_array().iter().any(|s| *s > 0.0);
+        cal.rows.push(rp::CalibrationRow {
+            method: m.name.clone(),
+            values: param_set(&m.params.params),
+            std: has_std.then(|| param_set(&m.params.std)),
+        });
+    }
+    if let Some(c) = methods
+        .iter()
+        .find(|m| m.name == "RTS")
+        .and_then(|m| m.calibration.as_ref())
+    {
+        cal.iterated_method = "RTS".into();
+        cal.iterations = std::iter::once(Params::nominal(&drive.vehicle))
+            .chain(c.history.iter().copied())
+            .map(|p| param_set(&p))
+            .collect();
+    }
+    input.calibration = Some(cal);
+    // Drift and distance before 1 m, against the truth.
+    if !drive.truth.is_empty() {
+        let mut d = rp::Drift::default();
+        for m in methods {
+            steps.step(&format!("drift with {}", m.name));
+            let p = &m.params.params;
+            let (Ok(dr), Ok(rs)) = (
+                metrics::drift(drive, p, 100.0, opts.timing),
+                metrics::reset_on_error(drive, p, 1.0, opts.timing),
+            ) else {
+                continue;
+            };
+            d.methods.push(rp::DriftMethod {
+                method: m.name.clone(),
+                error_after_segment_m: dr.errors_m,
+                distance_to_threshold_m: rs.distances_m,
+            });
+        }
+        input.drift = Some(d);
+    }
+    // Sliding outages.
+    if let Some(len) = outage_s {
+        let mut ev = rp::OutageEvaluation {
+            window_s: Some(len),
+            methods: Vec::new(),
+        };
+        for m in methods {
+            steps.step(&format!("{len} s outages with {}", m.name));
+            if let Ok(o) = outage::evaluate(drive, &m.params.params, len, len / 2.0, 5.0, &opts) {
+                ev.methods.push(rp::MethodSample {
+                    method: m.name.clone(),
+                    final_error_m: o.windows.iter().map(|w| w.final_error_m).collect(),
+                });
+            }
+        }
+        if !ev.methods.is_empty() {
+            input.outages = Some(ev);
+        }
+    }
+    Ok(input)
+}
+
+/// The footer: version and command line.
+pub fn footer() -> rp::Footer {
+    rp::Footer {
+        version: env!("CARGO_PKG_VERSION").into(),
+        command_line: std::env::args().collect::<Vec<_>>().join(" "),
+    }
+}
+
+/// Runs `report`.
+pub fn run(a: ReportArgs, quiet: bool) -> Result<()> {
+    let steps = Steps::new(8, quiet);
+    steps.step("reading the drive");
+    let drive = common::load_drive(&a.dir)?;
+    let mut methods = calibrations(&drive, &steps);
+    if let Some(p) = &a.params {
+        let params = common::load_params(p, &drive)?;
+        methods.push(Method_ {
+            name: "given".into(),
+            params: ParamsWithStd {
+                params,
+                std: Params::from_array([0.0; 6]),
+            },
+            calibration: None,
+        });
+    }
+    let mut input = four_wheel_input(&drive, &methods, a.outage, &steps)?;
+    if let Some(m) = &a.model {
+        steps.step("TedriS");
+        input.tedris = Some(tedris_section(&drive, m)?);
+    }
+    let name = a
+        .dir
+        .file_name()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| a.dir.display().to_string());
+    input.header = header(
+        &drive,
+        &name,
+        vec![("drive".into(), a.dir.display().to_string())],
+    );
+    input.footer = footer();
+    deadreckon_report::write_report(&a.out, &input)
+        .with_context(|| format!("writing {}", a.out.display()))?;
+    steps.finish();
+    println!("wrote {}", a.out.display());
+    Ok(())
+}
+
+/// The TedriS sections for a drive and a trained model.
+fn tedris_section(_drive: &Drive, model: &std::path::Path) -> Result<rp::Tedris> {
+    anyhow::bail!(
+        "TedriS report sections are not available yet ({})",
+        model.display()
+    )
+}
