@@ -8,22 +8,36 @@ use deadreckon_core::{rts, Params};
 fn filter_and_smoother(c: &mut Criterion) {
     let drive = deadreckon_bench::drive(600.0);
     let params = Params::nominal(&drive.vehicle);
-    let opts = FilterOptions { record_epochs: true, ..Default::default() };
+    let opts = FilterOptions {
+        record_epochs: true,
+        ..Default::default()
+    };
     let out = ekf::run(&drive, &params, &opts, &mut ()).unwrap();
     let n = out.epochs.len() as u64;
 
     let mut g = c.benchmark_group("epochs");
     g.throughput(Throughput::Elements(n));
-    g.bench_function("filter, dead reckoning (wheels, gyro, speed, steering)", |b| {
-        let o = FilterOptions { sensors: SensorSet::dead_reckoning(), record_epochs: false, ..Default::default() };
-        b.iter(|| ekf::run(&drive, &params, &o, &mut ()).unwrap())
+    g.bench_function(
+        "filter, dead reckoning (wheels, gyro, speed, steering)",
+        |b| {
+            let o = FilterOptions {
+                sensors: SensorSet::dead_reckoning(),
+                record_epochs: false,
+                ..Default::default()
+            };
+            b.iter(|| ekf::run(&drive, &params, &o, &mut ()).unwrap())
+        },
+    );
+    g.bench_function("filter with GNSS, recording epochs", |b| {
+        b.iter(|| ekf::run(&drive, &params, &opts, &mut ()).unwrap())
     });
-    g.bench_function("filter with GNSS, recording epochs", |b| b.iter(|| ekf::run(&drive, &params, &opts, &mut ()).unwrap()));
     g.bench_function("augmented filter (11 states), recording epochs", |b| {
         let prior = CalibrationOptions::default().prior_std;
         b.iter(|| ekf::run_augmented(&drive, &params, &prior, &opts).unwrap())
     });
-    g.bench_function("RTS smoother", |b| b.iter(|| rts::smooth(&out.epochs).unwrap()));
+    g.bench_function("RTS smoother", |b| {
+        b.iter(|| rts::smooth(&out.epochs).unwrap())
+    });
     g.finish();
 }
 

@@ -9,6 +9,8 @@ use deadreckon_core::Drive;
 
 /// A simulated calibration drive of `duration_s` seconds (seed 1).
 pub fn drive(duration_s: f64) -> Drive {
-    let sc = deadreckon_sim::Scenario::builtin("calibration").expect("built-in scenario").with_duration_s(duration_s);
+    let sc = deadreckon_sim::Scenario::builtin("calibration")
+        .expect("built-in scenario")
+        .with_duration_s(duration_s);
     deadreckon_sim::simulate(&sc, 1).expect("simulation").drive
 }

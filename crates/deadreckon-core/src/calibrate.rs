@@ -47,7 +47,9 @@ impl std::str::FromStr for Method {
             "rts" => Ok(Method::Rts),
             "zupt" => Ok(Method::Zupt),
             "truth" => Ok(Method::Truth),
-            _ => Err(Error::InvalidParams(format!("unknown calibration method `{s}` (rts, zupt, truth)"))),
+            _ => Err(Error::InvalidParams(format!(
+                "unknown calibration method `{s}` (rts, zupt, truth)"
+            ))),
         }
     }
 }
@@ -119,7 +121,10 @@ impl Default for CalibrationOptions {
             max_iterations: 60,
             tolerance: 1.0,
             min_speed_mps: 2.0,
-            filter: FilterOptions { record_epochs: true, ..Default::default() },
+            filter: FilterOptions {
+                record_epochs: true,
+                ..Default::default()
+            },
             initial: None,
         }
     }
@@ -157,17 +162,31 @@ pub fn calibrate(drive: &Drive, opts: &CalibrationOptions) -> Result<Calibration
     match opts.method {
         Method::Zupt => zupt(drive, &nominal),
         Method::Truth => {
-            let reference = Reference::from_truth(&drive.truth)
-                .ok_or_else(|| Error::Insufficient("truth calibration needs truth.csv with at least 3 poses".into()))?;
+            let reference = Reference::from_truth(&drive.truth).ok_or_else(|| {
+                Error::Insufficient(
+                    "truth calibration needs truth.csv with at least 3 poses".into(),
+                )
+            })?;
             let (est, samples) = least_squares(drive, &reference, opts.min_speed_mps, true)?;
-            Ok(Calibration { estimate: est, iterations: 1, history: vec![est.params], converged: true, samples, filter_stats: None })
+            Ok(Calibration {
+                estimate: est,
+                iterations: 1,
+                history: vec![est.params],
+                converged: true,
+                samples,
+                filter_stats: None,
+            })
         }
         Method::Rts => rts_calibration(drive, opts, start),
     }
 }
 
 /// One pass: filter with `p`, smooth, least squares on the smoothed states.
-pub fn smoothing_pass(drive: &Drive, p: &Params, opts: &CalibrationOptions) -> Result<(ParamsWithStd, [usize; 6], ekf::FilterStats), Error> {
+pub fn smoothing_pass(
+    drive: &Drive,
+    p: &Params,
+    opts: &CalibrationOptions,
+) -> Result<(ParamsWithStd, [usize; 6], ekf::FilterStats), Error> {
     let mut fopts = opts.filter.clone();
     fopts.record_epochs = true;
     if matches!(fopts.init, Init::Truth) {
@@ -177,25 +196,45 @@ pub fn smoothing_pass(drive: &Drive, p: &Params, opts: &CalibrationOptions) -> R
         PassState::Paper => {
             let out = ekf::run(drive, p, &fopts, &mut ())?;
             let sm = rts::smooth_states(&out.epochs)?;
-            (Reference::from_states(sm.iter().map(|s| s.0).collect(), sm.iter().map(|s| s.1).collect()), out.stats)
+            (
+                Reference::from_states(
+                    sm.iter().map(|s| s.0).collect(),
+                    sm.iter().map(|s| s.1).collect(),
+                ),
+                out.stats,
+            )
         }
         PassState::Augmented => {
             let out = ekf::run_augmented(drive, p, &opts.prior_std, &fopts)?;
             let sm = rts::smooth_states(&out.epochs)?;
-            let states = sm.iter().map(|s| s.1.fixed_rows::<5>(0).into_owned()).collect();
-            (Reference::from_states(sm.iter().map(|s| s.0).collect(), states), out.stats)
+            let states = sm
+                .iter()
+                .map(|s| s.1.fixed_rows::<5>(0).into_owned())
+                .collect();
+            (
+                Reference::from_states(sm.iter().map(|s| s.0).collect(), states),
+                out.stats,
+            )
         }
     };
     let (est, samples) = least_squares(drive, &reference, opts.min_speed_mps, false)?;
     Ok((est, samples, stats))
 }
 
-fn rts_calibration(drive: &Drive, opts: &CalibrationOptions, start: Params) -> Result<Calibration, Error> {
+fn rts_calibration(
+    drive: &Drive,
+    opts: &CalibrationOptions,
+    start: Params,
+) -> Result<Calibration, Error> {
     if drive.gnss.len() < 2 {
-        return Err(Error::Insufficient("RTS calibration needs GNSS fixes (gnss.csv)".into()));
+        return Err(Error::Insufficient(
+            "RTS calibration needs GNSS fixes (gnss.csv)".into(),
+        ));
     }
     let u = units(drive.vehicle.wheel_circumference_m);
-    let scale = |p: &Params| -> DVector<f64> { DVector::from_iterator(6, p.to_array().iter().zip(u.iter()).map(|(a, b)| a / b)) };
+    let scale = |p: &Params| -> DVector<f64> {
+        DVector::from_iterator(6, p.to_array().iter().zip(u.iter()).map(|(a, b)| a / b))
+    };
     let unscale = |v: &DVector<f64>| -> Params {
         let mut a = [0.0; 6];
         for i in 0..6 {
@@ -232,10 +271,22 @@ fn rts_calibration(drive: &Drive, opts: &CalibrationOptions, start: Params) -> R
             Iteration::Anderson => anderson(&xs, &gs),
         };
         let candidate = unscale(&next);
-        p = if candidate.validate().is_ok() { candidate } else { g.params };
+        p = if candidate.validate().is_ok() {
+            candidate
+        } else {
+            g.params
+        };
     }
-    let (estimate, samples, stats) = last.ok_or_else(|| Error::Insufficient("no calibration pass ran".into()))?;
-    Ok(Calibration { estimate, iterations: history.len(), history, converged, samples, filter_stats: Some(stats) })
+    let (estimate, samples, stats) =
+        last.ok_or_else(|| Error::Insufficient("no calibration pass ran".into()))?;
+    Ok(Calibration {
+        estimate,
+        iterations: history.len(),
+        history,
+        converged,
+        samples,
+        filter_stats: Some(stats),
+    })
 }
 
 /// Anderson mixing (type II, no damping): the next iterate from the last iterates
@@ -300,7 +351,12 @@ fn ls_1d(pairs: &[(f64, f64)]) -> Option<(f64, f64, usize)> {
 /// Eq. (23)–(26): the least-squares parameters from reference states (smoothed or
 /// true). `mid_interval` evaluates the state at the middle of each wheel
 /// counting interval (for the truth) instead of at its end (the filter's model).
-pub fn least_squares(drive: &Drive, reference: &Reference, min_speed: f64, mid_interval: bool) -> Result<(ParamsWithStd, [usize; 6]), Error> {
+pub fn least_squares(
+    drive: &Drive,
+    reference: &Reference,
+    min_speed: f64,
+    mid_interval: bool,
+) -> Result<(ParamsWithStd, [usize; 6]), Error> {
     let v = &drive.vehicle;
     let nominal = Params::nominal(v);
     let mut est = nominal;
@@ -327,7 +383,12 @@ pub fn least_squares(drive: &Drive, reference: &Reference, min_speed: f64, mid_i
     let pairs: Vec<(f64, f64)> = drive
         .speed
         .iter()
-        .filter_map(|s| reference.state_at(s.t_s).filter(|x| x[V] >= min_speed).map(|x| (s.value, x[V])))
+        .filter_map(|s| {
+            reference
+                .state_at(s.t_s)
+                .filter(|x| x[V] >= min_speed)
+                .map(|x| (s.value, x[V]))
+        })
         .collect();
     if let Some((a, sa, n)) = ls_1d(&pairs) {
         est.speed_scale = a;
@@ -342,7 +403,9 @@ pub fn least_squares(drive: &Drive, reference: &Reference, min_speed: f64, mid_i
     for k in 1..n_wheel {
         let (t0, t1) = (drive.wheels.t_s(k - 1), drive.wheels.t_s(k));
         let t_eval = if mid_interval { 0.5 * (t0 + t1) } else { t1 };
-        let Some(x) = reference.state_at(t_eval) else { continue };
+        let Some(x) = reference.state_at(t_eval) else {
+            continue;
+        };
         if x[V] < min_speed {
             continue;
         }
@@ -361,7 +424,10 @@ pub fn least_squares(drive: &Drive, reference: &Reference, min_speed: f64, mid_i
             }
             Wheels::Speeds(rows) => {
                 let r = rows[k];
-                for (i, z) in [r.fl_mps, r.fr_mps, r.rl_mps, r.rr_mps].into_iter().enumerate() {
+                for (i, z) in [r.fl_mps, r.fr_mps, r.rl_mps, r.rr_mps]
+                    .into_iter()
+                    .enumerate()
+                {
                     let g = sensors.wheel_ground_speed(i, x[V], x[YAW_RATE]).0;
                     pairs[i].push((z, sensors.nominal_circumference_m * g));
                 }
@@ -388,10 +454,18 @@ pub fn least_squares(drive: &Drive, reference: &Reference, min_speed: f64, mid_i
 /// (all four wheels still for at least 1 s; 0.3 s trimmed at each end).
 pub fn zupt(drive: &Drive, nominal: &Params) -> Result<Calibration, Error> {
     let still: Vec<bool> = match &drive.wheels {
-        Wheels::Ticks(r) => r.iter().map(|w| w.fl == 0 && w.fr == 0 && w.rl == 0 && w.rr == 0).collect(),
+        Wheels::Ticks(r) => r
+            .iter()
+            .map(|w| w.fl == 0 && w.fr == 0 && w.rl == 0 && w.rr == 0)
+            .collect(),
         Wheels::Speeds(r) => r
             .iter()
-            .map(|w| w.fl_mps.abs() < 0.01 && w.fr_mps.abs() < 0.01 && w.rl_mps.abs() < 0.01 && w.rr_mps.abs() < 0.01)
+            .map(|w| {
+                w.fl_mps.abs() < 0.01
+                    && w.fr_mps.abs() < 0.01
+                    && w.rl_mps.abs() < 0.01
+                    && w.rr_mps.abs() < 0.01
+            })
             .collect(),
     };
     let mut intervals = Vec::new();
@@ -418,7 +492,9 @@ pub fn zupt(drive: &Drive, nominal: &Params) -> Result<Calibration, Error> {
         .map(|s| s.value)
         .collect();
     if vals.len() < 3 {
-        return Err(Error::Insufficient("ZUPT found no standstill of at least 1 s with gyro readings".into()));
+        return Err(Error::Insufficient(
+            "ZUPT found no standstill of at least 1 s with gyro readings".into(),
+        ));
     }
     let n = vals.len() as f64;
     let mean = vals.iter().sum::<f64>() / n;
@@ -429,5 +505,12 @@ pub fn zupt(drive: &Drive, nominal: &Params) -> Result<Calibration, Error> {
     std.gyro_bias_rps = sd / n.sqrt();
     let mut samples = [0; 6];
     samples[0] = vals.len();
-    Ok(Calibration { estimate: ParamsWithStd { params: p, std }, iterations: 0, history: vec![p], converged: true, samples, filter_stats: None })
+    Ok(Calibration {
+        estimate: ParamsWithStd { params: p, std },
+        iterations: 0,
+        history: vec![p],
+        converged: true,
+        samples,
+        filter_stats: None,
+    })
 }

@@ -177,13 +177,17 @@ impl Drive {
     pub fn validate(&self) -> Result<(), Error> {
         self.vehicle.validate()?;
         if self.wheels.len() < 2 {
-            return Err(Error::InvalidDrive("the wheel stream needs at least two epochs".into()));
+            return Err(Error::InvalidDrive(
+                "the wheel stream needs at least two epochs".into(),
+            ));
         }
         let check = |name: &str, ts: &mut dyn Iterator<Item = f64>| -> Result<(), Error> {
             let mut prev = f64::NEG_INFINITY;
             for (i, t) in ts.enumerate() {
                 if !t.is_finite() {
-                    return Err(Error::InvalidDrive(format!("{name}: sample {i} has a non-finite time")));
+                    return Err(Error::InvalidDrive(format!(
+                        "{name}: sample {i} has a non-finite time"
+                    )));
                 }
                 if t <= prev {
                     return Err(Error::InvalidDrive(format!(
@@ -198,20 +202,33 @@ impl Drive {
             Wheels::Ticks(v) => check("wheel_ticks", &mut v.iter().map(|s| s.t_s))?,
             Wheels::Speeds(v) => {
                 check("wheel_speeds", &mut v.iter().map(|s| s.t_s))?;
-                if v.iter().any(|s| !(s.fl_mps.is_finite() && s.fr_mps.is_finite() && s.rl_mps.is_finite() && s.rr_mps.is_finite())) {
+                if v.iter().any(|s| {
+                    !(s.fl_mps.is_finite()
+                        && s.fr_mps.is_finite()
+                        && s.rl_mps.is_finite()
+                        && s.rr_mps.is_finite())
+                }) {
                     return Err(Error::InvalidDrive("wheel_speeds: non-finite speed".into()));
                 }
             }
         }
-        for (name, s) in [("yaw_rate", &self.yaw_rate), ("speed", &self.speed), ("steering", &self.steering)] {
+        for (name, s) in [
+            ("yaw_rate", &self.yaw_rate),
+            ("speed", &self.speed),
+            ("steering", &self.steering),
+        ] {
             check(name, &mut s.iter().map(|s| s.t_s))?;
             if s.iter().any(|s| !s.value.is_finite()) {
                 return Err(Error::InvalidDrive(format!("{name}: non-finite value")));
             }
         }
         check("gnss", &mut self.gnss.iter().map(|s| s.t_s))?;
-        if self.gnss.iter().any(|g| !(g.east_m.is_finite() && g.north_m.is_finite() && g.std_m.is_finite() && g.std_m > 0.0)) {
-            return Err(Error::InvalidDrive("gnss: non-finite position or non-positive std_m".into()));
+        if self.gnss.iter().any(|g| {
+            !(g.east_m.is_finite() && g.north_m.is_finite() && g.std_m.is_finite() && g.std_m > 0.0)
+        }) {
+            return Err(Error::InvalidDrive(
+                "gnss: non-finite position or non-positive std_m".into(),
+            ));
         }
         check("truth", &mut self.truth.iter().map(|s| s.t_s))?;
         Ok(())

@@ -73,14 +73,25 @@ pub struct SensorSet {
 
 impl Default for SensorSet {
     fn default() -> Self {
-        SensorSet { wheels: true, gyro: true, speed: true, steering: true, gnss: true, gnss_course: false }
+        SensorSet {
+            wheels: true,
+            gyro: true,
+            speed: true,
+            steering: true,
+            gnss: true,
+            gnss_course: false,
+        }
     }
 }
 
 impl SensorSet {
     /// Dead reckoning: every proprioceptive sensor, no GNSS.
     pub fn dead_reckoning() -> Self {
-        SensorSet { gnss: false, gnss_course: false, ..Default::default() }
+        SensorSet {
+            gnss: false,
+            gnss_course: false,
+            ..Default::default()
+        }
     }
 }
 
@@ -239,7 +250,11 @@ pub struct FilterOutput<const N: usize = 5> {
 
 impl<const N: usize> Default for FilterOutput<N> {
     fn default() -> Self {
-        FilterOutput { epochs: Vec::new(), innovations: Vec::new(), stats: FilterStats::default() }
+        FilterOutput {
+            epochs: Vec::new(),
+            innovations: Vec::new(),
+            stats: FilterStats::default(),
+        }
     }
 }
 
@@ -298,11 +313,17 @@ impl<const N: usize> Filter<'_, N> {
         let car = self.car();
         let f5 = model::jacobian(&car, dt);
         let q5 = model::process_noise(&self.noise, dt);
-        self.x.fixed_rows_mut::<5>(0).copy_from(&model::evolve(&car, dt));
+        self.x
+            .fixed_rows_mut::<5>(0)
+            .copy_from(&model::evolve(&car, dt));
         let mut f = SMatrix::<f64, N, N>::identity();
         f.fixed_view_mut::<5, 5>(0, 0).copy_from(&f5);
         if N == 5 {
-            self.p = kalman::predict_covariance(&self.p, &f, &SMatrix::<f64, N, N>::from_fn(|i, j| q5[(i % 5, j % 5)]));
+            self.p = kalman::predict_covariance(
+                &self.p,
+                &f,
+                &SMatrix::<f64, N, N>::from_fn(|i, j| q5[(i % 5, j % 5)]),
+            );
         } else {
             // F = diag(F_car, I) and Q = diag(Q_car, 0): only the car rows and
             // columns change. P11 ← F P11 Fᵀ + Q, P12 ← F P12, P22 unchanged.
@@ -326,14 +347,25 @@ impl<const N: usize> Filter<'_, N> {
     /// A scalar update from a car-state model `pred = (h, H)`; `param` adds the
     /// derivative with respect to one parameter (index in the parameter block)
     /// when the parameters are states.
-    fn scalar(&mut self, sensor: SensorKind, z: f64, pred: (f64, model::Row), r: f64, param: Option<(usize, f64)>) -> Result<(), Error> {
+    fn scalar(
+        &mut self,
+        sensor: SensorKind,
+        z: f64,
+        pred: (f64, model::Row),
+        r: f64,
+        param: Option<(usize, f64)>,
+    ) -> Result<(), Error> {
         let (h, row5) = pred;
         let mut row = SVector::<f64, N>::zeros();
         row.fixed_rows_mut::<5>(0).copy_from(&row5);
         if let (true, Some((j, d))) = (N == N_AUG, param) {
             row[5 + j] = d;
         }
-        let y = if sensor == SensorKind::Course { crate::angle::diff(z, h) } else { z - h };
+        let y = if sensor == SensorKind::Course {
+            crate::angle::diff(z, h)
+        } else {
+            z - h
+        };
         let inn = kalman::update_scalar(&mut self.x, &mut self.p, y, &row, r, self.form, self.t)?;
         self.refresh_params();
         if self.opts.record_innovations {
@@ -364,13 +396,22 @@ impl<const N: usize> Filter<'_, N> {
                     let pred = self.sensors.wheel_ticks(&self.car(), i, interval);
                     // ∂h/∂(1/ρ_i) = h·ρ_i: the model is linear in the inverse circumference.
                     let d = pred.0 / self.sensors.inv_circumference[i];
-                    self.scalar(SensorKind::Wheel(i as u8), z as f64, pred, r2, Some((2 + i, d)))?;
+                    self.scalar(
+                        SensorKind::Wheel(i as u8),
+                        z as f64,
+                        pred,
+                        r2,
+                        Some((2 + i, d)),
+                    )?;
                 }
             }
             Wheels::Speeds(rows) => {
                 let r = rows[k];
                 let r2 = self.noise.wheel_speed_mps.powi(2);
-                for (i, z) in [r.fl_mps, r.fr_mps, r.rl_mps, r.rr_mps].into_iter().enumerate() {
+                for (i, z) in [r.fl_mps, r.fr_mps, r.rl_mps, r.rr_mps]
+                    .into_iter()
+                    .enumerate()
+                {
                     let pred = self.sensors.wheel_speed(&self.car(), i);
                     let d = pred.0 / self.sensors.inv_circumference[i];
                     self.scalar(SensorKind::Wheel(i as u8), z, pred, r2, Some((2 + i, d)))?;
@@ -422,14 +463,23 @@ impl<const N: usize> Filter<'_, N> {
     fn record(&mut self, pred: (SVector<f64, N>, SMatrix<f64, N, N>, SMatrix<f64, N, N>)) {
         self.out.stats.epochs += 1;
         if self.opts.record_epochs {
-            self.out.epochs.push(Epoch { t_s: self.t, x_pred: pred.0, p_pred: pred.1, f: pred.2, x: self.x, p: self.p });
+            self.out.epochs.push(Epoch {
+                t_s: self.t,
+                x_pred: pred.0,
+                p_pred: pred.1,
+                f: pred.2,
+                x: self.x,
+                p: self.p,
+            });
         }
     }
 }
 
 /// Median wheel interval, s.
 fn median_interval(wheels: &Wheels) -> f64 {
-    let mut d: Vec<f64> = (1..wheels.len()).map(|k| wheels.t_s(k) - wheels.t_s(k - 1)).collect();
+    let mut d: Vec<f64> = (1..wheels.len())
+        .map(|k| wheels.t_s(k) - wheels.t_s(k - 1))
+        .collect();
     if d.is_empty() {
         return 0.02;
     }
@@ -447,9 +497,18 @@ fn initial_state(drive: &Drive, opts: &FilterOptions) -> Result<(f64, State, Mat
     match opts.init {
         Init::Given { t_s, x, p } => Ok((t_s, x, p)),
         Init::Truth => {
-            let t0 = drive.wheels.t_s(0).max(drive.truth.first().map(|t| t.t_s).unwrap_or(f64::NEG_INFINITY));
-            let x = truth_state(drive, t0)
-                .ok_or_else(|| Error::Insufficient("initialisation from the truth needs truth.csv covering the drive".into()))?;
+            let t0 = drive.wheels.t_s(0).max(
+                drive
+                    .truth
+                    .first()
+                    .map(|t| t.t_s)
+                    .unwrap_or(f64::NEG_INFINITY),
+            );
+            let x = truth_state(drive, t0).ok_or_else(|| {
+                Error::Insufficient(
+                    "initialisation from the truth needs truth.csv covering the drive".into(),
+                )
+            })?;
             let p = Mat::from_diagonal(&State::from([1e-4, 1e-4, 1e-6, 1e-2, 1e-4]));
             Ok((t0, x, p))
         }
@@ -458,16 +517,28 @@ fn initial_state(drive: &Drive, opts: &FilterOptions) -> Result<(f64, State, Mat
                 .gnss
                 .iter()
                 .find(|g| !in_outage(&opts.gnss_outages, g.t_s))
-                .ok_or_else(|| Error::Insufficient("initialisation from GNSS needs at least one fix".into()))?;
+                .ok_or_else(|| {
+                    Error::Insufficient("initialisation from GNSS needs at least one fix".into())
+                })?;
             let far = drive
                 .gnss
                 .iter()
                 .filter(|g| g.t_s > first.t_s && !in_outage(&opts.gnss_outages, g.t_s))
                 .find(|g| (g.east_m - first.east_m).hypot(g.north_m - first.north_m) >= 10.0)
-                .ok_or_else(|| Error::Insufficient("initialisation from GNSS needs the vehicle to move 10 m".into()))?;
+                .ok_or_else(|| {
+                    Error::Insufficient(
+                        "initialisation from GNSS needs the vehicle to move 10 m".into(),
+                    )
+                })?;
             let yaw = (far.north_m - first.north_m).atan2(far.east_m - first.east_m);
             let l = drive.vehicle.gnss_lever_arm_m;
-            let x = State::from([first.east_m - l * yaw.cos(), first.north_m - l * yaw.sin(), yaw, 0.0, 0.0]);
+            let x = State::from([
+                first.east_m - l * yaw.cos(),
+                first.north_m - l * yaw.sin(),
+                yaw,
+                0.0,
+                0.0,
+            ]);
             let sp = first.std_m.max(0.1);
             let p = Mat::from_diagonal(&State::from([sp * sp, sp * sp, 0.3f64.powi(2), 4.0, 0.25]));
             Ok((first.t_s, x, p))
@@ -487,7 +558,12 @@ struct Cursor {
 impl Cursor {
     /// Advances past all readings with `t <= t_end`; returns the index of the last
     /// one passed and how many were passed.
-    fn advance(&mut self, times: impl Fn(usize) -> f64, len: usize, t_end: f64) -> (Option<usize>, usize) {
+    fn advance(
+        &mut self,
+        times: impl Fn(usize) -> f64,
+        len: usize,
+        t_end: f64,
+    ) -> (Option<usize>, usize) {
         let start = self.next;
         while self.next < len && times(self.next) <= t_end {
             self.next += 1;
@@ -498,14 +574,24 @@ impl Cursor {
 }
 
 /// Runs the EKF over `drive` with the calibration `params`.
-pub fn run(drive: &Drive, params: &Params, opts: &FilterOptions, hook: &mut dyn EpochHook) -> Result<FilterOutput, Error> {
+pub fn run(
+    drive: &Drive,
+    params: &Params,
+    opts: &FilterOptions,
+    hook: &mut dyn EpochHook,
+) -> Result<FilterOutput, Error> {
     run_generic::<5>(drive, params, None, opts, hook)
 }
 
 /// Runs the EKF with the state augmented by the six parameters, which start at
 /// `params` with standard deviations `prior_std` (circumferences in metres) and
 /// are then estimated with the car state. Used by the calibration.
-pub fn run_augmented(drive: &Drive, params: &Params, prior_std: &Params, opts: &FilterOptions) -> Result<FilterOutput<N_AUG>, Error> {
+pub fn run_augmented(
+    drive: &Drive,
+    params: &Params,
+    prior_std: &Params,
+    opts: &FilterOptions,
+) -> Result<FilterOutput<N_AUG>, Error> {
     run_generic::<N_AUG>(drive, params, Some(prior_std), opts, &mut ())
 }
 
@@ -525,7 +611,9 @@ fn run_generic<const N: usize>(
     x.fixed_rows_mut::<5>(0).copy_from(&x0);
     p.fixed_view_mut::<5, 5>(0, 0).copy_from(&p0);
     if N == N_AUG {
-        let sd = prior_std.ok_or_else(|| Error::InvalidParams("the augmented filter needs prior standard deviations".into()))?;
+        let sd = prior_std.ok_or_else(|| {
+            Error::InvalidParams("the augmented filter needs prior standard deviations".into())
+        })?;
         let c = params.circumferences();
         let cs = sd.circumferences();
         x[AUG_BIAS] = params.gyro_bias_rps;
@@ -538,22 +626,45 @@ fn run_generic<const N: usize>(
             p[(AUG_INV_CIRC + i, AUG_INV_CIRC + i)] = (cs[i] / (c[i] * c[i])).powi(2);
         }
         if (0..6).any(|j| !(p[(5 + j, 5 + j)] > 0.0)) {
-            return Err(Error::InvalidParams("prior standard deviations of the parameters must be positive".into()));
+            return Err(Error::InvalidParams(
+                "prior standard deviations of the parameters must be positive".into(),
+            ));
         }
     }
-    let mut f = Filter { sensors, noise: drive.vehicle.noise, form: opts.covariance_form, x, p, t: t0, opts, out: FilterOutput::default() };
+    let mut f = Filter {
+        sensors,
+        noise: drive.vehicle.noise,
+        form: opts.covariance_form,
+        x,
+        p,
+        t: t0,
+        opts,
+        out: FilterOutput::default(),
+    };
     let wheels = &drive.wheels;
     let max_interval = 5.0 * median_interval(wheels);
-    let k0 = (0..wheels.len()).find(|&k| wheels.t_s(k) >= t0).unwrap_or(wheels.len());
+    let k0 = (0..wheels.len())
+        .find(|&k| wheels.t_s(k) >= t0)
+        .unwrap_or(wheels.len());
     if k0 + 1 >= wheels.len() {
-        return Err(Error::Insufficient("no wheel epochs after the initial time".into()));
+        return Err(Error::Insufficient(
+            "no wheel epochs after the initial time".into(),
+        ));
     }
     let use_ = opts.sensors;
     // Readings before the start are skipped.
-    let mut gyro = Cursor { next: drive.yaw_rate.partition_point(|s| s.t_s <= t0) };
-    let mut speed = Cursor { next: drive.speed.partition_point(|s| s.t_s <= t0) };
-    let mut steer = Cursor { next: drive.steering.partition_point(|s| s.t_s <= t0) };
-    let mut gnss = Cursor { next: drive.gnss.partition_point(|s| s.t_s <= t0) };
+    let mut gyro = Cursor {
+        next: drive.yaw_rate.partition_point(|s| s.t_s <= t0),
+    };
+    let mut speed = Cursor {
+        next: drive.speed.partition_point(|s| s.t_s <= t0),
+    };
+    let mut steer = Cursor {
+        next: drive.steering.partition_point(|s| s.t_s <= t0),
+    };
+    let mut gnss = Cursor {
+        next: drive.gnss.partition_point(|s| s.t_s <= t0),
+    };
     let beta_steer = f.noise.steering;
     let r_gyro = f.noise.gyro_rps.powi(2);
     let r_speed = f.noise.speed_mps.powi(2);
@@ -573,20 +684,34 @@ fn run_generic<const N: usize>(
                 if let (Some(i), true) = (gi, use_.gyro) {
                     f.out.stats.readings_superseded += n - 1;
                     let pred = f.sensors.gyro(&f.car());
-                    f.scalar(SensorKind::Gyro, drive.yaw_rate[i].value, pred, r_gyro, Some((0, 1.0)))?;
+                    f.scalar(
+                        SensorKind::Gyro,
+                        drive.yaw_rate[i].value,
+                        pred,
+                        r_gyro,
+                        Some((0, 1.0)),
+                    )?;
                     f.out.stats.gyro_updates += 1;
                 }
                 let (si, n) = speed.advance(|i| drive.speed[i].t_s, drive.speed.len(), t);
                 if let (Some(i), true) = (si, use_.speed) {
                     f.out.stats.readings_superseded += n - 1;
                     let pred = f.sensors.can_speed(&f.car());
-                    f.scalar(SensorKind::Speed, drive.speed[i].value, pred, r_speed, Some((1, f.x[V])))?;
+                    f.scalar(
+                        SensorKind::Speed,
+                        drive.speed[i].value,
+                        pred,
+                        r_speed,
+                        Some((1, f.x[V])),
+                    )?;
                     f.out.stats.speed_updates += 1;
                 }
                 let (di, n) = steer.advance(|i| drive.steering[i].t_s, drive.steering.len(), t);
                 if let (Some(i), true) = (di, use_.steering) {
                     f.out.stats.readings_superseded += n - 1;
-                    let (z, r) = f.sensors.steering_measurement(drive.steering[i].value, f.x[V], beta_steer);
+                    let (z, r) =
+                        f.sensors
+                            .steering_measurement(drive.steering[i].value, f.x[V], beta_steer);
                     let pred = f.sensors.steering(&f.car());
                     f.scalar(SensorKind::Steering, z, pred, r, None)?;
                     f.out.stats.steering_updates += 1;
@@ -595,8 +720,12 @@ fn run_generic<const N: usize>(
                 let (last, _) = gnss.advance(|i| drive.gnss[i].t_s, drive.gnss.len(), t);
                 if let (Some(last), true) = (last, use_.gnss) {
                     // Use the newest visible fix of the interval.
-                    let visible = (start..=last).rev().find(|&i| !in_outage(&opts.gnss_outages, drive.gnss[i].t_s));
-                    f.out.stats.gnss_hidden += (start..=last).filter(|&i| in_outage(&opts.gnss_outages, drive.gnss[i].t_s)).count();
+                    let visible = (start..=last)
+                        .rev()
+                        .find(|&i| !in_outage(&opts.gnss_outages, drive.gnss[i].t_s));
+                    f.out.stats.gnss_hidden += (start..=last)
+                        .filter(|&i| in_outage(&opts.gnss_outages, drive.gnss[i].t_s))
+                        .count();
                     if let Some(i) = visible {
                         f.gnss(&drive.gnss[i])?;
                     }
@@ -616,19 +745,46 @@ fn run_generic<const N: usize>(
                 Gnss(usize),
             }
             let mut evs: Vec<(f64, u8, Ev)> = Vec::new();
-            let t_end = wheels.t_s(wheels.len() - 1).min(opts.end_s.unwrap_or(f64::INFINITY));
+            let t_end = wheels
+                .t_s(wheels.len() - 1)
+                .min(opts.end_s.unwrap_or(f64::INFINITY));
             if use_.wheels {
-                evs.extend(((k0 + 1)..wheels.len()).filter(|&k| wheels.t_s(k) <= t_end).map(|k| (wheels.t_s(k), 0, Ev::Wheel(k))));
+                evs.extend(
+                    ((k0 + 1)..wheels.len())
+                        .filter(|&k| wheels.t_s(k) <= t_end)
+                        .map(|k| (wheels.t_s(k), 0, Ev::Wheel(k))),
+                );
             }
             let within = |t: f64| t > t0 && t <= t_end;
             if use_.gyro {
-                evs.extend(drive.yaw_rate.iter().enumerate().filter(|(_, s)| within(s.t_s)).map(|(i, s)| (s.t_s, 1, Ev::Gyro(i))));
+                evs.extend(
+                    drive
+                        .yaw_rate
+                        .iter()
+                        .enumerate()
+                        .filter(|(_, s)| within(s.t_s))
+                        .map(|(i, s)| (s.t_s, 1, Ev::Gyro(i))),
+                );
             }
             if use_.speed {
-                evs.extend(drive.speed.iter().enumerate().filter(|(_, s)| within(s.t_s)).map(|(i, s)| (s.t_s, 2, Ev::Speed(i))));
+                evs.extend(
+                    drive
+                        .speed
+                        .iter()
+                        .enumerate()
+                        .filter(|(_, s)| within(s.t_s))
+                        .map(|(i, s)| (s.t_s, 2, Ev::Speed(i))),
+                );
             }
             if use_.steering {
-                evs.extend(drive.steering.iter().enumerate().filter(|(_, s)| within(s.t_s)).map(|(i, s)| (s.t_s, 3, Ev::Steer(i))));
+                evs.extend(
+                    drive
+                        .steering
+                        .iter()
+                        .enumerate()
+                        .filter(|(_, s)| within(s.t_s))
+                        .map(|(i, s)| (s.t_s, 3, Ev::Steer(i))),
+                );
             }
             if use_.gnss {
                 for (i, g) in drive.gnss.iter().enumerate().filter(|(_, g)| within(g.t_s)) {
@@ -647,16 +803,32 @@ fn run_generic<const N: usize>(
                     Ev::Wheel(k) => f.wheels(wheels, k, max_interval)?,
                     Ev::Gyro(i) => {
                         let pred = f.sensors.gyro(&f.car());
-                        f.scalar(SensorKind::Gyro, drive.yaw_rate[i].value, pred, r_gyro, Some((0, 1.0)))?;
+                        f.scalar(
+                            SensorKind::Gyro,
+                            drive.yaw_rate[i].value,
+                            pred,
+                            r_gyro,
+                            Some((0, 1.0)),
+                        )?;
                         f.out.stats.gyro_updates += 1;
                     }
                     Ev::Speed(i) => {
                         let pred = f.sensors.can_speed(&f.car());
-                        f.scalar(SensorKind::Speed, drive.speed[i].value, pred, r_speed, Some((1, f.x[V])))?;
+                        f.scalar(
+                            SensorKind::Speed,
+                            drive.speed[i].value,
+                            pred,
+                            r_speed,
+                            Some((1, f.x[V])),
+                        )?;
                         f.out.stats.speed_updates += 1;
                     }
                     Ev::Steer(i) => {
-                        let (z, r) = f.sensors.steering_measurement(drive.steering[i].value, f.x[V], beta_steer);
+                        let (z, r) = f.sensors.steering_measurement(
+                            drive.steering[i].value,
+                            f.x[V],
+                            beta_steer,
+                        );
                         let pred = f.sensors.steering(&f.car());
                         f.scalar(SensorKind::Steering, z, pred, r, None)?;
                         f.out.stats.steering_updates += 1;

@@ -63,7 +63,10 @@ pub fn update_scalar<const N: usize>(
     // S = H P Hᵀ + R   (14)
     let s = h.dot(&ph) + r;
     if !(s.is_finite() && s > 0.0) || !y.is_finite() {
-        return Err(Error::Numerical { t_s, what: format!("innovation variance {s} or innovation {y} is not usable") });
+        return Err(Error::Numerical {
+            t_s,
+            what: format!("innovation variance {s} or innovation {y} is not usable"),
+        });
     }
     // K = P Hᵀ S⁻¹   (15)
     let k = ph / s;
@@ -84,7 +87,11 @@ pub fn update_scalar<const N: usize>(
             p[(j, i)] = v;
         }
     }
-    Ok(Innovation { y, s, nis: y * y / s })
+    Ok(Innovation {
+        y,
+        s,
+        nis: y * y / s,
+    })
 }
 
 /// Innovation statistics of an `M`-dimensional measurement without updating:
@@ -97,12 +104,16 @@ pub fn innovation_stats<const N: usize, const M: usize>(
     t_s: f64,
 ) -> Result<(SMatrix<f64, M, M>, SMatrix<f64, M, M>, f64), Error> {
     let s = h * p * h.transpose() + r;
-    let s_inv = s
-        .try_inverse()
-        .ok_or_else(|| Error::Numerical { t_s, what: "innovation covariance is singular".into() })?;
+    let s_inv = s.try_inverse().ok_or_else(|| Error::Numerical {
+        t_s,
+        what: "innovation covariance is singular".into(),
+    })?;
     let nis = (y.transpose() * s_inv * y)[(0, 0)];
     if !nis.is_finite() || nis < 0.0 {
-        return Err(Error::Numerical { t_s, what: format!("normalised innovation squared {nis} is not usable") });
+        return Err(Error::Numerical {
+            t_s,
+            what: format!("normalised innovation squared {nis} is not usable"),
+        });
     }
     Ok((s, s_inv, nis))
 }
@@ -128,5 +139,9 @@ pub fn update_vector<const N: usize, const M: usize>(
         CovarianceForm::Simple => (SMatrix::<f64, N, N>::identity() - k * h) * *p,
     };
     *p = (*p + p.transpose()) * 0.5;
-    Ok(Innovation { y: y[0], s: s[(0, 0)], nis })
+    Ok(Innovation {
+        y: y[0],
+        s: s[(0, 0)],
+        nis,
+    })
 }

@@ -47,8 +47,20 @@ impl Summary {
         let mut s = values.to_vec();
         s.sort_by(|a, b| a.total_cmp(b));
         let mean = s.iter().sum::<f64>() / n as f64;
-        let std = if n > 1 { (s.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1) as f64).sqrt() } else { 0.0 };
-        Summary { n, mean, std, median: quantile(&s, 0.5), p95: quantile(&s, 0.95), min: s[0], max: s[n - 1] }
+        let std = if n > 1 {
+            (s.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1) as f64).sqrt()
+        } else {
+            0.0
+        };
+        Summary {
+            n,
+            mean,
+            std,
+            median: quantile(&s, 0.5),
+            p95: quantile(&s, 0.95),
+            min: s[0],
+            max: s[n - 1],
+        }
     }
 }
 
@@ -77,7 +89,10 @@ pub struct DriftResult {
 impl DriftResult {
     /// Errors as a percentage of the segment length.
     pub fn errors_pct(&self) -> Vec<f64> {
-        self.errors_m.iter().map(|e| 100.0 * e / self.segment_m).collect()
+        self.errors_m
+            .iter()
+            .map(|e| 100.0 * e / self.segment_m)
+            .collect()
     }
 }
 
@@ -122,7 +137,9 @@ impl ResetHook<'_> {
 
 impl EpochHook for ResetHook<'_> {
     fn after_epoch(&mut self, t: f64, x: &mut State, p: &mut Mat) {
-        let (Some(truth), Some(d)) = (self.reference.state_at(t), self.distance_at(t)) else { return };
+        let (Some(truth), Some(d)) = (self.reference.state_at(t), self.distance_at(t)) else {
+            return;
+        };
         let err = (x[X] - truth[X]).hypot(x[Y] - truth[Y]);
         let travelled = d - self.last_reset_m;
         let reset = match self.rule {
@@ -156,10 +173,23 @@ impl EpochHook for ResetHook<'_> {
     }
 }
 
-fn run_with_resets(drive: &Drive, params: &Params, timing: Timing, rule: Rule) -> Result<(Vec<f64>, Vec<f64>), Error> {
-    let reference = Reference::from_truth(&drive.truth)
-        .ok_or_else(|| Error::Insufficient("evaluation needs truth.csv with at least 3 poses".into()))?;
-    let mut hook = ResetHook { distance: reference.distance(), reference: &reference, rule, last_reset_m: 0.0, values: Vec::new(), times: Vec::new() };
+fn run_with_resets(
+    drive: &Drive,
+    params: &Params,
+    timing: Timing,
+    rule: Rule,
+) -> Result<(Vec<f64>, Vec<f64>), Error> {
+    let reference = Reference::from_truth(&drive.truth).ok_or_else(|| {
+        Error::Insufficient("evaluation needs truth.csv with at least 3 poses".into())
+    })?;
+    let mut hook = ResetHook {
+        distance: reference.distance(),
+        reference: &reference,
+        rule,
+        last_reset_m: 0.0,
+        values: Vec::new(),
+        times: Vec::new(),
+    };
     let opts = FilterOptions {
         timing,
         init: Init::Truth,
@@ -172,15 +202,34 @@ fn run_with_resets(drive: &Drive, params: &Params, timing: Timing, rule: Rule) -
 }
 
 /// Table IV / figure 4: horizontal error after every `segment_m` of dead reckoning.
-pub fn drift(drive: &Drive, params: &Params, segment_m: f64, timing: Timing) -> Result<DriftResult, Error> {
+pub fn drift(
+    drive: &Drive,
+    params: &Params,
+    segment_m: f64,
+    timing: Timing,
+) -> Result<DriftResult, Error> {
     let (errors_m, times_s) = run_with_resets(drive, params, timing, Rule::Every(segment_m))?;
-    Ok(DriftResult { segment_m, errors_m, times_s })
+    Ok(DriftResult {
+        segment_m,
+        errors_m,
+        times_s,
+    })
 }
 
 /// Figure 5: distances travelled before the error reaches `threshold_m`.
-pub fn reset_on_error(drive: &Drive, params: &Params, threshold_m: f64, timing: Timing) -> Result<ResetResult, Error> {
-    let (distances_m, times_s) = run_with_resets(drive, params, timing, Rule::OnError(threshold_m))?;
-    Ok(ResetResult { threshold_m, distances_m, times_s })
+pub fn reset_on_error(
+    drive: &Drive,
+    params: &Params,
+    threshold_m: f64,
+    timing: Timing,
+) -> Result<ResetResult, Error> {
+    let (distances_m, times_s) =
+        run_with_resets(drive, params, timing, Rule::OnError(threshold_m))?;
+    Ok(ResetResult {
+        threshold_m,
+        distances_m,
+        times_s,
+    })
 }
 
 #[cfg(test)]

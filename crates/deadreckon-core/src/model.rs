@@ -97,7 +97,12 @@ mod tests {
             xm[j] -= h;
             let d = (evolve(&xp, dt) - evolve(&xm, dt)) / (2.0 * h);
             for i in 0..N {
-                assert!((d[i] - f[(i, j)]).abs() < 1e-8, "F[{i},{j}] {} vs {}", f[(i, j)], d[i]);
+                assert!(
+                    (d[i] - f[(i, j)]).abs() < 1e-8,
+                    "F[{i},{j}] {} vs {}",
+                    f[(i, j)],
+                    d[i]
+                );
             }
         }
     }

@@ -64,10 +64,22 @@ impl Sensors {
     /// signed like `v` so reversing gives negative speeds.
     pub fn wheel_ground_speed(&self, i: usize, v: f64, yaw_rate: f64) -> (f64, f64, f64) {
         match i {
-            RL => (v - 0.5 * self.track_rear_m * yaw_rate, 1.0, -0.5 * self.track_rear_m),
-            RR => (v + 0.5 * self.track_rear_m * yaw_rate, 1.0, 0.5 * self.track_rear_m),
+            RL => (
+                v - 0.5 * self.track_rear_m * yaw_rate,
+                1.0,
+                -0.5 * self.track_rear_m,
+            ),
+            RR => (
+                v + 0.5 * self.track_rear_m * yaw_rate,
+                1.0,
+                0.5 * self.track_rear_m,
+            ),
             _ => {
-                let c = if i == FL { -0.5 * self.track_front_m } else { 0.5 * self.track_front_m };
+                let c = if i == FL {
+                    -0.5 * self.track_front_m
+                } else {
+                    0.5 * self.track_front_m
+                };
                 let l = self.wheelbase_m;
                 let u = v + c * yaw_rate;
                 let s = v.signum();
@@ -125,7 +137,12 @@ impl Sensors {
     /// The steering pseudo-measurement `z = v·tan(δ/r_s)` and its variance
     /// `(v·β_δ)²` for the prior speed `v` (floored at 0.1 m/s so the variance never
     /// vanishes).
-    pub fn steering_measurement(&self, steering_wheel_rad: f64, v_prior: f64, beta: f64) -> (f64, f64) {
+    pub fn steering_measurement(
+        &self,
+        steering_wheel_rad: f64,
+        v_prior: f64,
+        beta: f64,
+    ) -> (f64, f64) {
         let z = v_prior * (steering_wheel_rad / self.steering_ratio).tan();
         let r = (v_prior.abs().max(0.1) * beta).powi(2);
         (z, r)
@@ -165,7 +182,11 @@ mod tests {
             xp[j] += e;
             xm[j] -= e;
             let d = (f(&xp).0 - f(&xm).0) / (2.0 * e);
-            assert!((d - h[j]).abs() < 1e-6 * (1.0 + d.abs()), "column {j}: analytic {} vs numeric {d}", h[j]);
+            assert!(
+                (d - h[j]).abs() < 1e-6 * (1.0 + d.abs()),
+                "column {j}: analytic {} vs numeric {d}",
+                h[j]
+            );
         }
     }
 

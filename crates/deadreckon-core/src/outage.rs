@@ -71,15 +71,34 @@ pub struct OutageEvaluation {
 impl OutageEvaluation {
     /// Summary of the final errors, m.
     pub fn final_error(&self) -> Summary {
-        Summary::of(&self.windows.iter().map(|w| w.final_error_m).collect::<Vec<_>>())
+        Summary::of(
+            &self
+                .windows
+                .iter()
+                .map(|w| w.final_error_m)
+                .collect::<Vec<_>>(),
+        )
     }
     /// Summary of the drift per 100 m, % (windows that travelled at least 10 m).
     pub fn drift_pct(&self) -> Summary {
-        Summary::of(&self.windows.iter().filter(|w| w.distance_m >= 10.0).map(|w| 100.0 * w.final_error_m / w.distance_m).collect::<Vec<_>>())
+        Summary::of(
+            &self
+                .windows
+                .iter()
+                .filter(|w| w.distance_m >= 10.0)
+                .map(|w| 100.0 * w.final_error_m / w.distance_m)
+                .collect::<Vec<_>>(),
+        )
     }
     /// Summary of the distances before 1 m of error, m (censored windows included at their length).
     pub fn distance_to_1m(&self) -> Summary {
-        Summary::of(&self.windows.iter().map(|w| w.distance_to_1m_m).collect::<Vec<_>>())
+        Summary::of(
+            &self
+                .windows
+                .iter()
+                .map(|w| w.distance_to_1m_m)
+                .collect::<Vec<_>>(),
+        )
     }
 }
 
@@ -95,17 +114,40 @@ impl EpochHook for Collect {
 ///
 /// The first window starts `warmup_s` after the filter's start; windows start
 /// every `step_s` and must end before the last GNSS fix (and the truth's end).
-pub fn evaluate(drive: &Drive, params: &Params, outage_s: f64, step_s: f64, warmup_s: f64, base: &FilterOptions) -> Result<OutageEvaluation, Error> {
+pub fn evaluate(
+    drive: &Drive,
+    params: &Params,
+    outage_s: f64,
+    step_s: f64,
+    warmup_s: f64,
+    base: &FilterOptions,
+) -> Result<OutageEvaluation, Error> {
     if !(outage_s > 0.0 && step_s > 0.0) {
-        return Err(Error::InvalidParams("outage length and step must be positive".into()));
+        return Err(Error::InvalidParams(
+            "outage length and step must be positive".into(),
+        ));
     }
     let truth = Reference::from_truth(&drive.truth);
-    let reference = if truth.is_some() { ReferenceKind::Truth } else { ReferenceKind::Gnss };
+    let reference = if truth.is_some() {
+        ReferenceKind::Truth
+    } else {
+        ReferenceKind::Gnss
+    };
     if reference == ReferenceKind::Gnss && drive.gnss.len() < 2 {
-        return Err(Error::Insufficient("outage evaluation needs truth.csv or GNSS fixes".into()));
+        return Err(Error::Insufficient(
+            "outage evaluation needs truth.csv or GNSS fixes".into(),
+        ));
     }
     // The GNSS-aided filter gives the state at every window start.
-    let aided = ekf::run(drive, params, &FilterOptions { record_epochs: true, ..base.clone() }, &mut ())?;
+    let aided = ekf::run(
+        drive,
+        params,
+        &FilterOptions {
+            record_epochs: true,
+            ..base.clone()
+        },
+        &mut (),
+    )?;
     let (Some(first), Some(last_epoch)) = (aided.epochs.first(), aided.epochs.last()) else {
         return Err(Error::Insufficient("the filter produced no epochs".into()));
     };
@@ -123,7 +165,11 @@ pub fn evaluate(drive: &Drive, params: &Params, outage_s: f64, step_s: f64, warm
         let i = aided.epochs.partition_point(|e| e.t_s <= start);
         let e0 = &aided.epochs[i.saturating_sub(1)];
         let opts = FilterOptions {
-            init: Init::Given { t_s: e0.t_s, x: e0.x, p: e0.p },
+            init: Init::Given {
+                t_s: e0.t_s,
+                x: e0.x,
+                p: e0.p,
+            },
             sensors: SensorSet::dead_reckoning(),
             record_epochs: false,
             end_s: Some(end),
@@ -144,7 +190,10 @@ pub fn evaluate(drive: &Drive, params: &Params, outage_s: f64, step_s: f64, warm
                 }
             }
             _ => {
-                let traj = Reference::from_states(states.iter().map(|s| s.0).collect(), states.iter().map(|s| s.1).collect());
+                let traj = Reference::from_states(
+                    states.iter().map(|s| s.0).collect(),
+                    states.iter().map(|s| s.1).collect(),
+                );
                 for g in drive.gnss.iter().filter(|g| g.t_s > e0.t_s && g.t_s <= end) {
                     if let Some(x) = traj.state_at(g.t_s) {
                         let (ae, an) = (x[X] + lever * x[YAW].cos(), x[Y] + lever * x[YAW].sin());
@@ -157,7 +206,8 @@ pub fn evaluate(drive: &Drive, params: &Params, outage_s: f64, step_s: f64, warm
             // Distance along the dead-reckoned path.
             let mut dist = vec![0.0];
             for w in states.windows(2) {
-                let d = dist.last().copied().unwrap_or(0.0) + (w[1].1[X] - w[0].1[X]).hypot(w[1].1[Y] - w[0].1[Y]);
+                let d = dist.last().copied().unwrap_or(0.0)
+                    + (w[1].1[X] - w[0].1[X]).hypot(w[1].1[Y] - w[0].1[Y]);
                 dist.push(d);
             }
             let distance_m = dist.last().copied().unwrap_or(0.0);
@@ -180,7 +230,13 @@ pub fn evaluate(drive: &Drive, params: &Params, outage_s: f64, step_s: f64, warm
         start += step_s;
     }
     if windows.is_empty() {
-        return Err(Error::Insufficient(format!("the drive is too short for a {outage_s} s outage after {warmup_s} s of warm-up")));
+        return Err(Error::Insufficient(format!(
+            "the drive is too short for a {outage_s} s outage after {warmup_s} s of warm-up"
+        )));
     }
-    Ok(OutageEvaluation { outage_s, reference, windows })
+    Ok(OutageEvaluation {
+        outage_s,
+        reference,
+        windows,
+    })
 }

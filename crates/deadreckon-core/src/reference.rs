@@ -33,13 +33,25 @@ impl Reference {
             let v = if have_speed {
                 truth[i].speed_mps.unwrap_or(0.0)
             } else {
-                let (de, dn) = (truth[b].east_m - truth[a].east_m, truth[b].north_m - truth[a].north_m);
+                let (de, dn) = (
+                    truth[b].east_m - truth[a].east_m,
+                    truth[b].north_m - truth[a].north_m,
+                );
                 (de * yaw[i].cos() + dn * yaw[i].sin()) / dt
             };
             let w = (yaw[b] - yaw[a]) / dt;
-            x.push(State::from([truth[i].east_m, truth[i].north_m, yaw[i], v, w]));
+            x.push(State::from([
+                truth[i].east_m,
+                truth[i].north_m,
+                yaw[i],
+                v,
+                w,
+            ]));
         }
-        Some(Reference { t: truth.iter().map(|p| p.t_s).collect(), x })
+        Some(Reference {
+            t: truth.iter().map(|p| p.t_s).collect(),
+            x,
+        })
     }
 
     /// Builds a reference from states at times (e.g. smoothed epochs).
@@ -97,7 +109,13 @@ mod tests {
             .map(|i| {
                 let t = i as f64 * 0.01;
                 let a = w * t;
-                TruthPose { t_s: t, east_m: r * a.sin(), north_m: r * (1.0 - a.cos()), yaw_rad: crate::angle::wrap(a), speed_mps: None }
+                TruthPose {
+                    t_s: t,
+                    east_m: r * a.sin(),
+                    north_m: r * (1.0 - a.cos()),
+                    yaw_rad: crate::angle::wrap(a),
+                    speed_mps: None,
+                }
             })
             .collect();
         let rf = Reference::from_truth(&truth).unwrap();

@@ -22,11 +22,17 @@ pub struct Smoothed<const N: usize = 5> {
 
 /// One backward step: from the smoothed epoch k+1 and the filter's epochs k and
 /// k+1, the smoothed epoch k.
-pub fn step<const N: usize>(k: &Epoch<N>, k1: &Epoch<N>, s1: &Smoothed<N>) -> Result<Smoothed<N>, Error> {
+pub fn step<const N: usize>(
+    k: &Epoch<N>,
+    k1: &Epoch<N>,
+    s1: &Smoothed<N>,
+) -> Result<Smoothed<N>, Error> {
     // J_k = P_{k|k} F_{k+1}ᵀ P_{k+1|k}⁻¹   (22)
     // computed as the solution of P_{k+1|k} J_kᵀ = F_{k+1} P_{k|k} (P symmetric).
-    let chol = Cholesky::new(k1.p_pred)
-        .ok_or_else(|| Error::Numerical { t_s: k1.t_s, what: "predicted covariance is not positive definite".into() })?;
+    let chol = Cholesky::new(k1.p_pred).ok_or_else(|| Error::Numerical {
+        t_s: k1.t_s,
+        what: "predicted covariance is not positive definite".into(),
+    })?;
     let jt = chol.solve(&(k1.f * k.p));
     let j = jt.transpose();
     // x̂_{k|N} = x̂_{k|k} + J_k (x̂_{k+1|N} − x̂_{k+1|k})   (20)
@@ -39,7 +45,9 @@ pub fn step<const N: usize>(k: &Epoch<N>, k1: &Epoch<N>, s1: &Smoothed<N>) -> Re
 
 /// Smooths the states only (eq. 20, 22), skipping the covariance recursion (21):
 /// what the calibration's least squares needs, at about half the cost.
-pub fn smooth_states<const N: usize>(epochs: &[Epoch<N>]) -> Result<Vec<(f64, SVector<f64, N>)>, Error> {
+pub fn smooth_states<const N: usize>(
+    epochs: &[Epoch<N>],
+) -> Result<Vec<(f64, SVector<f64, N>)>, Error> {
     let n = epochs.len();
     let mut out = vec![(0.0, SVector::<f64, N>::zeros()); n];
     if n == 0 {
@@ -48,8 +56,10 @@ pub fn smooth_states<const N: usize>(epochs: &[Epoch<N>]) -> Result<Vec<(f64, SV
     out[n - 1] = (epochs[n - 1].t_s, epochs[n - 1].x);
     for k in (0..n - 1).rev() {
         let (e, e1) = (&epochs[k], &epochs[k + 1]);
-        let chol = Cholesky::new(e1.p_pred)
-            .ok_or_else(|| Error::Numerical { t_s: e1.t_s, what: "predicted covariance is not positive definite".into() })?;
+        let chol = Cholesky::new(e1.p_pred).ok_or_else(|| Error::Numerical {
+            t_s: e1.t_s,
+            what: "predicted covariance is not positive definite".into(),
+        })?;
         // Jᵀ = P_{k+1|k}⁻¹ F_{k+1} P_{k|k}; x̂_{k|N} = x̂_{k|k} + J (x̂_{k+1|N} − x̂_{k+1|k}).
         // J d = P F ᵀ P_pred⁻¹ d, so solve P_pred u = d and take P Fᵀ u (one vector solve).
         let u = chol.solve(&(out[k + 1].1 - e1.x_pred));
@@ -64,8 +74,19 @@ pub fn smooth<const N: usize>(epochs: &[Epoch<N>]) -> Result<Vec<Smoothed<N>>, E
     if n == 0 {
         return Ok(Vec::new());
     }
-    let mut out = vec![Smoothed { t_s: 0.0, x: SVector::zeros(), p: SMatrix::zeros() }; n];
-    out[n - 1] = Smoothed { t_s: epochs[n - 1].t_s, x: epochs[n - 1].x, p: epochs[n - 1].p };
+    let mut out = vec![
+        Smoothed {
+            t_s: 0.0,
+            x: SVector::zeros(),
+            p: SMatrix::zeros()
+        };
+        n
+    ];
+    out[n - 1] = Smoothed {
+        t_s: epochs[n - 1].t_s,
+        x: epochs[n - 1].x,
+        p: epochs[n - 1].p,
+    };
     for k in (0..n - 1).rev() {
         out[k] = step(&epochs[k], &epochs[k + 1], &out[k + 1])?;
     }

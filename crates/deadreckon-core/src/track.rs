@@ -73,11 +73,29 @@ impl TrackPoint {
 impl Track {
     /// The filtered states of a filter run.
     pub fn from_epochs(name: &str, epochs: &[crate::ekf::Epoch], origin: Option<Origin>) -> Track {
-        Track { name: name.into(), points: epochs.iter().map(|e| TrackPoint::from_state(e.t_s, &e.x, &e.p)).collect(), origin }
+        Track {
+            name: name.into(),
+            points: epochs
+                .iter()
+                .map(|e| TrackPoint::from_state(e.t_s, &e.x, &e.p))
+                .collect(),
+            origin,
+        }
     }
 
     /// The smoothed states of an RTS pass.
-    pub fn from_smoothed(name: &str, smoothed: &[crate::rts::Smoothed], origin: Option<Origin>) -> Track {
-        Track { name: name.into(), points: smoothed.iter().map(|s| TrackPoint::from_state(s.t_s, &s.x, &s.p)).collect(), origin }
+    pub fn from_smoothed(
+        name: &str,
+        smoothed: &[crate::rts::Smoothed],
+        origin: Option<Origin>,
+    ) -> Track {
+        Track {
+            name: name.into(),
+            points: smoothed
+                .iter()
+                .map(|s| TrackPoint::from_state(s.t_s, &s.x, &s.p))
+                .collect(),
+            origin,
+        }
     }
 }

@@ -118,14 +118,20 @@ impl Vehicle {
         ];
         for (k, v) in pos {
             if !(v.is_finite() && v > 0.0) {
-                return Err(Error::InvalidVehicle(format!("{k} must be a positive number, got {v}")));
+                return Err(Error::InvalidVehicle(format!(
+                    "{k} must be a positive number, got {v}"
+                )));
             }
         }
         if !self.gnss_lever_arm_m.is_finite() {
-            return Err(Error::InvalidVehicle("gnss_lever_arm_m must be finite".into()));
+            return Err(Error::InvalidVehicle(
+                "gnss_lever_arm_m must be finite".into(),
+            ));
         }
         if self.ticks_per_rev == 0 {
-            return Err(Error::InvalidVehicle("ticks_per_rev must be positive".into()));
+            return Err(Error::InvalidVehicle(
+                "ticks_per_rev must be positive".into(),
+            ));
         }
         let n = &self.noise;
         for (k, v) in [
@@ -142,7 +148,9 @@ impl Vehicle {
             ("noise.gnss_gate_chi2", n.gnss_gate_chi2),
         ] {
             if !(v.is_finite() && v > 0.0) {
-                return Err(Error::InvalidVehicle(format!("{k} must be a positive number, got {v}")));
+                return Err(Error::InvalidVehicle(format!(
+                    "{k} must be a positive number, got {v}"
+                )));
             }
         }
         Ok(())
@@ -184,7 +192,12 @@ impl Params {
 
     /// The four circumferences in the order FL, FR, RL, RR.
     pub fn circumferences(&self) -> [f64; 4] {
-        [self.circumference_fl_m, self.circumference_fr_m, self.circumference_rl_m, self.circumference_rr_m]
+        [
+            self.circumference_fl_m,
+            self.circumference_fr_m,
+            self.circumference_rl_m,
+            self.circumference_rr_m,
+        ]
     }
 
     /// Sets the four circumferences from the order FL, FR, RL, RR.
@@ -228,7 +241,10 @@ impl Params {
         let a = self.to_array();
         for (i, v) in a.iter().enumerate() {
             if !v.is_finite() || (i > 0 && *v <= 0.0) {
-                return Err(Error::InvalidParams(format!("{} = {v} is not valid", Params::NAMES[i])));
+                return Err(Error::InvalidParams(format!(
+                    "{} = {v} is not valid",
+                    Params::NAMES[i]
+                )));
             }
         }
         Ok(())

@@ -22,7 +22,13 @@ fn randn(rng: &mut Pcg64) -> f64 {
 }
 
 /// A textbook KF step with a vector measurement and an explicit S⁻¹.
-fn textbook_update(x: &mut V4, p: &mut M4, z: &SVector<f64, 3>, h: &SMatrix<f64, 3, 4>, r: &SMatrix<f64, 3, 3>) {
+fn textbook_update(
+    x: &mut V4,
+    p: &mut M4,
+    z: &SVector<f64, 3>,
+    h: &SMatrix<f64, 3, 4>,
+    r: &SMatrix<f64, 3, 3>,
+) {
     let s = h * *p * h.transpose() + r;
     let k = *p * h.transpose() * s.try_inverse().unwrap();
     *x += k * (z - h * *x);
@@ -34,7 +40,9 @@ fn textbook_update(x: &mut V4, p: &mut M4, z: &SVector<f64, 3>, h: &SMatrix<f64,
 fn sequential_scalar_updates_equal_the_textbook_filter_on_a_linear_model() {
     let mut rng = Pcg64::seed_from_u64(7);
     let dt = 0.1;
-    let f = M4::new(1.0, 0.0, dt, 0.0, 0.0, 1.0, 0.0, dt, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0);
+    let f = M4::new(
+        1.0, 0.0, dt, 0.0, 0.0, 1.0, 0.0, dt, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0,
+    );
     let q = M4::from_diagonal(&V4::new(1e-4, 1e-4, 1e-2, 1e-2));
     let h = SMatrix::<f64, 3, 4>::new(1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.3, -0.2, 1.0, 0.5);
     let rd = [0.25, 0.36, 0.04];
@@ -52,7 +60,16 @@ fn sequential_scalar_updates_equal_the_textbook_filter_on_a_linear_model() {
         for i in 0..3 {
             let row: V4 = h.row(i).transpose();
             let y = z[i] - row.dot(&xa);
-            kalman::update_scalar(&mut xa, &mut pa, y, &row, rd[i], CovarianceForm::Joseph, step as f64).unwrap();
+            kalman::update_scalar(
+                &mut xa,
+                &mut pa,
+                y,
+                &row,
+                rd[i],
+                CovarianceForm::Joseph,
+                step as f64,
+            )
+            .unwrap();
         }
         // Reference.
         xb = f * xb;
@@ -78,7 +95,10 @@ fn vector_update_equals_textbook_in_both_covariance_forms() {
         let (mut x, mut p) = (x0, p0);
         let y = z - h * x;
         kalman::update_vector(&mut x, &mut p, &y, &h, &r, form, 0.0).unwrap();
-        assert!((x - xr).amax() < 1e-12 && (p - pr).amax() < 1e-12, "{form:?}");
+        assert!(
+            (x - xr).amax() < 1e-12 && (p - pr).amax() < 1e-12,
+            "{form:?}"
+        );
     }
 }
 
@@ -90,10 +110,30 @@ fn ekf_run_equals_a_plain_kalman_filter_on_its_linear_substate() {
     let vehicle = Vehicle::paper_car();
     let mut drive = Drive::empty(vehicle.clone());
     let n = 3000;
-    drive.wheels = Wheels::Ticks((0..n).map(|k| WheelTicks { t_s: k as f64 * 0.02, fl: 0, fr: 0, rl: 0, rr: 0 }).collect());
+    drive.wheels = Wheels::Ticks(
+        (0..n)
+            .map(|k| WheelTicks {
+                t_s: k as f64 * 0.02,
+                fl: 0,
+                fr: 0,
+                rl: 0,
+                rr: 0,
+            })
+            .collect(),
+    );
     // Gyro and speed synchronous with the wheels (one reading per epoch, just before it).
-    drive.yaw_rate = (1..n).map(|k| Scalar { t_s: k as f64 * 0.02 - 0.001, value: 0.1 + 0.01 * randn(&mut rng) }).collect();
-    drive.speed = (1..n).map(|k| Scalar { t_s: k as f64 * 0.02 - 0.001, value: 8.0 + 0.1 * randn(&mut rng) }).collect();
+    drive.yaw_rate = (1..n)
+        .map(|k| Scalar {
+            t_s: k as f64 * 0.02 - 0.001,
+            value: 0.1 + 0.01 * randn(&mut rng),
+        })
+        .collect();
+    drive.speed = (1..n)
+        .map(|k| Scalar {
+            t_s: k as f64 * 0.02 - 0.001,
+            value: 8.0 + 0.1 * randn(&mut rng),
+        })
+        .collect();
     let mut params = Params::nominal(&vehicle);
     params.gyro_bias_rps = -0.003;
     params.speed_scale = 0.987;
@@ -101,8 +141,19 @@ fn ekf_run_equals_a_plain_kalman_filter_on_its_linear_substate() {
     let x0 = State::from([0.0, 0.0, 0.3, 0.0, 0.0]);
     let opts = FilterOptions {
         timing: Timing::WheelEpochs,
-        init: Init::Given { t_s: 0.0, x: x0, p: p0 },
-        sensors: SensorSet { wheels: false, gyro: true, speed: true, steering: false, gnss: false, gnss_course: false },
+        init: Init::Given {
+            t_s: 0.0,
+            x: x0,
+            p: p0,
+        },
+        sensors: SensorSet {
+            wheels: false,
+            gyro: true,
+            speed: true,
+            steering: false,
+            gnss: false,
+            gnss_course: false,
+        },
         ..Default::default()
     };
     let out = ekf::run(&drive, &params, &opts, &mut ()).unwrap();
@@ -111,11 +162,16 @@ fn ekf_run_equals_a_plain_kalman_filter_on_its_linear_substate() {
     let noise = vehicle.noise;
     let mut x = nalgebra::Vector2::new(0.0, 0.0);
     let mut p = nalgebra::Matrix2::new(4.0, 0.0, 0.0, 0.25);
-    let q = nalgebra::Matrix2::new(noise.process_speed_mps.powi(2), 0.0, 0.0, noise.process_yaw_rate_rps.powi(2));
+    let q = nalgebra::Matrix2::new(
+        noise.process_speed_mps.powi(2),
+        0.0,
+        0.0,
+        noise.process_yaw_rate_rps.powi(2),
+    );
     let mut max_diff: f64 = 0.0;
     for k in 1..n {
         p += q; // dt = 0.02 = the reference step
-        // gyro: z = ψ̇ + b
+                // gyro: z = ψ̇ + b
         let h = nalgebra::RowVector2::new(0.0, 1.0);
         let s = (h * p * h.transpose())[(0, 0)] + noise.gyro_rps.powi(2);
         let kk = p * h.transpose() / s;
@@ -150,7 +206,13 @@ fn rts_equals_batch_least_squares_on_a_linear_model() {
     // Use the car model with yaw and yaw rate fixed at 0 and only speed/position
     // observed: x_{k+1} = x_k + dt v_k is linear.
     let f = model::jacobian(&State::from([0.0, 0.0, 0.0, 5.0, 0.0]), dt);
-    let noise = deadreckon_core::vehicle::Noise { process_xy_m: 0.05, process_yaw_rad: 0.01, process_speed_mps: 0.5, process_yaw_rate_rps: 0.1, ..Default::default() };
+    let noise = deadreckon_core::vehicle::Noise {
+        process_xy_m: 0.05,
+        process_yaw_rad: 0.01,
+        process_speed_mps: 0.5,
+        process_yaw_rate_rps: 0.1,
+        ..Default::default()
+    };
     let q = model::process_noise(&noise, dt);
     let h = SMatrix::<f64, 3, 5>::new(
         1.0, 0.0, 0.0, 0.0, 0.0, //
@@ -160,21 +222,49 @@ fn rts_equals_batch_least_squares_on_a_linear_model() {
     let rd = [0.3f64, 0.1, 0.01];
     let x0 = State::from([0.0, 0.0, 0.0, 5.0, 0.0]);
     let p0 = Mat::from_diagonal(&State::from([1.0, 1.0, 0.1, 1.0, 0.1]));
-    let zs: Vec<SVector<f64, 3>> = (0..n).map(|k| SVector::<f64, 3>::new(5.0 * dt * k as f64 + rd[0] * randn(&mut rng), 5.0 + rd[1] * randn(&mut rng), rd[2] * randn(&mut rng))).collect();
+    let zs: Vec<SVector<f64, 3>> = (0..n)
+        .map(|k| {
+            SVector::<f64, 3>::new(
+                5.0 * dt * k as f64 + rd[0] * randn(&mut rng),
+                5.0 + rd[1] * randn(&mut rng),
+                rd[2] * randn(&mut rng),
+            )
+        })
+        .collect();
 
     // Filter, recording epochs as the EKF does (epoch 0 is the prior).
     let mut epochs = Vec::new();
     let (mut x, mut p) = (x0, p0);
     for (k, z) in zs.iter().enumerate() {
-        let (xp, pp) = if k == 0 { (x, p) } else { (f * x, kalman::predict_covariance(&p, &f, &q)) };
+        let (xp, pp) = if k == 0 {
+            (x, p)
+        } else {
+            (f * x, kalman::predict_covariance(&p, &f, &q))
+        };
         x = xp;
         p = pp;
         for i in 0..3 {
             let row: State = h.row(i).transpose();
             let y = z[i] - row.dot(&x);
-            kalman::update_scalar(&mut x, &mut p, y, &row, rd[i] * rd[i], CovarianceForm::Joseph, 0.0).unwrap();
+            kalman::update_scalar(
+                &mut x,
+                &mut p,
+                y,
+                &row,
+                rd[i] * rd[i],
+                CovarianceForm::Joseph,
+                0.0,
+            )
+            .unwrap();
         }
-        epochs.push(ekf::Epoch { t_s: k as f64 * dt, x_pred: xp, p_pred: pp, f, x, p });
+        epochs.push(ekf::Epoch {
+            t_s: k as f64 * dt,
+            x_pred: xp,
+            p_pred: pp,
+            f,
+            x,
+            p,
+        });
     }
     let sm = rts::smooth(&epochs).unwrap();
 
@@ -185,7 +275,8 @@ fn rts_equals_batch_least_squares_on_a_linear_model() {
     let mut vec = DVector::<f64>::zeros(dim);
     let p0i = p0.try_inverse().unwrap();
     let qi = q.try_inverse().unwrap();
-    let ri = SMatrix::<f64, 3, 3>::from_diagonal(&SVector::<f64, 3>::from(rd.map(|r| 1.0 / (r * r))));
+    let ri =
+        SMatrix::<f64, 3, 3>::from_diagonal(&SVector::<f64, 3>::from(rd.map(|r| 1.0 / (r * r))));
     let add = |info: &mut DMatrix<f64>, r0: usize, c0: usize, m: &Mat| {
         for i in 0..5 {
             for j in 0..5 {
@@ -226,9 +317,15 @@ fn rts_equals_batch_least_squares_on_a_linear_model() {
         // Smoothed covariance never exceeds the filtered one.
         let d = epochs[k].p - sm[k].p;
         let min_eig = d.symmetric_eigen().eigenvalues.min();
-        assert!(min_eig > -1e-12, "epoch {k}: P_filt − P_smooth has eigenvalue {min_eig:e}");
+        assert!(
+            min_eig > -1e-12,
+            "epoch {k}: P_filt − P_smooth has eigenvalue {min_eig:e}"
+        );
     }
-    assert!(max_x < 1e-8 && max_p < 1e-8, "state diff {max_x:e}, covariance diff {max_p:e}");
+    assert!(
+        max_x < 1e-8 && max_p < 1e-8,
+        "state diff {max_x:e}, covariance diff {max_p:e}"
+    );
 }
 
 #[test]
@@ -237,11 +334,42 @@ fn state_only_smoothing_equals_the_full_smoother() {
     let mut rng = Pcg64::seed_from_u64(21);
     let mut drive = Drive::empty(vehicle.clone());
     let n = 500;
-    drive.wheels = Wheels::Ticks((0..n).map(|k| WheelTicks { t_s: k as f64 * 0.02, fl: 4, fr: 4, rl: 4, rr: 5 }).collect());
-    drive.yaw_rate = (1..n).map(|k| Scalar { t_s: k as f64 * 0.02 - 0.003, value: 0.02 + 0.003 * randn(&mut rng) }).collect();
-    drive.gnss = (1..n / 25).map(|k| deadreckon_core::drive::GnssFix { t_s: k as f64 * 0.5 + 0.001, east_m: 4.0 * k as f64 + 0.5 * randn(&mut rng), north_m: 0.5 * randn(&mut rng), std_m: 0.5, course_deg: None, speed_mps: None }).collect();
+    drive.wheels = Wheels::Ticks(
+        (0..n)
+            .map(|k| WheelTicks {
+                t_s: k as f64 * 0.02,
+                fl: 4,
+                fr: 4,
+                rl: 4,
+                rr: 5,
+            })
+            .collect(),
+    );
+    drive.yaw_rate = (1..n)
+        .map(|k| Scalar {
+            t_s: k as f64 * 0.02 - 0.003,
+            value: 0.02 + 0.003 * randn(&mut rng),
+        })
+        .collect();
+    drive.gnss = (1..n / 25)
+        .map(|k| deadreckon_core::drive::GnssFix {
+            t_s: k as f64 * 0.5 + 0.001,
+            east_m: 4.0 * k as f64 + 0.5 * randn(&mut rng),
+            north_m: 0.5 * randn(&mut rng),
+            std_m: 0.5,
+            course_deg: None,
+            speed_mps: None,
+        })
+        .collect();
     let p0 = Mat::from_diagonal(&State::from([1.0, 1.0, 0.1, 4.0, 0.25]));
-    let opts = FilterOptions { init: Init::Given { t_s: 0.0, x: State::from([0.0, 0.0, 0.0, 8.0, 0.0]), p: p0 }, ..Default::default() };
+    let opts = FilterOptions {
+        init: Init::Given {
+            t_s: 0.0,
+            x: State::from([0.0, 0.0, 0.0, 8.0, 0.0]),
+            p: p0,
+        },
+        ..Default::default()
+    };
     let params = Params::nominal(&vehicle);
     let out = ekf::run(&drive, &params, &opts, &mut ()).unwrap();
     let full = rts::smooth(&out.epochs).unwrap();
