@@ -12,6 +12,9 @@ struct Cli {
     /// No progress display.
     #[arg(long, global = true)]
     quiet: bool,
+    /// Topic-to-stream mapping (TOML) for ROS bags and MCAP files (default: built-in Husky/Jackal).
+    #[arg(long, global = true)]
+    mapping: Option<std::path::PathBuf>,
     #[command(subcommand)]
     command: Command,
 }
@@ -46,6 +49,9 @@ fn main() {
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
+    if let Some(m) = &cli.mapping {
+        let _ = cmd::ROS_MAPPING.set(m.clone());
+    }
     match cli.command {
         Command::Simulate(a) => cmd::simulate::run(a),
         Command::Calibrate(a) => cmd::calibrate::run(a),

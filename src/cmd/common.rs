@@ -7,9 +7,27 @@ use deadreckon_core::calibrate::Calibration;
 use deadreckon_core::ekf::Timing;
 use deadreckon_core::{Drive, Params, ParamsWithStd};
 
-/// Reads a drive directory.
-pub fn load_drive(dir: &Path) -> Result<Drive> {
-    deadreckon_io::read_drive(dir).with_context(|| format!("reading drive {}", dir.display()))
+/// Reads a drive from a drive directory or, directly, from a recording that a
+/// reader understands: a comma2k19 segment directory, a ROS1 `.bag`, a ROS2
+/// `.mcap` (with the built-in mapping) or a tricycle `dataset.txt`.
+pub fn load_drive(path: &Path) -> Result<Drive> {
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+    if path.is_dir() && !path.join("vehicle.toml").exists() && path.join("processed_log").is_dir() {
+        return deadreckon_import::read_comma2k19(path, None).with_context(|| format!("reading comma2k19 segment {}", path.display()));
+    }
+    if path.is_file() {
+        match ext {
+            "bag" | "mcap" => return super::load_ros(path),
+            "txt" => {
+                let o = deadreckon_import::tricycle::TricycleOptions::default();
+                return Ok(deadreckon_import::tricycle::read_tricycle(path, &o)
+                    .with_context(|| format!("reading tricycle log {}", path.display()))?
+                    .drive);
+            }
+            _ => anyhow::bail!("{}: not a drive directory and not a recording this tool reads (.bag, .mcap, comma2k19 segment, tricycle .txt)", path.display()),
+        }
+    }
+    deadreckon_io::read_drive(path).with_context(|| format!("reading drive {}", path.display()))
 }
 
 /// `--params nominal` or a `params.toml` path.
@@ -91,7 +109,7 @@ pub fn calibration_json(method: &str, c: &Calibration) -> serde_json::Value {
     if let Some(st) = &c.filter_stats {
         m.insert(
             "gnss".into(),
-            serde_json::json!({"used": st.gnss_updates, "rejected": st.gnss_rejected, "hidden": st.gnss_hidden}),
+            serde_json::json!({"used": st.gnss_updates, "rejected": st.gnss_rejected, "recoveries": st.gnss_recoveries, "hidden": st.gnss_hidden}),
         );
         m.insert("wheel_gaps".into(), st.wheel_gaps.into());
     }
@@ -101,7 +119,7 @@ pub fn calibration_json(method: &str, c: &Calibration) -> serde_json::Value {
 /// A one-line account of what the filter used and gated.
 pub fn stats_line(st: &deadreckon_core::ekf::FilterStats) -> String {
     format!(
-        "filter: {} epochs, GNSS {} used / {} rejected by the gate / {} hidden, {} wheel gaps skipped",
-        st.epochs, st.gnss_updates, st.gnss_rejected, st.gnss_hidden, st.wheel_gaps
+        "filter: {} epochs, GNSS {} used / {} rejected by the gate ({} recoveries after {} consecutive rejections) / {} hidden, {} wheel gaps skipped",
+        st.epochs, st.gnss_updates, st.gnss_rejected, st.gnss_recoveries, 10, st.gnss_hidden, st.wheel_gaps
     )
 }

@@ -145,7 +145,11 @@ pub fn run(a: ImportArgs) -> Result<()> {
             let i = deadreckon_import::tricycle::read_tricycle(&a.source, &o)?;
             (i.drive, i.report.to_string())
         }
-        other => bail!("unknown import format `{other}` (comma2k19, can, tricycle)"),
+        "rosbag" | "mcap" => {
+            let drive = super::load_ros(&a.source)?;
+            (drive, String::new())
+        }
+        other => bail!("unknown import format `{other}` (comma2k19, can, tricycle, rosbag, mcap)"),
     };
     write_new_or_update(&a.out, &drive)?;
     print!("{report}");

@@ -10,13 +10,28 @@ pub mod run;
 pub mod simulate;
 pub mod tedris;
 
-/// Writes tracks as MCAP with Foxglove schemas.
-pub fn write_mcap(
-    path: &std::path::Path,
-    _tracks: &[deadreckon_core::Track],
-) -> anyhow::Result<()> {
-    anyhow::bail!(
-        "MCAP output is not available in this build ({})",
-        path.display()
-    )
+/// Writes tracks as MCAP with Foxglove schemas (`foxglove.PoseInFrame`,
+/// `foxglove.LocationFix` where the drive has a geodetic origin).
+pub fn write_mcap(path: &std::path::Path, tracks: &[deadreckon_core::Track]) -> anyhow::Result<()> {
+    deadreckon_ros::write_tracks_mcap(path, tracks)?;
+    Ok(())
+}
+
+/// The `--mapping` file given on the command line, for ROS recordings.
+pub static ROS_MAPPING: std::sync::OnceLock<std::path::PathBuf> = std::sync::OnceLock::new();
+
+/// Reads a ROS1 bag or ROS2 MCAP recording with the `--mapping` file, or the
+/// built-in mapping (Husky, or Jackal when the file name says so).
+pub fn load_ros(path: &std::path::Path) -> anyhow::Result<deadreckon_core::Drive> {
+    use anyhow::Context;
+    let mapping = match ROS_MAPPING.get() {
+        Some(m) => {
+            let text = std::fs::read_to_string(m).with_context(|| format!("reading mapping {}", m.display()))?;
+            deadreckon_ros::Mapping::from_toml_str(&text).with_context(|| format!("mapping {}", m.display()))?
+        }
+        None if path.file_name().is_some_and(|n| n.to_string_lossy().contains("jackal")) => deadreckon_ros::Mapping::jackal(),
+        None => deadreckon_ros::Mapping::husky(),
+    };
+    let (drive, _report) = deadreckon_ros::read_log(path, &mapping).with_context(|| format!("reading {}", path.display()))?;
+    Ok(drive)
 }

@@ -231,6 +231,9 @@ pub struct FilterStats {
     pub gnss_updates: usize,
     /// GNSS fixes rejected by the Mahalanobis gate.
     pub gnss_rejected: usize,
+    /// Fixes accepted after `gnss_max_rejections` consecutive rejections, with the
+    /// position covariance inflated (the filter had lost the GNSS track).
+    pub gnss_recoveries: usize,
     /// GNSS fixes hidden by an outage window.
     pub gnss_hidden: usize,
     /// GNSS course readings used.
@@ -290,6 +293,7 @@ struct Filter<'a, const N: usize> {
     t: f64,
     opts: &'a FilterOptions,
     out: FilterOutput<N>,
+    consecutive_rejections: u32,
 }
 
 impl<const N: usize> Filter<'_, N> {
@@ -427,8 +431,21 @@ impl<const N: usize> Filter<'_, N> {
         jac.fixed_view_mut::<2, 5>(0, 0).copy_from(&jac5);
         let y = Vector2::new(fix.east_m, fix.north_m) - h;
         let r = Matrix2::identity() * fix.std_m.powi(2);
-        let (s, _, nis) = kalman::innovation_stats(&self.p, &y, &jac, &r, self.t)?;
-        let accepted = nis <= self.noise.gnss_gate_chi2;
+        let (mut s, _, mut nis) = kalman::innovation_stats(&self.p, &y, &jac, &r, self.t)?;
+        let mut accepted = nis <= self.noise.gnss_gate_chi2;
+        if !accepted && self.consecutive_rejections >= self.noise.gnss_max_rejections {
+            // Lost: widen the position (and yaw) uncertainty to cover the
+            // innovation, then take the fix.
+            let d2 = y.norm_squared();
+            for i in [model::X, model::Y] {
+                self.p[(i, i)] += d2;
+            }
+            self.p[(model::YAW, model::YAW)] += 0.1f64.powi(2);
+            (s, _, nis) = kalman::innovation_stats(&self.p, &y, &jac, &r, self.t)?;
+            accepted = true;
+            self.out.stats.gnss_recoveries += 1;
+        }
+        self.consecutive_rejections = if accepted { 0 } else { self.consecutive_rejections + 1 };
         if accepted {
             kalman::update_vector(&mut self.x, &mut self.p, &y, &jac, &r, self.form, self.t)?;
             self.refresh_params();
@@ -640,6 +657,7 @@ fn run_generic<const N: usize>(
         t: t0,
         opts,
         out: FilterOutput::default(),
+        consecutive_rejections: 0,
     };
     let wheels = &drive.wheels;
     let max_interval = 5.0 * median_interval(wheels);

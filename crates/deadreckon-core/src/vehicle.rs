@@ -44,6 +44,12 @@ pub struct Noise {
     /// Mahalanobis gate for GNSS fixes: the chi-square (2 degrees of freedom) value
     /// above which a fix is rejected and counted (default 13.82, p = 0.001).
     pub gnss_gate_chi2: f64,
+    /// After this many consecutive gated fixes the filter takes itself to be
+    /// lost (its position no longer agrees with GNSS beyond its own covariance,
+    /// which tiny position process noise cannot widen): the next fix is accepted
+    /// after inflating the position covariance by the innovation, and counted
+    /// as a recovery (default 10).
+    pub gnss_max_rejections: u32,
 }
 
 impl Default for Noise {
@@ -60,6 +66,7 @@ impl Default for Noise {
             wheel_speed_mps: 0.05,
             steering: 0.02,
             gnss_gate_chi2: 13.815510557964274,
+            gnss_max_rejections: 10,
         }
     }
 }
