@@ -187,7 +187,8 @@ fn malformed_drives_are_reported_with_file_line_and_column() {
     simulate(&dir, "evaluation", 3);
     let yaw = dir.join("yaw_rate.csv");
     let original = std::fs::read_to_string(&yaw).unwrap();
-    let cases: [(&str, Box<dyn Fn(&str) -> String>); 4] = [
+    type Corrupt = Box<dyn Fn(&str) -> String>;
+    let cases: [(&str, Corrupt); 4] = [
         (
             "bad number",
             Box::new(|s: &str| s.replacen("\n0.", "\nzero.", 1)),
@@ -378,7 +379,10 @@ fn comma2k19_import_calibrate_evaluate_report() {
     check_in_chromium(&html, 15);
 }
 
-const HUSKY: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/husky-gps-bag/husky_gps.bag");
+const HUSKY: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../shared/data/husky-gps-bag/husky_gps.bag"
+);
 
 /// The Husky bag is read directly by every command (no conversion step), and
 /// dead-reckons through 30 s outages against the hidden GNSS fixes.
@@ -386,21 +390,49 @@ const HUSKY: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/husky-g
 fn husky_bag_read_directly_through_30_s_outages() {
     let tmp = tempfile::tempdir().unwrap();
     let params = tmp.path().join("husky.toml");
-    let c = json(&run_ok(&["calibrate", HUSKY, "--min-speed", "0.5", "--json", "--out", params.to_str().unwrap()]));
+    let c = json(&run_ok(&[
+        "calibrate",
+        HUSKY,
+        "--min-speed",
+        "0.5",
+        "--json",
+        "--out",
+        params.to_str().unwrap(),
+    ]));
     // The SBAS fixes wander: most are used, the gate rejects some, and the filter
     // recovers instead of locking itself out.
     let used = c["gnss"]["used"].as_u64().unwrap();
     let rejected = c["gnss"]["rejected"].as_u64().unwrap();
     assert!(used > 8 * rejected, "{c}");
-    let o = json(&run_ok(&["evaluate", HUSKY, "--params", params.to_str().unwrap(), "--outage", "30", "--step", "10", "--json"]));
+    let o = json(&run_ok(&[
+        "evaluate",
+        HUSKY,
+        "--params",
+        params.to_str().unwrap(),
+        "--outage",
+        "30",
+        "--step",
+        "10",
+        "--json",
+    ]));
     eprintln!("husky 30 s outages: {o}");
     assert_eq!(o["reference"], "gnss");
     assert!(o["windows"].as_u64().unwrap() >= 30, "{o}");
     let fe = &o["final_error_m"];
-    assert!(fe["mean"].as_f64().unwrap() < 6.0 && fe["max"].as_f64().unwrap() < 20.0, "{o}");
+    assert!(
+        fe["mean"].as_f64().unwrap() < 6.0 && fe["max"].as_f64().unwrap() < 20.0,
+        "{o}"
+    );
     // And written out for Foxglove.
     let mcap = tmp.path().join("husky.mcap");
-    run_ok(&["run", HUSKY, "--params", params.to_str().unwrap(), "--out", mcap.to_str().unwrap()]);
+    run_ok(&[
+        "run",
+        HUSKY,
+        "--params",
+        params.to_str().unwrap(),
+        "--out",
+        mcap.to_str().unwrap(),
+    ]);
     let bytes = std::fs::read(&mcap).unwrap();
     assert!(bytes.starts_with(b"\x89MCAP0\r\n"), "not an MCAP file");
 }

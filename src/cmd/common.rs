@@ -13,7 +13,8 @@ use deadreckon_core::{Drive, Params, ParamsWithStd};
 pub fn load_drive(path: &Path) -> Result<Drive> {
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
     if path.is_dir() && !path.join("vehicle.toml").exists() && path.join("processed_log").is_dir() {
-        return deadreckon_import::read_comma2k19(path, None).with_context(|| format!("reading comma2k19 segment {}", path.display()));
+        return deadreckon_import::read_comma2k19(path, None)
+            .with_context(|| format!("reading comma2k19 segment {}", path.display()));
     }
     if path.is_file() {
         match ext {

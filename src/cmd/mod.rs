@@ -26,12 +26,20 @@ pub fn load_ros(path: &std::path::Path) -> anyhow::Result<deadreckon_core::Drive
     use anyhow::Context;
     let mapping = match ROS_MAPPING.get() {
         Some(m) => {
-            let text = std::fs::read_to_string(m).with_context(|| format!("reading mapping {}", m.display()))?;
-            deadreckon_ros::Mapping::from_toml_str(&text).with_context(|| format!("mapping {}", m.display()))?
+            let text = std::fs::read_to_string(m)
+                .with_context(|| format!("reading mapping {}", m.display()))?;
+            deadreckon_ros::Mapping::from_toml_str(&text)
+                .with_context(|| format!("mapping {}", m.display()))?
         }
-        None if path.file_name().is_some_and(|n| n.to_string_lossy().contains("jackal")) => deadreckon_ros::Mapping::jackal(),
+        None if path
+            .file_name()
+            .is_some_and(|n| n.to_string_lossy().contains("jackal")) =>
+        {
+            deadreckon_ros::Mapping::jackal()
+        }
         None => deadreckon_ros::Mapping::husky(),
     };
-    let (drive, _report) = deadreckon_ros::read_log(path, &mapping).with_context(|| format!("reading {}", path.display()))?;
+    let (drive, _report) = deadreckon_ros::read_log(path, &mapping)
+        .with_context(|| format!("reading {}", path.display()))?;
     Ok(drive)
 }

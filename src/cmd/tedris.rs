@@ -1,17 +1,364 @@
-//! `deadreckon tedris ...` (owned by the TedriS work; placeholder until it lands).
-use clap::Subcommand;
+//! `deadreckon tedris train|run`: TedriS over a drive directory (the library is
+//! `deadreckon-tedris`; this file parses, calls and prints).
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Context, Result};
+use clap::{Subcommand, ValueEnum};
+use deadreckon_tedris::{
+    run_outages_with, train, ModelChoice, ModelKind, Outage, ReferenceSource, RepositoryFit,
+    RunOptions, TedrisConfig, TedrisModel,
+};
+
+/// The reference heading the model learns from.
+#[derive(ValueEnum, Clone, Copy, Debug)]
+pub enum Reference {
+    /// GNSS course if the receiver gives one, else the course from successive fixes, else the gyro.
+    Auto,
+    /// The receiver's course over ground (`course_deg`).
+    Course,
+    /// The direction between successive GNSS fixes.
+    Track,
+    /// The integrated gyro (the paper's robot).
+    Gyro,
+}
+
+impl Reference {
+    fn source(self) -> Option<ReferenceSource> {
+        match self {
+            Reference::Auto => None,
+            Reference::Course => Some(ReferenceSource::GnssCourse),
+            Reference::Track => Some(ReferenceSource::GnssTrack),
+            Reference::Gyro => Some(ReferenceSource::Gyro),
+        }
+    }
+}
+
+/// The regression.
+#[derive(ValueEnum, Clone, Copy, Debug)]
+pub enum Kind {
+    /// Chosen by the residual statistics (smallest BIC with white final innovations).
+    Auto,
+    /// The paper's γ = α0 + α1·ω.
+    Paper,
+    /// γ = α0 + α1·ω + α2·d (travelled distance per sample).
+    Distance,
+    /// ARX(1,1) over consecutive blocks.
+    Arx,
+}
 
 /// TedriS subcommands.
 #[derive(Subcommand, Debug)]
 pub enum TedrisCommand {
-    /// Train a model on a drive.
+    /// Train a model on a drive (GNSS good throughout) and print the regression
+    /// table, lag, µ, W_L, W_H, ε and the repository fill.
     Train {
         /// The drive directory.
-        dir: std::path::PathBuf,
+        dir: PathBuf,
+        /// Where to write the model (JSON).
+        #[arg(long)]
+        out: PathBuf,
+        /// Reference heading.
+        #[arg(long, value_enum, default_value = "auto")]
+        reference: Reference,
+        /// Regression kind.
+        #[arg(long, value_enum, default_value = "auto")]
+        model: Kind,
+        /// τ, samples per block.
+        #[arg(long)]
+        tau: Option<usize>,
+        /// k of ε = k·(W_H − W_L); `inf` for one repository (the paper's robot).
+        #[arg(long)]
+        epsilon_k: Option<String>,
+        /// Fit each repository separately, as in the paper (default: pooled slopes).
+        #[arg(long)]
+        separate_repositories: bool,
+        /// A TedriS configuration (JSON; missing keys take their defaults).
+        #[arg(long)]
+        config: Option<PathBuf>,
+        /// Print JSON instead of tables.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Blank GNSS in the outage windows, predict through them, write the track and
+    /// report the error over each outage.
+    Run {
+        /// The drive directory.
+        dir: PathBuf,
+        /// The trained model.
+        #[arg(long)]
+        model: PathBuf,
+        /// An outage window `START_S:END_S` (drive clock); repeatable.
+        #[arg(long = "outage", required = true)]
+        outages: Vec<String>,
+        /// Where to write the track (CSV).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Reference heading.
+        #[arg(long, value_enum, default_value = "auto")]
+        reference: Reference,
+        /// The error threshold reported as `time_to_threshold_s`, m.
+        #[arg(long, default_value_t = 1.0)]
+        threshold_m: f64,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
     },
 }
 
 /// Runs a TedriS subcommand.
-pub fn run(_c: TedrisCommand) -> anyhow::Result<()> {
-    anyhow::bail!("tedris is not available yet")
+pub fn run(c: TedrisCommand) -> Result<()> {
+    match c {
+        TedrisCommand::Train {
+            dir,
+            out,
+            reference,
+            model,
+            tau,
+            epsilon_k,
+            separate_repositories,
+            config,
+            json,
+        } => {
+            let mut cfg = match &config {
+                Some(p) => {
+                    let text = std::fs::read_to_string(p)
+                        .with_context(|| format!("reading {}", p.display()))?;
+                    serde_json::from_str::<TedrisConfig>(&text)
+                        .with_context(|| format!("parsing {}", p.display()))?
+                }
+                None if matches!(reference, Reference::Gyro) => TedrisConfig::robot(),
+                None => TedrisConfig::default(),
+            };
+            cfg.model = match model {
+                Kind::Auto => cfg.model,
+                Kind::Paper => ModelChoice::Fixed(ModelKind::Paper),
+                Kind::Distance => ModelChoice::Fixed(ModelKind::Distance),
+                Kind::Arx => ModelChoice::Fixed(ModelKind::Arx),
+            };
+            if let Some(t) = tau {
+                cfg.tau_samples = t;
+            }
+            if let Some(k) = epsilon_k {
+                cfg.epsilon_factor = if k == "inf" {
+                    None
+                } else {
+                    Some(
+                        k.parse()
+                            .with_context(|| format!("--epsilon-k {k} is not a number or inf"))?,
+                    )
+                };
+            }
+            if separate_repositories {
+                cfg.repository_fit = RepositoryFit::Separate;
+            }
+            cfg.validate()?;
+            let drive = super::common::load_drive(&dir)?;
+            let (m, source) = train(&drive, cfg, reference.source())?;
+            let text = serde_json::to_string_pretty(&m)?;
+            std::fs::write(&out, text).with_context(|| format!("writing {}", out.display()))?;
+            if json {
+                println!("{}", serde_json::to_string_pretty(&train_json(&m, source))?);
+            } else {
+                print_train(&m, source);
+                println!("model written to {}", out.display());
+            }
+            Ok(())
+        }
+        TedrisCommand::Run {
+            dir,
+            model,
+            outages,
+            out,
+            reference,
+            threshold_m,
+            json,
+        } => {
+            let text = std::fs::read_to_string(&model)
+                .with_context(|| format!("reading {}", model.display()))?;
+            let m: TedrisModel = serde_json::from_str(&text)
+                .with_context(|| format!("parsing the model {}", model.display()))?;
+            m.validate()?;
+            let outages: Vec<Outage> = outages
+                .iter()
+                .map(|s| s.parse())
+                .collect::<Result<_, _>>()?;
+            if !(threshold_m.is_finite() && threshold_m > 0.0) {
+                bail!("--threshold-m must be a positive number");
+            }
+            let drive = super::common::load_drive(&dir)?;
+            let opts = RunOptions {
+                source: reference.source(),
+                threshold_m: Some(threshold_m),
+            };
+            let r = run_outages_with(&drive, &m, &outages, &opts)?;
+            if let Some(p) = &out {
+                deadreckon_io::write_track_csv(p, std::slice::from_ref(&r.track))
+                    .with_context(|| format!("writing {}", p.display()))?;
+            }
+            if json {
+                let v = serde_json::json!({
+                    "outages": r.outages,
+                    "reference": r.reference,
+                    "source": r.source,
+                    "model": m.chosen.name(),
+                    "track": out.as_ref().map(|p| p.display().to_string()),
+                });
+                println!("{}", serde_json::to_string_pretty(&v)?);
+            } else {
+                println!(
+                    "reference heading: {:?}; errors against {}",
+                    r.source, r.reference
+                );
+                println!(
+                    "{:>9} {:>9} {:>10} {:>9} {:>10} {:>12} {:>12}",
+                    "start_s",
+                    "end_s",
+                    "mean_m",
+                    "max_m",
+                    "final_m",
+                    "to_1m_s",
+                    format!("to_{threshold_m}m_s")
+                );
+                let opt = |v: Option<f64>| v.map_or("never".to_string(), |x| format!("{x:.1}"));
+                for o in &r.outages {
+                    println!(
+                        "{:>9.1} {:>9.1} {:>10.2} {:>9.2} {:>10.2} {:>12} {:>12}",
+                        o.start_s,
+                        o.end_s,
+                        o.mean_error_m,
+                        o.max_error_m,
+                        o.final_error_m,
+                        opt(o.time_to_1m_s),
+                        opt(o.time_to_threshold_s)
+                    );
+                }
+                if let Some(p) = &out {
+                    println!("track written to {}", p.display());
+                }
+            }
+            Ok(())
+        }
+    }
+}
+
+fn train_json(m: &TedrisModel, source: ReferenceSource) -> serde_json::Value {
+    let s = m.straight();
+    serde_json::json!({
+        "source": source,
+        "chosen": m.chosen.name(),
+        "lag_samples": m.lag_samples,
+        "tau_samples": m.config.tau_samples,
+        "sample_period_s": m.sample_period_s,
+        "mu_m": s.mu_m,
+        "w_low_m": s.w_low_m,
+        "w_high_m": s.w_high_m,
+        "epsilon_m": s.epsilon_m,
+        "dcf0_rad": m.dcf0_rad,
+        "dcf_rad": m.dcf_rad,
+        "turn_gain": m.turn_gain,
+        "complete": m.complete,
+        "fill": m.repositories.fill(m.config.required_bins),
+        "fits": m.fits,
+    })
+}
+
+fn print_train(m: &TedrisModel, source: ReferenceSource) {
+    let s = m.straight();
+    println!("reference heading: {source:?}");
+    println!(
+        "tau = {} samples, sample period {:.4} s, lag h = {} samples (peak corr {:.3})",
+        m.config.tau_samples,
+        m.sample_period_s,
+        m.lag_samples,
+        m.ccf
+            .values
+            .iter()
+            .copied()
+            .fold(f64::NEG_INFINITY, f64::max)
+    );
+    let eps = s.epsilon_m.map_or("inf".to_string(), |e| format!("{e:.6}"));
+    println!(
+        "straight line ({} blocks{}): mu = {:.6} m, W_L = {:.6} m, W_H = {:.6} m, epsilon = {} m (per wheel sample)",
+        s.blocks,
+        if s.fallback { ", quietest blocks" } else { "" },
+        s.mu_m,
+        s.w_low_m,
+        s.w_high_m,
+        eps
+    );
+    println!(
+        "DCF0 = {:.3e} rad/sample, DCF = {:.3e} rad/sample, turn gain = {:.4}",
+        m.dcf0_rad, m.dcf_rad, m.turn_gain
+    );
+    for f in &m.fits {
+        let mark = if f.kind == m.chosen {
+            "  <- chosen"
+        } else {
+            ""
+        };
+        println!();
+        println!(
+            "model {} (n = {}, R² = {:.4}, sigma = {:.3e}, AIC = {:.1}, BIC = {:.1}){mark}",
+            f.kind.name(),
+            f.global.n,
+            f.global.r_squared,
+            f.global.sigma2.sqrt(),
+            f.global.aic,
+            f.global.bic
+        );
+        print_table(&f.global.coefficients);
+        println!(
+            "  Box-Pierce Q = {:.2} (L = {}, p = {:.4}); Ljung-Box Q* = {:.2} (p = {:.4})",
+            f.box_pierce.statistic,
+            f.box_pierce.lags,
+            f.box_pierce.p_value,
+            f.ljung_box.statistic,
+            f.ljung_box.p_value
+        );
+        match (&f.correction, &f.corrected) {
+            (Some(c), Some(t)) => {
+                println!(
+                    "  residuals not white: {} correction (innovations Ljung-Box p = {:.4}); joint refit:",
+                    c.correction.label(),
+                    c.ljung_box.p_value
+                );
+                print_table(&t.coefficients);
+            }
+            (Some(c), None) => {
+                println!("  residuals not white: {} correction", c.correction.label())
+            }
+            _ => println!("  residuals white: no correction"),
+        }
+    }
+    println!();
+    println!("repositories (omega interval per wheel sample, m):");
+    for r in m.repositories.fill(m.config.required_bins) {
+        println!(
+            "  R{:<4} [{:>10.5}, {:>10.5}]  {:>6} tuples{}",
+            r.index,
+            r.low_m,
+            r.high_m,
+            r.tuples,
+            if r.filled {
+                ""
+            } else {
+                "  (below minimum fill)"
+            }
+        );
+    }
+    println!("training complete: {}", m.complete);
+}
+
+fn print_table(c: &[deadreckon_tedris::stats::Coefficient]) {
+    println!(
+        "  {:<12} {:>14} {:>14} {:>10} {:>10}",
+        "", "Estimate", "Std. Error", "t value", "p value"
+    );
+    for r in c {
+        println!(
+            "  {:<12} {:>14.6e} {:>14.6e} {:>10.2} {:>10.4}",
+            r.name, r.estimate, r.std_error, r.t_value, r.p_value
+        );
+    }
 }

@@ -34,6 +34,7 @@ pub enum Timing {
 }
 
 /// How the filter's initial state is chosen.
+#[allow(clippy::large_enum_variant)] // a plain value passed once per run
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum Init {
     /// From GNSS: the first fix for the position (minus the lever arm) and the
@@ -445,7 +446,11 @@ impl<const N: usize> Filter<'_, N> {
             accepted = true;
             self.out.stats.gnss_recoveries += 1;
         }
-        self.consecutive_rejections = if accepted { 0 } else { self.consecutive_rejections + 1 };
+        self.consecutive_rejections = if accepted {
+            0
+        } else {
+            self.consecutive_rejections + 1
+        };
         if accepted {
             kalman::update_vector(&mut self.x, &mut self.p, &y, &jac, &r, self.form, self.t)?;
             self.refresh_params();
@@ -642,7 +647,7 @@ fn run_generic<const N: usize>(
             // σ(1/ρ) = σ(ρ)/ρ².
             p[(AUG_INV_CIRC + i, AUG_INV_CIRC + i)] = (cs[i] / (c[i] * c[i])).powi(2);
         }
-        if (0..6).any(|j| !(p[(5 + j, 5 + j)] > 0.0)) {
+        if (0..6).any(|j| p[(5 + j, 5 + j)].is_nan() || p[(5 + j, 5 + j)] <= 0.0) {
             return Err(Error::InvalidParams(
                 "prior standard deviations of the parameters must be positive".into(),
             ));

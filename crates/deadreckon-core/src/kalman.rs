@@ -62,7 +62,7 @@ pub fn update_scalar<const N: usize>(
     }
     // S = H P Hᵀ + R   (14)
     let s = h.dot(&ph) + r;
-    if !(s.is_finite() && s > 0.0) || !y.is_finite() {
+    if !(s.is_finite() && s > 0.0 && y.is_finite()) {
         return Err(Error::Numerical {
             t_s,
             what: format!("innovation variance {s} or innovation {y} is not usable"),
