@@ -31,6 +31,8 @@ enum Command {
     Run(cmd::run::RunArgs),
     /// Simulate, calibrate with every method, evaluate, print tables III and IV, write the report.
     Demo(cmd::demo::DemoArgs),
+    /// TedriS and the calibrated four-wheel EKF through the same GNSS outages, in one table.
+    Compare(cmd::compare::CompareArgs),
     /// Write one self-contained HTML report with the papers' tables and figures for a drive.
     Report(cmd::report::ReportArgs),
     /// TedriS time-series dead reckoning: train a model, predict through outages.
@@ -58,6 +60,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Evaluate(a) => cmd::evaluate::run(a),
         Command::Run(a) => cmd::run::run(a),
         Command::Demo(a) => cmd::demo::run(a, cli.quiet),
+        Command::Compare(a) => cmd::compare::run(a),
         Command::Report(a) => cmd::report::run(a, cli.quiet),
         Command::Tedris(c) => cmd::tedris::run(c),
         Command::Import(a) => cmd::import::run(a),

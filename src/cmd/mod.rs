@@ -1,6 +1,7 @@
 //! One module per subcommand.
 pub mod calibrate;
 pub mod common;
+pub mod compare;
 pub mod demo;
 pub mod evaluate;
 pub mod import;

@@ -157,7 +157,6 @@ pub fn evaluate(
     } else if let Some(g) = drive.gnss.last() {
         end_limit = end_limit.min(g.t_s);
     }
-    let lever = drive.vehicle.gnss_lever_arm_m;
     let mut windows = Vec::new();
     let mut start = first.t_s + warmup_s;
     while start + outage_s <= end_limit {
@@ -178,54 +177,8 @@ pub fn evaluate(
         };
         let mut hook = Collect(Vec::new());
         ekf::run(drive, params, &opts, &mut hook)?;
-        let states = hook.0;
-        // Errors at the reference's times.
-        let mut errors = Vec::new();
-        match (&truth, reference) {
-            (Some(t), ReferenceKind::Truth) => {
-                for (ts, x) in &states {
-                    if let Some(r) = t.state_at(*ts) {
-                        errors.push((*ts - e0.t_s, (x[X] - r[X]).hypot(x[Y] - r[Y])));
-                    }
-                }
-            }
-            _ => {
-                let traj = Reference::from_states(
-                    states.iter().map(|s| s.0).collect(),
-                    states.iter().map(|s| s.1).collect(),
-                );
-                for g in drive.gnss.iter().filter(|g| g.t_s > e0.t_s && g.t_s <= end) {
-                    if let Some(x) = traj.state_at(g.t_s) {
-                        let (ae, an) = (x[X] + lever * x[YAW].cos(), x[Y] + lever * x[YAW].sin());
-                        errors.push((g.t_s - e0.t_s, (ae - g.east_m).hypot(an - g.north_m)));
-                    }
-                }
-            }
-        }
-        if let Some(&(_, final_error_m)) = errors.last() {
-            // Distance along the dead-reckoned path.
-            let mut dist = vec![0.0];
-            for w in states.windows(2) {
-                let d = dist.last().copied().unwrap_or(0.0)
-                    + (w[1].1[X] - w[0].1[X]).hypot(w[1].1[Y] - w[0].1[Y]);
-                dist.push(d);
-            }
-            let distance_m = dist.last().copied().unwrap_or(0.0);
-            let dist_at = |dt: f64| -> f64 {
-                let k = states.partition_point(|s| s.0 - e0.t_s <= dt);
-                dist[k.saturating_sub(1).min(dist.len() - 1)]
-            };
-            let hit = errors.iter().find(|e| e.1 >= 1.0);
-            windows.push(Window {
-                start_s: start,
-                end_s: end,
-                final_error_m,
-                max_error_m: errors.iter().map(|e| e.1).fold(0.0, f64::max),
-                distance_m,
-                distance_to_1m_m: hit.map(|h| dist_at(h.0)).unwrap_or(distance_m),
-                reached_1m: hit.is_some(),
-                errors,
-            });
+        if let Some(w) = window_errors(drive, truth.as_ref(), &hook.0, e0.t_s, start, end) {
+            windows.push(w);
         }
         start += step_s;
     }
@@ -238,5 +191,107 @@ pub fn evaluate(
         outage_s,
         reference,
         windows,
+    })
+}
+
+/// The errors of dead-reckoned `states` (from `t0`, the start of dead reckoning)
+/// over the window `[start, end)`, against the truth or, without it, the GNSS
+/// fixes of the window (compared at the antenna). `None` when nothing compares.
+fn window_errors(
+    drive: &Drive,
+    truth: Option<&Reference>,
+    states: &[(f64, State)],
+    t0: f64,
+    start: f64,
+    end: f64,
+) -> Option<Window> {
+    let lever = drive.vehicle.gnss_lever_arm_m;
+    let states: Vec<(f64, State)> = states
+        .iter()
+        .filter(|s| s.0 >= t0 && s.0 <= end)
+        .copied()
+        .collect();
+    let mut errors = Vec::new();
+    match truth {
+        Some(t) => {
+            for (ts, x) in &states {
+                if let Some(r) = t.state_at(*ts) {
+                    errors.push((*ts - t0, (x[X] - r[X]).hypot(x[Y] - r[Y])));
+                }
+            }
+        }
+        None => {
+            let traj = Reference::from_states(
+                states.iter().map(|s| s.0).collect(),
+                states.iter().map(|s| s.1).collect(),
+            );
+            for g in drive.gnss.iter().filter(|g| g.t_s > t0 && g.t_s <= end) {
+                if let Some(x) = traj.state_at(g.t_s) {
+                    let (ae, an) = (x[X] + lever * x[YAW].cos(), x[Y] + lever * x[YAW].sin());
+                    errors.push((g.t_s - t0, (ae - g.east_m).hypot(an - g.north_m)));
+                }
+            }
+        }
+    }
+    let &(_, final_error_m) = errors.last()?;
+    let mut dist = vec![0.0];
+    for w in states.windows(2) {
+        let d = dist.last().copied().unwrap_or(0.0)
+            + (w[1].1[X] - w[0].1[X]).hypot(w[1].1[Y] - w[0].1[Y]);
+        dist.push(d);
+    }
+    let distance_m = dist.last().copied().unwrap_or(0.0);
+    let dist_at = |dt: f64| -> f64 {
+        let k = states.partition_point(|s| s.0 - t0 <= dt);
+        dist[k.saturating_sub(1).min(dist.len() - 1)]
+    };
+    let hit = errors.iter().find(|e| e.1 >= 1.0);
+    Some(Window {
+        start_s: start,
+        end_s: end,
+        final_error_m,
+        max_error_m: errors.iter().map(|e| e.1).fold(0.0, f64::max),
+        distance_m,
+        distance_to_1m_m: hit.map(|h| dist_at(h.0)).unwrap_or(distance_m),
+        reached_1m: hit.is_some(),
+        errors,
+    })
+}
+
+/// The GNSS-aided filter run once with GNSS hidden in every window of
+/// `windows` (s): the errors through each window, as for the sliding evaluation.
+/// Used to compare methods through the same outages.
+pub fn through_windows(
+    drive: &Drive,
+    params: &Params,
+    windows: &[(f64, f64)],
+    base: &FilterOptions,
+) -> Result<OutageEvaluation, Error> {
+    let truth = Reference::from_truth(&drive.truth);
+    let reference = if truth.is_some() {
+        ReferenceKind::Truth
+    } else {
+        ReferenceKind::Gnss
+    };
+    let opts = FilterOptions {
+        gnss_outages: windows.to_vec(),
+        record_epochs: false,
+        ..base.clone()
+    };
+    let mut hook = Collect(Vec::new());
+    ekf::run(drive, params, &opts, &mut hook)?;
+    let mut out = Vec::new();
+    for &(a, b) in windows {
+        // Dead reckoning starts at the last epoch before the window.
+        let i = hook.0.partition_point(|s| s.0 < a);
+        let t0 = hook.0.get(i.saturating_sub(1)).map(|s| s.0).unwrap_or(a);
+        if let Some(w) = window_errors(drive, truth.as_ref(), &hook.0, t0, a, b) {
+            out.push(w);
+        }
+    }
+    Ok(OutageEvaluation {
+        outage_s: windows.iter().map(|w| w.1 - w.0).fold(0.0, f64::max),
+        reference,
+        windows: out,
     })
 }
