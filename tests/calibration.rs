@@ -217,3 +217,46 @@ fn covariances_stay_symmetric_positive_definite_over_two_hours() {
         }
     }
 }
+
+/// Any sensor may be absent: the filter uses what the drive has, and dead
+/// reckoning still works with the calibrated parameters.
+#[test]
+fn filter_runs_with_any_sensor_absent() {
+    let cal = simulate(&Scenario::builtin("evaluation").unwrap(), 31).unwrap();
+    let p = cal.truth_params;
+    let full = Summary::of(
+        &metrics::drift(&cal.drive, &p, 100.0, Timing::WheelEpochs)
+            .unwrap()
+            .errors_pct(),
+    )
+    .mean;
+    let strip: [(&str, fn(&mut deadreckon_core::Drive)); 4] = [
+        ("gyro", |d| d.yaw_rate.clear()),
+        ("speed", |d| d.speed.clear()),
+        ("steering", |d| d.steering.clear()),
+        ("gnss", |d| d.gnss.clear()),
+    ];
+    for (name, f) in strip {
+        let mut d = cal.drive.clone();
+        f(&mut d);
+        let drift = Summary::of(
+            &metrics::drift(&d, &p, 100.0, Timing::EachMeasurement)
+                .unwrap()
+                .errors_pct(),
+        )
+        .mean;
+        eprintln!("without {name}: drift {drift:.3}% (all sensors {full:.3}%)");
+        // The wheels alone still dead-reckon; losing the gyro costs the most.
+        assert!(
+            drift < if name == "gyro" { 5.0 } else { 0.5 },
+            "without {name}: {drift}%"
+        );
+    }
+    // GNSS-aided filtering without the CAN speed and steering.
+    let mut d = cal.drive.clone();
+    d.speed.clear();
+    d.steering.clear();
+    let out = ekf::run(&d, &p, &FilterOptions::default(), &mut ()).unwrap();
+    assert_eq!(out.stats.speed_updates + out.stats.steering_updates, 0);
+    assert!(out.stats.gnss_updates > 1000);
+}
