@@ -240,7 +240,7 @@ fn filter_runs_with_any_sensor_absent() {
         let mut d = cal.drive.clone();
         f(&mut d);
         let drift = Summary::of(
-            &metrics::drift(&d, &p, 100.0, Timing::EachMeasurement)
+            &metrics::drift(&d, &p, 100.0, Timing::WheelEpochs)
                 .unwrap()
                 .errors_pct(),
         )
