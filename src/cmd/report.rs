@@ -383,7 +383,7 @@ pub fn run(a: ReportArgs, quiet: bool) -> Result<()> {
     let mut input = four_wheel_input(&drive, &methods, a.outage, &steps)?;
     if let Some(m) = &a.model {
         steps.step("TedriS");
-        input.tedris = Some(tedris_section(&drive, m)?);
+        input.tedris = Some(tedris_section(&drive, m, a.outage)?);
     }
     let name = a
         .dir
@@ -403,10 +403,171 @@ pub fn run(a: ReportArgs, quiet: bool) -> Result<()> {
     Ok(())
 }
 
-/// The TedriS sections for a drive and a trained model.
-fn tedris_section(_drive: &Drive, model: &std::path::Path) -> Result<rp::Tedris> {
-    anyhow::bail!(
-        "TedriS report sections are not available yet ({})",
-        model.display()
-    )
+/// The TedriS sections for a drive and a trained model: the cross-correlation,
+/// the regression tables of every model kind, the repositories, the training
+/// heading against the reference, and the error through outages of `outage_s`
+/// (default 80 s) at a quarter, half and three quarters of the drive.
+pub fn tedris_section(
+    drive: &Drive,
+    model_path: &std::path::Path,
+    outage_s: Option<f64>,
+) -> Result<rp::Tedris> {
+    let text = std::fs::read_to_string(model_path)
+        .with_context(|| format!("reading {}", model_path.display()))?;
+    let m: deadreckon_tedris::TedrisModel =
+        serde_json::from_str(&text).with_context(|| format!("parsing {}", model_path.display()))?;
+    tedris_from_model(drive, &m, outage_s)
+}
+
+/// [`tedris_section`] for a model in memory.
+pub fn tedris_from_model(
+    drive: &Drive,
+    m: &deadreckon_tedris::TedrisModel,
+    outage_s: Option<f64>,
+) -> Result<rp::Tedris> {
+    let mut t = rp::Tedris {
+        cross_correlation: Some(rp::CrossCorrelation {
+            lag: m.ccf.lags.clone(),
+            correlation: m.ccf.values.clone(),
+            chosen_lag: Some(m.lag_samples),
+        }),
+        ..Default::default()
+    };
+    for f in &m.fits {
+        let nv = |name: &str, value: f64| rp::NamedValue {
+            name: name.into(),
+            value,
+        };
+        let name = if f.kind == m.chosen {
+            format!("{} (chosen)", f.kind.name())
+        } else {
+            f.kind.name().to_string()
+        };
+        t.models.push(rp::RegressionModel {
+            name,
+            coefficients: f
+                .global
+                .coefficients
+                .iter()
+                .map(|c| rp::Coefficient {
+                    name: c.name.clone(),
+                    estimate: c.estimate,
+                    std_error: c.std_error,
+                    t_value: c.t_value,
+                    p_value: c.p_value,
+                })
+                .collect(),
+            statistics: vec![
+                nv("n", f.global.n as f64),
+                nv("R²", f.global.r_squared),
+                nv("AIC", f.global.aic),
+                nv("BIC", f.global.bic),
+                nv("Box–Pierce Q", f.box_pierce.statistic),
+                nv("Box–Pierce p", f.box_pierce.p_value),
+                nv("Ljung–Box Q*", f.ljung_box.statistic),
+                nv("Ljung–Box p", f.ljung_box.p_value),
+            ],
+        });
+    }
+    let fill = m.repositories.fill(m.config.required_bins);
+    t.repositories = Some(rp::Repositories {
+        index: fill.iter().map(|f| f.index as i64).collect(),
+        fill: fill.iter().map(|f| f.tuples as u64).collect(),
+        min_fill: Some(m.config.min_fill as u64),
+        max_fill: Some(m.config.max_fill as u64),
+    });
+    // Outages spread over the drive.
+    let (t0, t1) = drive
+        .time_span()
+        .ok_or_else(|| anyhow::anyhow!("empty drive"))?;
+    let len = outage_s.unwrap_or(80.0).min(0.2 * (t1 - t0));
+    let outages: Vec<deadreckon_tedris::Outage> = [0.25, 0.5, 0.75]
+        .iter()
+        .map(|f| {
+            let a = t0 + f * (t1 - t0) - 0.5 * len;
+            deadreckon_tedris::Outage {
+                start_s: a,
+                end_s: a + len,
+            }
+        })
+        .collect();
+    let run = deadreckon_tedris::run_outages(drive, m, &outages)?;
+    // Training heading (TedriS's own estimate outside outages) against the reference course.
+    let course: Vec<(f64, f64)> = drive
+        .gnss
+        .iter()
+        .filter_map(|g| g.course_yaw_rad().map(|c| (g.t_s, c)))
+        .collect();
+    if !course.is_empty() {
+        let unwrap = |v: Vec<(f64, f64)>| -> rp::TimeSeries {
+            let a = deadreckon_core::angle::unwrap(&v.iter().map(|x| x.1).collect::<Vec<_>>());
+            rp::TimeSeries {
+                t_s: v.iter().map(|x| x.0).collect(),
+                value: a,
+            }
+        };
+        t.gnss_heading_rad = Some(unwrap(course));
+        t.training_heading_rad = Some(unwrap(
+            run.track
+                .points
+                .iter()
+                .map(|p| (p.t_s, p.yaw_rad))
+                .collect(),
+        ));
+    }
+    // Error through each outage for TedriS and the four-wheel EKF (calibrated with the outages hidden).
+    let windows: Vec<(f64, f64)> = outages.iter().map(|o| (o.start_s, o.end_s)).collect();
+    let mut hidden = drive.clone();
+    hidden
+        .gnss
+        .retain(|g| !windows.iter().any(|&(a, b)| g.t_s >= a && g.t_s < b));
+    let fw = calibrate::calibrate(&hidden, &CalibrationOptions::default())
+        .ok()
+        .and_then(|c| {
+            outage::through_windows(
+                drive,
+                &c.estimate.params,
+                &windows,
+                &FilterOptions::default(),
+            )
+            .ok()
+        });
+    let truth = deadreckon_core::reference::Reference::from_truth(&drive.truth);
+    for o in &outages {
+        let mut series = Vec::new();
+        if let Some(tr) = &truth {
+            let pts: Vec<(f64, f64)> = run
+                .track
+                .points
+                .iter()
+                .filter(|p| p.t_s >= o.start_s && p.t_s <= o.end_s)
+                .filter_map(|p| {
+                    tr.state_at(p.t_s)
+                        .map(|x| (p.t_s - o.start_s, (p.east_m - x[0]).hypot(p.north_m - x[1])))
+                })
+                .collect();
+            series.push(rp::MethodSeries {
+                method: "TedriS".into(),
+                t_s: pts.iter().map(|p| p.0).collect(),
+                error_m: pts.iter().map(|p| p.1).collect(),
+            });
+        }
+        if let Some(w) = fw
+            .as_ref()
+            .and_then(|f| f.windows.iter().find(|w| w.start_s == o.start_s))
+        {
+            series.push(rp::MethodSeries {
+                method: "RTS".into(),
+                t_s: w.errors.iter().map(|e| e.0).collect(),
+                error_m: w.errors.iter().map(|e| e.1).collect(),
+            });
+        }
+        if !series.is_empty() {
+            t.outages.push(rp::OutageRun {
+                name: format!("outage {:.0}–{:.0} s", o.start_s - t0, o.end_s - t0),
+                series,
+            });
+        }
+    }
+    Ok(t)
 }

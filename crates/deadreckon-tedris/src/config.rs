@@ -1,0 +1,270 @@
+//! Configuration of TedriS: every key with its unit and default.
+
+use serde::{Deserialize, Serialize};
+
+use crate::Error;
+
+/// Which regression links the wheel series to the reference heading increments.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ModelKind {
+    /// The paper's eq. (3): `γ = α0 + α1·ω` (constant offset, plus DCF).
+    Paper,
+    /// Multiple regression: `γ = α0 + α1·ω + α2·d`, d the distance travelled per
+    /// sample. Follows the speed-proportional bias of unequal rear tyre radii.
+    Distance,
+    /// ARX(1,1) over consecutive blocks: `γ_k = α0 + α1·ω_k + α2·d_k + b1·ω_{k−1} + a1·γ_{k−1}`;
+    /// in prediction `γ_{k−1}` is the model's own previous output.
+    Arx,
+}
+
+impl ModelKind {
+    /// All kinds, in report order.
+    pub const ALL: [ModelKind; 3] = [ModelKind::Paper, ModelKind::Distance, ModelKind::Arx];
+
+    /// Names of the regressors, in design-column order.
+    pub fn regressors(self) -> &'static [&'static str] {
+        match self {
+            ModelKind::Paper => &["alpha0", "alpha1"],
+            ModelKind::Distance => &["alpha0", "alpha1", "distance"],
+            ModelKind::Arx => &["alpha0", "alpha1", "distance", "omega_prev", "gamma_prev"],
+        }
+    }
+
+    /// The snake-case name.
+    pub fn name(self) -> &'static str {
+        match self {
+            ModelKind::Paper => "paper",
+            ModelKind::Distance => "distance",
+            ModelKind::Arx => "arx",
+        }
+    }
+}
+
+/// How the model is chosen.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ModelChoice {
+    /// The kind with the smallest BIC of its simulation residuals (ARX fed its own
+    /// output, as in dead reckoning) among those whose residuals, after the AR/MA
+    /// correction if one was needed, pass Ljung–Box; the smallest overall otherwise.
+    Auto,
+    /// Always this kind.
+    Fixed(ModelKind),
+}
+
+/// How each repository's regression is fitted.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RepositoryFit {
+    /// The paper: an independent regression per repository (needs a wide spread of ω in it).
+    Separate,
+    /// The slopes of the global fit, with an intercept per repository (the mean of the
+    /// global residuals of its tuples). Immune to the attenuation of slopes fitted
+    /// on the narrow, noisy ω range of one repository.
+    PooledSlopes,
+}
+
+/// TedriS parameters. Units are in the key names; `_samples` counts wheel samples.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct TedrisConfig {
+    /// τ: samples per block, the FIFO length (paper: 6).
+    pub tau_samples: usize,
+    /// Summarise blocks by their means instead of the paper's medians (default false).
+    pub block_mean: bool,
+    /// Half-width of the lag window searched for the cross-correlation peak (default 10).
+    pub max_lag_samples: usize,
+    /// Relative tolerance on the cross-correlation peak: the shortest lag within it
+    /// is taken (default 0.005; 0 = the highest peak, as in the paper).
+    pub lag_tolerance: f64,
+    /// Model kind, or automatic choice by the residual statistics (default auto).
+    pub model: ModelChoice,
+    /// Repository regression (default pooled slopes).
+    pub repository_fit: RepositoryFit,
+    /// k of ε = k·(W_H − W_L); `None` for ε = ∞, one repository (paper: 1.5 car, ∞ robot).
+    pub epsilon_factor: Option<f64>,
+    /// Minimum tuples in each required repository for training to be complete (default 20).
+    pub min_fill: usize,
+    /// Maximum tuples per repository; the oldest is dropped beyond it (default 3000).
+    pub max_fill: usize,
+    /// Required repositories: R−n … Rn must reach `min_fill` (default 1).
+    pub required_bins: i32,
+    /// Valid synchronised samples needed before the lag and the straight-line
+    /// parameters are estimated (default 1500, 60 s at 25 Hz).
+    pub init_samples: usize,
+    /// Smallest cross-correlation peak accepted for the first fit; below it the
+    /// machine waits for more turning (or a full history) (default 0.3).
+    pub min_ccf_peak: f64,
+    /// Wheel samples kept for the lag, the straight-line band and the DCF update
+    /// (default 30000, 20 min at 25 Hz).
+    pub history_samples: usize,
+    /// Wheel speed below which the GNSS course is not trusted for training, m/s (default 1.0).
+    pub min_course_speed_mps: f64,
+    /// Largest gap between two reference headings that is still interpolated, s (default 1.0).
+    pub max_heading_gap_s: f64,
+    /// No reference heading for this long means GNSS (or gyro) lost, s (default 1.0).
+    pub reference_timeout_s: f64,
+    /// Window of the heading anchor (mean reference − DR difference), s (default 10).
+    pub heading_anchor_window_s: f64,
+    /// Evaluate the heading anchor on a straight-line trend of the pairs at the
+    /// current time rather than their mean (default false).
+    pub anchor_trend: bool,
+    /// Window of the position anchor (mean fix − DR difference), s (default 5).
+    pub position_anchor_window_s: f64,
+    /// Reference data after an outage before the update phase resumes, s (default 3).
+    pub retrain_s: f64,
+    /// Window of the DCF update (eq. 6), s (default 30).
+    pub update_window_s: f64,
+    /// Interval between DCF updates, s (default 10).
+    pub update_interval_s: f64,
+    /// Interval between regression refits once trained, s (default 60).
+    pub refit_interval_s: f64,
+    /// Correct the ω slope for the noise of the block medians (errors in variables,
+    /// noise variance from the straight blocks; default true). Plain OLS
+    /// underestimates the slope by the ratio noise / spread of ω.
+    pub eiv_correction: bool,
+    /// Inside the straight-line band, use the straight-line ω instead of the
+    /// sample's (see `TedrisModel::effective_omega`; default true).
+    pub straight_band: bool,
+    /// Half-width of the dead band in robust standard deviations of the straight
+    /// blocks' ω (default 3).
+    pub straight_band_sigmas: f64,
+    /// Estimate the turn gain (see `gain`) at every fit (default true).
+    pub turn_gain: bool,
+    /// Segment length of the turn-gain estimate, s (default 10).
+    pub gain_segment_s: f64,
+    /// Update the DCF by eq. (6); when false it stays at DCF₀ (default true).
+    pub dcf_update: bool,
+    /// Weight of each new DCF estimate against the previous DCF, in (0, 1]
+    /// (default 1: eq. (6) as in the paper).
+    pub dcf_smoothing: f64,
+    /// Half-width of the DCF search interval, in units of |α1|·(W_H − W_L) (default 2).
+    pub dcf_bound_factor: f64,
+    /// Window over which the straight-line detector measures the heading change, s (default 3).
+    pub slt_window_s: f64,
+    /// Largest reference heading change over `slt_window_s` on a straight line, degrees (default 1).
+    pub slt_max_change_deg: f64,
+    /// Autocorrelation lags of the portmanteau tests (default 10).
+    pub portmanteau_lags: usize,
+    /// Significance level of the Ljung–Box test that triggers a correction (default 0.05).
+    pub alpha: f64,
+    /// Largest AR or MA order tried (default 3).
+    pub max_correction_order: usize,
+}
+
+impl Default for TedrisConfig {
+    fn default() -> Self {
+        TedrisConfig {
+            tau_samples: 6,
+            block_mean: false,
+            max_lag_samples: 10,
+            lag_tolerance: 0.005,
+            model: ModelChoice::Auto,
+            repository_fit: RepositoryFit::PooledSlopes,
+            epsilon_factor: Some(1.5),
+            min_fill: 20,
+            max_fill: 3000,
+            required_bins: 1,
+            init_samples: 1500,
+            min_ccf_peak: 0.3,
+            history_samples: 30_000,
+            min_course_speed_mps: 1.0,
+            max_heading_gap_s: 1.0,
+            reference_timeout_s: 1.0,
+            heading_anchor_window_s: 10.0,
+            anchor_trend: false,
+            position_anchor_window_s: 5.0,
+            retrain_s: 3.0,
+            update_window_s: 30.0,
+            update_interval_s: 10.0,
+            refit_interval_s: 60.0,
+            eiv_correction: true,
+            straight_band: true,
+            straight_band_sigmas: 3.0,
+            turn_gain: true,
+            gain_segment_s: 10.0,
+            dcf_update: true,
+            dcf_smoothing: 1.0,
+            dcf_bound_factor: 2.0,
+            slt_window_s: 3.0,
+            slt_max_change_deg: 1.0,
+            portmanteau_lags: 10,
+            alpha: 0.05,
+            max_correction_order: 3,
+        }
+    }
+}
+
+impl TedrisConfig {
+    /// The paper's robot settings: ε = ∞ (one repository), no course speed gate.
+    pub fn robot() -> Self {
+        TedrisConfig {
+            epsilon_factor: None,
+            min_course_speed_mps: 0.0,
+            required_bins: 0,
+            init_samples: 600,
+            ..Self::default()
+        }
+    }
+
+    /// Checks every value is usable.
+    pub fn validate(&self) -> Result<(), Error> {
+        let bad = |k: &str, v: String| Err(Error::Config(format!("{k} = {v} is not valid")));
+        if self.tau_samples == 0 {
+            return bad("tau_samples", "0".into());
+        }
+        if let Some(k) = self.epsilon_factor {
+            if !(k.is_finite() && k > 0.0) {
+                return bad("epsilon_factor", k.to_string());
+            }
+        }
+        if self.min_fill < 3 || self.max_fill < self.min_fill {
+            return bad(
+                "min_fill/max_fill",
+                format!("{}/{}", self.min_fill, self.max_fill),
+            );
+        }
+        if self.required_bins < 0 {
+            return bad("required_bins", self.required_bins.to_string());
+        }
+        if self.init_samples < 50 {
+            return bad("init_samples", self.init_samples.to_string());
+        }
+        for (k, v) in [
+            ("max_heading_gap_s", self.max_heading_gap_s),
+            ("reference_timeout_s", self.reference_timeout_s),
+            ("heading_anchor_window_s", self.heading_anchor_window_s),
+            ("position_anchor_window_s", self.position_anchor_window_s),
+            ("update_window_s", self.update_window_s),
+            ("update_interval_s", self.update_interval_s),
+            ("refit_interval_s", self.refit_interval_s),
+            ("dcf_bound_factor", self.dcf_bound_factor),
+            ("slt_window_s", self.slt_window_s),
+            ("slt_max_change_deg", self.slt_max_change_deg),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return bad(k, v.to_string());
+            }
+        }
+        if !(self.min_course_speed_mps.is_finite()
+            && self.min_course_speed_mps >= 0.0
+            && self.retrain_s >= 0.0)
+        {
+            return bad(
+                "min_course_speed_mps/retrain_s",
+                format!("{}/{}", self.min_course_speed_mps, self.retrain_s),
+            );
+        }
+        if !(self.dcf_smoothing > 0.0 && self.dcf_smoothing <= 1.0) {
+            return bad("dcf_smoothing", self.dcf_smoothing.to_string());
+        }
+        if !(self.alpha > 0.0 && self.alpha < 1.0) || self.portmanteau_lags == 0 {
+            return bad(
+                "alpha/portmanteau_lags",
+                format!("{}/{}", self.alpha, self.portmanteau_lags),
+            );
+        }
+        Ok(())
+    }
+}

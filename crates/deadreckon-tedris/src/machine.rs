@@ -1,0 +1,755 @@
+//! The TedriS state machine of section 3.3, fed one sample at a time.
+//!
+//! ```text
+//!            reference heading good                  all repositories filled
+//!  Blind ────────────────────────────▶ Training ────────────────────────────▶ Update
+//!    ▲                                  ▲    │ reference lost                   │ reference lost
+//!    │ no model yet                     │    ▼                                  ▼
+//!    └──────────────────────────────── Predicting ◀─────────────────────────────┘
+//!                reference back: Training again (then Update after `retrain_s`)
+//! ```
+//!
+//! Every wheel sample advances the dead-reckoned heading by γ̂ (eq. 4–5) and the
+//! rear-axle position by the rear wheel distance along that heading. While the
+//! reference is good, the output is anchored to it: the heading offset is the mean
+//! of (reference − DR heading) over `heading_anchor_window_s`, compared at the lag h
+//! (the reference responds h samples after the wheels), and the position offset the
+//! mean of (fix, lever arm removed − DR position) over `position_anchor_window_s`.
+//! When the reference is lost both offsets freeze and the chain runs on the wheels alone.
+
+use std::collections::VecDeque;
+
+use serde::{Deserialize, Serialize};
+
+use crate::config::TedrisConfig;
+use crate::history::{masked_ccf, BlockFormer, History, Sample};
+use crate::minimise::brent;
+use crate::model::{design_row, TedrisModel};
+use crate::predict::Predictor;
+use crate::repository::{Repositories, StraightLine, Tuple};
+use crate::Error;
+use deadreckon_core::angle::wrap;
+
+/// Rear wheel distances travelled since the previous wheel sample.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct WheelSample {
+    /// Timestamp, s.
+    pub t_s: f64,
+    /// Rear-left wheel distance, m.
+    pub left_m: f64,
+    /// Rear-right wheel distance, m.
+    pub right_m: f64,
+}
+
+/// A reference heading: the GNSS course as a yaw, or the integrated gyro heading.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct HeadingSample {
+    /// Timestamp, s.
+    pub t_s: f64,
+    /// Yaw, rad, counter-clockwise from east (any branch: it is unwrapped here).
+    pub yaw_rad: f64,
+}
+
+/// A GNSS antenna position.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PositionFix {
+    /// Timestamp, s.
+    pub t_s: f64,
+    /// East, m.
+    pub east_m: f64,
+    /// North, m.
+    pub north_m: f64,
+}
+
+/// Geometry the machine needs.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Geometry {
+    /// Rear track width, m (nominal yaw rate ω / track before a model exists).
+    pub track_rear_m: f64,
+    /// GNSS antenna distance forward of the rear-axle centre, m.
+    pub lever_arm_m: f64,
+    /// The reference heading is a GNSS course (of the antenna, gated by speed);
+    /// false for a gyro heading.
+    pub heading_is_course: bool,
+}
+
+/// The phase of section 3.3.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Phase {
+    /// No reference and no model: the heading follows the nominal ω / track.
+    Blind,
+    /// Reference good, repositories not yet filled (or just back after an outage).
+    Training,
+    /// Reference good, repositories filled: DCF updates (eq. 6) and refits.
+    Update,
+    /// Reference lost: dead reckoning with the model.
+    Predicting,
+}
+
+/// The estimate after one wheel sample.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Estimate {
+    /// Timestamp, s.
+    pub t_s: f64,
+    /// Rear-axle centre, east, m.
+    pub east_m: f64,
+    /// Rear-axle centre, north, m.
+    pub north_m: f64,
+    /// Yaw, rad, counter-clockwise from east, wrapped to (−π, π].
+    pub yaw_rad: f64,
+    /// Rear wheel speed, m/s.
+    pub speed_mps: f64,
+    /// Heading rate, rad/s.
+    pub yaw_rate_rps: f64,
+    /// Phase after the sample.
+    pub phase: Phase,
+}
+
+/// The streaming TedriS estimator. Serialises to JSON with its model and buffers.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Tedris {
+    config: TedrisConfig,
+    geometry: Geometry,
+    phase: Phase,
+    model: Option<TedrisModel>,
+    history: History,
+    former: Option<BlockFormer>,
+    predictor: Predictor,
+    recent: VecDeque<Tuple>,
+    next_idx: u64,
+    pending_from: u64,
+    last_t: Option<f64>,
+    /// (time, unwrapped antenna heading, raw yaw, rear-axle heading, usable).
+    last_heading: Option<(f64, f64, f64, f64, bool)>,
+    heading_pairs: VecDeque<(f64, f64)>,
+    position_pairs: VecDeque<(f64, f64, f64)>,
+    heading_offset: f64,
+    position_offset: (f64, f64),
+    theta_dr: f64,
+    pos_dr: (f64, f64),
+    speed_mps: f64,
+    good_since: Option<f64>,
+    last_update_t: f64,
+    last_refit_t: f64,
+    last_init_try_t: f64,
+    rejected: u64,
+}
+
+impl Tedris {
+    /// A machine that trains from scratch.
+    pub fn new(config: TedrisConfig, geometry: Geometry) -> Result<Self, Error> {
+        config.validate()?;
+        if !(geometry.track_rear_m.is_finite()
+            && geometry.track_rear_m > 0.0
+            && geometry.lever_arm_m.is_finite())
+        {
+            return Err(Error::Config(format!("geometry {geometry:?} is not valid")));
+        }
+        let cap = (4 * config.init_samples).max(config.history_samples);
+        Ok(Tedris {
+            history: History::new(cap),
+            config,
+            geometry,
+            phase: Phase::Blind,
+            model: None,
+            former: None,
+            predictor: Predictor::default(),
+            recent: VecDeque::new(),
+            next_idx: 0,
+            pending_from: 0,
+            last_t: None,
+            last_heading: None,
+            heading_pairs: VecDeque::new(),
+            position_pairs: VecDeque::new(),
+            heading_offset: 0.0,
+            position_offset: (0.0, 0.0),
+            theta_dr: 0.0,
+            pos_dr: (0.0, 0.0),
+            speed_mps: 0.0,
+            good_since: None,
+            last_update_t: f64::MIN,
+            last_refit_t: f64::MIN,
+            last_init_try_t: f64::MIN,
+            rejected: 0,
+        })
+    }
+
+    /// A machine that starts from a trained model (and keeps training on new data).
+    pub fn with_model(model: TedrisModel, geometry: Geometry) -> Result<Self, Error> {
+        model.validate()?;
+        let mut m = Tedris::new(model.config.clone(), geometry)?;
+        let c = &model.config;
+        let mut former = BlockFormer::new(
+            c.tau_samples,
+            model.lag_samples,
+            1,
+            c.slt_max_change_deg.to_radians(),
+            0,
+        );
+        former.use_mean = c.block_mean;
+        m.former = Some(former);
+        m.model = Some(model);
+        m.fix_slt_window();
+        Ok(m)
+    }
+
+    fn fix_slt_window(&mut self) {
+        if let (Some(f), Some(m)) = (self.former.as_mut(), self.model.as_ref()) {
+            f.slt_window = (self.config.slt_window_s / m.sample_period_s)
+                .round()
+                .max(1.0) as u64;
+        }
+    }
+
+    /// Sets the current pose (for drives whose frame is defined by a known start pose).
+    pub fn set_pose(&mut self, east_m: f64, north_m: f64, yaw_rad: f64) {
+        self.position_offset = (east_m - self.pos_dr.0, north_m - self.pos_dr.1);
+        self.heading_offset = yaw_rad - self.theta_dr;
+    }
+
+    /// The phase.
+    pub fn phase(&self) -> Phase {
+        self.phase
+    }
+
+    /// The model, once the first fit is done.
+    pub fn model(&self) -> Option<&TedrisModel> {
+        self.model.as_ref()
+    }
+
+    /// The recent wheel samples with their synchronised reference heading (diagnostics).
+    pub fn history(&self) -> &History {
+        &self.history
+    }
+
+    /// Samples rejected as invalid (non-finite values, time going backwards).
+    pub fn rejected(&self) -> u64 {
+        self.rejected
+    }
+
+    /// The state as JSON.
+    pub fn to_json(&self) -> Result<String, Error> {
+        serde_json::to_string(self).map_err(|e| Error::Json(e.to_string()))
+    }
+
+    /// A state saved by [`Tedris::to_json`].
+    pub fn from_json(s: &str) -> Result<Self, Error> {
+        let m: Tedris = serde_json::from_str(s).map_err(|e| Error::Json(e.to_string()))?;
+        m.config.validate()?;
+        if let Some(model) = &m.model {
+            model.validate()?;
+        }
+        Ok(m)
+    }
+
+    fn heading_out(&self) -> f64 {
+        self.theta_dr + self.heading_offset
+    }
+
+    fn lag(&self) -> i64 {
+        self.model.as_ref().map_or(0, |m| m.lag_samples)
+    }
+
+    /// Feeds one wheel sample; returns the estimate after it.
+    pub fn push_wheel(&mut self, w: WheelSample) -> Result<Estimate, Error> {
+        if !(w.t_s.is_finite() && w.left_m.is_finite() && w.right_m.is_finite())
+            || self.last_t.is_some_and(|t| w.t_s <= t)
+        {
+            self.rejected += 1;
+            return Err(Error::Input(format!(
+                "wheel sample at t={} s is not finite or not after the previous one",
+                w.t_s
+            )));
+        }
+        let dt = self.last_t.map_or(0.0, |t| w.t_s - t);
+        self.last_t = Some(w.t_s);
+        let omega = w.right_m - w.left_m;
+        let dist = 0.5 * (w.left_m + w.right_m);
+        let rate = match &self.model {
+            Some(m) => self.predictor.step(m, omega, dist, m.dcf_rad).total_rad,
+            None => omega / self.geometry.track_rear_m,
+        };
+        let before = self.heading_out();
+        self.theta_dr += rate;
+        let mid = before + 0.5 * rate;
+        self.pos_dr.0 += dist * mid.cos();
+        self.pos_dr.1 += dist * mid.sin();
+        self.speed_mps = if dt > 0.0 { dist / dt } else { 0.0 };
+        let idx = self.next_idx;
+        self.next_idx += 1;
+        self.history.push(Sample {
+            idx,
+            t_s: w.t_s,
+            dt_s: dt,
+            omega_m: omega,
+            dist_m: dist,
+            theta_rad: None,
+            theta_dr_rad: self.theta_dr,
+        });
+        self.advance_phase(w.t_s);
+        let (e, n) = (
+            self.pos_dr.0 + self.position_offset.0,
+            self.pos_dr.1 + self.position_offset.1,
+        );
+        Ok(Estimate {
+            t_s: w.t_s,
+            east_m: e,
+            north_m: n,
+            yaw_rad: wrap(self.heading_out()),
+            speed_mps: self.speed_mps,
+            yaw_rate_rps: if dt > 0.0 { rate / dt } else { 0.0 },
+            phase: self.phase,
+        })
+    }
+
+    fn advance_phase(&mut self, t: f64) {
+        let ref_ok = self
+            .last_heading
+            .is_some_and(|h| t - h.0 <= self.config.reference_timeout_s);
+        match (self.phase, ref_ok) {
+            (Phase::Training | Phase::Update, false) => self.start_outage(),
+            (Phase::Predicting | Phase::Blind, true) => {
+                self.predictor.end_correction();
+                self.good_since = Some(t);
+                self.phase = Phase::Training;
+            }
+            (Phase::Training, true) => {
+                let ready = self.model.as_ref().is_some_and(|m| m.complete);
+                if ready
+                    && self
+                        .good_since
+                        .is_some_and(|g| t - g >= self.config.retrain_s)
+                {
+                    self.phase = Phase::Update;
+                    self.update_dcf(t);
+                }
+            }
+            (Phase::Update, true) => {
+                if self.last_refit_t == f64::MIN {
+                    // A loaded model: the first refit comes one interval from now.
+                    self.last_refit_t = t;
+                }
+                if t - self.last_refit_t >= self.config.refit_interval_s {
+                    self.refit(t);
+                } else if t - self.last_update_t >= self.config.update_interval_s {
+                    self.update_dcf(t);
+                }
+            }
+            (Phase::Predicting | Phase::Blind, false) => {}
+        }
+    }
+
+    fn start_outage(&mut self) {
+        let Some(model) = &self.model else {
+            self.phase = Phase::Blind;
+            return;
+        };
+        let fit = model.chosen_fit();
+        let tau = model.config.tau_samples as u64;
+        // The trailing run of contiguous blocks.
+        let mut run: Vec<&Tuple> = Vec::new();
+        for t in self.recent.iter().rev() {
+            if run.last().is_some_and(|l| l.seq != t.seq + tau) {
+                break;
+            }
+            run.push(t);
+        }
+        run.reverse();
+        let e: Vec<f64> = run
+            .iter()
+            .filter_map(|t| {
+                let r = design_row(fit.kind, t)?;
+                let n = model.straight().bin(t.omega_m)?;
+                Some(t.gamma_rad - fit.beta(n).iter().zip(&r).map(|(a, b)| a * b).sum::<f64>())
+            })
+            .collect();
+        let u = fit.correction().innovations(&e);
+        let skipped = run.last().map_or(0, |l| {
+            (self.next_idx.saturating_sub(l.seq + tau) / tau) as usize
+        });
+        let model = model.clone();
+        self.predictor.begin_correction(&model, e, u, skipped);
+        self.phase = Phase::Predicting;
+    }
+
+    /// Feeds one reference heading.
+    pub fn push_heading(&mut self, hs: HeadingSample) -> Result<(), Error> {
+        if !(hs.t_s.is_finite() && hs.yaw_rad.is_finite())
+            || self.last_heading.is_some_and(|h| hs.t_s <= h.0)
+        {
+            self.rejected += 1;
+            return Err(Error::Input(format!(
+                "heading at t={} s is not finite or not after the previous one",
+                hs.t_s
+            )));
+        }
+        let prev = self.last_heading;
+        let theta = match prev {
+            Some((_, th, raw, _, _)) => th + wrap(hs.yaw_rad - raw),
+            None => hs.yaw_rad,
+        };
+        // A GNSS course is the antenna's: the antenna moves at atan(l ψ̇ / v) from the
+        // rear-axle heading. ψ̇ and v are the wheels' over the last 0.25 s (or since the
+        // previous heading), so the correction is smooth; slow courses are not used.
+        let (mut theta_m, mut usable) = (theta, true);
+        if self.geometry.heading_is_course {
+            let w0 = hs.t_s - prev.map_or(0.25, |p| (hs.t_s - p.0).clamp(0.1, 0.5));
+            let (mut sw, mut sd, mut st) = (0.0, 0.0, 0.0);
+            for s in self.history.iter().rev() {
+                if s.t_s <= w0 {
+                    break;
+                }
+                if s.t_s <= hs.t_s && s.dt_s.is_finite() {
+                    sw += s.omega_m;
+                    sd += s.dist_m;
+                    st += s.dt_s;
+                }
+            }
+            let v = if st > 0.0 { sd / st } else { 0.0 };
+            if v.abs() < self.config.min_course_speed_mps.max(1e-3) {
+                usable = false;
+            } else {
+                let yaw_rate = sw / self.geometry.track_rear_m / st;
+                theta_m -= (self.geometry.lever_arm_m * yaw_rate / v).atan();
+            }
+        }
+        self.last_heading = Some((hs.t_s, theta, hs.yaw_rad, theta_m, usable));
+        if self.good_since.is_none() {
+            self.good_since = Some(hs.t_s);
+        }
+        // Synchronise: every pending wheel sample up to this heading gets its θ,
+        // linearly interpolated between the two rear-axle headings around it.
+        let lag = self.lag();
+        let mut assigned = Vec::new();
+        while self.pending_from < self.next_idx {
+            let idx = self.pending_from;
+            let Some(s) = self.history.get(idx).copied() else {
+                self.pending_from += 1;
+                continue;
+            };
+            if s.t_s > hs.t_s {
+                break;
+            }
+            self.pending_from += 1;
+            let Some((tp, _, _, thp, prev_usable)) = prev else {
+                continue;
+            };
+            if !(usable && prev_usable) || hs.t_s - tp > self.config.max_heading_gap_s || s.t_s < tp
+            {
+                continue;
+            }
+            let a = if hs.t_s > tp {
+                (s.t_s - tp) / (hs.t_s - tp)
+            } else {
+                1.0
+            };
+            let th = thp + a * (theta_m - thp);
+            if let Some(m) = self.history.get_mut(idx) {
+                m.theta_rad = Some(th);
+            }
+            assigned.push((idx, s.t_s, th));
+        }
+        for (idx, t, th) in assigned {
+            let src = idx as i64 - lag;
+            if src < 0 {
+                continue;
+            }
+            if let Some(dr) = self.history.get(src as u64).map(|s| s.theta_dr_rad) {
+                let d = self.heading_offset + wrap(th - dr - self.heading_offset);
+                self.heading_pairs.push_back((t, d));
+            }
+        }
+        let win = self.config.heading_anchor_window_s;
+        while self
+            .heading_pairs
+            .front()
+            .is_some_and(|p| hs.t_s - p.0 > win)
+        {
+            self.heading_pairs.pop_front();
+        }
+        if !self.heading_pairs.is_empty() {
+            self.heading_offset = anchor(&self.heading_pairs, hs.t_s, self.config.anchor_trend);
+        }
+        self.train(hs.t_s);
+        Ok(())
+    }
+
+    /// Feeds one GNSS antenna position.
+    pub fn push_fix(&mut self, f: PositionFix) -> Result<(), Error> {
+        if !(f.t_s.is_finite() && f.east_m.is_finite() && f.north_m.is_finite()) {
+            self.rejected += 1;
+            return Err(Error::Input(format!("fix at t={} s is not finite", f.t_s)));
+        }
+        let Some(t_last) = self.last_t else {
+            return Ok(());
+        };
+        let yaw = self.heading_out();
+        let ahead = (f.t_s - t_last).clamp(-1.0, 1.0) * self.speed_mps;
+        let (pe, pn) = (
+            self.pos_dr.0 + ahead * yaw.cos(),
+            self.pos_dr.1 + ahead * yaw.sin(),
+        );
+        let l = self.geometry.lever_arm_m;
+        let (me, mn) = (f.east_m - l * yaw.cos(), f.north_m - l * yaw.sin());
+        self.position_pairs.push_back((f.t_s, me - pe, mn - pn));
+        let win = self.config.position_anchor_window_s;
+        while self
+            .position_pairs
+            .front()
+            .is_some_and(|p| f.t_s - p.0 > win)
+        {
+            self.position_pairs.pop_front();
+        }
+        let n = self.position_pairs.len() as f64;
+        self.position_offset = (
+            self.position_pairs.iter().map(|p| p.1).sum::<f64>() / n,
+            self.position_pairs.iter().map(|p| p.2).sum::<f64>() / n,
+        );
+        Ok(())
+    }
+
+    /// Forms blocks and fits, after new samples were synchronised.
+    fn train(&mut self, t: f64) {
+        let final_upto = self.pending_from.saturating_sub(1);
+        if self.model.is_none() {
+            if t - self.last_init_try_t >= 1.0
+                && self.history.gamma_count() >= self.config.init_samples
+            {
+                self.last_init_try_t = t;
+                self.init(t, final_upto);
+            }
+            return;
+        }
+        let Some(former) = self.former.as_mut() else {
+            return;
+        };
+        let tuples = former.form(&self.history, final_upto);
+        let Some(model) = self.model.as_mut() else {
+            return;
+        };
+        for tu in tuples {
+            model.repositories.insert(tu);
+            self.recent.push_back(tu);
+        }
+        while self.recent.len() > 32 {
+            self.recent.pop_front();
+        }
+        if !model.complete && model.repositories.complete(model.config.required_bins) {
+            self.refit(t);
+        }
+    }
+
+    fn sample_period(&self) -> f64 {
+        let dts: Vec<f64> = self
+            .history
+            .iter()
+            .map(|s| s.dt_s)
+            .filter(|d| d.is_finite() && *d > 0.0)
+            .collect();
+        let p = crate::stats::median(&dts);
+        if p.is_finite() {
+            p
+        } else {
+            0.04
+        }
+    }
+
+    /// First fit: the lag from the cross-correlation over the history, the blocks,
+    /// the straight-line band and the repositories. Waits (returns) while the
+    /// cross-correlation peak is below `min_ccf_peak` (too little turning yet).
+    fn init(&mut self, t: f64, final_upto: u64) {
+        let ccf = masked_ccf(&self.history, self.config.max_lag_samples);
+        let peak = ccf_peak_value(&ccf);
+        let full = self.history.len() >= self.history.capacity();
+        if peak < self.config.min_ccf_peak && !full {
+            return;
+        }
+        self.rebuild(t, final_upto, ccf);
+    }
+
+    /// Rebuilds the repositories from the history with the lag of `ccf`.
+    fn rebuild(&mut self, t: f64, final_upto: u64, ccf: crate::ccf::CrossCorrelation) -> bool {
+        let c = &self.config;
+        let lag = ccf.peak_lag_within(self.config.lag_tolerance);
+        let period = self.sample_period();
+        let slt_window = (c.slt_window_s / period).round().max(1.0) as u64;
+        let start = self.history.span().map_or(0, |s| s.0);
+        let mut former = BlockFormer::new(
+            c.tau_samples,
+            lag,
+            slt_window,
+            c.slt_max_change_deg.to_radians(),
+            start,
+        );
+        former.use_mean = c.block_mean;
+        let tuples = former.form(&self.history, final_upto);
+        let Some(straight) = straight_line(&tuples, c.epsilon_factor) else {
+            return false;
+        };
+        let mut repos = Repositories::new(straight, c.min_fill, c.max_fill);
+        for tu in &tuples {
+            repos.insert(*tu);
+        }
+        match TedrisModel::fit(c.clone(), period, lag, ccf, repos) {
+            Ok(model) => {
+                self.recent = tuples.iter().rev().take(32).rev().copied().collect();
+                self.model = Some(model);
+                self.estimate_gain();
+                self.former = Some(former);
+                self.last_refit_t = t;
+                self.update_dcf(t);
+                true
+            }
+            Err(_) => false,
+        }
+    }
+
+    /// Refit. Until training first completes, the lag is re-estimated on the
+    /// history, and a different lag with a higher correlation peak rebuilds the
+    /// repositories from the history; otherwise (and always once complete) the
+    /// regressions are refitted on the repositories as they are.
+    fn refit(&mut self, t: f64) {
+        self.last_refit_t = t;
+        let Some(old) = &self.model else { return };
+        let ccf = masked_ccf(&self.history, self.config.max_lag_samples);
+        if !old.complete
+            && ccf.peak_lag_within(self.config.lag_tolerance) != old.lag_samples
+            && ccf_peak_value(&ccf) > ccf_peak_value(&old.ccf)
+        {
+            let final_upto = self.pending_from.saturating_sub(1);
+            if self.rebuild(t, final_upto, ccf) {
+                return;
+            }
+        }
+        let Some(old) = &self.model else { return };
+        let gain = old.turn_gain;
+        if let Ok(mut m) = TedrisModel::fit(
+            old.config.clone(),
+            old.sample_period_s,
+            old.lag_samples,
+            old.ccf.clone(),
+            old.repositories.clone(),
+        ) {
+            m.turn_gain = gain;
+            self.model = Some(m);
+        }
+        self.estimate_gain();
+        self.update_dcf(t);
+    }
+
+    fn estimate_gain(&mut self) {
+        let Some(model) = self.model.as_mut() else {
+            return;
+        };
+        if !model.config.turn_gain {
+            return;
+        }
+        let samples: Vec<Sample> = self.history.iter().copied().collect();
+        let seg = (model.config.gain_segment_s / model.sample_period_s).round() as usize;
+        if let Some(g) = crate::gain::estimate_turn_gain(model, &samples, seg) {
+            model.turn_gain = g;
+        }
+    }
+
+    /// Eq. (6): the DCF minimising the RMSE between the reference heading and the
+    /// DR heading over the last `update_window_s` (the constant offset removed).
+    fn update_dcf(&mut self, t: f64) {
+        self.last_update_t = t;
+        let Some(model) = self.model.as_mut() else {
+            return;
+        };
+        let tau = model.config.tau_samples;
+        let lag = model.lag_samples;
+        let t0 = t - model.config.update_window_s;
+        let samples: Vec<Sample> = self.history.iter().copied().collect();
+        let Some(first) = samples.iter().position(|s| s.t_s >= t0) else {
+            return;
+        };
+        let warm = first.saturating_sub(tau);
+        let mut p = Predictor::default();
+        let mut cum = Vec::with_capacity(samples.len() - warm);
+        let mut acc = 0.0;
+        for (k, s) in samples[warm..].iter().enumerate() {
+            let r = p.step(model, s.omega_m, s.dist_m, 0.0);
+            if warm + k >= first {
+                acc += r.base_rad;
+                cum.push(acc);
+            }
+        }
+        let win = &samples[first..];
+        let pairs: Vec<(usize, f64)> = win
+            .iter()
+            .enumerate()
+            .filter_map(|(j, s)| {
+                let th = s.theta_rad?;
+                let src = usize::try_from(j as i64 - lag)
+                    .ok()
+                    .filter(|&i| i < cum.len())?;
+                Some((src, th))
+            })
+            .collect();
+        if pairs.len() < 2 * tau.max(10) {
+            return;
+        }
+        let cost = |dcf: f64| {
+            let d: Vec<f64> = pairs
+                .iter()
+                .map(|&(i, th)| th - (cum[i] + dcf * (i + 1) as f64))
+                .collect();
+            let m = crate::stats::mean(&d);
+            (d.iter().map(|v| (v - m).powi(2)).sum::<f64>() / d.len() as f64).sqrt()
+        };
+        let (lo, hi) = (
+            model.dcf0_rad - model.dcf_bound_rad,
+            model.dcf0_rad + model.dcf_bound_rad,
+        );
+        let (x, _) = brent(cost, lo, hi, model.dcf_bound_rad * 1e-6, 200);
+        if x.is_finite() && model.config.dcf_update {
+            // dcf_smoothing = 1 is eq. (6) as in the paper; below 1 the new
+            // estimate is blended into the previous one.
+            let w = model.config.dcf_smoothing;
+            model.dcf_rad = w * x + (1.0 - w) * model.dcf_rad;
+        }
+    }
+}
+
+/// The heading offset from (t, reference − DR) pairs: their mean, or with
+/// `trend` the least-squares line through them evaluated at `t_now` (the DR
+/// heading may drift within the window, e.g. through a turn).
+fn anchor(pairs: &VecDeque<(f64, f64)>, t_now: f64, trend: bool) -> f64 {
+    let n = pairs.len() as f64;
+    let mt = pairs.iter().map(|p| p.0).sum::<f64>() / n;
+    let md = pairs.iter().map(|p| p.1).sum::<f64>() / n;
+    if !trend || pairs.len() < 10 {
+        return md;
+    }
+    let stt: f64 = pairs.iter().map(|p| (p.0 - mt).powi(2)).sum();
+    let std: f64 = pairs.iter().map(|p| (p.0 - mt) * (p.1 - md)).sum();
+    if stt <= 0.0 {
+        return md;
+    }
+    md + std / stt * (t_now - mt)
+}
+
+fn ccf_peak_value(c: &crate::ccf::CrossCorrelation) -> f64 {
+    c.values.iter().copied().fold(f64::MIN, f64::max)
+}
+
+/// The straight-line parameters from the blocks flagged straight; the quietest
+/// tenth of the blocks (smallest |γ|) stand in when fewer than 10 are flagged.
+pub fn straight_line(tuples: &[Tuple], epsilon_factor: Option<f64>) -> Option<StraightLine> {
+    let flagged: Vec<f64> = tuples
+        .iter()
+        .filter(|t| t.straight)
+        .map(|t| t.omega_m)
+        .collect();
+    if flagged.len() >= 10 {
+        return StraightLine::from_omegas(&flagged, epsilon_factor, false);
+    }
+    let mut by_gamma: Vec<&Tuple> = tuples.iter().collect();
+    by_gamma.sort_by(|a, b| a.gamma_rad.abs().total_cmp(&b.gamma_rad.abs()));
+    let k = (tuples.len() / 10).max(3).min(tuples.len());
+    let quiet: Vec<f64> = by_gamma[..k].iter().map(|t| t.omega_m).collect();
+    StraightLine::from_omegas(&quiet, epsilon_factor, true)
+}

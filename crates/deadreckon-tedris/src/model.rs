@@ -1,0 +1,509 @@
+//! The fitted TedriS model: the regressions of eq. (2)–(3) for each model kind,
+//! their residual analysis and AR/MA correction, the repository regressions, and
+//! the evaluation of the heading increment γ̂ of eq. (4).
+//!
+//! All regressions are on block medians in per-sample units: ω and d in metres per
+//! wheel sample, γ in radians per wheel sample. Because they are linear, a fit on
+//! block medians applies sample by sample: eq. (4) is evaluated at each wheel sample
+//! with that sample's ω and d, the repository being chosen by the median of the
+//! last τ samples of ω.
+
+use std::collections::BTreeMap;
+
+use serde::{Deserialize, Serialize};
+
+use crate::ccf::CrossCorrelation;
+use crate::config::{ModelChoice, ModelKind, RepositoryFit, TedrisConfig};
+use crate::repository::{Repositories, StraightLine, Tuple};
+use crate::residuals::{
+    box_pierce, ljung_box, select_correction, Correction, CorrectionFit, Portmanteau,
+};
+use crate::stats::{mean, ols, ols_eiv, OlsFit};
+use crate::Error;
+
+/// The design row of a tuple for a kind (`None` when ARX lacks the previous block).
+pub fn design_row(kind: ModelKind, t: &Tuple) -> Option<Vec<f64>> {
+    Some(match kind {
+        ModelKind::Paper => vec![1.0, t.omega_m],
+        ModelKind::Distance => vec![1.0, t.omega_m, t.dist_m],
+        ModelKind::Arx => {
+            let (wp, gp) = t.prev?;
+            vec![1.0, t.omega_m, t.dist_m, wp, gp]
+        }
+    })
+}
+
+/// The fit of one model kind: global regression, residual tests, correction and
+/// the repository regressions.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct KindFit {
+    /// The kind.
+    pub kind: ModelKind,
+    /// The regression on all tuples (the coefficient table).
+    pub global: OlsFit,
+    /// Box–Pierce test of the global residuals.
+    pub box_pierce: Portmanteau,
+    /// Ljung–Box test of the global residuals.
+    pub ljung_box: Portmanteau,
+    /// The AR/MA correction, when Ljung–Box rejected white residuals.
+    pub correction: Option<CorrectionFit>,
+    /// The regression refitted jointly with the correction terms (the paper's table 2).
+    pub corrected: Option<OlsFit>,
+    /// Coefficients of each repository's regression (same columns as `global`).
+    pub repositories: BTreeMap<i32, Vec<f64>>,
+    /// The global coefficients, used where no repository has a fit.
+    pub global_beta: Vec<f64>,
+    /// BIC of the simulation residuals: for ARX, γ_{k−1} is the model's own
+    /// previous output along each run of contiguous blocks, as in dead reckoning;
+    /// for the static kinds it is the BIC of the fit.
+    #[serde(default)]
+    pub sim_bic: f64,
+}
+
+impl KindFit {
+    /// The coefficients used for repository `n`: its own, else the nearest repository's, else the global ones.
+    pub fn beta(&self, n: i32) -> &[f64] {
+        if let Some(b) = self.repositories.get(&n) {
+            return b;
+        }
+        let lower = self.repositories.range(..n).next_back();
+        let upper = self.repositories.range(n..).next();
+        match (lower, upper) {
+            (Some((a, ba)), Some((b, bb))) => {
+                if n - a <= b - n {
+                    ba
+                } else {
+                    bb
+                }
+            }
+            (Some((_, b)), None) | (None, Some((_, b))) => b,
+            (None, None) => &self.global_beta,
+        }
+    }
+
+    /// The correction, `None` as [`Correction::None`].
+    pub fn correction(&self) -> Correction {
+        self.correction
+            .as_ref()
+            .map_or(Correction::None, |c| c.correction.clone())
+    }
+}
+
+/// Fits one kind on time-ordered tuples and the repositories.
+/// `omega_noise_var` is the variance of the noise of a block median of ω (m²),
+/// for the errors-in-variables correction of the ω columns (0: plain OLS).
+pub fn fit_kind(
+    kind: ModelKind,
+    tuples: &[Tuple],
+    repos: &Repositories,
+    cfg: &TedrisConfig,
+    omega_noise_var: f64,
+) -> Result<KindFit, Error> {
+    let rows: Vec<(Vec<f64>, f64)> = tuples
+        .iter()
+        .filter_map(|t| Some((design_row(kind, t)?, t.gamma_rad)))
+        .collect();
+    let (x, y): (Vec<Vec<f64>>, Vec<f64>) = rows.into_iter().unzip();
+    let names = kind.regressors();
+    let noise: Vec<f64> = names
+        .iter()
+        .map(|n| {
+            if *n == "alpha1" || *n == "omega_prev" {
+                omega_noise_var
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let global = ols_eiv(&x, &y, names, &noise)?;
+    let e = global.residuals(&x, &y);
+    let lags = cfg.portmanteau_lags.min(e.len() / 4).max(1);
+    let bp = box_pierce(&e, lags, 0);
+    let lb = ljung_box(&e, lags, 0);
+    let correction = if e.len() > 60 {
+        select_correction(&e, lags, cfg.alpha, cfg.max_correction_order)
+    } else {
+        None
+    };
+    let corrected = correction
+        .as_ref()
+        .and_then(|c| joint_refit(&x, &y, &e, &c.correction, names));
+    let beta_g = global.beta();
+    let mut repositories = BTreeMap::new();
+    for (&n, q) in &repos.bins {
+        let tq: Vec<&Tuple> = q.iter().collect();
+        let rows: Vec<(Vec<f64>, f64)> = tq
+            .iter()
+            .filter_map(|t| Some((design_row(kind, t)?, t.gamma_rad)))
+            .collect();
+        if rows.len() < 3 {
+            continue;
+        }
+        let beta = match cfg.repository_fit {
+            RepositoryFit::PooledSlopes => {
+                let offs: Vec<f64> = rows.iter().map(|(r, yv)| yv - dot(&beta_g, r)).collect();
+                let mut b = beta_g.clone();
+                b[0] += mean(&offs);
+                b
+            }
+            RepositoryFit::Separate => {
+                if rows.len() < names.len() + 3 {
+                    continue;
+                }
+                let (rx, ry): (Vec<Vec<f64>>, Vec<f64>) = rows.into_iter().unzip();
+                match ols_eiv(&rx, &ry, names, &noise) {
+                    Ok(f) => f.beta(),
+                    Err(_) => continue,
+                }
+            }
+        };
+        repositories.insert(n, beta);
+    }
+    let sim_bic = simulation_bic(kind, tuples, &beta_g, cfg.tau_samples as u64, global.bic);
+    Ok(KindFit {
+        kind,
+        global,
+        sim_bic,
+        box_pierce: bp,
+        ljung_box: lb,
+        correction,
+        corrected,
+        repositories,
+        global_beta: beta_g,
+    })
+}
+
+/// See [`KindFit::sim_bic`].
+fn simulation_bic(kind: ModelKind, tuples: &[Tuple], beta: &[f64], tau: u64, bic: f64) -> f64 {
+    if kind != ModelKind::Arx {
+        return bic;
+    }
+    let mut rss = 0.0;
+    let mut n = 0usize;
+    let mut last: Option<(u64, f64, f64)> = None;
+    for t in tuples {
+        let Some((wp, gp)) = t.prev else {
+            last = None;
+            continue;
+        };
+        let gp = match last {
+            Some((seq, _, g)) if seq + tau == t.seq => g,
+            _ => gp,
+        };
+        let pred = beta[0] + beta[1] * t.omega_m + beta[2] * t.dist_m + beta[3] * wp + beta[4] * gp;
+        rss += (t.gamma_rad - pred).powi(2);
+        n += 1;
+        last = Some((t.seq, t.omega_m, pred));
+    }
+    if n == 0 {
+        return f64::MAX;
+    }
+    let p = beta.len() as f64;
+    n as f64 * (rss.max(f64::MIN_POSITIVE) / n as f64).ln() + p * (n as f64).ln()
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+/// Regression with the correction terms as extra columns (lagged residuals for
+/// AR, lagged long-AR innovations for MA), as in the paper's table 2.
+fn joint_refit(
+    x: &[Vec<f64>],
+    y: &[f64],
+    e: &[f64],
+    c: &Correction,
+    names: &[&str],
+) -> Option<OlsFit> {
+    let (extra, label, start): (Vec<f64>, &str, usize) = match c {
+        Correction::None => return None,
+        Correction::Ar { phi } => (e.to_vec(), "ar", phi.len()),
+        Correction::Ma { theta } => {
+            let m = (theta.len() * 3).max(6);
+            let u = crate::residuals::long_ar_innovations(e, m).ok()?;
+            (u, "ma", m + theta.len())
+        }
+    };
+    let order = c.order();
+    let mut all_names: Vec<String> = names.iter().map(|s| s.to_string()).collect();
+    all_names.extend((1..=order).map(|i| format!("{label}{i}")));
+    let refs: Vec<&str> = all_names.iter().map(String::as_str).collect();
+    let rows: Vec<Vec<f64>> = (start..x.len())
+        .map(|t| {
+            let mut r = x[t].clone();
+            r.extend((1..=order).map(|i| extra[t - i]));
+            r
+        })
+        .collect();
+    ols(&rows, &y[start..], &refs).ok()
+}
+
+/// A trained TedriS model: what `tedris train` writes and `tedris run` reads.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TedrisModel {
+    /// The configuration it was trained with.
+    pub config: TedrisConfig,
+    /// Wheel sample period, s (median).
+    pub sample_period_s: f64,
+    /// h: lag of the cross-correlation peak, samples (γ_t responds to ω_{t−h}).
+    pub lag_samples: i64,
+    /// The cross-correlation of ω and γ over the lag window.
+    pub ccf: CrossCorrelation,
+    /// The training repositories (tuples and binning: µ, W_L, W_H, ε).
+    pub repositories: Repositories,
+    /// The fit of every kind, in [`ModelKind::ALL`] order.
+    pub fits: Vec<KindFit>,
+    /// The kind used for prediction.
+    pub chosen: ModelKind,
+    /// DCF₀: the dynamic correction factor's starting value, rad per sample
+    /// (the straight-line mean residual: µ carried into heading units).
+    pub dcf0_rad: f64,
+    /// DCF: the dynamic correction factor of eq. (4), rad per sample.
+    pub dcf_rad: f64,
+    /// Half-width of the DCF search interval, rad per sample.
+    pub dcf_bound_rad: f64,
+    /// The expected ω on a straight line, `c0 + c1·d` (m per sample): an OLS of the
+    /// straight blocks' ω on their d (the tyre-radius bias grows with speed).
+    pub straight_omega: (f64, f64),
+    /// Robust standard deviation (1.4826 × MAD) of the straight blocks' ω about
+    /// `straight_omega`, m per sample: the half-width of the dead band is
+    /// `straight_band_sigmas` times it.
+    pub straight_sigma_m: f64,
+    /// Every required repository reached its minimum fill.
+    pub complete: bool,
+    /// g: gain on the turning part of γ̂ (1 = the regression as fitted), estimated
+    /// from the heading change over whole segments (see [`crate::gain`]).
+    #[serde(default = "one")]
+    pub turn_gain: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+impl TedrisModel {
+    /// Fits every kind on the repositories and chooses one.
+    pub fn fit(
+        config: TedrisConfig,
+        sample_period_s: f64,
+        lag_samples: i64,
+        ccf: CrossCorrelation,
+        repositories: Repositories,
+    ) -> Result<Self, Error> {
+        let tuples = repositories.all_sorted();
+        // Compare the kinds on the same tuples: those with a contiguous previous block.
+        let common: Vec<Tuple> = tuples
+            .iter()
+            .filter(|t| t.prev.is_some())
+            .copied()
+            .collect();
+        let base = if common.len() > 20 { &common } else { &tuples };
+        let (straight_omega, straight_sigma_m) = straight_stats(&repositories);
+        let noise_var = if config.eiv_correction {
+            straight_sigma_m * straight_sigma_m
+        } else {
+            0.0
+        };
+        let mut fits = Vec::new();
+        for kind in ModelKind::ALL {
+            match fit_kind(kind, base, &repositories, &config, noise_var) {
+                Ok(f) => fits.push(f),
+                Err(e) if kind == ModelKind::Paper => return Err(e),
+                Err(_) => {}
+            }
+        }
+        let chosen = match config.model {
+            ModelChoice::Fixed(k) if fits.iter().any(|f| f.kind == k) => k,
+            ModelChoice::Fixed(k) => {
+                return Err(Error::Regression(format!(
+                    "the {} model could not be fitted",
+                    k.name()
+                )))
+            }
+            ModelChoice::Auto => choose(&fits),
+        };
+        let mut m = TedrisModel {
+            complete: repositories.complete(config.required_bins),
+            config,
+            sample_period_s,
+            lag_samples,
+            ccf,
+            repositories,
+            fits,
+            chosen,
+            dcf0_rad: 0.0,
+            dcf_rad: 0.0,
+            dcf_bound_rad: 0.0,
+            straight_omega,
+            straight_sigma_m,
+            turn_gain: 1.0,
+        };
+        m.set_dcf0();
+        Ok(m)
+    }
+
+    fn set_dcf0(&mut self) {
+        let f = self.chosen_fit();
+        let straight: Vec<f64> = self
+            .repositories
+            .all_sorted()
+            .iter()
+            .filter(|t| t.straight)
+            .filter_map(|t| {
+                let mut t = *t;
+                t.omega_m = self.effective_omega(t.omega_m, t.omega_m, t.dist_m);
+                let r = design_row(f.kind, &t)?;
+                let n = self.repositories.straight.bin(t.omega_m)?;
+                Some(t.gamma_rad - dot(f.beta(n), &r))
+            })
+            .collect();
+        let slope = f
+            .global
+            .coefficients
+            .get(1)
+            .map_or(0.0, |c| c.estimate.abs());
+        self.dcf0_rad = if straight.is_empty() {
+            0.0
+        } else {
+            crate::stats::median(&straight)
+        };
+        let s = &self.repositories.straight;
+        self.dcf_bound_rad =
+            (self.config.dcf_bound_factor * slope * (s.w_high_m - s.w_low_m)).max(1e-6);
+        self.dcf_rad = self.dcf0_rad;
+    }
+
+    /// The ω used in eq. (4) for a sample: its own, or, when the block median
+    /// `median_m` lies in the straight-line dead band (and `straight_band` is on),
+    /// the straight-line ω: that band is noise around a straight line, so the
+    /// heading advances by the straight-line rate instead of integrating the noise.
+    ///
+    /// The band is the paper's straight-line noise band [W_L, W_H] made robust and
+    /// speed-aware: centred on the expected straight-line ω at this distance per
+    /// sample, `c0 + c1·d` (the Paper kind: µ), half-width `straight_band_sigmas`
+    /// robust standard deviations of the straight blocks.
+    pub fn effective_omega(&self, omega_m: f64, median_m: f64, dist_m: f64) -> f64 {
+        if !self.config.straight_band {
+            return omega_m;
+        }
+        let centre = self.straight_centre(dist_m);
+        if (median_m - centre).abs() <= self.config.straight_band_sigmas * self.straight_sigma_m {
+            centre
+        } else {
+            omega_m
+        }
+    }
+
+    /// The expected ω on a straight line at `dist_m` per sample, m per sample
+    /// (`c0 + c1·d`; µ for the Paper kind, which knows no speed).
+    pub fn straight_centre(&self, dist_m: f64) -> f64 {
+        match self.chosen {
+            ModelKind::Paper => self.repositories.straight.mu_m,
+            _ => self.straight_omega.0 + self.straight_omega.1 * dist_m,
+        }
+    }
+
+    /// The fit of the chosen kind.
+    pub fn chosen_fit(&self) -> &KindFit {
+        self.fits
+            .iter()
+            .find(|f| f.kind == self.chosen)
+            .unwrap_or(&self.fits[0])
+    }
+
+    /// The straight-line parameters.
+    pub fn straight(&self) -> &StraightLine {
+        &self.repositories.straight
+    }
+
+    /// Checks a loaded model is usable (non-empty fits, finite numbers).
+    pub fn validate(&self) -> Result<(), Error> {
+        self.config.validate()?;
+        if self.fits.is_empty() || !self.fits.iter().any(|f| f.kind == self.chosen) {
+            return Err(Error::Model(
+                "the model has no fit for its chosen kind".into(),
+            ));
+        }
+        let p = |f: &KindFit| f.kind.regressors().len();
+        let consistent = self.fits.iter().all(|f| {
+            f.global.coefficients.iter().all(|c| c.estimate.is_finite())
+                && f.global_beta.len() == p(f)
+                && f.global_beta.iter().all(|v| v.is_finite())
+                && f.repositories.values().flatten().all(|v| v.is_finite())
+                && f.repositories
+                    .values()
+                    .all(|b| b.len() == f.kind.regressors().len())
+                && f.global.coefficients.len() == f.kind.regressors().len()
+        });
+        let scalars = [
+            self.dcf_rad,
+            self.dcf0_rad,
+            self.dcf_bound_rad,
+            self.straight_sigma_m,
+            self.straight_omega.0,
+            self.straight_omega.1,
+        ];
+        let ok = consistent
+            && scalars.iter().all(|v| v.is_finite())
+            && self.sample_period_s.is_finite()
+            && self.sample_period_s > 0.0
+            && self.turn_gain.is_finite()
+            && self.turn_gain > 0.0;
+        if !ok {
+            return Err(Error::Model(
+                "the model holds non-finite or inconsistent values".into(),
+            ));
+        }
+        if self.lag_samples.unsigned_abs() > 10_000 {
+            return Err(Error::Model(format!(
+                "lag {} is out of range",
+                self.lag_samples
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// The straight-line ω model `c0 + c1·d` (OLS over the straight blocks; µ and 0
+/// when fewer than 10) and the robust standard deviation about it (1.4826 × MAD).
+fn straight_stats(repos: &Repositories) -> ((f64, f64), f64) {
+    let st: Vec<Tuple> = repos
+        .all_sorted()
+        .into_iter()
+        .filter(|t| t.straight)
+        .collect();
+    let x: Vec<Vec<f64>> = st.iter().map(|t| vec![1.0, t.dist_m]).collect();
+    let y: Vec<f64> = st.iter().map(|t| t.omega_m).collect();
+    let (c0, c1) = match ols(&x, &y, &["c0", "c1"]) {
+        Ok(f) if st.len() >= 10 => (f.coefficients[0].estimate, f.coefficients[1].estimate),
+        _ => (repos.straight.mu_m, 0.0),
+    };
+    let dev: Vec<f64> = st
+        .iter()
+        .map(|t| (t.omega_m - c0 - c1 * t.dist_m).abs())
+        .collect();
+    let sigma = if dev.len() >= 10 {
+        1.4826 * crate::stats::median(&dev)
+    } else {
+        0.25 * (repos.straight.w_high_m - repos.straight.w_low_m)
+    };
+    ((c0, c1), sigma)
+}
+
+/// The automatic choice: smallest simulation BIC among kinds whose final
+/// innovations pass Ljung–Box (p ≥ 0.01), else smallest simulation BIC.
+fn choose(fits: &[KindFit]) -> ModelKind {
+    let white = |f: &KindFit| match &f.correction {
+        None => true,
+        Some(c) => c.ljung_box.p_value >= 0.01,
+    };
+    let best = |pred: &dyn Fn(&KindFit) -> bool| {
+        fits.iter()
+            .filter(|f| pred(f))
+            .min_by(|a, b| a.sim_bic.total_cmp(&b.sim_bic))
+            .map(|f| f.kind)
+    };
+    best(&white)
+        .or_else(|| best(&|_| true))
+        .unwrap_or(ModelKind::Paper)
+}

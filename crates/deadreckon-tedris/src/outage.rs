@@ -1,0 +1,344 @@
+//! Batch use over a whole drive: training ([`train`]) and prediction through
+//! GNSS outages with the errors of figures 6 and 7 ([`run_outages`]).
+//!
+//! The error reference, in order of preference:
+//! - `truth`: `truth.csv` (rear-axle centre), interpolated at each estimate;
+//! - `truth aligned at outage start`: for drives without GNSS positions (the robot),
+//!   both tracks are translated to agree at the outage start, so the error is the
+//!   dead-reckoning drift during the outage;
+//! - `hidden gnss`: the blanked fixes, moved from the antenna to the rear-axle
+//!   centre with the lever arm along the course (or the estimated yaw).
+
+use serde::{Deserialize, Serialize};
+
+use deadreckon_core::drive::Drive;
+use deadreckon_core::{Track, TrackPoint};
+
+use crate::config::TedrisConfig;
+use crate::input::{drive_input, Event, ReferenceSource};
+use crate::machine::{Estimate, Phase, Tedris};
+use crate::model::TedrisModel;
+use crate::Error;
+
+/// A GNSS outage window, s (drive clock).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Outage {
+    /// Start, s.
+    pub start_s: f64,
+    /// End, s.
+    pub end_s: f64,
+}
+
+impl std::str::FromStr for Outage {
+    type Err = Error;
+    /// Parses `START_S:END_S`.
+    fn from_str(s: &str) -> Result<Self, Error> {
+        let bad = || {
+            Error::Config(format!(
+                "outage `{s}` is not START_S:END_S with START_S < END_S"
+            ))
+        };
+        let (a, b) = s.split_once(':').ok_or_else(bad)?;
+        let start_s: f64 = a.trim().parse().map_err(|_| bad())?;
+        let end_s: f64 = b.trim().parse().map_err(|_| bad())?;
+        if !(start_s.is_finite() && end_s.is_finite() && start_s < end_s) {
+            return Err(bad());
+        }
+        Ok(Outage { start_s, end_s })
+    }
+}
+
+/// The errors over one outage.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct OutageError {
+    /// Start, s.
+    pub start_s: f64,
+    /// End, s.
+    pub end_s: f64,
+    /// Mean horizontal error, m.
+    pub mean_error_m: f64,
+    /// Largest horizontal error, m.
+    pub max_error_m: f64,
+    /// Error at the last estimate of the outage, m.
+    pub final_error_m: f64,
+    /// Time from the outage start until the error first exceeds 1 m, s (`None`: never).
+    pub time_to_1m_s: Option<f64>,
+    /// The threshold of `time_to_threshold_s`, m (1 m for a car; 0.159 m for the paper's robot).
+    pub threshold_m: f64,
+    /// Time from the outage start until the error first exceeds `threshold_m`, s (`None`: never).
+    pub time_to_threshold_s: Option<f64>,
+    /// Points compared.
+    pub points: usize,
+    /// Estimates of the outage made while the machine was predicting with a model.
+    pub predicted_fraction: f64,
+}
+
+/// The result of [`run_outages`].
+#[derive(Debug, Clone)]
+pub struct OutageReport {
+    /// What the errors are measured against (`truth`, `truth aligned at outage start`, `hidden gnss`).
+    pub reference: String,
+    /// The reference heading source used.
+    pub source: ReferenceSource,
+    /// One entry per outage.
+    pub outages: Vec<OutageError>,
+    /// The estimated track over the whole drive (covariances are not estimated: zeros).
+    pub track: Track,
+    /// The phase after each track point.
+    pub phases: Vec<Phase>,
+    /// The machine at the end of the drive (model retrained on this drive included).
+    pub machine: Tedris,
+}
+
+/// Options of a run.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct RunOptions {
+    /// Reference heading source (default: [`ReferenceSource::auto`]).
+    pub source: Option<ReferenceSource>,
+    /// The error threshold reported as `time_to_threshold_s`, m (default 1).
+    pub threshold_m: Option<f64>,
+}
+
+fn feed(machine: &mut Tedris, events: &[Event]) -> Vec<Estimate> {
+    let mut out = Vec::new();
+    for e in events {
+        // Invalid samples are counted by the machine and skipped.
+        match e {
+            Event::Wheel(w) => {
+                if let Ok(est) = machine.push_wheel(*w) {
+                    out.push(est);
+                }
+            }
+            Event::Heading(h) => {
+                let _ = machine.push_heading(*h);
+            }
+            Event::Fix(f) => {
+                let _ = machine.push_fix(*f);
+            }
+        }
+    }
+    out
+}
+
+/// Trains a model over a whole drive (GNSS or gyro good throughout).
+pub fn train(
+    drive: &Drive,
+    config: TedrisConfig,
+    source: Option<ReferenceSource>,
+) -> Result<(TedrisModel, ReferenceSource), Error> {
+    let input = drive_input(drive, source, &[])?;
+    let mut m = Tedris::new(config, input.geometry)?;
+    if let Some((e, n, y)) = input.initial_pose {
+        m.set_pose(e, n, y);
+    }
+    feed(&mut m, &input.events);
+    let model = m.model().cloned().ok_or_else(|| {
+        Error::Insufficient(
+            "not enough synchronised samples with a reference heading to train (see init_samples)"
+                .into(),
+        )
+    })?;
+    let refit = TedrisModel::fit(
+        model.config.clone(),
+        model.sample_period_s,
+        model.lag_samples,
+        model.ccf.clone(),
+        model.repositories.clone(),
+    )
+    .map(|mut f| {
+        f.dcf_rad = model.dcf_rad;
+        f.turn_gain = model.turn_gain;
+        f
+    })
+    .unwrap_or(model);
+    Ok((refit, input.source))
+}
+
+/// Runs a drive with GNSS blanked in `outages`, starting from `model`, and
+/// measures the error over each outage.
+pub fn run_outages(
+    drive: &Drive,
+    model: &TedrisModel,
+    outages: &[Outage],
+) -> Result<OutageReport, Error> {
+    run_outages_with(drive, model, outages, &RunOptions::default())
+}
+
+/// [`run_outages`] with options.
+pub fn run_outages_with(
+    drive: &Drive,
+    model: &TedrisModel,
+    outages: &[Outage],
+    opts: &RunOptions,
+) -> Result<OutageReport, Error> {
+    let windows: Vec<(f64, f64)> = outages.iter().map(|o| (o.start_s, o.end_s)).collect();
+    let input = drive_input(drive, opts.source, &windows)?;
+    let mut m = Tedris::with_model(model.clone(), input.geometry)?;
+    if let Some((e, n, y)) = input.initial_pose {
+        m.set_pose(e, n, y);
+    }
+    let est = feed(&mut m, &input.events);
+    let points: Vec<TrackPoint> = est
+        .iter()
+        .map(|e| TrackPoint {
+            t_s: e.t_s,
+            east_m: e.east_m,
+            north_m: e.north_m,
+            yaw_rad: e.yaw_rad,
+            speed_mps: e.speed_mps,
+            yaw_rate_rps: e.yaw_rate_rps,
+            cov_pose: [0.0; 9],
+        })
+        .collect();
+    let phases: Vec<Phase> = est.iter().map(|e| e.phase).collect();
+    let threshold = opts.threshold_m.unwrap_or(1.0);
+    let (reference, errors) = if drive.truth.len() >= 2 {
+        let aligned = drive.gnss.is_empty() || input.source == ReferenceSource::Gyro;
+        let name = if aligned {
+            "truth aligned at outage start"
+        } else {
+            "truth"
+        };
+        (
+            name.to_string(),
+            outages
+                .iter()
+                .map(|o| truth_errors(drive, &points, &phases, o, aligned, threshold))
+                .collect(),
+        )
+    } else {
+        (
+            "hidden gnss".to_string(),
+            outages
+                .iter()
+                .map(|o| gnss_errors(drive, &points, &phases, o, threshold))
+                .collect(),
+        )
+    };
+    Ok(OutageReport {
+        reference,
+        source: input.source,
+        outages: errors,
+        track: Track {
+            name: "tedris".into(),
+            points,
+            origin: drive.vehicle.origin,
+        },
+        phases,
+        machine: m,
+    })
+}
+
+fn interp_truth(drive: &Drive, t: f64) -> Option<(f64, f64)> {
+    let tr = &drive.truth;
+    let i = tr.partition_point(|p| p.t_s < t);
+    if i == 0 || i >= tr.len() {
+        return tr
+            .get(i)
+            .filter(|p| (p.t_s - t).abs() < 1e-9)
+            .map(|p| (p.east_m, p.north_m));
+    }
+    let (a, b) = (&tr[i - 1], &tr[i]);
+    let f = (t - a.t_s) / (b.t_s - a.t_s);
+    Some((
+        a.east_m + f * (b.east_m - a.east_m),
+        a.north_m + f * (b.north_m - a.north_m),
+    ))
+}
+
+fn summarise(
+    o: &Outage,
+    errs: &[(f64, f64)],
+    predicted: usize,
+    total: usize,
+    threshold: f64,
+) -> OutageError {
+    let first_above = |th: f64| errs.iter().find(|e| e.1 > th).map(|e| e.0 - o.start_s);
+    let n = errs.len();
+    OutageError {
+        start_s: o.start_s,
+        end_s: o.end_s,
+        mean_error_m: if n > 0 {
+            errs.iter().map(|e| e.1).sum::<f64>() / n as f64
+        } else {
+            f64::NAN
+        },
+        max_error_m: errs.iter().map(|e| e.1).fold(f64::NAN, f64::max),
+        final_error_m: errs.last().map_or(f64::NAN, |e| e.1),
+        time_to_1m_s: first_above(1.0),
+        threshold_m: threshold,
+        time_to_threshold_s: first_above(threshold),
+        points: n,
+        predicted_fraction: if total > 0 {
+            predicted as f64 / total as f64
+        } else {
+            0.0
+        },
+    }
+}
+
+fn truth_errors(
+    drive: &Drive,
+    pts: &[TrackPoint],
+    phases: &[Phase],
+    o: &Outage,
+    aligned: bool,
+    threshold: f64,
+) -> OutageError {
+    let mut errs = Vec::new();
+    let mut offset: Option<(f64, f64)> = None;
+    let (mut pred, mut total) = (0, 0);
+    for (p, ph) in pts.iter().zip(phases) {
+        if p.t_s < o.start_s || p.t_s >= o.end_s {
+            continue;
+        }
+        let Some((te, tn)) = interp_truth(drive, p.t_s) else {
+            continue;
+        };
+        total += 1;
+        pred += usize::from(*ph == Phase::Predicting);
+        let (oe, on) = if aligned {
+            *offset.get_or_insert((te - p.east_m, tn - p.north_m))
+        } else {
+            (0.0, 0.0)
+        };
+        errs.push((p.t_s, (p.east_m + oe - te).hypot(p.north_m + on - tn)));
+    }
+    summarise(o, &errs, pred, total, threshold)
+}
+
+fn gnss_errors(
+    drive: &Drive,
+    pts: &[TrackPoint],
+    phases: &[Phase],
+    o: &Outage,
+    threshold: f64,
+) -> OutageError {
+    let l = drive.vehicle.gnss_lever_arm_m;
+    let mut errs = Vec::new();
+    let (mut pred, mut total) = (0, 0);
+    for g in drive
+        .gnss
+        .iter()
+        .filter(|g| g.t_s >= o.start_s && g.t_s < o.end_s)
+    {
+        let i = pts.partition_point(|p| p.t_s < g.t_s);
+        let Some(p) = pts
+            .get(i.saturating_sub(1))
+            .filter(|p| (p.t_s - g.t_s).abs() < 0.5)
+        else {
+            continue;
+        };
+        total += 1;
+        pred += usize::from(phases[i.saturating_sub(1)] == Phase::Predicting);
+        let yaw = g.course_yaw_rad().unwrap_or(p.yaw_rad);
+        let (me, mn) = (g.east_m - l * yaw.cos(), g.north_m - l * yaw.sin());
+        let ahead = (g.t_s - p.t_s) * p.speed_mps;
+        errs.push((
+            g.t_s,
+            (p.east_m + ahead * p.yaw_rad.cos() - me)
+                .hypot(p.north_m + ahead * p.yaw_rad.sin() - mn),
+        ));
+    }
+    summarise(o, &errs, pred, total, threshold)
+}
