@@ -10,6 +10,7 @@
 #   3. takes a screenshot.
 #
 # Usage: tests/report_chromium.sh REPORT.html OUT.png [WINDOW_HEIGHT_PX]
+# Also writes OUT-<section>.png, one screenshot per report section.
 # Exit status: 0 when every figure has data and there are no errors, 1 otherwise,
 # 2 on bad usage or when Chromium is missing.
 set -euo pipefail
@@ -84,4 +85,18 @@ if [[ ! -s $png ]]; then
 else
     echo "screenshot: $png"
 fi
+# Chromium draws nothing below about 16k pixels of a headless screenshot, so a
+# long report is also shot one section at a time (the others hidden), for people
+# to look at: OUT-<section>.png.
+for id in $(grep -o '<section id="[a-z0-9-]*"' "$html" | sed 's/.*id="\([^"]*\)"/\1/'); do
+    one="$work/section-$id.html"
+    sed "s#</head>#<style>section:not(\#$id){display:none !important}</style></head>#" "$html" >"$one"
+    shot="${png%.png}-$id.png"
+    if run_chromium --screenshot="$shot" --window-size="1200,$height" "file://$one" >/dev/null 2>&1 && [[ -s $shot ]]; then
+        echo "section screenshot: $shot"
+    else
+        echo "FAIL: no screenshot of section $id" >&2
+        status=1
+    fi
+done
 exit $status
