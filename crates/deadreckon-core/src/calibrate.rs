@@ -437,6 +437,9 @@ pub fn least_squares(
     let mut circ = nominal.circumferences();
     let mut circ_std = [0.0; 4];
     for i in 0..4 {
+        if !v.wheels_present[i] {
+            continue;
+        }
         if let Some((k, sk, n)) = ls_1d(&pairs[i]) {
             if k > 0.0 {
                 circ[i] = 1.0 / k;

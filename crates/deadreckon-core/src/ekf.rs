@@ -295,6 +295,7 @@ struct Filter<'a, const N: usize> {
     opts: &'a FilterOptions,
     out: FilterOutput<N>,
     consecutive_rejections: u32,
+    wheels_present: [bool; 4],
 }
 
 impl<const N: usize> Filter<'_, N> {
@@ -398,6 +399,9 @@ impl<const N: usize> Filter<'_, N> {
                 let r = rows[k];
                 let r2 = self.noise.wheel_ticks.powi(2);
                 for (i, z) in [r.fl, r.fr, r.rl, r.rr].into_iter().enumerate() {
+                    if !self.wheels_present[i] {
+                        continue;
+                    }
                     let pred = self.sensors.wheel_ticks(&self.car(), i, interval);
                     // ∂h/∂(1/ρ_i) = h·ρ_i: the model is linear in the inverse circumference.
                     let d = pred.0 / self.sensors.inv_circumference[i];
@@ -663,6 +667,7 @@ fn run_generic<const N: usize>(
         opts,
         out: FilterOutput::default(),
         consecutive_rejections: 0,
+        wheels_present: drive.vehicle.wheels_present,
     };
     let wheels = &drive.wheels;
     let max_interval = 5.0 * median_interval(wheels);

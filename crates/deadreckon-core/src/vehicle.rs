@@ -71,6 +71,14 @@ impl Default for Noise {
     }
 }
 
+fn all_wheels() -> [bool; 4] {
+    [true; 4]
+}
+
+fn is_all_wheels(w: &[bool; 4]) -> bool {
+    w.iter().all(|p| *p)
+}
+
 /// The vehicle: geometry (figure 1 of the paper), nominal parameters and noise.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -89,6 +97,11 @@ pub struct Vehicle {
     pub wheel_circumference_m: f64,
     /// r_s: steering wheel angle / virtual front wheel angle.
     pub steering_ratio: f64,
+    /// Which wheels carry a sensor, FL, FR, RL, RR (default: all four). The
+    /// columns of an absent wheel are ignored by the filter and the calibration
+    /// (e.g. a tricycle's single traction encoder, written as FL).
+    #[serde(default = "all_wheels", skip_serializing_if = "is_all_wheels")]
+    pub wheels_present: [bool; 4],
     /// Origin for drives in latitude/longitude (otherwise the first fix is the origin).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub origin: Option<Origin>,
@@ -109,6 +122,7 @@ impl Vehicle {
             ticks_per_rev: 48,
             wheel_circumference_m: 1.92,
             steering_ratio: 15.9,
+            wheels_present: [true; 4],
             origin: None,
             noise: Noise::default(),
         }
@@ -133,6 +147,11 @@ impl Vehicle {
         if !self.gnss_lever_arm_m.is_finite() {
             return Err(Error::InvalidVehicle(
                 "gnss_lever_arm_m must be finite".into(),
+            ));
+        }
+        if !self.wheels_present.iter().any(|p| *p) {
+            return Err(Error::InvalidVehicle(
+                "wheels_present must name at least one wheel".into(),
             ));
         }
         if self.ticks_per_rev == 0 {

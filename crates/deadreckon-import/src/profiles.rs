@@ -33,6 +33,7 @@ pub fn toyota_rav4() -> Vehicle {
         ticks_per_rev: 48,
         wheel_circumference_m: std::f64::consts::PI * (17.0 * 0.0254 + 2.0 * 0.65 * 0.225),
         steering_ratio: 14.5,
+        wheels_present: [true; 4],
         origin: None,
         noise: Noise::default(),
     }

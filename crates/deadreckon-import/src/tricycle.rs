@@ -408,6 +408,7 @@ pub fn vehicle_from_header(h: &TricycleHeader) -> Vehicle {
         } else {
             f64::INFINITY
         },
+        wheels_present: [true, false, false, false],
         origin: None,
         noise: Noise::default(),
     }
