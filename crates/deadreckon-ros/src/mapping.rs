@@ -239,6 +239,7 @@ pub fn differential_vehicle(track_m: f64, wheel_radius_m: f64) -> Vehicle {
         ticks_per_rev: 1,
         wheel_circumference_m: 2.0 * std::f64::consts::PI * wheel_radius_m,
         steering_ratio: 1.0,
+        wheels_present: [true; 4],
         origin: None,
         noise: Noise::default(),
     }
