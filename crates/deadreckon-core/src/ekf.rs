@@ -486,6 +486,36 @@ impl<const N: usize> Filter<'_, N> {
         Ok(())
     }
 
+    /// Eq. (4): one gyro reading.
+    fn gyro(&mut self, value: f64) -> Result<(), Error> {
+        let pred = self.sensors.gyro(&self.car());
+        let r = self.noise.gyro_rps.powi(2);
+        self.scalar(SensorKind::Gyro, value, pred, r, Some((0, 1.0)))?;
+        self.out.stats.gyro_updates += 1;
+        Ok(())
+    }
+
+    /// Eq. (5): one CAN speed reading.
+    fn can_speed(&mut self, value: f64) -> Result<(), Error> {
+        let pred = self.sensors.can_speed(&self.car());
+        let r = self.noise.speed_mps.powi(2);
+        let d_scale = self.x[V];
+        self.scalar(SensorKind::Speed, value, pred, r, Some((1, d_scale)))?;
+        self.out.stats.speed_updates += 1;
+        Ok(())
+    }
+
+    /// Eq. (7): one steering-wheel reading, with the prior speed.
+    fn steering(&mut self, steering_wheel_rad: f64) -> Result<(), Error> {
+        let (z, r) =
+            self.sensors
+                .steering_measurement(steering_wheel_rad, self.x[V], self.noise.steering);
+        let pred = self.sensors.steering(&self.car());
+        self.scalar(SensorKind::Steering, z, pred, r, None)?;
+        self.out.stats.steering_updates += 1;
+        Ok(())
+    }
+
     fn record(&mut self, pred: (SVector<f64, N>, SMatrix<f64, N, N>, SMatrix<f64, N, N>)) {
         self.out.stats.epochs += 1;
         if self.opts.record_epochs {
@@ -693,9 +723,6 @@ fn run_generic<const N: usize>(
     let mut gnss = Cursor {
         next: drive.gnss.partition_point(|s| s.t_s <= t0),
     };
-    let beta_steer = f.noise.steering;
-    let r_gyro = f.noise.gyro_rps.powi(2);
-    let r_speed = f.noise.speed_mps.powi(2);
 
     match opts.timing {
         Timing::WheelEpochs => {
@@ -711,38 +738,17 @@ fn run_generic<const N: usize>(
                 let (gi, n) = gyro.advance(|i| drive.yaw_rate[i].t_s, drive.yaw_rate.len(), t);
                 if let (Some(i), true) = (gi, use_.gyro) {
                     f.out.stats.readings_superseded += n - 1;
-                    let pred = f.sensors.gyro(&f.car());
-                    f.scalar(
-                        SensorKind::Gyro,
-                        drive.yaw_rate[i].value,
-                        pred,
-                        r_gyro,
-                        Some((0, 1.0)),
-                    )?;
-                    f.out.stats.gyro_updates += 1;
+                    f.gyro(drive.yaw_rate[i].value)?;
                 }
                 let (si, n) = speed.advance(|i| drive.speed[i].t_s, drive.speed.len(), t);
                 if let (Some(i), true) = (si, use_.speed) {
                     f.out.stats.readings_superseded += n - 1;
-                    let pred = f.sensors.can_speed(&f.car());
-                    f.scalar(
-                        SensorKind::Speed,
-                        drive.speed[i].value,
-                        pred,
-                        r_speed,
-                        Some((1, f.x[V])),
-                    )?;
-                    f.out.stats.speed_updates += 1;
+                    f.can_speed(drive.speed[i].value)?;
                 }
                 let (di, n) = steer.advance(|i| drive.steering[i].t_s, drive.steering.len(), t);
                 if let (Some(i), true) = (di, use_.steering) {
                     f.out.stats.readings_superseded += n - 1;
-                    let (z, r) =
-                        f.sensors
-                            .steering_measurement(drive.steering[i].value, f.x[V], beta_steer);
-                    let pred = f.sensors.steering(&f.car());
-                    f.scalar(SensorKind::Steering, z, pred, r, None)?;
-                    f.out.stats.steering_updates += 1;
+                    f.steering(drive.steering[i].value)?;
                 }
                 let start = gnss.next;
                 let (last, _) = gnss.advance(|i| drive.gnss[i].t_s, drive.gnss.len(), t);
@@ -824,43 +830,13 @@ fn run_generic<const N: usize>(
                 }
             }
             evs.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-            let _ = (&mut gyro, &mut speed, &mut steer, &mut gnss);
             for (t, _, ev) in evs {
                 let pred = f.predict(t);
                 match ev {
                     Ev::Wheel(k) => f.wheels(wheels, k, max_interval)?,
-                    Ev::Gyro(i) => {
-                        let pred = f.sensors.gyro(&f.car());
-                        f.scalar(
-                            SensorKind::Gyro,
-                            drive.yaw_rate[i].value,
-                            pred,
-                            r_gyro,
-                            Some((0, 1.0)),
-                        )?;
-                        f.out.stats.gyro_updates += 1;
-                    }
-                    Ev::Speed(i) => {
-                        let pred = f.sensors.can_speed(&f.car());
-                        f.scalar(
-                            SensorKind::Speed,
-                            drive.speed[i].value,
-                            pred,
-                            r_speed,
-                            Some((1, f.x[V])),
-                        )?;
-                        f.out.stats.speed_updates += 1;
-                    }
-                    Ev::Steer(i) => {
-                        let (z, r) = f.sensors.steering_measurement(
-                            drive.steering[i].value,
-                            f.x[V],
-                            beta_steer,
-                        );
-                        let pred = f.sensors.steering(&f.car());
-                        f.scalar(SensorKind::Steering, z, pred, r, None)?;
-                        f.out.stats.steering_updates += 1;
-                    }
+                    Ev::Gyro(i) => f.gyro(drive.yaw_rate[i].value)?,
+                    Ev::Speed(i) => f.can_speed(drive.speed[i].value)?,
+                    Ev::Steer(i) => f.steering(drive.steering[i].value)?,
                     Ev::Gnss(i) => f.gnss(&drive.gnss[i])?,
                 }
                 hook.after_epoch(t, &mut f.x, &mut f.p);
