@@ -273,6 +273,17 @@ fn demo_reproduces_the_papers_ordering() {
     assert!(rts <= 1.1 * truth, "RTS {rts} truth {truth}");
     assert!(tmp.path().join("params_rts.toml").exists());
     check_in_chromium(&tmp.path().join("report.html"), 24);
+    // The TedriS part: both methods through three outages, and its report.
+    let outages = v["tedris_comparison"]["outages"].as_array().unwrap();
+    assert_eq!(outages.len(), 3);
+    for o in outages {
+        assert!(
+            o["four_wheel"]["mean_error_m"].as_f64().unwrap() < 3.0,
+            "{o}"
+        );
+        assert!(o["tedris"]["mean_error_m"].as_f64().is_some(), "{o}");
+    }
+    check_in_chromium(&tmp.path().join("tedris-report.html"), 30);
 }
 
 /// Renders a report in headless Chromium (`tests/report_chromium.sh`): every

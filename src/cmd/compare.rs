@@ -8,7 +8,7 @@ use anyhow::{Context, Result};
 use clap::Args;
 use deadreckon_core::calibrate::{self, CalibrationOptions};
 use deadreckon_core::ekf::FilterOptions;
-use deadreckon_core::{outage, Drive};
+use deadreckon_core::{outage, Drive, Params};
 use deadreckon_tedris::{Outage, TedrisConfig, TedrisModel};
 use serde_json::json;
 
@@ -34,34 +34,54 @@ pub struct CompareArgs {
 }
 
 /// One method's errors through one outage.
-struct Row {
-    mean: f64,
-    max: f64,
-    fin: f64,
-    to_1m: Option<f64>,
+pub struct Row {
+    /// Mean horizontal error, m.
+    pub mean: f64,
+    /// Largest error, m.
+    pub max: f64,
+    /// Error at the end, m.
+    pub fin: f64,
+    /// Time until the error first reaches 1 m, s.
+    pub to_1m: Option<f64>,
+}
+
+/// The comparison through a set of outages.
+pub struct Comparison {
+    /// Where the four-wheel parameters came from.
+    pub params_source: String,
+    /// Where the TedriS model came from.
+    pub model_source: String,
+    /// The four-wheel reference ("truth" or "gnss").
+    pub four_wheel_reference: String,
+    /// The TedriS reference.
+    pub tedris_reference: String,
+    /// Per outage: the window, the four-wheel row, the TedriS row.
+    pub rows: Vec<(Outage, Option<Row>, Option<Row>)>,
+    /// The TedriS model used.
+    pub model: TedrisModel,
 }
 
 /// The drive without GNSS inside the windows.
-fn hide(drive: &Drive, windows: &[(f64, f64)]) -> Drive {
+pub fn hide(drive: &Drive, windows: &[(f64, f64)]) -> Drive {
     let mut d = drive.clone();
     d.gnss
         .retain(|g| !windows.iter().any(|&(a, b)| g.t_s >= a && g.t_s < b));
     d
 }
 
-/// Runs `compare`.
-pub fn run(a: CompareArgs) -> Result<()> {
-    let drive = common::load_drive(&a.dir)?;
-    let outages: Vec<Outage> = a
-        .outage
-        .iter()
-        .map(|s| s.parse::<Outage>())
-        .collect::<Result<_, _>>()?;
+/// Runs both methods through `outages`. Without `params`, the four-wheel
+/// parameters are calibrated (RTS) on the drive with the outages hidden; without
+/// `model`, TedriS is trained on the drive with the outages hidden.
+pub fn compare(
+    drive: &Drive,
+    outages: &[Outage],
+    params: Option<(Params, String)>,
+    model: Option<(TedrisModel, String)>,
+) -> Result<Comparison> {
     let windows: Vec<(f64, f64)> = outages.iter().map(|o| (o.start_s, o.end_s)).collect();
-    let hidden = hide(&drive, &windows);
-
-    let (params, params_source) = match &a.params {
-        Some(p) => (common::load_params(p, &drive)?, p.clone()),
+    let hidden = hide(drive, &windows);
+    let (params, params_source) = match params {
+        Some(p) => p,
         None => {
             let c = calibrate::calibrate(&hidden, &CalibrationOptions::default())
                 .context("RTS calibration with the outages hidden")?;
@@ -71,28 +91,18 @@ pub fn run(a: CompareArgs) -> Result<()> {
             )
         }
     };
-    let fw = outage::through_windows(&drive, &params, &windows, &FilterOptions::default())?;
-
-    let (model, model_source) = match &a.model {
-        Some(m) => {
-            let text =
-                std::fs::read_to_string(m).with_context(|| format!("reading {}", m.display()))?;
-            (
-                serde_json::from_str::<TedrisModel>(&text)
-                    .with_context(|| format!("parsing {}", m.display()))?,
-                m.display().to_string(),
-            )
-        }
+    let fw = outage::through_windows(drive, &params, &windows, &FilterOptions::default())?;
+    let (model, model_source) = match model {
+        Some(m) => m,
         None => {
             let (m, _) = deadreckon_tedris::train(&hidden, TedrisConfig::default(), None)
                 .context("TedriS training with the outages hidden")?;
             (m, "TedriS trained on the drive, outages hidden".into())
         }
     };
-    let td = deadreckon_tedris::run_outages(&drive, &model, &outages)?;
-
+    let td = deadreckon_tedris::run_outages(drive, &model, outages)?;
     let mut rows = Vec::new();
-    for o in &outages {
+    for o in outages {
         let f = fw
             .windows
             .iter()
@@ -113,42 +123,54 @@ pub fn run(a: CompareArgs) -> Result<()> {
                 fin: e.final_error_m,
                 to_1m: e.time_to_1m_s,
             });
-        rows.push((o, f, t));
+        rows.push((*o, f, t));
     }
+    Ok(Comparison {
+        params_source,
+        model_source,
+        four_wheel_reference: fw.reference.name().into(),
+        tedris_reference: td.reference.clone(),
+        rows,
+        model,
+    })
+}
+
+/// The comparison as JSON.
+pub fn to_json(c: &Comparison) -> serde_json::Value {
     let row_json = |r: &Option<Row>| match r {
         Some(r) => {
             json!({"mean_error_m": r.mean, "max_error_m": r.max, "final_error_m": r.fin, "time_to_1m_s": r.to_1m})
         }
         None => serde_json::Value::Null,
     };
-    if a.json {
-        let v = json!({
-            "reference": {"four_wheel": fw.reference.name(), "tedris": td.reference},
-            "four_wheel_params": params_source,
-            "tedris_model": model_source,
-            "outages": rows.iter().map(|(o, f, t)| json!({
-                "start_s": o.start_s, "end_s": o.end_s,
-                "four_wheel": row_json(f), "tedris": row_json(t),
-            })).collect::<Vec<_>>(),
-        });
-        println!("{}", serde_json::to_string_pretty(&v)?);
-        return Ok(());
-    }
+    json!({
+        "reference": {"four_wheel": c.four_wheel_reference, "tedris": c.tedris_reference},
+        "four_wheel_params": c.params_source,
+        "tedris_model": c.model_source,
+        "outages": c.rows.iter().map(|(o, f, t)| json!({
+            "start_s": o.start_s, "end_s": o.end_s,
+            "four_wheel": row_json(f), "tedris": row_json(t),
+        })).collect::<Vec<_>>(),
+    })
+}
+
+/// Prints the comparison table; `t0` is subtracted from the outage times.
+pub fn print(c: &Comparison, t0: f64) {
     println!(
-        "four-wheel EKF: {params_source}; errors against the {}",
-        fw.reference.name()
+        "four-wheel EKF: {}; errors against the {}",
+        c.params_source, c.four_wheel_reference
     );
     println!(
-        "TedriS: {model_source}; errors against the {}",
-        td.reference
+        "TedriS: {}; errors against the {}",
+        c.model_source, c.tedris_reference
     );
     println!(
-        "{:<20} {:<12} {:>10} {:>10} {:>10} {:>14}",
+        "{:<20} {:<12} {:>10} {:>10} {:>10} {:>16}",
         "outage (s)", "method", "mean (m)", "max (m)", "final (m)", "time to 1 m (s)"
     );
     let fmt = |r: &Option<Row>| match r {
         Some(r) => format!(
-            "{:>10.2} {:>10.2} {:>10.2} {:>14}",
+            "{:>10.2} {:>10.2} {:>10.2} {:>16}",
             r.mean,
             r.max,
             r.fin,
@@ -156,12 +178,44 @@ pub fn run(a: CompareArgs) -> Result<()> {
                 .map(|t| format!("{t:.1}"))
                 .unwrap_or_else(|| "never".into())
         ),
-        None => format!("{:>10} {:>10} {:>10} {:>14}", "-", "-", "-", "-"),
+        None => format!("{:>10} {:>10} {:>10} {:>16}", "-", "-", "-", "-"),
     };
-    for (o, f, t) in &rows {
-        let w = format!("{:.1}:{:.1}", o.start_s, o.end_s);
+    for (o, f, t) in &c.rows {
+        let w = format!("{:.1}:{:.1}", o.start_s - t0, o.end_s - t0);
         println!("{:<20} {:<12} {}", w, "four-wheel", fmt(f));
         println!("{:<20} {:<12} {}", "", "TedriS", fmt(t));
+    }
+}
+
+/// Runs `compare`.
+pub fn run(a: CompareArgs) -> Result<()> {
+    let drive = common::load_drive(&a.dir)?;
+    let outages: Vec<Outage> = a
+        .outage
+        .iter()
+        .map(|s| s.parse::<Outage>())
+        .collect::<Result<_, _>>()?;
+    let params = match &a.params {
+        Some(p) => Some((common::load_params(p, &drive)?, p.clone())),
+        None => None,
+    };
+    let model = match &a.model {
+        Some(m) => {
+            let text =
+                std::fs::read_to_string(m).with_context(|| format!("reading {}", m.display()))?;
+            Some((
+                serde_json::from_str::<TedrisModel>(&text)
+                    .with_context(|| format!("parsing {}", m.display()))?,
+                m.display().to_string(),
+            ))
+        }
+        None => None,
+    };
+    let c = compare(&drive, &outages, params, model)?;
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&to_json(&c))?);
+    } else {
+        print(&c, 0.0);
     }
     Ok(())
 }

@@ -144,6 +144,7 @@ pub fn run(a: DemoArgs, quiet: bool) -> Result<()> {
         },
     )?;
     let truth = sim_cal.truth_params;
+    let tedris = tedris_part(&a, &steps)?;
     steps.finish();
     if a.json {
         let rows: Vec<serde_json::Value> = results
@@ -161,7 +162,12 @@ pub fn run(a: DemoArgs, quiet: bool) -> Result<()> {
                 })
             })
             .collect();
-        let v = serde_json::json!({"truth_params": truth.to_array(), "methods": rows, "plain_iterations": plain.iterations});
+        let v = serde_json::json!({
+            "truth_params": truth.to_array(),
+            "methods": rows,
+            "plain_iterations": plain.iterations,
+            "tedris_comparison": super::compare::to_json(&tedris.0),
+        });
         println!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
     }
@@ -243,5 +249,50 @@ pub fn run(a: DemoArgs, quiet: bool) -> Result<()> {
         a.out.display(),
         report_path.display()
     );
+    println!();
+    println!(
+        "TedriS and the four-wheel EKF through 80 s GNSS outages on the simulated campus drive"
+    );
+    super::compare::print(&tedris.0, tedris.1);
+    println!("report in {}", tedris.2.display());
     Ok(())
+}
+
+/// TedriS beside the four-wheel EKF on the simulated campus drive: three 80 s
+/// outages, both methods calibrated or trained with the outages hidden, and a
+/// report with the TedriS sections.
+fn tedris_part(
+    a: &DemoArgs,
+    steps: &super::progress::Steps,
+) -> Result<(super::compare::Comparison, f64, PathBuf)> {
+    steps.step("TedriS campus drive");
+    let dir = a.out.join("tedris-car");
+    simulate::simulate_to("tedris-car", a.seed + 2, &dir)?;
+    let drive = common::load_drive(&dir)?;
+    let (t0, t1) = drive.time_span().context("empty drive")?;
+    let outages: Vec<deadreckon_tedris::Outage> = [0.3, 0.55, 0.8]
+        .iter()
+        .map(|f| {
+            let s = t0 + f * (t1 - t0) - 40.0;
+            deadreckon_tedris::Outage {
+                start_s: s,
+                end_s: s + 80.0,
+            }
+        })
+        .collect();
+    let c = super::compare::compare(&drive, &outages, None, None)?;
+    // The report of the campus drive, with the TedriS sections.
+    steps.step("TedriS report");
+    let methods = report::calibrations(&drive, steps);
+    let mut input = report::four_wheel_input(&drive, &methods, None, steps)?;
+    input.tedris = Some(report::tedris_from_model(&drive, &c.model, Some(80.0))?);
+    input.header = report::header(
+        &drive,
+        "demo: TedriS campus drive",
+        vec![("drive".into(), dir.display().to_string())],
+    );
+    input.footer = report::footer();
+    let path = a.out.join("tedris-report.html");
+    deadreckon_report::write_report(&path, &input)?;
+    Ok((c, t0, path))
 }
