@@ -283,7 +283,7 @@ fn demo_reproduces_the_papers_ordering() {
         );
         assert!(o["tedris"]["mean_error_m"].as_f64().is_some(), "{o}");
     }
-    check_in_chromium(&tmp.path().join("tedris-report.html"), 30);
+    check_in_chromium(&tmp.path().join("tedris-report.html"), 27);
 }
 
 /// Renders a report in headless Chromium (`tests/report_chromium.sh`): every

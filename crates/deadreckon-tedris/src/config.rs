@@ -137,10 +137,17 @@ pub struct TedrisConfig {
     /// Update the DCF by eq. (6); when false it stays at DCF₀ (default true).
     pub dcf_update: bool,
     /// Weight of each new DCF estimate against the previous DCF, in (0, 1]
-    /// (default 1: eq. (6) as in the paper).
+    /// (default 0.2; 1 is eq. (6) as in the paper, whose 30 s estimates are noisy).
     pub dcf_smoothing: f64,
     /// Half-width of the DCF search interval, in units of |α1|·(W_H − W_L) (default 2).
     pub dcf_bound_factor: f64,
+    /// Update the DCF jointly with a distance term and the turn gain, by linear
+    /// least squares of the reference heading on the model's cumulative heading over
+    /// `calibration_window_s` (default true; false: eq. (6) over `update_window_s`).
+    /// See `Tedris` (module `machine`) for the equations.
+    pub joint_calibration: bool,
+    /// Window of the joint calibration, s (default 600).
+    pub calibration_window_s: f64,
     /// Window over which the straight-line detector measures the heading change, s (default 3).
     pub slt_window_s: f64,
     /// Largest reference heading change over `slt_window_s` on a straight line, degrees (default 1).
@@ -185,8 +192,10 @@ impl Default for TedrisConfig {
             turn_gain: true,
             gain_segment_s: 10.0,
             dcf_update: true,
-            dcf_smoothing: 1.0,
+            dcf_smoothing: 0.2,
             dcf_bound_factor: 2.0,
+            joint_calibration: true,
+            calibration_window_s: 600.0,
             slt_window_s: 3.0,
             slt_max_change_deg: 1.0,
             portmanteau_lags: 10,
@@ -197,13 +206,16 @@ impl Default for TedrisConfig {
 }
 
 impl TedrisConfig {
-    /// The paper's robot settings: ε = ∞ (one repository), no course speed gate.
+    /// The paper's robot settings: ε = ∞ (one repository), no course speed gate,
+    /// only R0 required, 60 s of samples to start, the DCF of eq. (6) unsmoothed
+    /// (the gyro reference is smooth enough).
     pub fn robot() -> Self {
         TedrisConfig {
             epsilon_factor: None,
             min_course_speed_mps: 0.0,
             required_bins: 0,
             init_samples: 600,
+            dcf_smoothing: 1.0,
             ..Self::default()
         }
     }
@@ -240,6 +252,7 @@ impl TedrisConfig {
             ("update_interval_s", self.update_interval_s),
             ("refit_interval_s", self.refit_interval_s),
             ("dcf_bound_factor", self.dcf_bound_factor),
+            ("calibration_window_s", self.calibration_window_s),
             ("slt_window_s", self.slt_window_s),
             ("slt_max_change_deg", self.slt_max_change_deg),
         ] {

@@ -260,6 +260,10 @@ pub struct TedrisModel {
     pub dcf0_rad: f64,
     /// DCF: the dynamic correction factor of eq. (4), rad per sample.
     pub dcf_rad: f64,
+    /// Distance term of the DCF, rad per metre: γ̂ gains `dcf_distance_rad_per_m · d`
+    /// (estimated by the joint calibration; 0 otherwise).
+    #[serde(default)]
+    pub dcf_distance_rad_per_m: f64,
     /// Half-width of the DCF search interval, rad per sample.
     pub dcf_bound_rad: f64,
     /// The expected ω on a straight line, `c0 + c1·d` (m per sample): an OLS of the
@@ -333,6 +337,7 @@ impl TedrisModel {
             chosen,
             dcf0_rad: 0.0,
             dcf_rad: 0.0,
+            dcf_distance_rad_per_m: 0.0,
             dcf_bound_rad: 0.0,
             straight_omega,
             straight_sigma_m,
@@ -437,6 +442,7 @@ impl TedrisModel {
         });
         let scalars = [
             self.dcf_rad,
+            self.dcf_distance_rad_per_m,
             self.dcf0_rad,
             self.dcf_bound_rad,
             self.straight_sigma_m,

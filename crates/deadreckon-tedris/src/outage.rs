@@ -147,6 +147,7 @@ pub fn train(
     )
     .map(|mut f| {
         f.dcf_rad = model.dcf_rad;
+        f.dcf_distance_rad_per_m = model.dcf_distance_rad_per_m;
         f.turn_gain = model.turn_gain;
         f
     })

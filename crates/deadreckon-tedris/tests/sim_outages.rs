@@ -54,28 +54,39 @@ fn car_errors(kind: ModelChoice, seeds: std::ops::RangeInclusive<u64>) -> Vec<f6
     all
 }
 
-#[test]
-fn car_80s_outages_distance_model() {
-    let e = car_errors(ModelChoice::Fixed(ModelKind::Distance), 1..=4);
+fn summary(name: &str, e: &[f64]) -> (f64, f64) {
     let mean = e.iter().sum::<f64>() / e.len() as f64;
+    let max = e.iter().copied().fold(0.0, f64::max);
     eprintln!(
-        "car distance: mean of mean errors over {} outages = {mean:.2} m",
+        "car {name}: mean error over {} outages of 80 s = {mean:.2} m (largest {max:.2} m)",
         e.len()
     );
-    // Measured 4.8 m (paper: about 3 m in figure 6b, about 4 m in figure 6c).
-    assert!(mean < 6.0, "{mean}");
-    assert!(e.iter().all(|v| *v < 15.0), "{e:?}");
+    (mean, max)
+}
+
+#[test]
+fn car_80s_outages_distance_model() {
+    let e = car_errors(ModelChoice::Fixed(ModelKind::Distance), 1..=6);
+    let (mean, max) = summary("distance", &e);
+    // Measured 3.40 m, largest 6.7 m (the paper: about 3 m in figure 6b, 4 m in 6c).
+    assert!(mean < 4.0, "{mean}");
+    assert!(max < 9.0, "{e:?}");
 }
 
 #[test]
 fn car_80s_outages_paper_model() {
-    let e = car_errors(ModelChoice::Fixed(ModelKind::Paper), 1..=4);
-    let mean = e.iter().sum::<f64>() / e.len() as f64;
-    eprintln!(
-        "car paper: mean of mean errors over {} outages = {mean:.2} m",
-        e.len()
-    );
-    assert!(mean < 8.0, "{mean}");
+    let e = car_errors(ModelChoice::Fixed(ModelKind::Paper), 1..=6);
+    let (mean, _) = summary("paper", &e);
+    // Measured 4.31 m.
+    assert!(mean < 5.5, "{mean}");
+}
+
+#[test]
+fn car_80s_outages_automatic_choice() {
+    let e = car_errors(ModelChoice::Auto, 1..=6);
+    let (mean, _) = summary("auto", &e);
+    // Measured 3.53 m.
+    assert!(mean < 4.5, "{mean}");
 }
 
 #[test]
