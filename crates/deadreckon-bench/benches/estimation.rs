@@ -42,12 +42,17 @@ fn filter_and_smoother(c: &mut Criterion) {
 }
 
 fn calibration(c: &mut Criterion) {
-    let drive = deadreckon_bench::drive(3600.0);
+    let drive = deadreckon_bench::laps(8);
+    let (t0, t1) = drive.time_span().unwrap();
     let mut g = c.benchmark_group("calibration");
     g.sample_size(10);
-    g.bench_function("RTS calibration of a 1-hour 50 Hz drive", |b| {
-        b.iter(|| calibrate::calibrate(&drive, &CalibrationOptions::default()).unwrap())
-    });
+    g.bench_function(
+        format!(
+            "RTS calibration of a {:.0} min 50 Hz drive",
+            (t1 - t0) / 60.0
+        ),
+        |b| b.iter(|| calibrate::calibrate(&drive, &CalibrationOptions::default()).unwrap()),
+    );
     g.finish();
 }
 
