@@ -7,6 +7,7 @@ use nalgebra::Cholesky;
 use nalgebra::{SMatrix, SVector};
 
 use crate::ekf::Epoch;
+use crate::model::Mat;
 use crate::Error;
 
 /// One smoothed epoch: x̂_{k|N} and P_{k|N}.
@@ -18,6 +19,22 @@ pub struct Smoothed<const N: usize = 5> {
     pub x: SVector<f64, N>,
     /// P_{k|N}.
     pub p: SMatrix<f64, N, N>,
+}
+
+/// `F M` for `F = diag(f_car, I)`.
+fn f_times<const N: usize>(f_car: &Mat, m: &SMatrix<f64, N, N>) -> SMatrix<f64, N, N> {
+    let mut out = *m;
+    let top = f_car * m.fixed_view::<5, N>(0, 0);
+    out.fixed_view_mut::<5, N>(0, 0).copy_from(&top);
+    out
+}
+
+/// `Fᵀ u` for `F = diag(f_car, I)`.
+fn ft_times<const N: usize>(f_car: &Mat, u: &SVector<f64, N>) -> SVector<f64, N> {
+    let mut out = *u;
+    let top = f_car.transpose() * u.fixed_rows::<5>(0);
+    out.fixed_rows_mut::<5>(0).copy_from(&top);
+    out
 }
 
 /// One backward step: from the smoothed epoch k+1 and the filter's epochs k and
@@ -33,7 +50,7 @@ pub fn step<const N: usize>(
         t_s: k1.t_s,
         what: "predicted covariance is not positive definite".into(),
     })?;
-    let jt = chol.solve(&(k1.f * k.p));
+    let jt = chol.solve(&f_times(&k1.f, &k.p));
     let j = jt.transpose();
     // x̂_{k|N} = x̂_{k|k} + J_k (x̂_{k+1|N} − x̂_{k+1|k})   (20)
     let x = k.x + j * (s1.x - k1.x_pred);
@@ -63,7 +80,7 @@ pub fn smooth_states<const N: usize>(
         // Jᵀ = P_{k+1|k}⁻¹ F_{k+1} P_{k|k}; x̂_{k|N} = x̂_{k|k} + J (x̂_{k+1|N} − x̂_{k+1|k}).
         // J d = P F ᵀ P_pred⁻¹ d, so solve P_pred u = d and take P Fᵀ u (one vector solve).
         let u = chol.solve(&(out[k + 1].1 - e1.x_pred));
-        out[k] = (e.t_s, e.x + e.p * (e1.f.transpose() * u));
+        out[k] = (e.t_s, e.x + e.p * ft_times(&e1.f, &u));
     }
     Ok(out)
 }
