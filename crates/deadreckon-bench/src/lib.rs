@@ -14,3 +14,11 @@ pub fn drive(duration_s: f64) -> Drive {
         .with_duration_s(duration_s);
     deadreckon_sim::simulate(&sc, 1).expect("simulation").drive
 }
+
+/// The calibration loop driven `laps` times (8 laps: about an hour of driving, 32 km).
+pub fn laps(laps: u32) -> Drive {
+    let sc = deadreckon_sim::Scenario::builtin("calibration")
+        .expect("built-in scenario")
+        .with_laps(laps);
+    deadreckon_sim::simulate(&sc, 1).expect("simulation").drive
+}
