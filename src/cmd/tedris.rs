@@ -6,14 +6,14 @@ use std::path::PathBuf;
 use anyhow::{bail, Context, Result};
 use clap::{Subcommand, ValueEnum};
 use deadreckon_tedris::{
-    run_outages_with, train, ModelChoice, ModelKind, Outage, ReferenceSource, RepositoryFit,
-    RunOptions, TedrisConfig, TedrisModel,
+    run_outages_with, time_range, train, ModelChoice, ModelKind, Outage, ReferenceSource,
+    RepositoryFit, RunOptions, TedrisConfig, TedrisModel,
 };
 
 /// The reference heading the model learns from.
 #[derive(ValueEnum, Clone, Copy, Debug)]
 pub enum Reference {
-    /// GNSS course if the receiver gives one, else the course from successive fixes, else the gyro.
+    /// GNSS course if the receiver gives one, else the gyro, else the course from chords between fixes.
     Auto,
     /// The receiver's course over ground (`course_deg`).
     Course,
@@ -76,6 +76,12 @@ pub enum TedrisCommand {
         /// A TedriS configuration (JSON; missing keys take their defaults).
         #[arg(long)]
         config: Option<PathBuf>,
+        /// Train only on data from this time on, s (drive clock).
+        #[arg(long = "from")]
+        from_s: Option<f64>,
+        /// Train only on data before this time, s (drive clock).
+        #[arg(long = "until")]
+        until_s: Option<f64>,
         /// Print JSON instead of tables.
         #[arg(long)]
         json: bool,
@@ -118,8 +124,25 @@ pub fn run(c: TedrisCommand) -> Result<()> {
             epsilon_k,
             separate_repositories,
             config,
+            from_s,
+            until_s,
             json,
         } => {
+            if let (Some(a), Some(b)) = (from_s, until_s) {
+                if a.partial_cmp(&b) != Some(std::cmp::Ordering::Less) {
+                    bail!("--from {a} must be before --until {b}");
+                }
+            }
+            let drive = super::common::load_drive(&dir)?;
+            let drive = if from_s.is_some() || until_s.is_some() {
+                time_range(&drive, from_s, until_s)
+            } else {
+                drive
+            };
+            let source = match reference.source() {
+                Some(s) => Some(s),
+                None => ReferenceSource::auto(&drive).ok(),
+            };
             let mut cfg = match &config {
                 Some(p) => {
                     let text = std::fs::read_to_string(p)
@@ -127,7 +150,7 @@ pub fn run(c: TedrisCommand) -> Result<()> {
                     serde_json::from_str::<TedrisConfig>(&text)
                         .with_context(|| format!("parsing {}", p.display()))?
                 }
-                None if matches!(reference, Reference::Gyro) => TedrisConfig::robot(),
+                None if source == Some(ReferenceSource::Gyro) => TedrisConfig::robot(),
                 None => TedrisConfig::default(),
             };
             cfg.model = match model {
@@ -153,8 +176,7 @@ pub fn run(c: TedrisCommand) -> Result<()> {
                 cfg.repository_fit = RepositoryFit::Separate;
             }
             cfg.validate()?;
-            let drive = super::common::load_drive(&dir)?;
-            let (m, source) = train(&drive, cfg, reference.source())?;
+            let (m, source) = train(&drive, cfg, source)?;
             let text = serde_json::to_string_pretty(&m)?;
             std::fs::write(&out, text).with_context(|| format!("writing {}", out.display()))?;
             if json {
@@ -256,6 +278,8 @@ fn train_json(m: &TedrisModel, source: ReferenceSource) -> serde_json::Value {
         "epsilon_m": s.epsilon_m,
         "dcf0_rad": m.dcf0_rad,
         "dcf_rad": m.dcf_rad,
+        "dcf_distance_rad_per_m": m.dcf_distance_rad_per_m,
+        "gyro_bias": m.gyro_bias,
         "turn_gain": m.turn_gain,
         "complete": m.complete,
         "fill": m.repositories.fill(m.config.required_bins),
@@ -288,8 +312,8 @@ fn print_train(m: &TedrisModel, source: ReferenceSource) {
         eps
     );
     println!(
-        "DCF0 = {:.3e} rad/sample, DCF = {:.3e} rad/sample, turn gain = {:.4}",
-        m.dcf0_rad, m.dcf_rad, m.turn_gain
+        "DCF0 = {:.3e} rad/sample, DCF = {:.3e} rad/sample + {:.3e} rad/m, turn gain = {:.4}",
+        m.dcf0_rad, m.dcf_rad, m.dcf_distance_rad_per_m, m.turn_gain
     );
     for f in &m.fits {
         let mark = if f.kind == m.chosen {

@@ -1,8 +1,10 @@
 //! The turn gain: a correction of the regression's turning part estimated from
 //! the heading change over whole segments of the history, not from blocks.
 //!
-//! The block regression of eq. (3) sees the heading through short, smoothed and
-//! noisy increments; on the simulated car its slope comes out about 1.5 % low,
+//! Used when `joint_calibration` is off (the joint calibration estimates g
+//! together with the DCF). The block regression of eq. (3) sees the heading
+//! through short, smoothed and noisy increments; on the simulated car its slope
+//! came out about 1.5 % low (mostly the lagged lever-arm conversion, since fixed),
 //! and the straight-line dead band clips the ends of every turn, so each 90° turn
 //! loses a few hundredths of a radian. Over segments of `gain_segment_s` the
 //! reference heading change Δθ is accurate, so the residual of the model's summed

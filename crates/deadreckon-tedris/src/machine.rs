@@ -130,6 +130,9 @@ pub struct Tedris {
     #[serde(default)]
     last_heading_in_t: Option<f64>,
     heading_pairs: VecDeque<(f64, f64)>,
+    /// (DR sample index, time, reference heading) waiting for their DR sample.
+    #[serde(default)]
+    deferred_pairs: VecDeque<(u64, f64, f64)>,
     position_pairs: VecDeque<(f64, f64, f64)>,
     heading_offset: f64,
     position_offset: (f64, f64),
@@ -170,6 +173,7 @@ impl Tedris {
             queued_headings: VecDeque::new(),
             last_heading_in_t: None,
             heading_pairs: VecDeque::new(),
+            deferred_pairs: VecDeque::new(),
             position_pairs: VecDeque::new(),
             heading_offset: 0.0,
             position_offset: (0.0, 0.0),
@@ -300,6 +304,9 @@ impl Tedris {
             theta_dr_rad: self.theta_dr,
         });
         self.flush_headings(w.t_s);
+        if !self.deferred_pairs.is_empty() {
+            self.resolve_pairs(w.t_s);
+        }
         self.advance_phase(w.t_s);
         let (e, n) = (
             self.pos_dr.0 + self.position_offset.0,
@@ -518,23 +525,44 @@ impl Tedris {
             if src < 0 {
                 continue;
             }
-            if let Some(dr) = self.history.get(src as u64).map(|s| s.theta_dr_rad) {
+            // With a negative lag the reference leads the wheels: the DR heading
+            // it pairs with comes with a later wheel sample.
+            self.deferred_pairs.push_back((src as u64, t, th));
+        }
+        self.resolve_pairs(hs.t_s);
+        self.train(hs.t_s);
+    }
+
+    /// Turns the deferred (DR sample, time, reference) triples whose DR sample
+    /// exists into anchor pairs and updates the heading offset.
+    fn resolve_pairs(&mut self, t_now: f64) {
+        let newest = self.next_idx.saturating_sub(1);
+        let mut added = false;
+        while let Some(&(src, t, th)) = self.deferred_pairs.front() {
+            if self.next_idx == 0 || src > newest {
+                break;
+            }
+            self.deferred_pairs.pop_front();
+            if let Some(dr) = self.history.get(src).map(|s| s.theta_dr_rad) {
                 let d = self.heading_offset + wrap(th - dr - self.heading_offset);
                 self.heading_pairs.push_back((t, d));
+                added = true;
             }
+        }
+        if !added {
+            return;
         }
         let win = self.config.heading_anchor_window_s;
         while self
             .heading_pairs
             .front()
-            .is_some_and(|p| hs.t_s - p.0 > win)
+            .is_some_and(|p| t_now - p.0 > win)
         {
             self.heading_pairs.pop_front();
         }
         if !self.heading_pairs.is_empty() {
-            self.heading_offset = anchor(&self.heading_pairs, hs.t_s, self.config.anchor_trend);
+            self.heading_offset = anchor(&self.heading_pairs, t_now, self.config.anchor_trend);
         }
-        self.train(hs.t_s);
     }
 
     /// Feeds one GNSS antenna position.
@@ -633,7 +661,7 @@ impl Tedris {
     /// Rebuilds the repositories from the history with the lag of `ccf`.
     fn rebuild(&mut self, t: f64, final_upto: u64, ccf: crate::ccf::CrossCorrelation) -> bool {
         let c = &self.config;
-        let lag = ccf.peak_lag_within(self.config.lag_tolerance);
+        let lag = self.choose_lag(&ccf);
         let period = self.sample_period();
         let slt_window = (c.slt_window_s / period).round().max(1.0) as u64;
         let start = self.history.span().map_or(0, |s| s.0);
@@ -667,6 +695,17 @@ impl Tedris {
         }
     }
 
+    /// The lag h: from the heading fit ([`heading_lag`]) when `lag_from_heading`
+    /// is on and it has the data, else at the cross-correlation peak.
+    fn choose_lag(&self, ccf: &crate::ccf::CrossCorrelation) -> i64 {
+        let from_ccf = ccf.peak_lag_within(self.config.lag_tolerance);
+        if self.config.lag_from_heading {
+            heading_lag(&self.history, self.config.max_lag_samples).unwrap_or(from_ccf)
+        } else {
+            from_ccf
+        }
+    }
+
     /// Refit. Until training first completes, the lag is re-estimated on the
     /// history, and a different lag with a higher correlation peak rebuilds the
     /// repositories from the history; otherwise (and always once complete) the
@@ -675,10 +714,9 @@ impl Tedris {
         self.last_refit_t = t;
         let Some(old) = &self.model else { return };
         let ccf = masked_ccf(&self.history, self.config.max_lag_samples);
-        if !old.complete
-            && ccf.peak_lag_within(self.config.lag_tolerance) != old.lag_samples
-            && ccf_peak_value(&ccf) > ccf_peak_value(&old.ccf)
-        {
+        let better =
+            self.config.lag_from_heading || ccf_peak_value(&ccf) > ccf_peak_value(&old.ccf);
+        if !old.complete && self.choose_lag(&ccf) != old.lag_samples && better {
             let final_upto = self.pending_from.saturating_sub(1);
             if self.rebuild(t, final_upto, ccf) {
                 return;
@@ -718,7 +756,11 @@ impl Tedris {
     /// DR heading over the last `update_window_s` (the constant offset removed).
     fn update_dcf(&mut self, t: f64) {
         self.last_update_t = t;
-        if self.model.as_ref().is_some_and(|m| m.config.joint_calibration) {
+        if self
+            .model
+            .as_ref()
+            .is_some_and(|m| m.config.joint_calibration)
+        {
             self.calibrate(t);
             return;
         }
@@ -795,10 +837,7 @@ impl Tedris {
     /// increments, so these three numbers, which decide the drift during an
     /// outage, come out 10–100 times more precise. Columns without support
     /// (speed too constant, too little turning) are left out and keep their values.
-    fn calibrate(&mut self, t: f64) {
-        let Some(model) = self.model.as_ref() else {
-            return;
-        };
+    fn calibration_fit(&self, model: &TedrisModel, t: f64) -> Option<Calibration> {
         let mut unit = model.clone();
         unit.turn_gain = 1.0;
         let lag = model.lag_samples;
@@ -827,7 +866,7 @@ impl Tedris {
             })
             .collect();
         if rows.len() < 200 {
-            return;
+            return None;
         }
         let n = rows.len() as f64;
         let mut m = [0.0; 4];
@@ -865,7 +904,15 @@ impl Tedris {
                 v
             })
             .collect();
-        let y: Vec<f64> = rows.iter().map(|r| r[3]).collect();
+        // A term left out keeps its current value.
+        let (old_d, old_g) = (model.dcf_distance_rad_per_m, model.turn_gain);
+        let y: Vec<f64> = rows
+            .iter()
+            .map(|r| {
+                r[3] - if use_d { 0.0 } else { old_d * r[1] }
+                    - if use_g { 0.0 } else { (old_g - 1.0) * r[2] }
+            })
+            .collect();
         let mut names = vec!["c", "dcf"];
         if use_d {
             names.push("dcf_distance");
@@ -874,29 +921,81 @@ impl Tedris {
             names.push("gain");
         }
         let Ok(fit) = crate::stats::ols(&x, &y, &names) else {
-            return;
+            return None;
         };
         let beta = fit.beta();
         if !beta.iter().all(|v| v.is_finite()) {
-            return;
+            return None;
         }
+        let bound = model.dcf_bound_rad;
+        let mut k = 2;
+        let mut c = Calibration {
+            dcf_rad: beta[1].clamp(model.dcf0_rad - bound, model.dcf0_rad + bound),
+            distance_rad_per_m: None,
+            gain: None,
+            rms_rad: fit.sigma2.sqrt(),
+        };
+        if use_d {
+            c.distance_rad_per_m = Some(beta[k].clamp(-0.05, 0.05));
+            k += 1;
+        }
+        if use_g {
+            c.gain = Some((1.0 + beta[k]).clamp(0.8, 1.2));
+        }
+        Some(c)
+    }
+
+    /// Applies the joint calibration; with the automatic model choice, the kind
+    /// whose calibrated heading fits the reference best is chosen (the criterion
+    /// that matters for dead reckoning, where the block-level BIC favours ARX,
+    /// which drifts more).
+    fn calibrate(&mut self, t: f64) {
+        let Some(model) = self.model.as_ref() else {
+            return;
+        };
+        let best = if model.config.model == crate::config::ModelChoice::Auto {
+            let mut best: Option<(crate::config::ModelKind, Calibration)> = None;
+            for f in &model.fits {
+                let mut m = model.clone();
+                m.chosen = f.kind;
+                if let Some(c) = self.calibration_fit(&m, t) {
+                    if best.as_ref().is_none_or(|b| c.rms_rad < b.1.rms_rad) {
+                        best = Some((f.kind, c));
+                    }
+                }
+            }
+            best
+        } else {
+            self.calibration_fit(model, t).map(|c| (model.chosen, c))
+        };
+        let Some((kind, c)) = best else {
+            return;
+        };
         let Some(model) = self.model.as_mut() else {
             return;
         };
         if !model.config.dcf_update {
             return;
         }
-        let bound = model.dcf_bound_rad;
-        model.dcf_rad = beta[1].clamp(model.dcf0_rad - bound, model.dcf0_rad + bound);
-        let mut k = 2;
-        if use_d {
-            model.dcf_distance_rad_per_m = beta[k].clamp(-0.05, 0.05);
-            k += 1;
+        model.chosen = kind;
+        model.dcf_rad = c.dcf_rad;
+        if let Some(d) = c.distance_rad_per_m {
+            model.dcf_distance_rad_per_m = d;
         }
-        if use_g {
-            model.turn_gain = (1.0 + beta[k]).clamp(0.8, 1.2);
+        if let Some(g) = c.gain {
+            model.turn_gain = g;
         }
     }
+}
+
+/// The result of one joint calibration.
+#[derive(Debug, Clone, Copy)]
+struct Calibration {
+    dcf_rad: f64,
+    distance_rad_per_m: Option<f64>,
+    gain: Option<f64>,
+    /// Residual standard deviation of the reference heading, rad.
+    rms_rad: f64,
 }
 
 /// The heading offset from (t, reference − DR) pairs: their mean, or with
@@ -915,6 +1014,56 @@ fn anchor(pairs: &VecDeque<(f64, f64)>, t_now: f64, trend: bool) -> f64 {
         return md;
     }
     md + std / stt * (t_now - mt)
+}
+
+/// The lag h ∈ ±`max_lag` for which the reference heading is best explained
+/// (least squares) by the wheels' cumulative sums h samples earlier:
+/// `θ_ref(k) ≈ c0 + a·Σω(k − h) + b·Σd(k − h) + e·k`. The per-sample
+/// cross-correlation of ω with increments of a course interpolated between 4 Hz
+/// fixes has a flat, noisy peak (±3 samples on the simulated car); the heading
+/// itself pins the lag through the shape of every turn. `None` with fewer than
+/// 200 usable samples.
+pub fn heading_lag(h: &History, max_lag: usize) -> Option<i64> {
+    let samples: Vec<&Sample> = h.iter().collect();
+    let mut cw = Vec::with_capacity(samples.len());
+    let mut cd = Vec::with_capacity(samples.len());
+    let (mut w, mut d) = (0.0, 0.0);
+    for s in &samples {
+        w += s.omega_m;
+        d += s.dist_m;
+        cw.push(w);
+        cd.push(d);
+    }
+    let ml = max_lag as i64;
+    let mut best: Option<(f64, i64)> = None;
+    for lag in -ml..=ml {
+        let (x, y): (Vec<Vec<f64>>, Vec<f64>) = samples
+            .iter()
+            .enumerate()
+            .filter_map(|(j, s)| {
+                let th = s.theta_rad?;
+                let src = usize::try_from(j as i64 - lag).ok()?;
+                Some((vec![1.0, *cw.get(src)?, cd[src], j as f64], th))
+            })
+            .unzip();
+        if y.len() < 200 {
+            return None;
+        }
+        // Centre the columns for conditioning.
+        let n = y.len() as f64;
+        let m: Vec<f64> = (1..4)
+            .map(|c| x.iter().map(|r| r[c]).sum::<f64>() / n)
+            .collect();
+        let xc: Vec<Vec<f64>> = x
+            .iter()
+            .map(|r| vec![1.0, r[1] - m[0], r[2] - m[1], r[3] - m[2]])
+            .collect();
+        let fit = crate::stats::ols(&xc, &y, &["c", "omega", "distance", "rate"]).ok()?;
+        if best.is_none_or(|b| fit.rss < b.0) {
+            best = Some((fit.rss, lag));
+        }
+    }
+    best.map(|b| b.1)
 }
 
 fn ccf_peak_value(c: &crate::ccf::CrossCorrelation) -> f64 {

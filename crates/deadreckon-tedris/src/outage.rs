@@ -11,11 +11,11 @@
 
 use serde::{Deserialize, Serialize};
 
-use deadreckon_core::drive::Drive;
+use deadreckon_core::drive::{Drive, Wheels};
 use deadreckon_core::{Track, TrackPoint};
 
 use crate::config::TedrisConfig;
-use crate::input::{drive_input, Event, ReferenceSource};
+use crate::input::{drive_input, drive_input_with, standstill_gyro_stats, Event, ReferenceSource};
 use crate::machine::{Estimate, Phase, Tedris};
 use crate::model::TedrisModel;
 use crate::Error;
@@ -120,6 +120,25 @@ fn feed(machine: &mut Tedris, events: &[Event]) -> Vec<Estimate> {
     out
 }
 
+/// The part of a drive with `from_s ≤ t < until_s` (drive clock; `None`: open),
+/// every stream cut alike (wheel ticks are per-epoch increments, so the cut is exact).
+pub fn time_range(drive: &Drive, from_s: Option<f64>, until_s: Option<f64>) -> Drive {
+    let lo = from_s.unwrap_or(f64::NEG_INFINITY);
+    let hi = until_s.unwrap_or(f64::INFINITY);
+    let keep = |t: f64| t >= lo && t < hi;
+    let mut d = drive.clone();
+    match &mut d.wheels {
+        Wheels::Ticks(v) => v.retain(|w| keep(w.t_s)),
+        Wheels::Speeds(v) => v.retain(|w| keep(w.t_s)),
+    }
+    d.yaw_rate.retain(|s| keep(s.t_s));
+    d.speed.retain(|s| keep(s.t_s));
+    d.steering.retain(|s| keep(s.t_s));
+    d.gnss.retain(|g| keep(g.t_s));
+    d.truth.retain(|p| keep(p.t_s));
+    d
+}
+
 /// Trains a model over a whole drive (GNSS or gyro good throughout).
 pub fn train(
     drive: &Drive,
@@ -146,12 +165,21 @@ pub fn train(
         model.repositories.clone(),
     )
     .map(|mut f| {
+        if f.fits.iter().any(|k| k.kind == model.chosen) {
+            // The machine's choice (by the calibrated heading when automatic).
+            f.chosen = model.chosen;
+        }
         f.dcf_rad = model.dcf_rad;
         f.dcf_distance_rad_per_m = model.dcf_distance_rad_per_m;
         f.turn_gain = model.turn_gain;
         f
     })
     .unwrap_or(model);
+    let mut refit = refit;
+    if input.source == ReferenceSource::Gyro {
+        let (b, n) = standstill_gyro_stats(drive);
+        refit.gyro_bias = (n > 0).then_some((b, n));
+    }
     Ok((refit, input.source))
 }
 
@@ -173,7 +201,7 @@ pub fn run_outages_with(
     opts: &RunOptions,
 ) -> Result<OutageReport, Error> {
     let windows: Vec<(f64, f64)> = outages.iter().map(|o| (o.start_s, o.end_s)).collect();
-    let input = drive_input(drive, opts.source, &windows)?;
+    let input = drive_input_with(drive, opts.source, &windows, model.gyro_bias)?;
     let mut m = Tedris::with_model(model.clone(), input.geometry)?;
     if let Some((e, n, y)) = input.initial_pose {
         m.set_pose(e, n, y);

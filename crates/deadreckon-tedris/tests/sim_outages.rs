@@ -1,10 +1,18 @@
 //! TedriS on the simulator's `tedris-car` and `tedris-robot` scenarios: train on
-//! one seed, predict through outages on another seed's drive, print the errors
-//! (`cargo test -p deadreckon-tedris --test sim_outages -- --nocapture`) and bound them.
+//! one seed, predict through outages on another seed's drive (seed + 100), print
+//! the errors (`cargo test --release -p deadreckon-tedris --test sim_outages --
+//! --nocapture`) and assert the targets:
 //!
-//! The bounds are what this implementation reaches, not the paper's targets (car:
-//! mean below 3 m; robot: under 0.159 m for at least 60 s): see the crate
-//! documentation, section "Measured", for the numbers and the gap.
+//! - car (the paper's figure 6b): the mean position error over 80 s outages is
+//!   below 3 m averaged over seeds 1–6 (three outages each), and below 4 m for
+//!   every seed;
+//! - robot (figure 7b): the error stays under 0.159 m for at least 60 s in the
+//!   majority of 90 s outages (seeds 1–6, eight outages each) and the median
+//!   time is at least 60 s.
+//!
+//! The default configuration is asserted for the distance, paper and automatic
+//! kinds; the paper's method alone ([`TedrisConfig::paper`]) is only printed and
+//! loosely bounded (it does not reach the targets).
 
 use deadreckon_sim::{simulate, Scenario};
 use deadreckon_tedris::{
@@ -13,22 +21,21 @@ use deadreckon_tedris::{
 };
 
 const CAR_WINDOWS: [f64; 3] = [200.0, 350.0, 500.0];
+const SEEDS: std::ops::RangeInclusive<u64> = 1..=6;
 
-fn car_errors(kind: ModelChoice, seeds: std::ops::RangeInclusive<u64>) -> Vec<f64> {
+/// Per seed, the mean of the mean errors of its 80 s outages.
+fn car_seed_means(cfg: &TedrisConfig, name: &str) -> Vec<f64> {
     let sc = Scenario::builtin("tedris-car").unwrap();
-    let mut all = Vec::new();
-    for seed in seeds {
+    let mut means = Vec::new();
+    for seed in SEEDS {
         let train_drive = simulate(&sc, seed).unwrap().drive;
         let run_drive = simulate(&sc, seed + 100).unwrap().drive;
-        let cfg = TedrisConfig {
-            model: kind,
-            ..TedrisConfig::default()
-        };
-        let (model, _) = train(&train_drive, cfg, None).unwrap();
+        let (model, _) = train(&train_drive, cfg.clone(), None).unwrap();
         let mut line = format!(
-            "car {kind:?} seed {seed} (chosen {:?}, lag {}):",
+            "car {name} seed {seed} (chosen {:?}, lag {}):",
             model.chosen, model.lag_samples
         );
+        let mut sum = 0.0;
         for start in CAR_WINDOWS {
             let o = Outage {
                 start_s: start,
@@ -47,53 +54,72 @@ fn car_errors(kind: ModelChoice, seeds: std::ops::RangeInclusive<u64>) -> Vec<f6
                 e.mean_error_m,
                 e.max_error_m
             );
-            all.push(e.mean_error_m);
+            sum += e.mean_error_m;
         }
-        eprintln!("{line}");
+        let m = sum / CAR_WINDOWS.len() as f64;
+        eprintln!("{line} seed mean {m:.2} m");
+        means.push(m);
     }
-    all
+    let all = means.iter().sum::<f64>() / means.len() as f64;
+    eprintln!(
+        "car {name}: mean error over 80 s outages {all:.2} m (seeds {SEEDS:?}, per seed {:?})",
+        means
+            .iter()
+            .map(|v| (v * 100.0).round() / 100.0)
+            .collect::<Vec<_>>()
+    );
+    means
 }
 
-fn summary(name: &str, e: &[f64]) -> (f64, f64) {
-    let mean = e.iter().sum::<f64>() / e.len() as f64;
-    let max = e.iter().copied().fold(0.0, f64::max);
-    eprintln!(
-        "car {name}: mean error over {} outages of 80 s = {mean:.2} m (largest {max:.2} m)",
-        e.len()
+fn assert_car_target(means: &[f64]) {
+    let all = means.iter().sum::<f64>() / means.len() as f64;
+    assert!(means.len() >= 4);
+    assert!(all < 3.0, "mean over seeds {all} m, target < 3 m");
+    assert!(
+        means.iter().all(|m| *m < 4.0),
+        "a seed's mean error reaches 4 m: {means:?}"
     );
-    (mean, max)
+}
+
+fn with_kind(kind: ModelKind) -> TedrisConfig {
+    TedrisConfig {
+        model: ModelChoice::Fixed(kind),
+        ..TedrisConfig::default()
+    }
 }
 
 #[test]
 fn car_80s_outages_distance_model() {
-    let e = car_errors(ModelChoice::Fixed(ModelKind::Distance), 1..=6);
-    let (mean, max) = summary("distance", &e);
-    // Measured 3.40 m, largest 6.7 m (the paper: about 3 m in figure 6b, 4 m in 6c).
-    assert!(mean < 4.0, "{mean}");
-    assert!(max < 9.0, "{e:?}");
+    // Measured: 1.00 m over the seeds, 0.47–1.74 m per seed.
+    assert_car_target(&car_seed_means(&with_kind(ModelKind::Distance), "distance"));
 }
 
 #[test]
 fn car_80s_outages_paper_model() {
-    let e = car_errors(ModelChoice::Fixed(ModelKind::Paper), 1..=6);
-    let (mean, _) = summary("paper", &e);
-    // Measured 4.31 m.
-    assert!(mean < 5.5, "{mean}");
+    // The paper's regression with the default calibration; measured 1.00 m (0.47–1.70).
+    assert_car_target(&car_seed_means(&with_kind(ModelKind::Paper), "paper"));
 }
 
 #[test]
 fn car_80s_outages_automatic_choice() {
-    let e = car_errors(ModelChoice::Auto, 1..=6);
-    let (mean, _) = summary("auto", &e);
-    // Measured 3.53 m.
-    assert!(mean < 4.5, "{mean}");
+    // Measured 0.98 m, 0.33–1.71 m per seed.
+    assert_car_target(&car_seed_means(&TedrisConfig::default(), "auto"));
+}
+
+#[test]
+fn car_80s_outages_paper_method_alone() {
+    // The paper's method without this crate's additions: printed for the record
+    // (measured 5.58 m, 2.77–10.15 m per seed).
+    let means = car_seed_means(&TedrisConfig::paper(), "paper method alone");
+    let all = means.iter().sum::<f64>() / means.len() as f64;
+    assert!(all.is_finite() && all < 60.0, "{all}");
 }
 
 #[test]
 fn robot_time_under_0_159_m() {
     let sc = Scenario::builtin("tedris-robot").unwrap();
     let mut times = Vec::new();
-    for seed in 1..=5u64 {
+    for seed in SEEDS {
         let train_drive = simulate(&sc, seed).unwrap().drive;
         let run_drive = simulate(&sc, seed + 100).unwrap().drive;
         let (model, _) = train(
@@ -107,7 +133,7 @@ fn robot_time_under_0_159_m() {
             threshold_m: Some(0.159),
         };
         let mut line = format!("robot seed {seed} (chosen {:?}):", model.chosen);
-        for start in [60.0, 120.0, 180.0, 240.0] {
+        for start in [30.0, 60.0, 90.0, 120.0, 150.0, 180.0, 210.0, 240.0] {
             let o = Outage {
                 start_s: start,
                 end_s: start + 90.0,
@@ -116,10 +142,7 @@ fn robot_time_under_0_159_m() {
             assert_eq!(r.reference, "truth aligned at outage start");
             let e = &r.outages[0];
             let t = e.time_to_threshold_s.unwrap_or(90.0);
-            line += &format!(
-                " [{start:.0}: under 0.159 m for {t:.0} s, mean {:.3} m]",
-                e.mean_error_m
-            );
+            line += &format!(" [{start:.0}: {t:.0} s, mean {:.3} m]", e.mean_error_m);
             times.push(t);
         }
         eprintln!("{line}");
@@ -129,9 +152,11 @@ fn robot_time_under_0_159_m() {
     let median = sorted[sorted.len() / 2];
     let over60 = times.iter().filter(|t| **t >= 60.0).count();
     eprintln!(
-        "robot: median time under 0.159 m {median:.0} s; {over60}/{} outages at least 60 s",
-        times.len()
+        "robot: median time under 0.159 m {median:.0} s; {over60}/{} outages at least 60 s; shortest {:.0} s",
+        times.len(),
+        sorted[0]
     );
-    assert!(median >= 30.0, "{times:?}");
-    assert!(over60 >= times.len() / 3, "{times:?}");
+    // Measured: 39/48 at least 60 s, median 90 s, shortest 37 s.
+    assert!(2 * over60 > times.len(), "{times:?}");
+    assert!(median >= 60.0, "{times:?}");
 }

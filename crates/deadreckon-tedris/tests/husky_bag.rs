@@ -1,0 +1,125 @@
+//! TedriS end to end on the real Clearpath Husky bag
+//! (`/work/shared/data/husky-gps-bag/husky_gps.bag`, 395 s at about 1 m/s, SBAS
+//! GNSS with 0.9 m noise at 2.5 Hz, wheel odometry at 10 Hz, IMU gyro): train on
+//! the first half with the gyro reference (the Husky's GNSS has no course), then
+//! blank GNSS for 30 s and 60 s in the second half and measure the error against
+//! the hidden fixes. Skipped (with a message) when the bag is absent.
+//!
+//! `cargo test --release -p deadreckon-tedris --test husky_bag -- --nocapture`
+
+use deadreckon_tedris::{
+    run_outages_with, time_range, train, Outage, OutageError, ReferenceSource, RunOptions,
+    TedrisConfig,
+};
+
+const BAG: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../../../shared/data/husky-gps-bag/husky_gps.bag"
+);
+
+fn run(
+    source: ReferenceSource,
+    cfg: TedrisConfig,
+    rel_outages: &[(f64, f64)],
+) -> Option<Vec<OutageError>> {
+    assert!(
+        std::path::Path::new(BAG).exists(),
+        "{BAG} not found: the shared data must sit beside the project"
+    );
+    let (drive, _) = deadreckon_ros::read_log(BAG, &deadreckon_ros::Mapping::husky()).unwrap();
+    let (t0, t1) = drive.time_span().unwrap();
+    let half = 0.5 * (t0 + t1);
+    let (model, _) = train(&time_range(&drive, None, Some(half)), cfg, Some(source)).unwrap();
+    let outages: Vec<Outage> = rel_outages
+        .iter()
+        .map(|&(a, b)| Outage {
+            start_s: half + a,
+            end_s: half + b,
+        })
+        .collect();
+    let mut errs = Vec::new();
+    // One outage per run, so that each starts from a machine anchored to GNSS.
+    for o in &outages {
+        let r = run_outages_with(
+            &drive,
+            &model,
+            std::slice::from_ref(o),
+            &RunOptions {
+                source: Some(source),
+                threshold_m: None,
+            },
+        )
+        .unwrap();
+        assert_eq!(r.reference, "hidden gnss");
+        let e = r.outages[0].clone();
+        eprintln!(
+            "husky {source:?} (lag {}): outage [{:.0}, {:.0}) s after the half: mean {:.2} m, max {:.2} m, final {:.2} m ({} fixes)",
+            model.lag_samples,
+            o.start_s - half,
+            o.end_s - half,
+            e.mean_error_m,
+            e.max_error_m,
+            e.final_error_m,
+            e.points
+        );
+        errs.push(e);
+    }
+    Some(errs)
+}
+
+const OUT_30: [(f64, f64); 5] = [
+    (5.0, 35.0),
+    (45.0, 75.0),
+    (85.0, 115.0),
+    (125.0, 155.0),
+    (160.0, 190.0),
+];
+const OUT_60: [(f64, f64); 3] = [(5.0, 65.0), (65.0, 125.0), (125.0, 185.0)];
+
+#[test]
+fn husky_gyro_reference_30_and_60_s_outages() {
+    let Some(e30) = run(ReferenceSource::Gyro, TedrisConfig::robot(), &OUT_30) else {
+        return;
+    };
+    let e60 = run(ReferenceSource::Gyro, TedrisConfig::robot(), &OUT_60).unwrap();
+    // No course on the Husky: the automatic reference is the gyro.
+    let (drive, _) = deadreckon_ros::read_log(BAG, &deadreckon_ros::Mapping::husky()).unwrap();
+    assert_eq!(
+        ReferenceSource::auto(&drive).unwrap(),
+        ReferenceSource::Gyro
+    );
+    let mean = |e: &[OutageError]| e.iter().map(|o| o.mean_error_m).sum::<f64>() / e.len() as f64;
+    eprintln!(
+        "husky gyro: 30 s outages mean {:.2} m, 60 s outages mean {:.2} m",
+        mean(&e30),
+        mean(&e60)
+    );
+    // Measured (against fixes with 0.9 m noise): 30 s means 0.64–2.07 m (max 4.3 m),
+    // 60 s means 0.77–2.34 m (max 4.6 m).
+    for e in e30.iter().chain(&e60) {
+        assert!(e.points > 50 && e.predicted_fraction > 0.95, "{e:?}");
+        assert!(e.mean_error_m < 3.5, "{e:?}");
+        assert!(e.max_error_m < 7.0, "{e:?}");
+    }
+    assert!(mean(&e30) < 2.5 && mean(&e60) < 2.5);
+}
+
+#[test]
+fn husky_fix_track_reference_runs() {
+    // The course from chords between fixes is too noisy at 1 m/s for the block
+    // regression (cross-correlation peak about 0.06): printed, loosely bounded
+    // (measured 0.9–6.0 m mean, 10.7 m largest, over 30 s).
+    let cfg = TedrisConfig {
+        min_course_speed_mps: 0.3,
+        init_samples: 600,
+        required_bins: 0,
+        min_ccf_peak: 0.0,
+        ..TedrisConfig::default()
+    };
+    let Some(e) = run(ReferenceSource::GnssTrack, cfg, &OUT_30) else {
+        return;
+    };
+    for o in &e {
+        assert!(o.mean_error_m.is_finite() && o.mean_error_m < 30.0, "{o:?}");
+    }
+}
