@@ -230,7 +230,8 @@ fn filter_runs_with_any_sensor_absent() {
             .errors_pct(),
     )
     .mean;
-    let strip: [(&str, fn(&mut deadreckon_core::Drive)); 4] = [
+    type Strip = fn(&mut deadreckon_core::Drive);
+    let strip: [(&str, Strip); 4] = [
         ("gyro", |d| d.yaw_rate.clear()),
         ("speed", |d| d.speed.clear()),
         ("steering", |d| d.steering.clear()),

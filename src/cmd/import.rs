@@ -146,8 +146,21 @@ pub fn run(a: ImportArgs) -> Result<()> {
             (i.drive, i.report.to_string())
         }
         "rosbag" | "mcap" => {
-            let drive = super::load_ros(&a.source)?;
-            (drive, String::new())
+            // Samples out of order, duplicated or invalid are always dropped
+            // and counted by these readers (see the report); the topics and
+            // the vehicle come from `--mapping` (default: the built-in Husky).
+            if a.gate {
+                bail!("--gate does not apply to rosbag/mcap: their readers always drop and count bad samples");
+            }
+            let (mut drive, report) = super::load_ros_with_report(&a.source)?;
+            if let Some(v) = vehicle {
+                let origin = drive.vehicle.origin;
+                drive.vehicle = deadreckon_core::Vehicle {
+                    origin: v.origin.or(origin),
+                    ..v
+                };
+            }
+            (drive, format!("{report}\n"))
         }
         other => bail!("unknown import format `{other}` (comma2k19, can, tricycle, rosbag, mcap)"),
     };

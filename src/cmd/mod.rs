@@ -24,6 +24,13 @@ pub static ROS_MAPPING: std::sync::OnceLock<std::path::PathBuf> = std::sync::Onc
 /// Reads a ROS1 bag or ROS2 MCAP recording with the `--mapping` file, or the
 /// built-in mapping (Husky, or Jackal when the file name says so).
 pub fn load_ros(path: &std::path::Path) -> anyhow::Result<deadreckon_core::Drive> {
+    Ok(load_ros_with_report(path)?.0)
+}
+
+/// [`load_ros`] with the reader's report of what was used, dropped and counted.
+pub fn load_ros_with_report(
+    path: &std::path::Path,
+) -> anyhow::Result<(deadreckon_core::Drive, deadreckon_ros::ImportReport)> {
     use anyhow::Context;
     let mapping = match ROS_MAPPING.get() {
         Some(m) => {
@@ -40,7 +47,5 @@ pub fn load_ros(path: &std::path::Path) -> anyhow::Result<deadreckon_core::Drive
         }
         None => deadreckon_ros::Mapping::husky(),
     };
-    let (drive, _report) = deadreckon_ros::read_log(path, &mapping)
-        .with_context(|| format!("reading {}", path.display()))?;
-    Ok(drive)
+    deadreckon_ros::read_log(path, &mapping).with_context(|| format!("reading {}", path.display()))
 }

@@ -295,11 +295,24 @@ fn lz4_and_uncompressed_bag_chunks() {
 /// with index and chunk-info records) is a valid bag.
 #[test]
 fn fuzz_seed_bag_is_valid() {
-    let b = std::fs::read(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/fuzz/seeds/rosbag/husky_head.bag"
-    ))
-    .unwrap();
+    // The seed is cut from the shared recording by the script (the project keeps
+    // no copy of the shared data), here into a temporary directory.
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(tmp.path().join("seeds/rosbag")).unwrap();
+    let status = std::process::Command::new("python3")
+        .arg(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/fuzz/make_bag_seed.py"
+        ))
+        .arg(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../../shared/data/husky-gps-bag/husky_gps.bag"
+        ))
+        .current_dir(tmp.path())
+        .status()
+        .expect("python3 runs");
+    assert!(status.success(), "make_bag_seed.py failed");
+    let b = std::fs::read(tmp.path().join("seeds/rosbag/husky_head.bag")).unwrap();
     let (drive, report) = read_rosbag_bytes(&b, "seed.bag", &Mapping::husky()).unwrap();
     assert!(report.streams.iter().all(|s| s.messages == 2), "{report:?}");
     assert_eq!(drive.wheels.len(), 2);
