@@ -21,6 +21,7 @@ pub mod angle;
 pub mod calibrate;
 pub mod drive;
 pub mod ekf;
+pub mod geo;
 pub mod kalman;
 pub mod metrics;
 pub mod model;

@@ -34,7 +34,6 @@
 
 mod atomic;
 mod error;
-pub mod geo;
 mod read;
 mod table;
 mod toml_files;
@@ -42,6 +41,8 @@ mod track_out;
 mod write;
 
 pub use atomic::atomic_write;
+/// Latitude/longitude ↔ local east-north (re-exported from `deadreckon-core`).
+pub use deadreckon_core::geo;
 pub use error::IoError;
 pub use read::{read_drive, read_drive_with, ReadOptions, WheelFile};
 pub use toml_files::{

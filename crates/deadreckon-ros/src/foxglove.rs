@@ -127,16 +127,8 @@ fn stamp(t_s: f64, file: &str) -> Result<(u64, Value), RosError> {
 }
 
 fn geodetic(origin: Origin, east_m: f64, north_m: f64) -> (f64, f64, f64) {
-    let (lat, lon, alt) = map_3d::enu2geodetic(
-        east_m,
-        north_m,
-        0.0,
-        origin.lat_deg.to_radians(),
-        origin.lon_deg.to_radians(),
-        0.0,
-        map_3d::Ellipsoid::WGS84,
-    );
-    (lat.to_degrees(), lon.to_degrees(), alt)
+    let (lat, lon) = deadreckon_core::geo::en_to_geodetic(&origin, east_m, north_m);
+    (lat, lon, 0.0)
 }
 
 fn location_fix(

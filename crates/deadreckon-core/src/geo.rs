@@ -1,7 +1,7 @@
 //! Latitude/longitude ↔ local east-north, on the WGS84 ellipsoid, through
 //! `map_3d` (geodetic → ECEF → ENU about the origin, altitudes taken as 0).
 
-use deadreckon_core::vehicle::Origin;
+use crate::vehicle::Origin;
 
 /// East and north of `(lat_deg, lon_deg)` about `origin`, m (WGS84, both at
 /// zero ellipsoidal height; the local frame is the origin's tangent plane).
