@@ -7,7 +7,7 @@ use deadreckon_core::drive::{GnssFix, Scalar, TruthPose, WheelSpeeds, WheelTicks
 use deadreckon_core::vehicle::Origin;
 use deadreckon_core::Drive;
 
-use crate::table::{Limit, Table};
+use crate::table::{Col, Limit, Table};
 use crate::{files, geo, IoError};
 
 /// Which wheel file a drive's wheel stream comes from.
@@ -271,14 +271,13 @@ fn position_columns(t: &Table<'_>) -> Result<bool, IoError> {
     }
 }
 
-/// Parses `gnss.csv`; with latitude/longitude (flag `true`) the fixes carry
-/// latitude in `east_m` and longitude in `north_m` until converted.
-pub(crate) fn parse_gnss(file: &Path, bytes: &[u8]) -> Result<(Vec<GnssFix>, bool), IoError> {
-    let t = Table::new(file, bytes)?;
-    let geodetic = position_columns(&t)?;
-    let ts = t.col("t_s")?;
-    let std = t.col("std_m")?;
-    let (a, b, la, lb) = if geodetic {
+/// The two position columns and their range checks: latitude/longitude or
+/// east/north.
+fn position_indices(
+    t: &Table,
+    geodetic: bool,
+) -> Result<(Col, Col, Option<Limit>, Option<Limit>), IoError> {
+    Ok(if geodetic {
         (
             t.col("lat_deg")?,
             t.col("lon_deg")?,
@@ -287,7 +286,17 @@ pub(crate) fn parse_gnss(file: &Path, bytes: &[u8]) -> Result<(Vec<GnssFix>, boo
         )
     } else {
         (t.col("east_m")?, t.col("north_m")?, None, None)
-    };
+    })
+}
+
+/// Parses `gnss.csv`; with latitude/longitude (flag `true`) the fixes carry
+/// latitude in `east_m` and longitude in `north_m` until converted.
+pub(crate) fn parse_gnss(file: &Path, bytes: &[u8]) -> Result<(Vec<GnssFix>, bool), IoError> {
+    let t = Table::new(file, bytes)?;
+    let geodetic = position_columns(&t)?;
+    let ts = t.col("t_s")?;
+    let std = t.col("std_m")?;
+    let (a, b, la, lb) = position_indices(&t, geodetic)?;
     let (course, speed) = (t.opt_col("course_deg"), t.opt_col("speed_mps"));
     let fixes = t.rows(|r| {
         Ok(GnssFix {
@@ -308,16 +317,7 @@ pub(crate) fn parse_truth(file: &Path, bytes: &[u8]) -> Result<(Vec<TruthPose>, 
     let geodetic = position_columns(&t)?;
     let ts = t.col("t_s")?;
     let yaw = t.col("yaw_rad")?;
-    let (a, b, la, lb) = if geodetic {
-        (
-            t.col("lat_deg")?,
-            t.col("lon_deg")?,
-            Some(Limit::Lat),
-            Some(Limit::Lon),
-        )
-    } else {
-        (t.col("east_m")?, t.col("north_m")?, None, None)
-    };
+    let (a, b, la, lb) = position_indices(&t, geodetic)?;
     let speed = t.opt_col("speed_mps");
     let poses = t.rows(|r| {
         Ok(TruthPose {
