@@ -112,9 +112,9 @@ pub fn run(a: DemoArgs, quiet: bool) -> Result<()> {
         }
     }
     // The report of the evaluation drive with the calibrations made on the calibration drive.
-    let methods: Vec<report::Method_> = results
+    let methods: Vec<report::NamedParams> = results
         .iter()
-        .map(|r| report::Method_ {
+        .map(|r| report::NamedParams {
             name: r.name.into(),
             params: r.params,
             calibration: r.calibration.clone(),

@@ -34,7 +34,7 @@ pub struct ReportArgs {
 }
 
 /// A named parameter set for the report.
-pub struct Method_ {
+pub struct NamedParams {
     /// Display name.
     pub name: String,
     /// Parameters.
@@ -125,9 +125,9 @@ pub fn header(drive: &Drive, name: &str, inputs: Vec<(String, String)>) -> rp::H
 
 /// The calibrations a drive supports: nominal always, ZUPT with a standstill,
 /// RTS with GNSS, truth with a reference.
-pub fn calibrations(drive: &Drive, steps: &Steps) -> Vec<Method_> {
+pub fn calibrations(drive: &Drive, steps: &Steps) -> Vec<NamedParams> {
     let nominal = Params::nominal(&drive.vehicle);
-    let mut out = vec![Method_ {
+    let mut out = vec![NamedParams {
         name: "nominal".into(),
         params: ParamsWithStd {
             params: nominal,
@@ -148,7 +148,7 @@ pub fn calibrations(drive: &Drive, steps: &Steps) -> Vec<Method_> {
                 ..Default::default()
             },
         ) {
-            out.push(Method_ {
+            out.push(NamedParams {
                 name: name.into(),
                 params: c.estimate,
                 calibration: Some(c),
@@ -219,7 +219,7 @@ pub fn health(
 /// Builds the four-wheel part of a report for `drive` with the given parameter sets.
 pub fn four_wheel_input(
     drive: &Drive,
-    methods: &[Method_],
+    methods: &[NamedParams],
     outage_s: Option<f64>,
     steps: &Steps,
 ) -> Result<rp::ReportInput> {
@@ -273,21 +273,13 @@ pub fn four_wheel_input(
     let opts = FilterOptions::default();
     for m in methods {
         steps.step(&format!("dead reckoning with {}", m.name));
-        if let Ok(tr) = runcmd::tracks(
-            &Drive {
-                gnss: Vec::new(),
-                ..drive.clone()
-            },
-            &m.params.params,
-            &opts,
-            None,
-        ) {
-            if let Some(dr) = tr.iter().find(|t| t.name == "dead-reckoned") {
-                traj.dead_reckoned.push(rp::MethodPath {
-                    method: m.name.clone(),
-                    path: path_of(dr),
-                });
-            }
+        let init = runcmd::dead_reckoning_init(drive, None, None);
+        if let Ok(dr) = init.and_then(|i| runcmd::dead_reckoned(drive, &m.params.params, &opts, i))
+        {
+            traj.dead_reckoned.push(rp::MethodPath {
+                method: m.name.clone(),
+                path: path_of(&dr),
+            });
         }
     }
     input.trajectories = Some(traj);
@@ -371,7 +363,7 @@ pub fn run(a: ReportArgs, quiet: bool) -> Result<()> {
     let mut methods = calibrations(&drive, &steps);
     if let Some(p) = &a.params {
         let params = common::load_params(p, &drive)?;
-        methods.push(Method_ {
+        methods.push(NamedParams {
             name: "given".into(),
             params: ParamsWithStd {
                 params,
@@ -517,10 +509,7 @@ pub fn tedris_from_model(
     }
     // Error through each outage for TedriS and the four-wheel EKF (calibrated with the outages hidden).
     let windows: Vec<(f64, f64)> = outages.iter().map(|o| (o.start_s, o.end_s)).collect();
-    let mut hidden = drive.clone();
-    hidden
-        .gnss
-        .retain(|g| !windows.iter().any(|&(a, b)| g.t_s >= a && g.t_s < b));
+    let hidden = super::compare::hide(drive, &windows);
     let fw = calibrate::calibrate(&hidden, &CalibrationOptions::default())
         .ok()
         .and_then(|c| {

@@ -55,10 +55,21 @@ pub fn tracks(
         out.push(Track::from_epochs("filtered", &f.epochs, origin));
         out.push(Track::from_smoothed("smoothed", &s, origin));
     }
-    let init = if let Some((e, n, y)) = init_pose {
-        let t0 = drive.wheels.t_s(0);
+    let init = dead_reckoning_init(drive, init_pose, smoothed_start)?;
+    out.insert(0, dead_reckoned(drive, params, opts, init)?);
+    Ok(out)
+}
+
+/// Where dead reckoning starts: the given pose, else the truth, else the
+/// start of the smoothed GNSS-aided track.
+pub fn dead_reckoning_init(
+    drive: &Drive,
+    init_pose: Option<(f64, f64, f64)>,
+    smoothed_start: Option<(f64, State, Mat)>,
+) -> Result<Init> {
+    Ok(if let Some((e, n, y)) = init_pose {
         Init::Given {
-            t_s: t0,
+            t_s: drive.wheels.t_s(0),
             x: State::from([e, n, y, 0.0, 0.0]),
             p: Mat::from_diagonal(&State::from([1e-4, 1e-4, 1e-6, 4.0, 0.25])),
         }
@@ -68,7 +79,16 @@ pub fn tracks(
         Init::Given { t_s, x, p }
     } else {
         anyhow::bail!("dead reckoning needs an initial pose: truth.csv, gnss.csv or --init-pose");
-    };
+    })
+}
+
+/// The dead-reckoned track (proprioceptive sensors only) from `init`.
+pub fn dead_reckoned(
+    drive: &Drive,
+    params: &Params,
+    opts: &FilterOptions,
+    init: Init,
+) -> Result<Track> {
     let dr = ekf::run(
         drive,
         params,
@@ -80,8 +100,11 @@ pub fn tracks(
         },
         &mut (),
     )?;
-    out.insert(0, Track::from_epochs("dead-reckoned", &dr.epochs, origin));
-    Ok(out)
+    Ok(Track::from_epochs(
+        "dead-reckoned",
+        &dr.epochs,
+        drive.vehicle.origin,
+    ))
 }
 
 /// Writes tracks by the file's extension.

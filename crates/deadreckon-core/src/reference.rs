@@ -3,7 +3,7 @@
 //! file does not give them) and for smoothed estimates.
 
 use crate::drive::TruthPose;
-use crate::model::{State, V, X, Y, YAW, YAW_RATE};
+use crate::model::{State, X, Y};
 
 /// States at increasing times, linearly interpolated between samples.
 #[derive(Debug, Clone, Default)]
@@ -94,12 +94,10 @@ impl Reference {
     }
 }
 
-/// Indices of the state, re-exported for readers of this module.
-pub const INDICES: [usize; 5] = [X, Y, YAW, V, YAW_RATE];
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::{V, YAW_RATE};
     #[test]
     fn derives_speed_and_yaw_rate_on_a_circle() {
         let r = 20.0;
