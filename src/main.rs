@@ -38,6 +38,10 @@ enum Command {
     /// TedriS time-series dead reckoning: train a model, predict through outages.
     #[command(subcommand)]
     Tedris(cmd::tedris::TedrisCommand),
+    /// Print a drive as time-ordered JSON lines, one measurement a line (docs/events.md).
+    Events(cmd::events::EventsArgs),
+    /// Run the four-wheel filter on JSON-line events from standard input, one JSON line per epoch out.
+    Stream(cmd::stream::StreamArgs),
     /// Convert a log (comma2k19, ROS bag, MCAP, CAN + DBC, tricycle) into a drive directory.
     Import(cmd::import::ImportArgs),
 }
@@ -57,6 +61,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Simulate(a) => cmd::simulate::run(a),
         Command::Calibrate(a) => cmd::calibrate::run(a),
+        Command::Events(a) => cmd::events::run(a),
+        Command::Stream(a) => cmd::stream::run(a),
         Command::Evaluate(a) => cmd::evaluate::run(a),
         Command::Run(a) => cmd::run::run(a),
         Command::Demo(a) => cmd::demo::run(a, cli.quiet),

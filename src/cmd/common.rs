@@ -36,12 +36,26 @@ pub fn load_params(spec: &str, drive: &Drive) -> Result<Params> {
     if spec == "nominal" {
         return Ok(Params::nominal(&drive.vehicle));
     }
+    Ok(read_params_file(spec)?.params)
+}
+
+/// Reads a params.toml with its standard errors, validated.
+pub fn read_params_file(spec: &str) -> Result<deadreckon_core::ParamsWithStd> {
     let p = deadreckon_io::read_params(Path::new(spec))
         .with_context(|| format!("reading parameters {spec}"))?;
     p.params
         .validate()
         .with_context(|| format!("parameters in {spec}"))?;
-    Ok(p.params)
+    Ok(p)
+}
+
+/// Ends quietly when the reader of standard output went away (a closed pipe,
+/// as `| head` does); any other write error is an error.
+pub fn quiet_on_broken_pipe(r: std::io::Result<()>) -> Result<()> {
+    match r {
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        r => Ok(r.context("writing to standard output")?),
+    }
 }
 
 /// Parses `--timing`.
@@ -113,8 +127,23 @@ pub fn calibration_json(method: &str, c: &Calibration) -> serde_json::Value {
             serde_json::json!({"used": st.gnss_updates, "rejected": st.gnss_rejected, "recoveries": st.gnss_recoveries, "hidden": st.gnss_hidden}),
         );
         m.insert("wheel_gaps".into(), st.wheel_gaps.into());
+        m.insert("gates".into(), gates_json(&st.gates));
     }
     serde_json::Value::Object(m)
+}
+
+/// The per-sensor χ² gate counters as JSON: `{sensor: {accepted, rejected, recovered}}`.
+pub fn gates_json(g: &deadreckon_core::filter::GateCounts) -> serde_json::Value {
+    g.rows()
+        .into_iter()
+        .map(|(name, a, r, rec)| {
+            (
+                name.to_string(),
+                serde_json::json!({"accepted": a, "rejected": r, "recovered": rec}),
+            )
+        })
+        .collect::<serde_json::Map<_, _>>()
+        .into()
 }
 
 /// A one-line account of what the filter used and gated.

@@ -4,11 +4,13 @@ pub mod common;
 pub mod compare;
 pub mod demo;
 pub mod evaluate;
+pub mod events;
 pub mod import;
 pub mod progress;
 pub mod report;
 pub mod run;
 pub mod simulate;
+pub mod stream;
 pub mod tedris;
 
 /// Writes tracks as MCAP with Foxglove schemas (`foxglove.PoseInFrame`,

@@ -210,7 +210,8 @@ pub fn health(
             t_s: recs.iter().map(|r| r.t_s).collect(),
             nis: recs.iter().map(|r| r.nis).collect(),
             gated: recs.iter().map(|r| !r.accepted).collect(),
-            gate_chi2: (k == SensorKind::Gnss).then_some(drive.vehicle.noise.gnss_gate_chi2),
+            gate_chi2: Some(deadreckon_core::filter::gate_chi2(&drive.vehicle.noise, k))
+                .filter(|g| g.is_finite()),
         });
     }
     Ok((h, out.stats, tracks))

@@ -80,7 +80,7 @@ pub struct Scalar {
 }
 
 /// One GNSS fix in the local east-north frame.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct GnssFix {
     /// Timestamp, s.
     pub t_s: f64,

@@ -13,18 +13,24 @@
 //! Any sensor may be absent: the filter uses the streams the drive has. The
 //! per-epoch predicted and updated states, covariances and Jacobians are kept
 //! when asked (`record`), for the RTS smoother.
+//!
+//! Both schemes are causal: a [`Feeder`] takes time-ordered [`Event`]s one at a
+//! time (from [`DriveEvents`] over a recorded drive, or from a live stream) and
+//! drives the step filter of [`crate::filter`]; [`run`] is that loop over a
+//! drive.
 
-use nalgebra::{Matrix2, SMatrix, SVector, Vector2};
+use nalgebra::{SMatrix, SVector};
+use serde::{Deserialize, Serialize};
 
-use crate::drive::{Drive, Wheels};
-use crate::kalman::{self, CovarianceForm};
-use crate::model::{self, Mat, State, V};
-use crate::observation::Sensors;
-use crate::vehicle::{Noise, Params};
+use crate::drive::{Drive, GnssFix, Wheels};
+use crate::filter::{AugmentedLayout, CarLayout, Filter, Layout, Prediction};
+use crate::kalman::CovarianceForm;
+use crate::model::{Mat, State};
+use crate::vehicle::Params;
 use crate::Error;
 
 /// When the filter runs its epochs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub enum Timing {
     /// One epoch per wheel row, with the latest reading of the other sensors (the paper).
     #[default]
@@ -35,7 +41,7 @@ pub enum Timing {
 
 /// How the filter's initial state is chosen.
 #[allow(clippy::large_enum_variant)] // a plain value passed once per run
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub enum Init {
     /// From GNSS: the first fix for the position (minus the lever arm) and the
     /// direction of the first 10 m of displacement for the yaw. The filter starts at
@@ -56,7 +62,7 @@ pub enum Init {
 }
 
 /// Which sensors the filter uses (all by default, when present in the drive).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct SensorSet {
     /// Wheel encoders or wheel speeds.
     pub wheels: bool,
@@ -97,7 +103,7 @@ impl SensorSet {
 }
 
 /// Options of a filter run.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FilterOptions {
     /// Timing scheme.
     pub timing: Timing,
@@ -153,47 +159,7 @@ pub struct Epoch<const N: usize = 5> {
     pub p: SMatrix<f64, N, N>,
 }
 
-/// Which sensor an innovation belongs to.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum SensorKind {
-    /// Wheel `0..4` (FL, FR, RL, RR).
-    Wheel(u8),
-    /// Gyro.
-    Gyro,
-    /// CAN speed.
-    Speed,
-    /// Steering.
-    Steering,
-    /// GNSS position (2-D; the NIS has 2 degrees of freedom).
-    Gnss,
-    /// GNSS course.
-    Course,
-}
-
-impl SensorKind {
-    /// A short stable name.
-    pub fn name(&self) -> &'static str {
-        match self {
-            SensorKind::Wheel(0) => "wheel_fl",
-            SensorKind::Wheel(1) => "wheel_fr",
-            SensorKind::Wheel(2) => "wheel_rl",
-            SensorKind::Wheel(_) => "wheel_rr",
-            SensorKind::Gyro => "gyro",
-            SensorKind::Speed => "speed",
-            SensorKind::Steering => "steering",
-            SensorKind::Gnss => "gnss",
-            SensorKind::Course => "course",
-        }
-    }
-    /// Degrees of freedom of the measurement.
-    pub fn dof(&self) -> usize {
-        if *self == SensorKind::Gnss {
-            2
-        } else {
-            1
-        }
-    }
-}
+pub use crate::filter::{GateCounts, SensorKind, Update, AUG_BIAS, AUG_INV_CIRC, AUG_SCALE, N_AUG};
 
 /// One recorded innovation.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -213,7 +179,7 @@ pub struct InnovationRecord {
 }
 
 /// Counts of what the filter used, gated and skipped.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub struct FilterStats {
     /// Epochs run.
     pub epochs: usize,
@@ -222,11 +188,11 @@ pub struct FilterStats {
     /// Wheel rows skipped because the interval since the previous row was a gap
     /// (more than 5 times the median interval).
     pub wheel_gaps: usize,
-    /// Gyro readings used.
+    /// Gyro readings used (accepted by the gate).
     pub gyro_updates: usize,
-    /// CAN speed readings used.
+    /// CAN speed readings used (accepted by the gate).
     pub speed_updates: usize,
-    /// Steering readings used.
+    /// Steering readings used (accepted by the gate).
     pub steering_updates: usize,
     /// Readings of the other sensors not used because a newer one arrived before the
     /// next wheel epoch (the paper's scheme).
@@ -242,6 +208,8 @@ pub struct FilterStats {
     pub gnss_hidden: usize,
     /// GNSS course readings used.
     pub course_updates: usize,
+    /// Per-sensor χ² gate counters (accepted, rejected, recovered).
+    pub gates: GateCounts,
 }
 
 /// The result of a filter run.
@@ -270,278 +238,602 @@ impl<const N: usize> Default for FilterOutput<N> {
 pub trait EpochHook<const N: usize = 5> {
     /// Called after the updates of the epoch at `t_s`.
     fn after_epoch(&mut self, t_s: f64, x: &mut SVector<f64, N>, p: &mut SMatrix<f64, N, N>);
+    /// True for a hook that never changes anything (the loop then skips it).
+    fn is_noop(&self) -> bool {
+        false
+    }
 }
 
 impl<const N: usize> EpochHook<N> for () {
     fn after_epoch(&mut self, _t_s: f64, _x: &mut SVector<f64, N>, _p: &mut SMatrix<f64, N, N>) {}
-}
-
-/// Dimension of the augmented state: the car state then the six parameters
-/// `[b_gyro, a_v, 1/ρ_FL, 1/ρ_FR, 1/ρ_RL, 1/ρ_RR]`.
-pub const N_AUG: usize = 11;
-/// Index of the gyro bias in the augmented state.
-pub const AUG_BIAS: usize = 5;
-/// Index of the speed scale in the augmented state.
-pub const AUG_SCALE: usize = 6;
-/// Index of the first inverse circumference (FL, then FR, RL, RR) in the augmented state.
-pub const AUG_INV_CIRC: usize = 7;
-
-/// The filter's running state. With `N == 5` the parameters are fixed; with
-/// `N == N_AUG` they are states, and the sensor models read them from the state.
-struct Filter<'a, const N: usize> {
-    sensors: Sensors,
-    noise: Noise,
-    form: CovarianceForm,
-    x: SVector<f64, N>,
-    p: SMatrix<f64, N, N>,
-    t: f64,
-    opts: &'a FilterOptions,
-    out: FilterOutput<N>,
-    consecutive_rejections: u32,
-    wheels_present: [bool; 4],
-}
-
-impl<const N: usize> Filter<'_, N> {
-    fn car(&self) -> State {
-        self.x.fixed_rows::<5>(0).into_owned()
+    fn is_noop(&self) -> bool {
+        true
     }
+}
 
-    /// Points the sensor models at the parameters held in the augmented state.
-    fn refresh_params(&mut self) {
-        if N == N_AUG {
-            self.sensors.params.gyro_bias_rps = self.x[AUG_BIAS];
-            self.sensors.params.speed_scale = self.x[AUG_SCALE];
-            for i in 0..4 {
-                self.sensors.inv_circumference[i] = self.x[AUG_INV_CIRC + i];
-            }
+/// One measurement, as a drive or a live stream delivers it. The serde form is
+/// the JSON-lines event schema of `deadreckon events` (see `docs/events.md`):
+/// a `sensor` tag and the drive format's column names.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "sensor", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Measurement {
+    /// Ticks of each wheel since the previous wheel row.
+    WheelTicks {
+        /// Front left.
+        fl: i64,
+        /// Front right.
+        fr: i64,
+        /// Rear left.
+        rl: i64,
+        /// Rear right.
+        rr: i64,
+    },
+    /// Wheel speeds, m/s.
+    WheelSpeeds {
+        /// Front left, m/s.
+        fl_mps: f64,
+        /// Front right, m/s.
+        fr_mps: f64,
+        /// Rear left, m/s.
+        rl_mps: f64,
+        /// Rear right, m/s.
+        rr_mps: f64,
+    },
+    /// Raw gyro yaw rate, rad/s.
+    YawRate {
+        /// rad/s, counter-clockwise positive.
+        yaw_rate_rps: f64,
+    },
+    /// CAN vehicle speed, m/s.
+    Speed {
+        /// m/s.
+        speed_mps: f64,
+    },
+    /// Steering wheel angle, rad.
+    Steering {
+        /// rad, left positive.
+        steering_wheel_rad: f64,
+    },
+    /// A GNSS fix of the antenna.
+    Gnss {
+        /// m east of the origin.
+        east_m: f64,
+        /// m north of the origin.
+        north_m: f64,
+        /// Horizontal standard deviation, m.
+        std_m: f64,
+        /// Course, degrees clockwise from north.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        course_deg: Option<f64>,
+        /// Ground speed, m/s.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        speed_mps: Option<f64>,
+    },
+}
+
+/// A measurement with its timestamp.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Event {
+    /// Timestamp, s (the drive's clock).
+    pub t_s: f64,
+    /// The measurement.
+    #[serde(flatten)]
+    pub measurement: Measurement,
+}
+
+impl Event {
+    /// Order of events with equal timestamps: wheels, gyro, speed, steering,
+    /// GNSS (the per-measurement scheme processes them in this order).
+    fn rank(&self) -> u8 {
+        match self.measurement {
+            Measurement::WheelTicks { .. } | Measurement::WheelSpeeds { .. } => 0,
+            Measurement::YawRate { .. } => 1,
+            Measurement::Speed { .. } => 2,
+            Measurement::Steering { .. } => 3,
+            Measurement::Gnss { .. } => 4,
         }
     }
 
-    fn predict(&mut self, t: f64) -> (SVector<f64, N>, SMatrix<f64, N, N>, Mat) {
-        let dt = (t - self.t).max(0.0);
-        let car = self.car();
-        let f5 = model::jacobian(&car, dt);
-        let q5 = model::process_noise(&self.noise, dt);
-        self.x
-            .fixed_rows_mut::<5>(0)
-            .copy_from(&model::evolve(&car, dt));
-        if N == 5 {
-            self.p = kalman::predict_covariance(
-                &self.p,
-                &SMatrix::<f64, N, N>::from_fn(|i, j| f5[(i % 5, j % 5)]),
-                &SMatrix::<f64, N, N>::from_fn(|i, j| q5[(i % 5, j % 5)]),
-            );
-        } else {
-            // F = diag(F_car, I) and Q = diag(Q_car, 0): only the car rows and
-            // columns change. P11 ← F P11 Fᵀ + Q, P12 ← F P12, P22 unchanged.
-            let p11 = self.p.fixed_view::<5, 5>(0, 0).into_owned();
-            let n11 = f5 * p11 * f5.transpose() + q5;
-            let n11 = (n11 + n11.transpose()) * 0.5;
-            self.p.fixed_view_mut::<5, 5>(0, 0).copy_from(&n11);
-            for j in 5..N {
-                let col: State = self.p.fixed_view::<5, 1>(0, j).into_owned();
-                let nc = f5 * col;
-                for i in 0..5 {
-                    self.p[(i, j)] = nc[i];
-                    self.p[(j, i)] = nc[i];
+    fn is_wheel(&self) -> bool {
+        self.rank() == 0
+    }
+
+    /// The fix of a GNSS event.
+    pub fn gnss_fix(&self) -> Option<GnssFix> {
+        match self.measurement {
+            Measurement::Gnss {
+                east_m,
+                north_m,
+                std_m,
+                course_deg,
+                speed_mps,
+            } => Some(GnssFix {
+                t_s: self.t_s,
+                east_m,
+                north_m,
+                std_m,
+                course_deg,
+                speed_mps,
+            }),
+            _ => None,
+        }
+    }
+}
+
+/// The streams of a drive merged into time order (ties in [`Event`] rank
+/// order), lazily, from `after_s` (exclusive) to the last wheel row: readings
+/// after the last wheel row are never used.
+pub struct DriveEvents<'a> {
+    drive: &'a Drive,
+    next: [usize; 5],
+    t_end: f64,
+}
+
+impl<'a> DriveEvents<'a> {
+    /// Events of `drive` with `t > after_s`.
+    pub fn new(drive: &'a Drive, after_s: f64) -> Self {
+        let w = &drive.wheels;
+        let first_wheel = (0..w.len())
+            .find(|&k| w.t_s(k) > after_s)
+            .unwrap_or(w.len());
+        DriveEvents {
+            drive,
+            next: [
+                first_wheel,
+                drive.yaw_rate.partition_point(|s| s.t_s <= after_s),
+                drive.speed.partition_point(|s| s.t_s <= after_s),
+                drive.steering.partition_point(|s| s.t_s <= after_s),
+                drive.gnss.partition_point(|s| s.t_s <= after_s),
+            ],
+            t_end: if w.is_empty() {
+                f64::NEG_INFINITY
+            } else {
+                w.t_s(w.len() - 1)
+            },
+        }
+    }
+
+    /// Every event of `drive`.
+    pub fn all(drive: &'a Drive) -> Self {
+        Self::new(drive, f64::NEG_INFINITY)
+    }
+
+    fn time(&self, stream: usize) -> Option<f64> {
+        let d = self.drive;
+        let i = self.next[stream];
+        let t = match stream {
+            0 => (i < d.wheels.len()).then(|| d.wheels.t_s(i)),
+            1 => d.yaw_rate.get(i).map(|s| s.t_s),
+            2 => d.speed.get(i).map(|s| s.t_s),
+            3 => d.steering.get(i).map(|s| s.t_s),
+            _ => d.gnss.get(i).map(|s| s.t_s),
+        }?;
+        (t <= self.t_end).then_some(t)
+    }
+}
+
+impl Iterator for DriveEvents<'_> {
+    type Item = Event;
+    fn next(&mut self) -> Option<Event> {
+        let mut best: Option<(f64, usize)> = None;
+        for k in 0..5 {
+            if let Some(t) = self.time(k) {
+                if best.is_none_or(|(bt, _)| t < bt) {
+                    best = Some((t, k));
                 }
             }
         }
-        self.t = t;
-        (self.x, self.p, f5)
+        let (t_s, k) = best?;
+        let i = self.next[k];
+        self.next[k] += 1;
+        let d = self.drive;
+        let measurement = match k {
+            0 => match &d.wheels {
+                Wheels::Ticks(v) => Measurement::WheelTicks {
+                    fl: v[i].fl,
+                    fr: v[i].fr,
+                    rl: v[i].rl,
+                    rr: v[i].rr,
+                },
+                Wheels::Speeds(v) => Measurement::WheelSpeeds {
+                    fl_mps: v[i].fl_mps,
+                    fr_mps: v[i].fr_mps,
+                    rl_mps: v[i].rl_mps,
+                    rr_mps: v[i].rr_mps,
+                },
+            },
+            1 => Measurement::YawRate {
+                yaw_rate_rps: d.yaw_rate[i].value,
+            },
+            2 => Measurement::Speed {
+                speed_mps: d.speed[i].value,
+            },
+            3 => Measurement::Steering {
+                steering_wheel_rad: d.steering[i].value,
+            },
+            _ => {
+                let g = d.gnss[i];
+                Measurement::Gnss {
+                    east_m: g.east_m,
+                    north_m: g.north_m,
+                    std_m: g.std_m,
+                    course_deg: g.course_deg,
+                    speed_mps: g.speed_mps,
+                }
+            }
+        };
+        Some(Event { t_s, measurement })
+    }
+}
+
+/// Wheel intervals longer than this many times the median interval are gaps:
+/// the row is skipped (a tick count over a gap cannot be predicted from the
+/// speed at its end).
+const GAP_FACTOR: f64 = 5.0;
+/// The median wheel interval is taken over the first this many intervals (then
+/// kept), so the gap rule is causal.
+const GAP_MEDIAN_OF: usize = 64;
+/// No gap is declared before this many intervals have been seen.
+const GAP_MIN_INTERVALS: usize = 3;
+
+/// Feeds time-ordered events to a [`Filter`] in one of the two timing schemes,
+/// causally: an epoch is run once every event with its timestamp has arrived
+/// (a later event, or [`Feeder::finish`]). Serialisable with the filter, so a
+/// stream can stop and resume.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Feeder {
+    timing: Timing,
+    sensors: SensorSet,
+    outages: Vec<(f64, f64)>,
+    start_s: f64,
+    end_s: Option<f64>,
+    /// Time of the last wheel row (the start of the next wheel interval).
+    last_wheel_s: Option<f64>,
+    /// The first wheel intervals, for the gap rule.
+    intervals: Vec<f64>,
+    max_interval_s: Option<f64>,
+    /// Events sharing the newest timestamp, not yet processed.
+    batch: Vec<Event>,
+    /// The paper's scheme: newest unused reading of each other sensor.
+    pending_gyro: Option<f64>,
+    pending_speed: Option<f64>,
+    pending_steering: Option<f64>,
+    pending_gnss: Option<GnssFix>,
+    stats: FilterStats,
+    #[serde(skip)]
+    updates: Vec<Update>,
+}
+
+/// What one epoch did: the prediction and the updates.
+pub struct EpochOut<'a, const N: usize> {
+    /// The prediction to the epoch's time.
+    pub prediction: Prediction<N>,
+    /// The updates applied (or rejected) at the epoch.
+    pub updates: &'a [Update],
+}
+
+impl Feeder {
+    /// A feeder for a filter started at `start_s`: readings before it (and other
+    /// sensors' readings at it) are ignored; the first wheel row at or after it
+    /// opens the first wheel interval.
+    pub fn new(opts: &FilterOptions, start_s: f64) -> Self {
+        Feeder {
+            timing: opts.timing,
+            sensors: opts.sensors,
+            outages: opts.gnss_outages.clone(),
+            start_s,
+            end_s: opts.end_s,
+            last_wheel_s: None,
+            intervals: Vec::new(),
+            max_interval_s: None,
+            batch: Vec::new(),
+            pending_gyro: None,
+            pending_speed: None,
+            pending_steering: None,
+            pending_gnss: None,
+            stats: FilterStats::default(),
+            updates: Vec::new(),
+        }
     }
 
-    /// A scalar update from a car-state model `pred = (h, H)`; `param` adds the
-    /// derivative with respect to one parameter (index in the parameter block)
-    /// when the parameters are states.
-    fn scalar(
+    /// Counters so far (the gate counters are the filter's: see [`Feeder::stats_with`]).
+    pub fn stats(&self) -> &FilterStats {
+        &self.stats
+    }
+
+    /// Counters so far, with the filter's gate counters folded in.
+    pub fn stats_with<L: Layout<N>, const N: usize>(&self, f: &Filter<L, N>) -> FilterStats {
+        let g = f.gates();
+        let mut st = self.stats;
+        st.gates = *g;
+        st.gyro_updates = g.accepted(SensorKind::Gyro) as usize;
+        st.speed_updates = g.accepted(SensorKind::Speed) as usize;
+        st.steering_updates = g.accepted(SensorKind::Steering) as usize;
+        st.gnss_updates = g.accepted(SensorKind::Gnss) as usize;
+        st.gnss_rejected = g.rejected(SensorKind::Gnss) as usize;
+        st.gnss_recoveries = g.recovered(SensorKind::Gnss) as usize;
+        st.course_updates = g.accepted(SensorKind::Course) as usize;
+        st
+    }
+
+    /// Takes one event (timestamps must not decrease); runs the epochs it
+    /// completes, calling `epoch` after each with the filter (which the caller
+    /// may change, e.g. reset) and what the epoch did.
+    pub fn push<L: Layout<N>, const N: usize>(
         &mut self,
-        sensor: SensorKind,
-        z: f64,
-        pred: (f64, model::Row),
-        r: f64,
-        param: Option<(usize, f64)>,
+        f: &mut Filter<L, N>,
+        ev: Event,
+        epoch: &mut dyn FnMut(&mut Filter<L, N>, EpochOut<'_, N>),
     ) -> Result<(), Error> {
-        let (h, row5) = pred;
-        let mut row = SVector::<f64, N>::zeros();
-        row.fixed_rows_mut::<5>(0).copy_from(&row5);
-        if let (true, Some((j, d))) = (N == N_AUG, param) {
-            row[5 + j] = d;
+        if !ev.t_s.is_finite() {
+            return Err(Error::InvalidDrive(format!(
+                "event time {} is not finite",
+                ev.t_s
+            )));
         }
-        let y = if sensor == SensorKind::Course {
-            crate::angle::diff(z, h)
+        if let Some(last) = self.batch.last() {
+            if ev.t_s < last.t_s {
+                return Err(Error::InvalidDrive(format!(
+                    "event at t={} s comes after one at t={} s: events must be in time order",
+                    ev.t_s, last.t_s
+                )));
+            }
+            if ev.t_s > last.t_s {
+                self.process_batch(f, epoch)?;
+            }
+        }
+        // Readings at or before the start are not used; the first wheel row at
+        // or after it opens the first interval.
+        let keep = if ev.is_wheel() {
+            ev.t_s >= self.start_s
         } else {
-            z - h
+            ev.t_s > self.start_s
         };
-        let inn = kalman::update_scalar(&mut self.x, &mut self.p, y, &row, r, self.form, self.t)?;
-        self.refresh_params();
-        if self.opts.record_innovations {
-            self.out.innovations.push(InnovationRecord {
-                t_s: self.t,
-                sensor,
-                y: inn.y,
-                s: inn.s,
-                nis: inn.nis,
-                accepted: true,
-            });
+        if keep {
+            self.batch.push(ev);
         }
         Ok(())
     }
 
-    fn wheels(&mut self, wheels: &Wheels, k: usize, max_interval: f64) -> Result<(), Error> {
-        let interval = wheels.t_s(k) - wheels.t_s(k - 1);
-        if interval > max_interval {
-            self.out.stats.wheel_gaps += 1;
+    /// Runs what is still waiting (at the end of a stream).
+    pub fn finish<L: Layout<N>, const N: usize>(
+        &mut self,
+        f: &mut Filter<L, N>,
+        epoch: &mut dyn FnMut(&mut Filter<L, N>, EpochOut<'_, N>),
+    ) -> Result<(), Error> {
+        self.process_batch(f, epoch)
+    }
+
+    fn hidden(&self, t: f64) -> bool {
+        self.outages.iter().any(|&(a, b)| t >= a && t < b)
+    }
+
+    fn process_batch<L: Layout<N>, const N: usize>(
+        &mut self,
+        f: &mut Filter<L, N>,
+        epoch: &mut dyn FnMut(&mut Filter<L, N>, EpochOut<'_, N>),
+    ) -> Result<(), Error> {
+        let mut batch = std::mem::take(&mut self.batch);
+        // Equal timestamps: the paper's scheme takes the other readings into the
+        // wheel epoch of the same time, so they go first; the per-measurement
+        // scheme runs wheels first.
+        match self.timing {
+            Timing::WheelEpochs => batch.sort_by_key(|e| (e.is_wheel(), e.rank())),
+            Timing::EachMeasurement => batch.sort_by_key(|e| e.rank()),
+        }
+        let result = batch.iter().try_for_each(|ev| self.event(f, *ev, epoch));
+        batch.clear();
+        self.batch = batch;
+        result
+    }
+
+    /// The wheel interval ending at `t`, and whether it is a gap.
+    fn wheel_interval(&mut self, t: f64) -> Option<(f64, bool)> {
+        let prev = self.last_wheel_s.replace(t)?;
+        let interval = t - prev;
+        if self.max_interval_s.is_none() || self.intervals.len() < GAP_MEDIAN_OF {
+            self.intervals.push(interval);
+            if self.intervals.len() >= GAP_MIN_INTERVALS {
+                let mut d = self.intervals.clone();
+                let mid = d.len() / 2;
+                let med = *d.select_nth_unstable_by(mid, |a, b| a.total_cmp(b)).1;
+                self.max_interval_s = Some(GAP_FACTOR * med);
+            }
+        }
+        let gap = self.max_interval_s.is_some_and(|m| interval > m);
+        Some((interval, gap))
+    }
+
+    fn wheel_updates<L: Layout<N>, const N: usize>(
+        &mut self,
+        f: &mut Filter<L, N>,
+        m: &Measurement,
+        interval: f64,
+    ) -> Result<(), Error> {
+        self.stats.wheel_updates += 1;
+        match *m {
+            Measurement::WheelTicks { fl, fr, rl, rr } => {
+                for (i, z) in [fl, fr, rl, rr].into_iter().enumerate() {
+                    if let Some(u) = f.update_wheel_ticks(i, z as f64, interval)? {
+                        self.updates.push(u);
+                    }
+                }
+            }
+            Measurement::WheelSpeeds {
+                fl_mps,
+                fr_mps,
+                rl_mps,
+                rr_mps,
+            } => {
+                for (i, z) in [fl_mps, fr_mps, rl_mps, rr_mps].into_iter().enumerate() {
+                    if let Some(u) = f.update_wheel_speed(i, z)? {
+                        self.updates.push(u);
+                    }
+                }
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+
+    fn gnss_update<L: Layout<N>, const N: usize>(
+        &mut self,
+        f: &mut Filter<L, N>,
+        fix: &GnssFix,
+    ) -> Result<(), Error> {
+        let u = f.update_gnss(fix)?;
+        self.updates.push(u);
+        if u.accepted && self.sensors.gnss_course {
+            if let Some(course) = fix.course_yaw_rad() {
+                if let Some(u) = f.update_course(course, fix.speed_mps)? {
+                    self.updates.push(u);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn event<L: Layout<N>, const N: usize>(
+        &mut self,
+        f: &mut Filter<L, N>,
+        ev: Event,
+        epoch: &mut dyn FnMut(&mut Filter<L, N>, EpochOut<'_, N>),
+    ) -> Result<(), Error> {
+        let t = ev.t_s;
+        if self.end_s.is_some_and(|e| t > e) {
             return Ok(());
         }
-        self.out.stats.wheel_updates += 1;
-        match wheels {
-            Wheels::Ticks(rows) => {
-                let r = rows[k];
-                let r2 = self.noise.wheel_ticks.powi(2);
-                for (i, z) in [r.fl, r.fr, r.rl, r.rr].into_iter().enumerate() {
-                    if !self.wheels_present[i] {
-                        continue;
-                    }
-                    let pred = self.sensors.wheel_ticks(&self.car(), i, interval);
-                    // ∂h/∂(1/ρ_i) = h·ρ_i: the model is linear in the inverse circumference.
-                    let d = pred.0 / self.sensors.inv_circumference[i];
-                    self.scalar(
-                        SensorKind::Wheel(i as u8),
-                        z as f64,
-                        pred,
-                        r2,
-                        Some((2 + i, d)),
-                    )?;
-                }
+        let use_ = self.sensors;
+        self.updates.clear();
+        let supersede = |slot: &mut Option<f64>, v: f64, n: &mut usize| {
+            if slot.replace(v).is_some() {
+                *n += 1;
             }
-            Wheels::Speeds(rows) => {
-                let r = rows[k];
-                let r2 = self.noise.wheel_speed_mps.powi(2);
-                for (i, z) in [r.fl_mps, r.fr_mps, r.rl_mps, r.rr_mps]
-                    .into_iter()
-                    .enumerate()
-                {
-                    let pred = self.sensors.wheel_speed(&self.car(), i);
-                    let d = pred.0 / self.sensors.inv_circumference[i];
-                    self.scalar(SensorKind::Wheel(i as u8), z, pred, r2, Some((2 + i, d)))?;
-                }
-            }
-        }
-        Ok(())
-    }
-
-    fn gnss(&mut self, fix: &crate::drive::GnssFix) -> Result<(), Error> {
-        let (h, jac5) = self.sensors.gnss(&self.car());
-        let mut jac = SMatrix::<f64, 2, N>::zeros();
-        jac.fixed_view_mut::<2, 5>(0, 0).copy_from(&jac5);
-        let y = Vector2::new(fix.east_m, fix.north_m) - h;
-        let r = Matrix2::identity() * fix.std_m.powi(2);
-        let (mut s, _, mut nis) = kalman::innovation_stats(&self.p, &y, &jac, &r, self.t)?;
-        let mut accepted = nis <= self.noise.gnss_gate_chi2;
-        if !accepted && self.consecutive_rejections >= self.noise.gnss_max_rejections {
-            // Lost: widen the position (and yaw) uncertainty to cover the
-            // innovation, then take the fix.
-            let d2 = y.norm_squared();
-            for i in [model::X, model::Y] {
-                self.p[(i, i)] += d2;
-            }
-            self.p[(model::YAW, model::YAW)] += 0.1f64.powi(2);
-            (s, _, nis) = kalman::innovation_stats(&self.p, &y, &jac, &r, self.t)?;
-            accepted = true;
-            self.out.stats.gnss_recoveries += 1;
-        }
-        self.consecutive_rejections = if accepted {
-            0
-        } else {
-            self.consecutive_rejections + 1
         };
-        if accepted {
-            kalman::update_vector(&mut self.x, &mut self.p, &y, &jac, &r, self.form, self.t)?;
-            self.refresh_params();
-            self.out.stats.gnss_updates += 1;
-        } else {
-            self.out.stats.gnss_rejected += 1;
-        }
-        if self.opts.record_innovations {
-            self.out.innovations.push(InnovationRecord {
-                t_s: self.t,
-                sensor: SensorKind::Gnss,
-                y: y[0],
-                s: s[(0, 0)],
-                nis,
-                accepted,
-            });
-        }
-        if accepted && self.opts.sensors.gnss_course {
-            if let (Some(course), Some(speed)) = (fix.course_yaw_rad(), fix.speed_mps) {
-                if speed > 3.0 {
-                    // Course noise shrinks with speed: about 0.5 m/s of velocity noise.
-                    let sigma = (0.5 / speed).min(0.3);
-                    let pred = self.sensors.yaw(&self.car());
-                    self.scalar(SensorKind::Course, course, pred, sigma * sigma, None)?;
-                    self.out.stats.course_updates += 1;
+        match self.timing {
+            Timing::WheelEpochs => match ev.measurement {
+                Measurement::YawRate { yaw_rate_rps } if use_.gyro => supersede(
+                    &mut self.pending_gyro,
+                    yaw_rate_rps,
+                    &mut self.stats.readings_superseded,
+                ),
+                Measurement::Speed { speed_mps } if use_.speed => supersede(
+                    &mut self.pending_speed,
+                    speed_mps,
+                    &mut self.stats.readings_superseded,
+                ),
+                Measurement::Steering { steering_wheel_rad } if use_.steering => supersede(
+                    &mut self.pending_steering,
+                    steering_wheel_rad,
+                    &mut self.stats.readings_superseded,
+                ),
+                Measurement::Gnss { .. } if use_.gnss => {
+                    if self.hidden(t) {
+                        self.stats.gnss_hidden += 1;
+                    } else {
+                        self.pending_gnss = ev.gnss_fix();
+                    }
                 }
+                Measurement::WheelTicks { .. } | Measurement::WheelSpeeds { .. } => {
+                    let Some((interval, gap)) = self.wheel_interval(t) else {
+                        return Ok(());
+                    };
+                    let prediction = f.predict_to(t);
+                    if use_.wheels {
+                        if gap {
+                            self.stats.wheel_gaps += 1;
+                        } else {
+                            self.wheel_updates(f, &ev.measurement, interval)?;
+                        }
+                    }
+                    if let Some(v) = self.pending_gyro.take() {
+                        self.updates.push(f.update_gyro(v)?);
+                    }
+                    if let Some(v) = self.pending_speed.take() {
+                        self.updates.push(f.update_speed(v)?);
+                    }
+                    if let Some(v) = self.pending_steering.take() {
+                        self.updates.push(f.update_steering(v)?);
+                    }
+                    if let Some(fix) = self.pending_gnss.take() {
+                        self.gnss_update(f, &fix)?;
+                    }
+                    self.stats.epochs += 1;
+                    epoch(
+                        f,
+                        EpochOut {
+                            prediction,
+                            updates: &self.updates,
+                        },
+                    );
+                }
+                _ => {}
+            },
+            Timing::EachMeasurement => {
+                let wheel = if ev.is_wheel() {
+                    // The first row after the start only opens an interval.
+                    let Some(iv) = self.wheel_interval(t) else {
+                        return Ok(());
+                    };
+                    Some(iv)
+                } else {
+                    None
+                };
+                let used = match ev.measurement {
+                    Measurement::WheelTicks { .. } | Measurement::WheelSpeeds { .. } => use_.wheels,
+                    Measurement::YawRate { .. } => use_.gyro,
+                    Measurement::Speed { .. } => use_.speed,
+                    Measurement::Steering { .. } => use_.steering,
+                    Measurement::Gnss { .. } => {
+                        if use_.gnss && self.hidden(t) {
+                            self.stats.gnss_hidden += 1;
+                            false
+                        } else {
+                            use_.gnss
+                        }
+                    }
+                };
+                if !used {
+                    return Ok(());
+                }
+                let prediction = f.predict_to(t);
+                match ev.measurement {
+                    Measurement::WheelTicks { .. } | Measurement::WheelSpeeds { .. } => {
+                        if let Some((interval, gap)) = wheel {
+                            if gap {
+                                self.stats.wheel_gaps += 1;
+                            } else {
+                                self.wheel_updates(f, &ev.measurement, interval)?;
+                            }
+                        }
+                    }
+                    Measurement::YawRate { yaw_rate_rps } => {
+                        self.updates.push(f.update_gyro(yaw_rate_rps)?)
+                    }
+                    Measurement::Speed { speed_mps } => {
+                        self.updates.push(f.update_speed(speed_mps)?)
+                    }
+                    Measurement::Steering { steering_wheel_rad } => {
+                        self.updates.push(f.update_steering(steering_wheel_rad)?)
+                    }
+                    Measurement::Gnss { .. } => {
+                        if let Some(fix) = ev.gnss_fix() {
+                            self.gnss_update(f, &fix)?;
+                        }
+                    }
+                }
+                self.stats.epochs += 1;
+                epoch(
+                    f,
+                    EpochOut {
+                        prediction,
+                        updates: &self.updates,
+                    },
+                );
             }
         }
         Ok(())
     }
-
-    /// Eq. (4): one gyro reading.
-    fn gyro(&mut self, value: f64) -> Result<(), Error> {
-        let pred = self.sensors.gyro(&self.car());
-        let r = self.noise.gyro_rps.powi(2);
-        self.scalar(SensorKind::Gyro, value, pred, r, Some((0, 1.0)))?;
-        self.out.stats.gyro_updates += 1;
-        Ok(())
-    }
-
-    /// Eq. (5): one CAN speed reading.
-    fn can_speed(&mut self, value: f64) -> Result<(), Error> {
-        let pred = self.sensors.can_speed(&self.car());
-        let r = self.noise.speed_mps.powi(2);
-        let d_scale = self.x[V];
-        self.scalar(SensorKind::Speed, value, pred, r, Some((1, d_scale)))?;
-        self.out.stats.speed_updates += 1;
-        Ok(())
-    }
-
-    /// Eq. (7): one steering-wheel reading, with the prior speed.
-    fn steering(&mut self, steering_wheel_rad: f64) -> Result<(), Error> {
-        let (z, r) =
-            self.sensors
-                .steering_measurement(steering_wheel_rad, self.x[V], self.noise.steering);
-        let pred = self.sensors.steering(&self.car());
-        self.scalar(SensorKind::Steering, z, pred, r, None)?;
-        self.out.stats.steering_updates += 1;
-        Ok(())
-    }
-
-    fn record(&mut self, pred: (SVector<f64, N>, SMatrix<f64, N, N>, Mat)) {
-        self.out.stats.epochs += 1;
-        if self.opts.record_epochs {
-            self.out.epochs.push(Epoch {
-                t_s: self.t,
-                x_pred: pred.0,
-                p_pred: pred.1,
-                f: pred.2,
-                x: self.x,
-                p: self.p,
-            });
-        }
-    }
-}
-
-/// Median wheel interval, s.
-fn median_interval(wheels: &Wheels) -> f64 {
-    let mut d: Vec<f64> = (1..wheels.len())
-        .map(|k| wheels.t_s(k) - wheels.t_s(k - 1))
-        .collect();
-    if d.is_empty() {
-        return 0.02;
-    }
-    let mid = d.len() / 2;
-    *d.select_nth_unstable_by(mid, |a, b| a.total_cmp(b)).1
 }
 
 /// Interpolated reference pose from the truth at `t`, as a full state (speed and
@@ -550,7 +842,9 @@ pub fn truth_state(drive: &Drive, t: f64) -> Option<State> {
     crate::reference::Reference::from_truth(&drive.truth).and_then(|r| r.state_at(t))
 }
 
-fn initial_state(drive: &Drive, opts: &FilterOptions) -> Result<(f64, State, Mat), Error> {
+/// The filter's start: time, car state and covariance, as `opts.init` says.
+pub fn initial_state(drive: &Drive, opts: &FilterOptions) -> Result<(f64, State, Mat), Error> {
+    let hidden = |t: f64| opts.gnss_outages.iter().any(|&(a, b)| t >= a && t < b);
     match opts.init {
         Init::Given { t_s, x, p } => Ok((t_s, x, p)),
         Init::Truth => {
@@ -570,63 +864,81 @@ fn initial_state(drive: &Drive, opts: &FilterOptions) -> Result<(f64, State, Mat
             Ok((t0, x, p))
         }
         Init::Gnss => {
-            let first = drive
+            let visible: Vec<GnssFix> = drive
                 .gnss
                 .iter()
-                .find(|g| !in_outage(&opts.gnss_outages, g.t_s))
-                .ok_or_else(|| {
-                    Error::Insufficient("initialisation from GNSS needs at least one fix".into())
-                })?;
-            let far = drive
-                .gnss
+                .filter(|g| !hidden(g.t_s))
+                .copied()
+                .collect();
+            let mut init = GnssInit::new(drive.vehicle.gnss_lever_arm_m);
+            visible
                 .iter()
-                .filter(|g| g.t_s > first.t_s && !in_outage(&opts.gnss_outages, g.t_s))
-                .find(|g| (g.east_m - first.east_m).hypot(g.north_m - first.north_m) >= 10.0)
-                .ok_or_else(|| {
-                    Error::Insufficient(
-                        "initialisation from GNSS needs the vehicle to move 10 m".into(),
-                    )
-                })?;
-            let yaw = (far.north_m - first.north_m).atan2(far.east_m - first.east_m);
-            let l = drive.vehicle.gnss_lever_arm_m;
-            let x = State::from([
-                first.east_m - l * yaw.cos(),
-                first.north_m - l * yaw.sin(),
-                yaw,
-                0.0,
-                0.0,
-            ]);
-            let sp = first.std_m.max(0.1);
-            let p = Mat::from_diagonal(&State::from([sp * sp, sp * sp, 0.3f64.powi(2), 4.0, 0.25]));
-            Ok((first.t_s, x, p))
+                .find_map(|g| init.push(g))
+                .ok_or_else(|| init.why_not())
         }
     }
 }
 
-fn in_outage(outages: &[(f64, f64)], t: f64) -> bool {
-    outages.iter().any(|&(a, b)| t >= a && t < b)
+/// Initialisation from GNSS, one fix at a time (usable online): the first fix
+/// gives the position (minus the lever arm) and the direction of the first
+/// [`GnssInit::MIN_DISPLACEMENT_M`] of displacement the yaw; the filter starts
+/// at the first fix's time.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct GnssInit {
+    lever_arm_m: f64,
+    first: Option<GnssFix>,
 }
 
-/// A cursor over a timestamped stream: yields the readings up to a time.
-struct Cursor {
-    next: usize,
-}
+impl GnssInit {
+    /// Displacement from the first fix that fixes the initial yaw, m.
+    pub const MIN_DISPLACEMENT_M: f64 = 10.0;
 
-impl Cursor {
-    /// Advances past all readings with `t <= t_end`; returns the index of the last
-    /// one passed and how many were passed.
-    fn advance(
-        &mut self,
-        times: impl Fn(usize) -> f64,
-        len: usize,
-        t_end: f64,
-    ) -> (Option<usize>, usize) {
-        let start = self.next;
-        while self.next < len && times(self.next) <= t_end {
-            self.next += 1;
+    /// Waiting for fixes, with the vehicle's GNSS lever arm.
+    pub fn new(lever_arm_m: f64) -> Self {
+        GnssInit {
+            lever_arm_m,
+            first: None,
         }
-        let n = self.next - start;
-        (if n > 0 { Some(self.next - 1) } else { None }, n)
+    }
+
+    /// True once the first fix has been taken.
+    pub fn has_first(&self) -> bool {
+        self.first.is_some()
+    }
+
+    /// Takes one fix; returns the start (time, state, covariance) once the
+    /// vehicle has moved far enough from the first fix.
+    pub fn push(&mut self, g: &GnssFix) -> Option<(f64, State, Mat)> {
+        let Some(first) = self.first else {
+            self.first = Some(*g);
+            return None;
+        };
+        if g.t_s <= first.t_s
+            || (g.east_m - first.east_m).hypot(g.north_m - first.north_m) < Self::MIN_DISPLACEMENT_M
+        {
+            return None;
+        }
+        let yaw = (g.north_m - first.north_m).atan2(g.east_m - first.east_m);
+        let l = self.lever_arm_m;
+        let x = State::from([
+            first.east_m - l * yaw.cos(),
+            first.north_m - l * yaw.sin(),
+            yaw,
+            0.0,
+            0.0,
+        ]);
+        let sp = first.std_m.max(0.1);
+        let p = Mat::from_diagonal(&State::from([sp * sp, sp * sp, 0.3f64.powi(2), 4.0, 0.25]));
+        Some((first.t_s, x, p))
+    }
+
+    /// Why no start was found.
+    pub fn why_not(&self) -> Error {
+        Error::Insufficient(if self.first.is_none() {
+            "initialisation from GNSS needs at least one fix".into()
+        } else {
+            "initialisation from GNSS needs the vehicle to move 10 m".into()
+        })
     }
 }
 
@@ -637,7 +949,10 @@ pub fn run(
     opts: &FilterOptions,
     hook: &mut dyn EpochHook,
 ) -> Result<FilterOutput, Error> {
-    run_generic::<5>(drive, params, None, opts, hook)
+    let (t0, x0, p0) = start(drive, opts)?;
+    let f = Filter::<CarLayout, 5>::new(&drive.vehicle, params, None, t0, x0, p0)?
+        .with_covariance_form(opts.covariance_form);
+    run_filter(drive, f, opts, hook)
 }
 
 /// Runs the EKF with the state augmented by the six parameters, which start at
@@ -649,201 +964,77 @@ pub fn run_augmented(
     prior_std: &Params,
     opts: &FilterOptions,
 ) -> Result<FilterOutput<N_AUG>, Error> {
-    run_generic::<N_AUG>(drive, params, Some(prior_std), opts, &mut ())
+    let (t0, x0, p0) = start(drive, opts)?;
+    let f =
+        Filter::<AugmentedLayout, N_AUG>::new(&drive.vehicle, params, Some(prior_std), t0, x0, p0)?
+            .with_covariance_form(opts.covariance_form);
+    run_filter(drive, f, opts, &mut ())
 }
 
-fn run_generic<const N: usize>(
-    drive: &Drive,
-    params: &Params,
-    prior_std: Option<&Params>,
-    opts: &FilterOptions,
-    hook: &mut dyn EpochHook<N>,
-) -> Result<FilterOutput<N>, Error> {
+fn start(drive: &Drive, opts: &FilterOptions) -> Result<(f64, State, Mat), Error> {
     drive.validate()?;
-    params.validate()?;
     let (t0, x0, p0) = initial_state(drive, opts)?;
-    let sensors = Sensors::new(&drive.vehicle, params);
-    let mut x = SVector::<f64, N>::zeros();
-    let mut p = SMatrix::<f64, N, N>::zeros();
-    x.fixed_rows_mut::<5>(0).copy_from(&x0);
-    p.fixed_view_mut::<5, 5>(0, 0).copy_from(&p0);
-    if N == N_AUG {
-        let sd = prior_std.ok_or_else(|| {
-            Error::InvalidParams("the augmented filter needs prior standard deviations".into())
-        })?;
-        let c = params.circumferences();
-        let cs = sd.circumferences();
-        x[AUG_BIAS] = params.gyro_bias_rps;
-        x[AUG_SCALE] = params.speed_scale;
-        p[(AUG_BIAS, AUG_BIAS)] = sd.gyro_bias_rps.powi(2);
-        p[(AUG_SCALE, AUG_SCALE)] = sd.speed_scale.powi(2);
-        for i in 0..4 {
-            x[AUG_INV_CIRC + i] = 1.0 / c[i];
-            // σ(1/ρ) = σ(ρ)/ρ².
-            p[(AUG_INV_CIRC + i, AUG_INV_CIRC + i)] = (cs[i] / (c[i] * c[i])).powi(2);
-        }
-        if (0..6).any(|j| p[(5 + j, 5 + j)].is_nan() || p[(5 + j, 5 + j)] <= 0.0) {
-            return Err(Error::InvalidParams(
-                "prior standard deviations of the parameters must be positive".into(),
-            ));
-        }
-    }
-    let mut f = Filter {
-        sensors,
-        noise: drive.vehicle.noise,
-        form: opts.covariance_form,
-        x,
-        p,
-        t: t0,
-        opts,
-        out: FilterOutput::default(),
-        consecutive_rejections: 0,
-        wheels_present: drive.vehicle.wheels_present,
-    };
-    let wheels = &drive.wheels;
-    let max_interval = 5.0 * median_interval(wheels);
-    let k0 = (0..wheels.len())
-        .find(|&k| wheels.t_s(k) >= t0)
-        .unwrap_or(wheels.len());
-    if k0 + 1 >= wheels.len() {
+    let w = &drive.wheels;
+    if (0..w.len()).filter(|&k| w.t_s(k) >= t0).count() < 2 {
         return Err(Error::Insufficient(
             "no wheel epochs after the initial time".into(),
         ));
     }
-    let use_ = opts.sensors;
-    // Readings before the start are skipped.
-    let mut gyro = Cursor {
-        next: drive.yaw_rate.partition_point(|s| s.t_s <= t0),
-    };
-    let mut speed = Cursor {
-        next: drive.speed.partition_point(|s| s.t_s <= t0),
-    };
-    let mut steer = Cursor {
-        next: drive.steering.partition_point(|s| s.t_s <= t0),
-    };
-    let mut gnss = Cursor {
-        next: drive.gnss.partition_point(|s| s.t_s <= t0),
-    };
+    Ok((t0, x0, p0))
+}
 
-    match opts.timing {
-        Timing::WheelEpochs => {
-            for k in (k0 + 1)..wheels.len() {
-                let t = wheels.t_s(k);
-                if opts.end_s.is_some_and(|e| t > e) {
-                    break;
-                }
-                let pred = f.predict(t);
-                if use_.wheels {
-                    f.wheels(wheels, k, max_interval)?;
-                }
-                let (gi, n) = gyro.advance(|i| drive.yaw_rate[i].t_s, drive.yaw_rate.len(), t);
-                if let (Some(i), true) = (gi, use_.gyro) {
-                    f.out.stats.readings_superseded += n - 1;
-                    f.gyro(drive.yaw_rate[i].value)?;
-                }
-                let (si, n) = speed.advance(|i| drive.speed[i].t_s, drive.speed.len(), t);
-                if let (Some(i), true) = (si, use_.speed) {
-                    f.out.stats.readings_superseded += n - 1;
-                    f.can_speed(drive.speed[i].value)?;
-                }
-                let (di, n) = steer.advance(|i| drive.steering[i].t_s, drive.steering.len(), t);
-                if let (Some(i), true) = (di, use_.steering) {
-                    f.out.stats.readings_superseded += n - 1;
-                    f.steering(drive.steering[i].value)?;
-                }
-                let start = gnss.next;
-                let (last, _) = gnss.advance(|i| drive.gnss[i].t_s, drive.gnss.len(), t);
-                if let (Some(last), true) = (last, use_.gnss) {
-                    // Use the newest visible fix of the interval.
-                    let visible = (start..=last)
-                        .rev()
-                        .find(|&i| !in_outage(&opts.gnss_outages, drive.gnss[i].t_s));
-                    f.out.stats.gnss_hidden += (start..=last)
-                        .filter(|&i| in_outage(&opts.gnss_outages, drive.gnss[i].t_s))
-                        .count();
-                    if let Some(i) = visible {
-                        f.gnss(&drive.gnss[i])?;
-                    }
-                }
-                hook.after_epoch(t, &mut f.x, &mut f.p);
-                f.record(pred);
-            }
+/// The batch loop: every event of the drive after the start through a
+/// [`Feeder`] into the filter `f`, recording epochs and innovations as `opts`
+/// asks, with `hook` after every epoch.
+pub fn run_filter<L: Layout<N>, const N: usize>(
+    drive: &Drive,
+    mut f: Filter<L, N>,
+    opts: &FilterOptions,
+    hook: &mut dyn EpochHook<N>,
+) -> Result<FilterOutput<N>, Error> {
+    // The first wheel row at or after the start opens the first interval.
+    let w = &drive.wheels;
+    let t0 = f.time_s();
+    let k0 = (0..w.len()).find(|&k| w.t_s(k) >= t0).unwrap_or(w.len());
+    let before_first = if k0 > 0 {
+        w.t_s(k0 - 1)
+    } else {
+        f64::NEG_INFINITY
+    };
+    let mut feeder = Feeder::new(opts, t0);
+    let mut out = FilterOutput::<N>::default();
+    let mut record = |f: &mut Filter<L, N>, e: EpochOut<'_, N>| {
+        if !hook.is_noop() {
+            let (mut x, mut p) = (*f.state(), *f.covariance());
+            hook.after_epoch(f.time_s(), &mut x, &mut p);
+            f.set_state(x, p);
         }
-        Timing::EachMeasurement => {
-            // Merge the streams by time. Ties: wheels, gyro, speed, steering, GNSS.
-            #[derive(Clone, Copy)]
-            enum Ev {
-                Wheel(usize),
-                Gyro(usize),
-                Speed(usize),
-                Steer(usize),
-                Gnss(usize),
-            }
-            let mut evs: Vec<(f64, u8, Ev)> = Vec::new();
-            let t_end = wheels
-                .t_s(wheels.len() - 1)
-                .min(opts.end_s.unwrap_or(f64::INFINITY));
-            if use_.wheels {
-                evs.extend(
-                    ((k0 + 1)..wheels.len())
-                        .filter(|&k| wheels.t_s(k) <= t_end)
-                        .map(|k| (wheels.t_s(k), 0, Ev::Wheel(k))),
-                );
-            }
-            let within = |t: f64| t > t0 && t <= t_end;
-            if use_.gyro {
-                evs.extend(
-                    drive
-                        .yaw_rate
-                        .iter()
-                        .enumerate()
-                        .filter(|(_, s)| within(s.t_s))
-                        .map(|(i, s)| (s.t_s, 1, Ev::Gyro(i))),
-                );
-            }
-            if use_.speed {
-                evs.extend(
-                    drive
-                        .speed
-                        .iter()
-                        .enumerate()
-                        .filter(|(_, s)| within(s.t_s))
-                        .map(|(i, s)| (s.t_s, 2, Ev::Speed(i))),
-                );
-            }
-            if use_.steering {
-                evs.extend(
-                    drive
-                        .steering
-                        .iter()
-                        .enumerate()
-                        .filter(|(_, s)| within(s.t_s))
-                        .map(|(i, s)| (s.t_s, 3, Ev::Steer(i))),
-                );
-            }
-            if use_.gnss {
-                for (i, g) in drive.gnss.iter().enumerate().filter(|(_, g)| within(g.t_s)) {
-                    if in_outage(&opts.gnss_outages, g.t_s) {
-                        f.out.stats.gnss_hidden += 1;
-                    } else {
-                        evs.push((g.t_s, 4, Ev::Gnss(i)));
-                    }
-                }
-            }
-            evs.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-            for (t, _, ev) in evs {
-                let pred = f.predict(t);
-                match ev {
-                    Ev::Wheel(k) => f.wheels(wheels, k, max_interval)?,
-                    Ev::Gyro(i) => f.gyro(drive.yaw_rate[i].value)?,
-                    Ev::Speed(i) => f.can_speed(drive.speed[i].value)?,
-                    Ev::Steer(i) => f.steering(drive.steering[i].value)?,
-                    Ev::Gnss(i) => f.gnss(&drive.gnss[i])?,
-                }
-                hook.after_epoch(t, &mut f.x, &mut f.p);
-                f.record(pred);
-            }
+        if opts.record_innovations {
+            out.innovations
+                .extend(e.updates.iter().map(|u| InnovationRecord {
+                    t_s: f.time_s(),
+                    sensor: u.sensor,
+                    y: u.y,
+                    s: u.s,
+                    nis: u.nis,
+                    accepted: u.accepted,
+                }));
         }
+        if opts.record_epochs {
+            out.epochs.push(Epoch {
+                t_s: f.time_s(),
+                x_pred: e.prediction.x,
+                p_pred: e.prediction.p,
+                f: e.prediction.f,
+                x: *f.state(),
+                p: *f.covariance(),
+            });
+        }
+    };
+    for ev in DriveEvents::new(drive, before_first) {
+        feeder.push(&mut f, ev, &mut record)?;
     }
-    Ok(f.out)
+    feeder.finish(&mut f, &mut record)?;
+    out.stats = feeder.stats_with(&f);
+    Ok(out)
 }

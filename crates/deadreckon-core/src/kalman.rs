@@ -11,7 +11,7 @@ use nalgebra::{SMatrix, SVector};
 use crate::Error;
 
 /// How the updated covariance is computed.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 pub enum CovarianceForm {
     /// `P = (I − K H) P (I − K H)ᵀ + K R Kᵀ`: stays symmetric positive definite
     /// under rounding and for non-optimal gains.
@@ -40,6 +40,31 @@ pub fn predict_covariance<const N: usize>(
 ) -> SMatrix<f64, N, N> {
     let pp = f * p * f.transpose() + q;
     (pp + pp.transpose()) * 0.5
+}
+
+/// Eq. (14) for one scalar measurement without updating: `S = H P Hᵀ + R`,
+/// checked usable (finite, positive, with a finite innovation `y`), so the
+/// caller can gate before [`update_scalar`].
+pub fn scalar_innovation_variance<const N: usize>(
+    p: &SMatrix<f64, N, N>,
+    h: &SVector<f64, N>,
+    r: f64,
+    y: f64,
+    t_s: f64,
+) -> Result<f64, Error> {
+    let mut s = r;
+    for (j, &hj) in h.iter().enumerate() {
+        if hj != 0.0 {
+            s += hj * h.dot(&p.column(j));
+        }
+    }
+    if !(s.is_finite() && s > 0.0 && y.is_finite()) {
+        return Err(Error::Numerical {
+            t_s,
+            what: format!("innovation variance {s} or innovation {y} is not usable"),
+        });
+    }
+    Ok(s)
 }
 
 /// Eq. (13)–(17) for one scalar measurement with innovation `y = z − h(x)`,

@@ -18,7 +18,7 @@ pub const RR: usize = 3;
 
 /// The model quantities the observation models need, taken from the vehicle and
 /// the current parameter estimate.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Sensors {
     /// l_RF, m.
     pub wheelbase_m: f64,

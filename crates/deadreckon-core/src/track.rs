@@ -3,7 +3,7 @@
 use crate::vehicle::Origin;
 
 /// One estimated pose with its uncertainty.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct TrackPoint {
     /// Timestamp, s.
     pub t_s: f64,

@@ -9,6 +9,18 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum IoError {
+    /// A line of a JSON-lines event stream is not a valid event.
+    #[error("{source_name}: line {line}, column {column}: {msg}")]
+    BadEvent {
+        /// The stream's name (a file, or `stdin`).
+        source_name: String,
+        /// Line, 1-based.
+        line: u64,
+        /// Column, 1-based.
+        column: usize,
+        /// What is wrong.
+        msg: String,
+    },
     /// A required file does not exist.
     #[error("{}: missing required file ({note})", path.display())]
     MissingFile {

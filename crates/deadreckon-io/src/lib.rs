@@ -40,6 +40,7 @@ mod toml_files;
 mod track_out;
 mod write;
 
+pub mod events;
 pub use atomic::atomic_write;
 /// Latitude/longitude ↔ local east-north (re-exported from `deadreckon-core`).
 pub use deadreckon_core::geo;

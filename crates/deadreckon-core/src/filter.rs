@@ -1,0 +1,685 @@
+//! The four-wheel filter one measurement at a time: the step API.
+//!
+//! A [`Filter`] holds the state, its covariance, the sensor models and the gate
+//! counters. [`Filter::predict_to`] advances it in time (eq. 11–12) and one
+//! `update_*` method per sensor applies a measurement (eq. 13–17) after a
+//! χ² (Mahalanobis) gate with a per-sensor threshold from the vehicle's
+//! [`Noise`]. Every update returns an [`Update`]: the innovation, its variance,
+//! the normalised innovation squared and whether the gate accepted it.
+//!
+//! The state layout is a type: [`CarLayout`] (the five car states
+//! `[x, y, ψ, v, ψ̇]`, parameters fixed) or [`AugmentedLayout`] (the car states
+//! then the six parameters `[b_gyro, a_v, 1/ρ_FL, 1/ρ_FR, 1/ρ_RL, 1/ρ_RR]`,
+//! estimated with the car state, as the calibration and the online learner use).
+//!
+//! The filter serialises (serde) with everything it needs to go on, so a run can
+//! stop and resume bit-identically. Batch runs over a recorded drive
+//! ([`crate::ekf::run`]) are loops feeding it.
+//!
+//! ```
+//! use deadreckon_core::filter::{CarFilter, CarLayout};
+//! use deadreckon_core::model::{Mat, State};
+//! use deadreckon_core::{Params, Vehicle};
+//!
+//! let vehicle = Vehicle::paper_car();
+//! let params = Params::nominal(&vehicle);
+//! let x0 = State::from([0.0, 0.0, 0.0, 10.0, 0.0]);
+//! let p0 = Mat::from_diagonal(&State::from([1.0, 1.0, 0.01, 1.0, 0.01]));
+//! let mut f = CarFilter::new(&vehicle, &params, None, 0.0, x0, p0).unwrap();
+//! f.predict_to(0.02);
+//! // 10 m/s for 20 ms on a 1.92 m wheel with 48 ticks: 5 ticks.
+//! let u = f.update_wheel_ticks(2, 5.0, 0.02).unwrap().unwrap();
+//! assert!(u.accepted && u.nis < 3.0);
+//! let u = f.update_gyro(0.0).unwrap();
+//! assert!(u.accepted);
+//! assert!((f.car_state()[3] - 10.0).abs() < 0.5);
+//! ```
+
+use std::marker::PhantomData;
+
+use nalgebra::{Matrix2, SMatrix, SVector, Vector2};
+use serde::{Deserialize, Serialize};
+
+use crate::drive::GnssFix;
+use crate::kalman::{self, CovarianceForm};
+use crate::model::{self, Mat, State, V};
+use crate::observation::Sensors;
+use crate::vehicle::{Noise, Params, Vehicle};
+use crate::Error;
+
+/// Index of the gyro bias in the augmented state.
+pub const AUG_BIAS: usize = 5;
+/// Index of the speed scale in the augmented state.
+pub const AUG_SCALE: usize = 6;
+/// Index of the first inverse circumference (FL, then FR, RL, RR) in the augmented state.
+pub const AUG_INV_CIRC: usize = 7;
+/// Dimension of the augmented state.
+pub const N_AUG: usize = 11;
+
+/// Where the six parameters live in a state of dimension `N`.
+pub trait Layout<const N: usize>: Copy + std::fmt::Debug + Default + PartialEq {
+    /// A short name (`car`, `augmented`).
+    const NAME: &'static str;
+    /// Index in the state of parameter `j` (0 gyro bias, 1 speed scale, 2..6 the
+    /// inverse circumferences FL..RR), or `None` when the parameters are fixed.
+    fn param_index(j: usize) -> Option<usize>;
+}
+
+/// The five car states; the parameters are fixed.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct CarLayout;
+
+impl Layout<5> for CarLayout {
+    const NAME: &'static str = "car";
+    fn param_index(_j: usize) -> Option<usize> {
+        None
+    }
+}
+
+/// The car states then the six parameters, estimated as constant states.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct AugmentedLayout;
+
+impl Layout<N_AUG> for AugmentedLayout {
+    const NAME: &'static str = "augmented";
+    fn param_index(j: usize) -> Option<usize> {
+        (j < 6).then_some(5 + j)
+    }
+}
+
+/// The filter with fixed parameters.
+pub type CarFilter = Filter<CarLayout, 5>;
+/// The filter with the parameters as states.
+pub type AugmentedFilter = Filter<AugmentedLayout, N_AUG>;
+
+/// Which sensor a measurement comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+pub enum SensorKind {
+    /// Wheel `0..4` (FL, FR, RL, RR).
+    Wheel(u8),
+    /// Gyro.
+    Gyro,
+    /// CAN speed.
+    Speed,
+    /// Steering.
+    Steering,
+    /// GNSS position (2-D; the NIS has 2 degrees of freedom).
+    Gnss,
+    /// GNSS course.
+    Course,
+}
+
+impl SensorKind {
+    /// Every kind, in a fixed order (for tables).
+    pub const ALL: [SensorKind; 9] = [
+        SensorKind::Wheel(0),
+        SensorKind::Wheel(1),
+        SensorKind::Wheel(2),
+        SensorKind::Wheel(3),
+        SensorKind::Gyro,
+        SensorKind::Speed,
+        SensorKind::Steering,
+        SensorKind::Gnss,
+        SensorKind::Course,
+    ];
+
+    /// A short stable name.
+    pub fn name(&self) -> &'static str {
+        match self {
+            SensorKind::Wheel(0) => "wheel_fl",
+            SensorKind::Wheel(1) => "wheel_fr",
+            SensorKind::Wheel(2) => "wheel_rl",
+            SensorKind::Wheel(_) => "wheel_rr",
+            SensorKind::Gyro => "gyro",
+            SensorKind::Speed => "speed",
+            SensorKind::Steering => "steering",
+            SensorKind::Gnss => "gnss",
+            SensorKind::Course => "course",
+        }
+    }
+
+    /// Degrees of freedom of the measurement.
+    pub fn dof(&self) -> usize {
+        if *self == SensorKind::Gnss {
+            2
+        } else {
+            1
+        }
+    }
+
+    fn slot(&self) -> usize {
+        match self {
+            SensorKind::Wheel(i) => (*i as usize).min(3),
+            SensorKind::Gyro => 4,
+            SensorKind::Speed => 5,
+            SensorKind::Steering => 6,
+            SensorKind::Gnss => 7,
+            SensorKind::Course => 8,
+        }
+    }
+}
+
+/// The χ² gate of a sensor, from the vehicle's noise settings.
+pub fn gate_chi2(noise: &Noise, sensor: SensorKind) -> f64 {
+    match sensor {
+        SensorKind::Wheel(_) => noise.wheel_gate_chi2,
+        SensorKind::Gyro => noise.gyro_gate_chi2,
+        SensorKind::Speed => noise.speed_gate_chi2,
+        SensorKind::Steering => noise.steering_gate_chi2,
+        SensorKind::Course => noise.course_gate_chi2,
+        SensorKind::Gnss => noise.gnss_gate_chi2,
+    }
+}
+
+/// The outcome of one measurement update.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Update {
+    /// The sensor.
+    pub sensor: SensorKind,
+    /// Innovation `z − h(x̂⁻)` (first component for GNSS).
+    pub y: f64,
+    /// Innovation variance (first diagonal element for GNSS).
+    pub s: f64,
+    /// Normalised innovation squared `ỹᵀ S⁻¹ ỹ`.
+    pub nis: f64,
+    /// False when the χ² gate rejected the measurement (the state is unchanged).
+    pub accepted: bool,
+}
+
+/// Per-sensor gate counters: measurements used and rejected, and recoveries
+/// (a measurement accepted after too many consecutive rejections).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub struct GateCounts {
+    /// Accepted measurements, per sensor in [`SensorKind::ALL`] order.
+    pub accepted: [u64; 9],
+    /// Rejected measurements, same order.
+    pub rejected: [u64; 9],
+    /// Recoveries, same order.
+    pub recovered: [u64; 9],
+}
+
+impl GateCounts {
+    /// Accepted measurements of one sensor.
+    pub fn accepted(&self, k: SensorKind) -> u64 {
+        self.accepted[k.slot()]
+    }
+    /// Rejected measurements of one sensor.
+    pub fn rejected(&self, k: SensorKind) -> u64 {
+        self.rejected[k.slot()]
+    }
+    /// Recoveries of one sensor.
+    pub fn recovered(&self, k: SensorKind) -> u64 {
+        self.recovered[k.slot()]
+    }
+    /// `(name, accepted, rejected, recovered)` for every sensor with any measurement.
+    pub fn rows(&self) -> Vec<(&'static str, u64, u64, u64)> {
+        SensorKind::ALL
+            .iter()
+            .filter(|k| self.accepted(**k) + self.rejected(**k) > 0)
+            .map(|k| {
+                (
+                    k.name(),
+                    self.accepted(*k),
+                    self.rejected(*k),
+                    self.recovered(*k),
+                )
+            })
+            .collect()
+    }
+}
+
+/// The prediction of one step, as the smoother needs it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Prediction<const N: usize> {
+    /// x̂_{k|k-1}.
+    pub x: SVector<f64, N>,
+    /// P_{k|k-1}.
+    pub p: SMatrix<f64, N, N>,
+    /// Jacobian of the car block (the parameters are constants: F = diag(f, I)).
+    pub f: Mat,
+}
+
+/// The four-wheel EKF as a step object; see the module documentation.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(bound = "")]
+pub struct Filter<L: Layout<N>, const N: usize> {
+    sensors: Sensors,
+    noise: Noise,
+    form: CovarianceForm,
+    x: SVector<f64, N>,
+    p: SMatrix<f64, N, N>,
+    t_s: f64,
+    wheels_present: [bool; 4],
+    /// Consecutive rejections per sensor (same order as [`GateCounts`]).
+    consecutive: [u32; 9],
+    gates: GateCounts,
+    #[serde(skip)]
+    layout: PhantomData<L>,
+}
+
+impl<L: Layout<N>, const N: usize> Filter<L, N> {
+    /// A filter at time `t0_s` with car state `x0` and covariance `p0`. With a
+    /// layout that estimates the parameters, they start at `params` with standard
+    /// deviations `prior_std` (circumferences in metres), which is then required.
+    pub fn new(
+        vehicle: &Vehicle,
+        params: &Params,
+        prior_std: Option<&Params>,
+        t0_s: f64,
+        x0: State,
+        p0: Mat,
+    ) -> Result<Self, Error> {
+        vehicle.validate()?;
+        params.validate()?;
+        let mut x = SVector::<f64, N>::zeros();
+        let mut p = SMatrix::<f64, N, N>::zeros();
+        x.fixed_rows_mut::<5>(0).copy_from(&x0);
+        p.fixed_view_mut::<5, 5>(0, 0).copy_from(&p0);
+        if L::param_index(0).is_some() {
+            let sd = prior_std.ok_or_else(|| {
+                Error::InvalidParams("the augmented filter needs prior standard deviations".into())
+            })?;
+            let c = params.circumferences();
+            let cs = sd.circumferences();
+            let mut set = |j: usize, v: f64, var: f64| {
+                if let Some(i) = L::param_index(j) {
+                    x[i] = v;
+                    p[(i, i)] = var;
+                }
+            };
+            set(0, params.gyro_bias_rps, sd.gyro_bias_rps.powi(2));
+            set(1, params.speed_scale, sd.speed_scale.powi(2));
+            for i in 0..4 {
+                // σ(1/ρ) = σ(ρ)/ρ².
+                set(2 + i, 1.0 / c[i], (cs[i] / (c[i] * c[i])).powi(2));
+            }
+            if (5..N).any(|j| p[(j, j)].is_nan() || p[(j, j)] <= 0.0) {
+                return Err(Error::InvalidParams(
+                    "prior standard deviations of the parameters must be positive".into(),
+                ));
+            }
+        }
+        Ok(Filter {
+            sensors: Sensors::new(vehicle, params),
+            noise: vehicle.noise,
+            form: CovarianceForm::default(),
+            x,
+            p,
+            t_s: t0_s,
+            wheels_present: vehicle.wheels_present,
+            consecutive: [0; 9],
+            gates: GateCounts::default(),
+            layout: PhantomData,
+        })
+    }
+
+    /// Chooses the covariance update form (Joseph by default).
+    pub fn with_covariance_form(mut self, form: CovarianceForm) -> Self {
+        self.form = form;
+        self
+    }
+
+    /// Time of the state, s.
+    pub fn time_s(&self) -> f64 {
+        self.t_s
+    }
+    /// The whole state.
+    pub fn state(&self) -> &SVector<f64, N> {
+        &self.x
+    }
+    /// The whole covariance.
+    pub fn covariance(&self) -> &SMatrix<f64, N, N> {
+        &self.p
+    }
+    /// The car block `[x, y, ψ, v, ψ̇]` of the state.
+    pub fn car_state(&self) -> State {
+        self.x.fixed_rows::<5>(0).into_owned()
+    }
+    /// Replaces state and covariance (e.g. a reset to a reference pose).
+    pub fn set_state(&mut self, x: SVector<f64, N>, p: SMatrix<f64, N, N>) {
+        self.x = x;
+        self.p = p;
+        self.refresh_params();
+    }
+    /// The parameters the sensor models use now (estimated ones with the augmented layout).
+    pub fn params(&self) -> Params {
+        let mut p = self.sensors.params;
+        let c = self.sensors.inv_circumference;
+        p.circumference_fl_m = 1.0 / c[0];
+        p.circumference_fr_m = 1.0 / c[1];
+        p.circumference_rl_m = 1.0 / c[2];
+        p.circumference_rr_m = 1.0 / c[3];
+        p
+    }
+    /// Standard deviations of the parameters held in the state (circumferences
+    /// in metres), `None` when they are fixed.
+    pub fn params_std(&self) -> Option<Params> {
+        let sd = |j: usize| L::param_index(j).map(|i| self.p[(i, i)].max(0.0).sqrt());
+        let c = self.params().circumferences();
+        // σ(ρ) = ρ² σ(1/ρ).
+        Some(Params {
+            gyro_bias_rps: sd(0)?,
+            speed_scale: sd(1)?,
+            circumference_fl_m: c[0] * c[0] * sd(2)?,
+            circumference_fr_m: c[1] * c[1] * sd(3)?,
+            circumference_rl_m: c[2] * c[2] * sd(4)?,
+            circumference_rr_m: c[3] * c[3] * sd(5)?,
+        })
+    }
+    /// Gate counters since the start.
+    pub fn gates(&self) -> &GateCounts {
+        &self.gates
+    }
+    /// Whether wheel `i` has a sensor (`wheels_present`).
+    pub fn wheel_present(&self, i: usize) -> bool {
+        self.wheels_present.get(i).copied().unwrap_or(false)
+    }
+
+    /// Points the sensor models at the parameters held in the state.
+    fn refresh_params(&mut self) {
+        if let Some(i) = L::param_index(0) {
+            self.sensors.params.gyro_bias_rps = self.x[i];
+        }
+        if let Some(i) = L::param_index(1) {
+            self.sensors.params.speed_scale = self.x[i];
+        }
+        for w in 0..4 {
+            if let Some(i) = L::param_index(2 + w) {
+                self.sensors.inv_circumference[w] = self.x[i];
+            }
+        }
+    }
+
+    /// Eq. (11)–(12): predicts the state to `t_s` (no change for `t_s` before the
+    /// state's time). The parameters are constants: with F = diag(F_car, I) and
+    /// Q = diag(Q_car, 0) only the car rows and columns of P change.
+    pub fn predict_to(&mut self, t_s: f64) -> Prediction<N> {
+        let dt = (t_s - self.t_s).max(0.0);
+        let car = self.car_state();
+        let f5 = model::jacobian(&car, dt);
+        let q5 = model::process_noise(&self.noise, dt);
+        self.x
+            .fixed_rows_mut::<5>(0)
+            .copy_from(&model::evolve(&car, dt));
+        // P11 ← F P11 Fᵀ + Q (symmetrised), P12 ← F P12.
+        let p11 = self.p.fixed_view::<5, 5>(0, 0).into_owned();
+        let n11 = kalman::predict_covariance(&p11, &f5, &q5);
+        self.p.fixed_view_mut::<5, 5>(0, 0).copy_from(&n11);
+        for j in 5..N {
+            let col: State = self.p.fixed_view::<5, 1>(0, j).into_owned();
+            let nc = f5 * col;
+            for i in 0..5 {
+                self.p[(i, j)] = nc[i];
+                self.p[(j, i)] = nc[i];
+            }
+        }
+        self.t_s = t_s.max(self.t_s);
+        Prediction {
+            x: self.x,
+            p: self.p,
+            f: f5,
+        }
+    }
+
+    fn gate_chi2(&self, sensor: SensorKind) -> f64 {
+        gate_chi2(&self.noise, sensor)
+    }
+
+    /// Decides on a measurement with NIS `nis`: accepted when within the gate,
+    /// or after `max_rejections` consecutive rejections (a recovery).
+    fn decide(&mut self, sensor: SensorKind, nis: f64) -> (bool, bool) {
+        let k = sensor.slot();
+        let max = if sensor == SensorKind::Gnss {
+            self.noise.gnss_max_rejections
+        } else {
+            self.noise.max_rejections
+        };
+        let within = nis <= self.gate_chi2(sensor);
+        let recovery = !within && self.consecutive[k] >= max;
+        let accepted = within || recovery;
+        self.consecutive[k] = if accepted { 0 } else { self.consecutive[k] + 1 };
+        if accepted {
+            self.gates.accepted[k] += 1;
+        } else {
+            self.gates.rejected[k] += 1;
+        }
+        if recovery {
+            self.gates.recovered[k] += 1;
+        }
+        (accepted, recovery)
+    }
+
+    /// A gated scalar update from a car-state model `pred = (h, H)`; `param`
+    /// adds the derivative with respect to parameter `j` when it is a state.
+    fn scalar(
+        &mut self,
+        sensor: SensorKind,
+        z: f64,
+        pred: (f64, model::Row),
+        r: f64,
+        param: Option<(usize, f64)>,
+    ) -> Result<Update, Error> {
+        let (h, row5) = pred;
+        let mut row = SVector::<f64, N>::zeros();
+        row.fixed_rows_mut::<5>(0).copy_from(&row5);
+        if let Some((j, d)) = param {
+            if let Some(i) = L::param_index(j) {
+                row[i] = d;
+            }
+        }
+        let y = if sensor == SensorKind::Course {
+            crate::angle::diff(z, h)
+        } else {
+            z - h
+        };
+        let s = kalman::scalar_innovation_variance(&self.p, &row, r, y, self.t_s)?;
+        let nis = y * y / s;
+        let (accepted, _) = self.decide(sensor, nis);
+        if accepted {
+            kalman::update_scalar(&mut self.x, &mut self.p, y, &row, r, self.form, self.t_s)?;
+            self.refresh_params();
+        }
+        Ok(Update {
+            sensor,
+            y,
+            s,
+            nis,
+            accepted,
+        })
+    }
+
+    /// Eq. (6)/(8): the ticks of wheel `i` over `interval_s`. `None` when the
+    /// wheel has no sensor (`wheels_present`).
+    pub fn update_wheel_ticks(
+        &mut self,
+        i: usize,
+        ticks: f64,
+        interval_s: f64,
+    ) -> Result<Option<Update>, Error> {
+        if !self.wheel_present(i) {
+            return Ok(None);
+        }
+        let pred = self.sensors.wheel_ticks(&self.car_state(), i, interval_s);
+        // ∂h/∂(1/ρ_i) = h·ρ_i: the model is linear in the inverse circumference.
+        let d = pred.0 / self.sensors.inv_circumference[i];
+        let r = self.noise.wheel_ticks.powi(2);
+        self.scalar(SensorKind::Wheel(i as u8), ticks, pred, r, Some((2 + i, d)))
+            .map(Some)
+    }
+
+    /// The speed of wheel `i`, m/s. `None` when the wheel has no sensor.
+    pub fn update_wheel_speed(
+        &mut self,
+        i: usize,
+        speed_mps: f64,
+    ) -> Result<Option<Update>, Error> {
+        if !self.wheel_present(i) {
+            return Ok(None);
+        }
+        let pred = self.sensors.wheel_speed(&self.car_state(), i);
+        let d = pred.0 / self.sensors.inv_circumference[i];
+        let r = self.noise.wheel_speed_mps.powi(2);
+        self.scalar(
+            SensorKind::Wheel(i as u8),
+            speed_mps,
+            pred,
+            r,
+            Some((2 + i, d)),
+        )
+        .map(Some)
+    }
+
+    /// Eq. (4): one gyro reading, rad/s.
+    pub fn update_gyro(&mut self, yaw_rate_rps: f64) -> Result<Update, Error> {
+        let pred = self.sensors.gyro(&self.car_state());
+        let r = self.noise.gyro_rps.powi(2);
+        self.scalar(SensorKind::Gyro, yaw_rate_rps, pred, r, Some((0, 1.0)))
+    }
+
+    /// Eq. (5): one CAN speed reading, m/s.
+    pub fn update_speed(&mut self, speed_mps: f64) -> Result<Update, Error> {
+        let pred = self.sensors.can_speed(&self.car_state());
+        let r = self.noise.speed_mps.powi(2);
+        let d_scale = self.x[V];
+        self.scalar(SensorKind::Speed, speed_mps, pred, r, Some((1, d_scale)))
+    }
+
+    /// Eq. (7): one steering-wheel reading, rad, with the prior speed.
+    pub fn update_steering(&mut self, steering_wheel_rad: f64) -> Result<Update, Error> {
+        let (z, r) =
+            self.sensors
+                .steering_measurement(steering_wheel_rad, self.x[V], self.noise.steering);
+        let pred = self.sensors.steering(&self.car_state());
+        self.scalar(SensorKind::Steering, z, pred, r, None)
+    }
+
+    /// Eq. (10): one GNSS position (through the lever arm), gated by its
+    /// Mahalanobis distance. After `gnss_max_rejections` consecutive rejections
+    /// the filter takes itself to be lost: it widens its position (and yaw)
+    /// covariance to cover the innovation and takes the fix (a recovery).
+    pub fn update_gnss(&mut self, fix: &GnssFix) -> Result<Update, Error> {
+        let (h, jac5) = self.sensors.gnss(&self.car_state());
+        let mut jac = SMatrix::<f64, 2, N>::zeros();
+        jac.fixed_view_mut::<2, 5>(0, 0).copy_from(&jac5);
+        let y = Vector2::new(fix.east_m, fix.north_m) - h;
+        let r = Matrix2::identity() * fix.std_m.powi(2);
+        let (mut s, _, mut nis) = kalman::innovation_stats(&self.p, &y, &jac, &r, self.t_s)?;
+        let (accepted, recovery) = self.decide(SensorKind::Gnss, nis);
+        if recovery {
+            let d2 = y.norm_squared();
+            for i in [model::X, model::Y] {
+                self.p[(i, i)] += d2;
+            }
+            self.p[(model::YAW, model::YAW)] += 0.1f64.powi(2);
+            (s, _, nis) = kalman::innovation_stats(&self.p, &y, &jac, &r, self.t_s)?;
+        }
+        if accepted {
+            kalman::update_vector(&mut self.x, &mut self.p, &y, &jac, &r, self.form, self.t_s)?;
+            self.refresh_params();
+        }
+        Ok(Update {
+            sensor: SensorKind::Gnss,
+            y: y[0],
+            s: s[(0, 0)],
+            nis,
+            accepted,
+        })
+    }
+
+    /// A GNSS course (yaw, rad) as a yaw observation, used above 3 m/s only
+    /// (`None` below, or without a speed); its noise shrinks with speed (about
+    /// 0.5 m/s of velocity noise).
+    pub fn update_course(
+        &mut self,
+        course_yaw_rad: f64,
+        speed_mps: Option<f64>,
+    ) -> Result<Option<Update>, Error> {
+        let Some(speed) = speed_mps.filter(|s| *s > 3.0) else {
+            return Ok(None);
+        };
+        let sigma = (0.5 / speed).min(0.3);
+        let pred = self.sensors.yaw(&self.car_state());
+        self.scalar(
+            SensorKind::Course,
+            course_yaw_rad,
+            pred,
+            sigma * sigma,
+            None,
+        )
+        .map(Some)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn filter() -> CarFilter {
+        let v = Vehicle::paper_car();
+        let x0 = State::from([0.0, 0.0, 0.0, 10.0, 0.0]);
+        let p0 = Mat::from_diagonal(&State::from([1.0, 1.0, 0.01, 1.0, 0.01]));
+        CarFilter::new(&v, &Params::nominal(&v), None, 0.0, x0, p0).unwrap()
+    }
+
+    #[test]
+    fn a_wheel_reading_far_outside_the_gate_is_rejected_and_counted() {
+        let mut f = filter();
+        f.predict_to(0.02);
+        let before = *f.state();
+        let u = f.update_wheel_ticks(0, 500.0, 0.02).unwrap().unwrap();
+        assert!(!u.accepted && u.nis > 1e3);
+        assert_eq!(*f.state(), before);
+        assert_eq!(f.gates().rejected(SensorKind::Wheel(0)), 1);
+        assert_eq!(f.gates().accepted(SensorKind::Wheel(0)), 0);
+    }
+
+    #[test]
+    fn consecutive_rejections_end_in_a_recovery() {
+        let mut f = filter();
+        let max = Vehicle::paper_car().noise.max_rejections as u64;
+        let mut t = 0.0;
+        for _ in 0..=max {
+            t += 0.02;
+            f.predict_to(t);
+            f.update_wheel_ticks(2, 5000.0, 0.02).unwrap();
+        }
+        let rl = SensorKind::Wheel(2);
+        assert_eq!(f.gates().rejected(rl), max);
+        assert_eq!(f.gates().recovered(rl), 1);
+        assert_eq!(f.gates().accepted(rl), 1);
+    }
+
+    #[test]
+    fn absent_wheels_are_never_used() {
+        let mut v = Vehicle::paper_car();
+        v.wheels_present = [true, false, true, false];
+        let x0 = State::from([0.0, 0.0, 0.0, 10.0, 0.0]);
+        let mut f =
+            CarFilter::new(&v, &Params::nominal(&v), None, 0.0, x0, Mat::identity()).unwrap();
+        f.predict_to(0.02);
+        assert!(f.update_wheel_speed(1, 10.0).unwrap().is_none());
+        assert!(f.update_wheel_ticks(3, 5.0, 0.02).unwrap().is_none());
+        assert!(f.update_wheel_speed(0, 10.0).unwrap().is_some());
+    }
+
+    #[test]
+    fn the_augmented_layout_holds_the_parameters() {
+        let v = Vehicle::paper_car();
+        let p = Params::nominal(&v);
+        let sd = Params {
+            gyro_bias_rps: 0.01,
+            speed_scale: 0.05,
+            circumference_fl_m: 0.01,
+            circumference_fr_m: 0.01,
+            circumference_rl_m: 0.01,
+            circumference_rr_m: 0.01,
+        };
+        let x0 = State::from([0.0, 0.0, 0.0, 10.0, 0.0]);
+        let f = AugmentedFilter::new(&v, &p, Some(&sd), 0.0, x0, Mat::identity()).unwrap();
+        let got = f.params_std().unwrap();
+        assert!((got.circumference_fl_m - 0.01).abs() < 1e-12);
+        assert!((f.params().circumference_rr_m - p.circumference_rr_m).abs() < 1e-12);
+        assert!(AugmentedFilter::new(&v, &p, None, 0.0, x0, Mat::identity()).is_err());
+        assert!(filter().params_std().is_none());
+    }
+}

@@ -1,0 +1,279 @@
+//! The four-wheel filter on a live stream: initialisation, the filter and the
+//! timing scheme in one serialisable object, fed one [`Event`] at a time.
+//!
+//! [`Online`] starts from a given pose or from GNSS (the first fix and the
+//! direction of the first 10 m, as [`crate::ekf::Init::Gnss`]; events are kept
+//! until then and replayed, so the result equals the batch filter's), then
+//! emits one [`TrackPoint`] per filter epoch. With [`Online::learning`] it runs
+//! the state augmented with the six parameters and keeps them with their
+//! standard errors, a validity flag and a percentage calibrated
+//! ([`Learned`]), as production stacks learn their parameters while driving.
+//!
+//! Memory is constant once the filter has started; before, the events since the
+//! first GNSS fix are kept (the vehicle has to move 10 m).
+
+use serde::{Deserialize, Serialize};
+
+use crate::ekf::{Event, Feeder, FilterOptions, FilterStats, GnssInit};
+use crate::filter::{AugmentedFilter, CarFilter};
+use crate::model::{Mat, State};
+use crate::track::TrackPoint;
+use crate::vehicle::{Params, Vehicle};
+use crate::Error;
+
+/// The target standard errors of the learned parameters: the accuracy of the
+/// offline RTS calibration on the project's simulated drives (gyro bias 5% of a
+/// typical 1e-3 rad/s bias, speed scale 0.3%, circumferences 0.1%).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LearnTargets {
+    /// Gyro bias, rad/s.
+    pub gyro_bias_rps: f64,
+    /// Speed scale (unitless).
+    pub speed_scale: f64,
+    /// Circumference, relative (0.001 = 0.1%).
+    pub circumference_rel: f64,
+}
+
+impl Default for LearnTargets {
+    fn default() -> Self {
+        LearnTargets {
+            gyro_bias_rps: 5e-5,
+            speed_scale: 3e-3,
+            circumference_rel: 1e-3,
+        }
+    }
+}
+
+/// Learned parameters with their confidence.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Learned {
+    /// The estimates.
+    pub params: Params,
+    /// One standard error each (circumferences in metres).
+    pub std: Params,
+    /// True when every standard error is within its target ([`LearnTargets`]).
+    pub valid: bool,
+    /// Mean over the six parameters of min(1, target / standard error), in percent.
+    pub calibrated_pct: f64,
+}
+
+impl Learned {
+    fn new(params: Params, std: Params, t: &LearnTargets) -> Self {
+        let c = params.circumferences();
+        let cs = std.circumferences();
+        let ratios = [
+            t.gyro_bias_rps / std.gyro_bias_rps,
+            t.speed_scale / std.speed_scale,
+            t.circumference_rel * c[0] / cs[0],
+            t.circumference_rel * c[1] / cs[1],
+            t.circumference_rel * c[2] / cs[2],
+            t.circumference_rel * c[3] / cs[3],
+        ];
+        let valid = ratios.iter().all(|r| *r >= 1.0);
+        let pct = 100.0 * ratios.iter().map(|r| r.min(1.0)).sum::<f64>() / 6.0;
+        Learned {
+            params,
+            std,
+            valid,
+            calibrated_pct: pct,
+        }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+enum Stage {
+    /// Waiting for the GNSS initialisation; the events since the first fix.
+    Waiting { init: GnssInit, buffer: Vec<Event> },
+    Car {
+        filter: Box<CarFilter>,
+        feeder: Feeder,
+    },
+    Learning {
+        filter: Box<AugmentedFilter>,
+        feeder: Feeder,
+    },
+}
+
+/// The filter on a stream; see the module documentation.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Online {
+    vehicle: Vehicle,
+    params: Params,
+    /// Prior standard deviations when learning.
+    prior_std: Option<Params>,
+    opts: FilterOptions,
+    stage: Stage,
+}
+
+/// A dead-reckoning start for [`Online::new`].
+#[allow(clippy::large_enum_variant)] // a plain value passed once
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Start {
+    /// From GNSS, as [`crate::ekf::Init::Gnss`].
+    Gnss,
+    /// A given time, car state and covariance.
+    Given(f64, State, Mat),
+}
+
+impl Online {
+    /// A filter with fixed `params`. Only `timing`, `sensors`, `gnss_outages`,
+    /// `covariance_form` and `end_s` of `opts` apply.
+    pub fn new(
+        vehicle: &Vehicle,
+        params: &Params,
+        opts: &FilterOptions,
+        start: Start,
+    ) -> Result<Self, Error> {
+        Self::build(vehicle, params, None, opts, start)
+    }
+
+    /// A filter that learns the six parameters, starting from `params` with
+    /// standard deviations `prior_std` (circumferences in metres).
+    pub fn learning(
+        vehicle: &Vehicle,
+        params: &Params,
+        prior_std: &Params,
+        opts: &FilterOptions,
+        start: Start,
+    ) -> Result<Self, Error> {
+        Self::build(vehicle, params, Some(*prior_std), opts, start)
+    }
+
+    fn build(
+        vehicle: &Vehicle,
+        params: &Params,
+        prior_std: Option<Params>,
+        opts: &FilterOptions,
+        start: Start,
+    ) -> Result<Self, Error> {
+        vehicle.validate()?;
+        params.validate()?;
+        let mut o = Online {
+            vehicle: vehicle.clone(),
+            params: *params,
+            prior_std,
+            opts: FilterOptions {
+                record_epochs: false,
+                record_innovations: false,
+                ..opts.clone()
+            },
+            stage: Stage::Waiting {
+                init: GnssInit::new(vehicle.gnss_lever_arm_m),
+                buffer: Vec::new(),
+            },
+        };
+        if let Start::Given(t, x, p) = start {
+            o.stage = o.started(t, x, p)?;
+        }
+        Ok(o)
+    }
+
+    fn started(&self, t0: f64, x0: State, p0: Mat) -> Result<Stage, Error> {
+        let feeder = Feeder::new(&self.opts, t0);
+        let form = self.opts.covariance_form;
+        Ok(match &self.prior_std {
+            None => Stage::Car {
+                filter: Box::new(
+                    CarFilter::new(&self.vehicle, &self.params, None, t0, x0, p0)?
+                        .with_covariance_form(form),
+                ),
+                feeder,
+            },
+            Some(sd) => Stage::Learning {
+                filter: Box::new(
+                    AugmentedFilter::new(&self.vehicle, &self.params, Some(sd), t0, x0, p0)?
+                        .with_covariance_form(form),
+                ),
+                feeder,
+            },
+        })
+    }
+
+    /// True once the filter runs.
+    pub fn is_started(&self) -> bool {
+        !matches!(self.stage, Stage::Waiting { .. })
+    }
+
+    /// Takes one event (time order); calls `out` with the state after every
+    /// epoch it completes.
+    pub fn push(&mut self, ev: Event, out: &mut dyn FnMut(TrackPoint)) -> Result<(), Error> {
+        match &mut self.stage {
+            Stage::Waiting { init, buffer } => {
+                let hidden = |t: f64| self.opts.gnss_outages.iter().any(|&(a, b)| t >= a && t < b);
+                let mut start = None;
+                if let Some(fix) = ev.gnss_fix().filter(|g| !hidden(g.t_s)) {
+                    if !init.has_first() {
+                        // Nothing before the first fix is ever used.
+                        buffer.retain(|e| e.t_s >= fix.t_s);
+                    }
+                    start = init.push(&fix);
+                }
+                if let Some(b) = buffer.last() {
+                    if ev.t_s < b.t_s {
+                        return Err(Error::InvalidDrive(format!(
+                            "event at t={} s comes after one at t={} s: events must be in time order",
+                            ev.t_s, b.t_s
+                        )));
+                    }
+                }
+                buffer.push(ev);
+                if let Some((t0, x0, p0)) = start {
+                    let events = std::mem::take(buffer);
+                    self.stage = self.started(t0, x0, p0)?;
+                    for e in events {
+                        self.push(e, out)?;
+                    }
+                }
+                Ok(())
+            }
+            Stage::Car { filter, feeder } => feeder.push(filter.as_mut(), ev, &mut |f, _| {
+                out(point(f.time_s(), f.state(), f.covariance()))
+            }),
+            Stage::Learning { filter, feeder } => feeder.push(filter.as_mut(), ev, &mut |f, _| {
+                out(point(f.time_s(), f.state(), f.covariance()))
+            }),
+        }
+    }
+
+    /// Runs what is still waiting at the end of a stream.
+    pub fn finish(&mut self, out: &mut dyn FnMut(TrackPoint)) -> Result<(), Error> {
+        match &mut self.stage {
+            Stage::Waiting { init, .. } => Err(init.why_not()),
+            Stage::Car { filter, feeder } => feeder.finish(filter.as_mut(), &mut |f, _| {
+                out(point(f.time_s(), f.state(), f.covariance()))
+            }),
+            Stage::Learning { filter, feeder } => feeder.finish(filter.as_mut(), &mut |f, _| {
+                out(point(f.time_s(), f.state(), f.covariance()))
+            }),
+        }
+    }
+
+    /// Counters so far (`None` before the start).
+    pub fn stats(&self) -> Option<FilterStats> {
+        match &self.stage {
+            Stage::Waiting { .. } => None,
+            Stage::Car { filter, feeder } => Some(feeder.stats_with(filter.as_ref())),
+            Stage::Learning { filter, feeder } => Some(feeder.stats_with(filter.as_ref())),
+        }
+    }
+
+    /// The learned parameters (`None` unless learning and started).
+    pub fn learned(&self, targets: &LearnTargets) -> Option<Learned> {
+        match &self.stage {
+            Stage::Learning { filter, .. } => {
+                Some(Learned::new(filter.params(), filter.params_std()?, targets))
+            }
+            _ => None,
+        }
+    }
+}
+
+fn point<const N: usize>(
+    t_s: f64,
+    x: &nalgebra::SVector<f64, N>,
+    p: &nalgebra::SMatrix<f64, N, N>,
+) -> TrackPoint {
+    let car: State = x.fixed_rows::<5>(0).into_owned();
+    let pc: Mat = p.fixed_view::<5, 5>(0, 0).into_owned();
+    TrackPoint::from_state(t_s, &car, &pc)
+}

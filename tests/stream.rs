@@ -1,0 +1,338 @@
+//! The four-wheel filter online: the step API against the batch run, state
+//! round trips, and `deadreckon events | deadreckon stream` against
+//! `deadreckon run` (issue: "the four-wheel estimator online").
+
+use std::io::Write;
+use std::process::{Command, Stdio};
+
+use deadreckon_core::drive::Wheels;
+use deadreckon_core::ekf::{self, DriveEvents, FilterOptions, Init, Timing};
+use deadreckon_core::online::{Online, Start};
+use deadreckon_core::{Drive, Params, TrackPoint};
+use deadreckon_sim::{simulate, Scenario};
+
+fn drive(seed: u64, duration_s: f64) -> Drive {
+    let sc = Scenario::builtin("evaluation")
+        .unwrap()
+        .with_duration_s(duration_s);
+    simulate(&sc, seed).unwrap().drive
+}
+
+fn online_track(d: &Drive, params: &Params, timing: Timing) -> Vec<TrackPoint> {
+    let opts = FilterOptions {
+        timing,
+        ..Default::default()
+    };
+    let mut o = Online::new(&d.vehicle, params, &opts, Start::Gnss).unwrap();
+    let mut pts = Vec::new();
+    for ev in DriveEvents::all(d) {
+        o.push(ev, &mut |p| pts.push(p)).unwrap();
+    }
+    o.finish(&mut |p| pts.push(p)).unwrap();
+    pts
+}
+
+#[test]
+fn online_filter_equals_the_batch_run_in_both_timings() {
+    let d = drive(21, 90.0);
+    let params = Params::nominal(&d.vehicle);
+    for timing in [Timing::WheelEpochs, Timing::EachMeasurement] {
+        let batch = ekf::run(
+            &d,
+            &params,
+            &FilterOptions {
+                timing,
+                ..Default::default()
+            },
+            &mut (),
+        )
+        .unwrap();
+        let online = online_track(&d, &params, timing);
+        assert_eq!(online.len(), batch.epochs.len(), "{timing:?}");
+        for (p, e) in online.iter().zip(&batch.epochs) {
+            assert_eq!(p.t_s, e.t_s);
+            assert_eq!(p.east_m, e.x[0], "{timing:?} at {}", e.t_s);
+            assert_eq!(p.north_m, e.x[1]);
+            assert_eq!(p.speed_mps, e.x[3]);
+        }
+    }
+}
+
+#[test]
+fn a_stopped_and_resumed_stream_equals_an_uninterrupted_one_bit_for_bit() {
+    let d = drive(22, 60.0);
+    let params = Params::nominal(&d.vehicle);
+    let events: Vec<_> = DriveEvents::all(&d).collect();
+    // Split between two timestamps, after the filter has started.
+    let mut cut = events.len() / 2;
+    while events[cut].t_s == events[cut - 1].t_s {
+        cut += 1;
+    }
+    let opts = FilterOptions::default();
+    let mut whole = Vec::new();
+    let mut o = Online::new(&d.vehicle, &params, &opts, Start::Gnss).unwrap();
+    for ev in &events {
+        o.push(*ev, &mut |p| whole.push(p)).unwrap();
+    }
+    o.finish(&mut |p| whole.push(p)).unwrap();
+
+    let mut parts = Vec::new();
+    let mut a = Online::new(&d.vehicle, &params, &opts, Start::Gnss).unwrap();
+    for ev in &events[..cut] {
+        a.push(*ev, &mut |p| parts.push(p)).unwrap();
+    }
+    a.finish(&mut |p| parts.push(p)).unwrap();
+    assert!(a.is_started());
+    let json = serde_json::to_string(&a).unwrap();
+    let mut b: Online = serde_json::from_str(&json).unwrap();
+    assert_eq!(b, a, "the state loads back bit-identical");
+    assert_eq!(serde_json::to_string(&b).unwrap(), json);
+    for ev in &events[cut..] {
+        b.push(*ev, &mut |p| parts.push(p)).unwrap();
+    }
+    b.finish(&mut |p| parts.push(p)).unwrap();
+    assert_eq!(parts, whole);
+}
+
+/// Bug: the wheel-speed branch of the filter ignored `wheels_present`, so an
+/// absent wheel's column (a tricycle writes its one encoder as FL) was fused.
+#[test]
+fn regression_wheel_speeds_of_absent_wheels_were_fused() {
+    let mut sc = Scenario::builtin("evaluation")
+        .unwrap()
+        .with_duration_s(60.0);
+    sc.sensors.wheels.kind = deadreckon_sim::WheelKind::Speeds;
+    let mut d = simulate(&sc, 23).unwrap().drive;
+    d.vehicle.wheels_present = [false, false, true, true];
+    let params = Params::nominal(&d.vehicle);
+    let opts = FilterOptions::default();
+    let clean = ekf::run(&d, &params, &opts, &mut ()).unwrap();
+    let Wheels::Speeds(rows) = &mut d.wheels else {
+        panic!("wheel speeds expected")
+    };
+    for r in rows.iter_mut() {
+        r.fl_mps = 55.0;
+        r.fr_mps = -3.0;
+    }
+    let garbage = ekf::run(&d, &params, &opts, &mut ()).unwrap();
+    assert_eq!(clean.epochs.len(), garbage.epochs.len());
+    for (a, b) in clean.epochs.iter().zip(&garbage.epochs) {
+        assert_eq!(
+            a.x, b.x,
+            "the absent front wheels changed the state at {}",
+            a.t_s
+        );
+    }
+    assert_eq!(garbage.stats.gates.accepted(ekf::SensorKind::Wheel(0)), 0);
+    assert!(garbage.stats.gates.accepted(ekf::SensorKind::Wheel(2)) > 1000);
+}
+
+#[test]
+fn a_slipping_wheel_is_gated_and_counted() {
+    let mut d = drive(24, 60.0);
+    let params = Params::nominal(&d.vehicle);
+    let Wheels::Ticks(rows) = &mut d.wheels else {
+        panic!("wheel ticks expected")
+    };
+    // The rear-left wheel spins: 40 extra ticks per row for 20 rows.
+    let n = rows.len();
+    for r in rows[n / 2..n / 2 + 20].iter_mut() {
+        r.rl += 40;
+    }
+    let out = ekf::run(&d, &params, &FilterOptions::default(), &mut ()).unwrap();
+    let rl = out.stats.gates.rejected(ekf::SensorKind::Wheel(2));
+    assert!((18..=20).contains(&rl), "{rl} rejected");
+    assert_eq!(out.stats.gates.rejected(ekf::SensorKind::Wheel(0)), 0);
+}
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_deadreckon"))
+}
+
+fn csv_filtered(path: &std::path::Path) -> Vec<(f64, f64, f64, f64)> {
+    let mut r = csv::Reader::from_path(path).unwrap();
+    let h = r.headers().unwrap().clone();
+    let col = |n: &str| h.iter().position(|c| c == n).unwrap();
+    let (t, tr, e, no, y) = (
+        col("t_s"),
+        col("track"),
+        col("east_m"),
+        col("north_m"),
+        col("yaw_rad"),
+    );
+    r.records()
+        .map(|x| x.unwrap())
+        .filter(|x| &x[tr] == "filtered")
+        .map(|x| {
+            (
+                x[t].parse().unwrap(),
+                x[e].parse().unwrap(),
+                x[no].parse().unwrap(),
+                x[y].parse().unwrap(),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn events_piped_into_stream_reproduce_the_filtered_track_of_run() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("d");
+    let st = bin()
+        .args([
+            "simulate",
+            "--scenario",
+            "evaluation",
+            "--seed",
+            "25",
+            "--duration",
+            "90",
+        ])
+        .arg("--out")
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let track = tmp.path().join("t.csv");
+    let st = bin()
+        .arg("run")
+        .arg(&dir)
+        .arg("--out")
+        .arg(&track)
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let events = bin().arg("events").arg(&dir).output().unwrap();
+    assert!(events.status.success());
+    let mut child = bin()
+        .arg("stream")
+        .arg("--vehicle")
+        .arg(dir.join("vehicle.toml"))
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Feed standard input from a thread: the child writes while it reads.
+    let mut stdin = child.stdin.take().unwrap();
+    let input = events.stdout.clone();
+    let feeder = std::thread::spawn(move || stdin.write_all(&input));
+    let out = child.wait_with_output().unwrap();
+    feeder.join().unwrap().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let lines: Vec<TrackPoint> = String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let want = csv_filtered(&track);
+    assert_eq!(lines.len(), want.len());
+    for (p, w) in lines.iter().zip(&want) {
+        assert!((p.t_s - w.0).abs() < 1e-9);
+        assert!((p.east_m - w.1).abs() < 1e-9, "{} vs {}", p.east_m, w.1);
+        assert!((p.north_m - w.2).abs() < 1e-9);
+        assert!((p.yaw_rad - w.3).abs() < 1e-9);
+    }
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("epochs"), "{err}");
+}
+
+#[test]
+fn stream_names_the_bad_line_and_skips_it_when_asked() {
+    let tmp = tempfile::tempdir().unwrap();
+    let vehicle = tmp.path().join("vehicle.toml");
+    deadreckon_io::write_vehicle(&vehicle, &deadreckon_core::Vehicle::paper_car()).unwrap();
+    let input = "{\"t_s\": 0.0, \"sensor\": \"yaw_rate\", \"yaw_rate_rps\": 0.0}\n{\"t_s\": 0.1, \"sensor\": \"yaw_rate\", \"yaw_rate_rps\": \"x\"}\n";
+    let run = |mode: &str| {
+        let mut c = bin()
+            .arg("stream")
+            .arg("--vehicle")
+            .arg(&vehicle)
+            .args(["--on-bad-line", mode])
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        c.stdin.take().unwrap().write_all(input.as_bytes()).unwrap();
+        c.wait_with_output().unwrap()
+    };
+    let refused = run("refuse");
+    assert!(!refused.status.success());
+    let err = String::from_utf8_lossy(&refused.stderr);
+    assert!(err.contains("stdin: line 2, column"), "{err}");
+    let skipped = run("skip");
+    let err = String::from_utf8_lossy(&skipped.stderr);
+    assert!(err.contains("skipped: stdin: line 2"), "{err}");
+    // No GNSS ever arrived: the filter never started, which is an error, not a panic.
+    assert!(err.contains("needs at least one fix"), "{err}");
+}
+
+#[test]
+fn events_into_a_closed_pipe_exits_quietly() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("d");
+    let st = bin()
+        .args([
+            "simulate",
+            "--scenario",
+            "evaluation",
+            "--seed",
+            "26",
+            "--duration",
+            "30",
+        ])
+        .arg("--out")
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(st.status.success());
+    let mut c = bin()
+        .arg("events")
+        .arg(&dir)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(c.stdout.take());
+    let out = c.wait_with_output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        out.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+fn init_given_starts_at_once() {
+    let d = drive(27, 30.0);
+    let params = Params::nominal(&d.vehicle);
+    let x0 = ekf::truth_state(&d, 1.0).unwrap();
+    let p0 = deadreckon_core::model::Mat::identity() * 0.01;
+    let o = Online::new(
+        &d.vehicle,
+        &params,
+        &FilterOptions::default(),
+        Start::Given(1.0, x0, p0),
+    )
+    .unwrap();
+    assert!(o.is_started());
+    let _ = Init::Truth;
+}
