@@ -336,3 +336,22 @@ fn init_given_starts_at_once() {
     assert!(o.is_started());
     let _ = Init::Truth;
 }
+
+#[test]
+fn checkpointed_smoothing_equals_smoothing_a_recorded_run_exactly() {
+    let d = drive(28, 240.0);
+    let params = Params::nominal(&d.vehicle);
+    let prior = deadreckon_core::calibrate::CalibrationOptions::default().prior_std;
+    let opts = FilterOptions::default();
+    let full = ekf::run_augmented(&d, &params, &prior, &opts).unwrap();
+    let want = deadreckon_core::rts::smooth_states(&full.epochs).unwrap();
+    let f = ekf::augmented_filter(&d, &params, &prior, &opts).unwrap();
+    let (got, stats) = deadreckon_core::checkpoint::smooth_car_states(&d, f, &opts).unwrap();
+    assert_eq!(got.len(), want.len());
+    assert!(got.len() > 10_000, "{} epochs: several segments", got.len());
+    for (g, w) in got.iter().zip(&want) {
+        assert_eq!(g.0, w.0);
+        assert_eq!(g.1, w.1.fixed_rows::<5>(0).into_owned(), "at {}", g.0);
+    }
+    assert_eq!(stats, full.stats);
+}

@@ -148,8 +148,21 @@ pub fn gates_json(g: &deadreckon_core::filter::GateCounts) -> serde_json::Value 
 
 /// A one-line account of what the filter used and gated.
 pub fn stats_line(st: &deadreckon_core::ekf::FilterStats) -> String {
+    let gated: Vec<String> = st
+        .gates
+        .rows()
+        .into_iter()
+        .filter(|r| r.2 > 0)
+        .map(|(name, a, r, _)| format!("{name} {r}/{}", a + r))
+        .collect();
     format!(
-        "filter: {} epochs, GNSS {} used / {} rejected by the gate ({} recoveries after {} consecutive rejections) / {} hidden, {} wheel gaps skipped",
-        st.epochs, st.gnss_updates, st.gnss_rejected, st.gnss_recoveries, 10, st.gnss_hidden, st.wheel_gaps
+        "filter: {} epochs, GNSS {} used / {} rejected by the gate ({} recoveries) / {} hidden, {} wheel gaps skipped; rejected by the χ² gates: {}",
+        st.epochs,
+        st.gnss_updates,
+        st.gnss_rejected,
+        st.gnss_recoveries,
+        st.gnss_hidden,
+        st.wheel_gaps,
+        if gated.is_empty() { "none".to_string() } else { gated.join(", ") }
     )
 }

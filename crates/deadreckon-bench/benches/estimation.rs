@@ -41,6 +41,66 @@ fn filter_and_smoother(c: &mut Criterion) {
     g.finish();
 }
 
+/// The online filter one event at a time (`deadreckon stream`): events per
+/// second, and the per-event latency quantiles printed once.
+fn online(c: &mut Criterion) {
+    use deadreckon_core::ekf::DriveEvents;
+    use deadreckon_core::online::{Online, Start};
+    let drive = deadreckon_bench::drive(600.0);
+    let params = Params::nominal(&drive.vehicle);
+    let events: Vec<_> = DriveEvents::all(&drive).collect();
+    let opts = FilterOptions::default();
+    let run_all = |learn: bool| {
+        let mut o = if learn {
+            let prior = CalibrationOptions::default().prior_std;
+            Online::learning(&drive.vehicle, &params, &prior, &opts, Start::Gnss).unwrap()
+        } else {
+            Online::new(&drive.vehicle, &params, &opts, Start::Gnss).unwrap()
+        };
+        let mut n = 0usize;
+        for ev in &events {
+            o.push(*ev, &mut |_| n += 1).unwrap();
+        }
+        n
+    };
+    // Latency of each push once started (µs), median and p99.
+    for learn in [false, true] {
+        let mut o = if learn {
+            let prior = CalibrationOptions::default().prior_std;
+            Online::learning(&drive.vehicle, &params, &prior, &opts, Start::Gnss).unwrap()
+        } else {
+            Online::new(&drive.vehicle, &params, &opts, Start::Gnss).unwrap()
+        };
+        let mut lat = Vec::with_capacity(events.len());
+        for ev in &events {
+            let started = o.is_started();
+            let t = std::time::Instant::now();
+            o.push(*ev, &mut |p| {
+                std::hint::black_box(p);
+            })
+            .unwrap();
+            if started {
+                lat.push(t.elapsed().as_secs_f64() * 1e6);
+            }
+        }
+        lat.sort_by(f64::total_cmp);
+        eprintln!(
+            "stream{} per-event latency over {} events: median {:.2} µs, p99 {:.2} µs",
+            if learn { " --learn" } else { "" },
+            lat.len(),
+            lat[lat.len() / 2],
+            lat[lat.len() * 99 / 100]
+        );
+    }
+    let mut g = c.benchmark_group("stream");
+    g.throughput(Throughput::Elements(events.len() as u64));
+    g.bench_function("online filter, events", |b| b.iter(|| run_all(false)));
+    g.bench_function("online learner (11 states), events", |b| {
+        b.iter(|| run_all(true))
+    });
+    g.finish();
+}
+
 fn calibration(c: &mut Criterion) {
     let drive = deadreckon_bench::laps(8);
     let (t0, t1) = drive.time_span().unwrap();
@@ -56,5 +116,5 @@ fn calibration(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, filter_and_smoother, calibration);
+criterion_group!(benches, filter_and_smoother, online, calibration);
 criterion_main!(benches);

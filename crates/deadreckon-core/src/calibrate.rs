@@ -25,7 +25,7 @@ use crate::ekf::{self, FilterOptions, Init};
 use crate::model::{State, V, YAW_RATE};
 use crate::observation::Sensors;
 use crate::reference::Reference;
-use crate::rts;
+
 use crate::vehicle::{Params, ParamsWithStd};
 use crate::Error;
 
@@ -192,31 +192,20 @@ pub fn smoothing_pass(
     if matches!(fopts.init, Init::Truth) {
         fopts.init = Init::Gnss;
     }
-    let (reference, stats) = match opts.state {
+    // Smoothed in O(√N) memory (checkpointed re-runs), equal to smoothing a
+    // recorded run.
+    let (sm, stats) = match opts.state {
         PassState::Paper => {
-            let out = ekf::run(drive, p, &fopts, &mut ())?;
-            let sm = rts::smooth_states(&out.epochs)?;
-            (
-                Reference::from_states(
-                    sm.iter().map(|s| s.0).collect(),
-                    sm.iter().map(|s| s.1).collect(),
-                ),
-                out.stats,
-            )
+            let f = ekf::car_filter(drive, p, &fopts)?;
+            crate::checkpoint::smooth_car_states(drive, f, &fopts)?
         }
         PassState::Augmented => {
-            let out = ekf::run_augmented(drive, p, &opts.prior_std, &fopts)?;
-            let sm = rts::smooth_states(&out.epochs)?;
-            let states = sm
-                .iter()
-                .map(|s| s.1.fixed_rows::<5>(0).into_owned())
-                .collect();
-            (
-                Reference::from_states(sm.iter().map(|s| s.0).collect(), states),
-                out.stats,
-            )
+            let f = ekf::augmented_filter(drive, p, &opts.prior_std, &fopts)?;
+            crate::checkpoint::smooth_car_states(drive, f, &fopts)?
         }
     };
+    let (t, x): (Vec<f64>, Vec<State>) = sm.into_iter().unzip();
+    let reference = Reference::from_states(t, x);
     let (est, samples) = least_squares(drive, &reference, opts.min_speed_mps, false)?;
     Ok((est, samples, stats))
 }

@@ -363,6 +363,7 @@ impl Event {
 /// The streams of a drive merged into time order (ties in [`Event`] rank
 /// order), lazily, from `after_s` (exclusive) to the last wheel row: readings
 /// after the last wheel row are never used.
+#[derive(Debug, Clone)]
 pub struct DriveEvents<'a> {
     drive: &'a Drive,
     next: [usize; 5],
@@ -949,10 +950,7 @@ pub fn run(
     opts: &FilterOptions,
     hook: &mut dyn EpochHook,
 ) -> Result<FilterOutput, Error> {
-    let (t0, x0, p0) = start(drive, opts)?;
-    let f = Filter::<CarLayout, 5>::new(&drive.vehicle, params, None, t0, x0, p0)?
-        .with_covariance_form(opts.covariance_form);
-    run_filter(drive, f, opts, hook)
+    run_filter(drive, car_filter(drive, params, opts)?, opts, hook)
 }
 
 /// Runs the EKF with the state augmented by the six parameters, which start at
@@ -964,14 +962,39 @@ pub fn run_augmented(
     prior_std: &Params,
     opts: &FilterOptions,
 ) -> Result<FilterOutput<N_AUG>, Error> {
-    let (t0, x0, p0) = start(drive, opts)?;
-    let f =
-        Filter::<AugmentedLayout, N_AUG>::new(&drive.vehicle, params, Some(prior_std), t0, x0, p0)?
-            .with_covariance_form(opts.covariance_form);
+    let f = augmented_filter(drive, params, prior_std, opts)?;
     run_filter(drive, f, opts, &mut ())
 }
 
-fn start(drive: &Drive, opts: &FilterOptions) -> Result<(f64, State, Mat), Error> {
+/// The 5-state filter at the start `opts.init` gives on `drive`.
+pub fn car_filter(
+    drive: &Drive,
+    params: &Params,
+    opts: &FilterOptions,
+) -> Result<Filter<CarLayout, 5>, Error> {
+    let (t0, x0, p0) = start(drive, opts)?;
+    Ok(
+        Filter::<CarLayout, 5>::new(&drive.vehicle, params, None, t0, x0, p0)?
+            .with_covariance_form(opts.covariance_form),
+    )
+}
+
+/// The 11-state filter (parameters as states, starting at `params` with
+/// standard deviations `prior_std`) at the start `opts.init` gives on `drive`.
+pub fn augmented_filter(
+    drive: &Drive,
+    params: &Params,
+    prior_std: &Params,
+    opts: &FilterOptions,
+) -> Result<Filter<AugmentedLayout, N_AUG>, Error> {
+    let (t0, x0, p0) = start(drive, opts)?;
+    Ok(
+        Filter::<AugmentedLayout, N_AUG>::new(&drive.vehicle, params, Some(prior_std), t0, x0, p0)?
+            .with_covariance_form(opts.covariance_form),
+    )
+}
+
+pub(crate) fn start(drive: &Drive, opts: &FilterOptions) -> Result<(f64, State, Mat), Error> {
     drive.validate()?;
     let (t0, x0, p0) = initial_state(drive, opts)?;
     let w = &drive.wheels;
@@ -983,6 +1006,22 @@ fn start(drive: &Drive, opts: &FilterOptions) -> Result<(f64, State, Mat), Error
     Ok((t0, x0, p0))
 }
 
+/// The feeder of a filter started at `t0_s` and the drive's events it needs
+/// (from the wheel row before the first one at or after `t0_s`).
+pub fn feed<'a>(drive: &'a Drive, opts: &FilterOptions, t0_s: f64) -> (Feeder, DriveEvents<'a>) {
+    let w = &drive.wheels;
+    let k0 = (0..w.len()).find(|&k| w.t_s(k) >= t0_s).unwrap_or(w.len());
+    let before_first = if k0 > 0 {
+        w.t_s(k0 - 1)
+    } else {
+        f64::NEG_INFINITY
+    };
+    (
+        Feeder::new(opts, t0_s),
+        DriveEvents::new(drive, before_first),
+    )
+}
+
 /// The batch loop: every event of the drive after the start through a
 /// [`Feeder`] into the filter `f`, recording epochs and innovations as `opts`
 /// asks, with `hook` after every epoch.
@@ -992,16 +1031,7 @@ pub fn run_filter<L: Layout<N>, const N: usize>(
     opts: &FilterOptions,
     hook: &mut dyn EpochHook<N>,
 ) -> Result<FilterOutput<N>, Error> {
-    // The first wheel row at or after the start opens the first interval.
-    let w = &drive.wheels;
-    let t0 = f.time_s();
-    let k0 = (0..w.len()).find(|&k| w.t_s(k) >= t0).unwrap_or(w.len());
-    let before_first = if k0 > 0 {
-        w.t_s(k0 - 1)
-    } else {
-        f64::NEG_INFINITY
-    };
-    let mut feeder = Feeder::new(opts, t0);
+    let (mut feeder, events) = feed(drive, opts, f.time_s());
     let mut out = FilterOutput::<N>::default();
     let mut record = |f: &mut Filter<L, N>, e: EpochOut<'_, N>| {
         if !hook.is_noop() {
@@ -1031,7 +1061,7 @@ pub fn run_filter<L: Layout<N>, const N: usize>(
             });
         }
     };
-    for ev in DriveEvents::new(drive, before_first) {
+    for ev in events {
         feeder.push(&mut f, ev, &mut record)?;
     }
     feeder.finish(&mut f, &mut record)?;

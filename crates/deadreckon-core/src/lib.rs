@@ -19,6 +19,7 @@
 
 pub mod angle;
 pub mod calibrate;
+pub mod checkpoint;
 pub mod drive;
 pub mod ekf;
 pub mod filter;

@@ -30,7 +30,7 @@ fn f_times<const N: usize>(f_car: &Mat, m: &SMatrix<f64, N, N>) -> SMatrix<f64, 
 }
 
 /// `Fᵀ u` for `F = diag(f_car, I)`.
-fn ft_times<const N: usize>(f_car: &Mat, u: &SVector<f64, N>) -> SVector<f64, N> {
+pub(crate) fn ft_times<const N: usize>(f_car: &Mat, u: &SVector<f64, N>) -> SVector<f64, N> {
     let mut out = *u;
     let top = f_car.transpose() * u.fixed_rows::<5>(0);
     out.fixed_rows_mut::<5>(0).copy_from(&top);
