@@ -26,7 +26,7 @@ fn main() {
     };
     let bounds = [0.05, 0.003, 0.001, 0.001, 0.001, 0.001];
     println!(
-        "seed  km_total  km_to_within_bounds (bias, scale, rho_FL, rho_FR, rho_RL, rho_RR, all)  valid_at_end  calibrated_pct"
+        "seed  km_total  km_to_within_bounds (bias, scale, rho_FL, rho_FR, rho_RL, rho_RR, all)  km_to_valid  valid_at_end  calibrated_pct"
     );
     for seed in seeds {
         let sc = Scenario::builtin("calibration").unwrap().with_laps(laps);
@@ -47,6 +47,7 @@ fn main() {
         let mut km = 0.0;
         let mut last_t: Option<f64> = None;
         let mut last_out = [0.0f64; 6];
+        let mut valid_km: Option<f64> = None;
         let targets = LearnTargets::default();
         let mut pts = Vec::new();
         for ev in DriveEvents::all(&d) {
@@ -62,6 +63,9 @@ fn main() {
                 continue;
             }
             let l = o.learned(&targets).unwrap();
+            if l.valid && valid_km.is_none() {
+                valid_km = Some(km);
+            }
             let e = l.params.to_array();
             for i in 0..6 {
                 if ((e[i] - truth[i]) / truth[i]).abs() > bounds[i] {
@@ -79,13 +83,14 @@ fn main() {
             }
         };
         println!(
-            "{seed:<5} {km:8.2}  {}  {:>5}  {:5.1}",
+            "{seed:<5} {km:8.2}  {}  {:>6}  {:>5}  {:5.1}",
             last_out
                 .iter()
                 .chain(std::iter::once(&all))
                 .map(|x| cell(*x))
                 .collect::<Vec<_>>()
                 .join(" "),
+            valid_km.map_or("never".into(), |k| format!("{k:.2}")),
             l.valid,
             l.calibrated_pct
         );

@@ -355,3 +355,79 @@ fn checkpointed_smoothing_equals_smoothing_a_recorded_run_exactly() {
     }
     assert_eq!(stats, full.stats);
 }
+
+fn stream_with(args: &[&str], input: &[u8]) -> std::process::Output {
+    let mut child = bin()
+        .arg("stream")
+        .args(args)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stdin = child.stdin.take().unwrap();
+    let input = input.to_vec();
+    let feeder = std::thread::spawn(move || stdin.write_all(&input));
+    let out = child.wait_with_output().unwrap();
+    feeder.join().unwrap().unwrap();
+    out
+}
+
+#[test]
+fn stream_learns_the_parameters_and_the_next_drive_starts_from_them() {
+    let tmp = tempfile::tempdir().unwrap();
+    let sc = Scenario::builtin("calibration").unwrap().with_laps(2);
+    let mut learned = Vec::new();
+    let mut prev: Option<std::path::PathBuf> = None;
+    for (k, seed) in [31u64, 32].into_iter().enumerate() {
+        let sim = simulate(&sc, seed).unwrap();
+        let vehicle = tmp.path().join("vehicle.toml");
+        deadreckon_io::write_vehicle(&vehicle, &sim.drive.vehicle).unwrap();
+        let mut input = String::new();
+        for ev in DriveEvents::all(&sim.drive) {
+            input.push_str(&deadreckon_io::events::to_line(&ev));
+            input.push('\n');
+        }
+        let out_path = tmp.path().join(format!("learned{k}.toml"));
+        let params_arg = prev
+            .as_ref()
+            .map(|p| p.to_str().unwrap().to_string())
+            .unwrap_or_else(|| "nominal".into());
+        let out = stream_with(
+            &[
+                "--vehicle",
+                vehicle.to_str().unwrap(),
+                "--params",
+                &params_arg,
+                "--learn",
+                "--params-out",
+                out_path.to_str().unwrap(),
+            ],
+            input.as_bytes(),
+        );
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{err}");
+        assert!(err.contains("100% calibrated, valid"), "{err}");
+        let (p, extra) = deadreckon_io::read_params_with_extra(&out_path).unwrap();
+        assert_eq!(extra["valid"].as_bool(), Some(true));
+        let truth = sim.truth_params.to_array();
+        let est = p.params.to_array();
+        let bounds = [0.05, 0.003, 0.001, 0.001, 0.001, 0.001];
+        for i in 0..6 {
+            let rel = ((est[i] - truth[i]) / truth[i]).abs();
+            assert!(
+                rel < bounds[i],
+                "drive {k}: {} off by {rel}",
+                Params::NAMES[i]
+            );
+        }
+        learned.push(p);
+        prev = Some(out_path);
+    }
+    // The second drive started from the first's estimates and their std: it
+    // ends at least as sure of every circumference.
+    let (a, b) = (learned[0].std.to_array(), learned[1].std.to_array());
+    for i in 2..6 {
+        assert!(b[i] <= a[i], "{}: {} then {}", Params::NAMES[i], a[i], b[i]);
+    }
+}

@@ -996,9 +996,14 @@ pub fn augmented_filter(
 
 pub(crate) fn start(drive: &Drive, opts: &FilterOptions) -> Result<(f64, State, Mat), Error> {
     drive.validate()?;
+    start_validated(drive, opts)
+}
+
+/// [`start`] on a drive already validated (the outage evaluation validates once,
+/// not once per window).
+fn start_validated(drive: &Drive, opts: &FilterOptions) -> Result<(f64, State, Mat), Error> {
     let (t0, x0, p0) = initial_state(drive, opts)?;
-    let w = &drive.wheels;
-    if (0..w.len()).filter(|&k| w.t_s(k) >= t0).count() < 2 {
+    if first_wheel_at_or_after(&drive.wheels, t0) + 1 >= drive.wheels.len() {
         return Err(Error::Insufficient(
             "no wheel epochs after the initial time".into(),
         ));
@@ -1006,11 +1011,40 @@ pub(crate) fn start(drive: &Drive, opts: &FilterOptions) -> Result<(f64, State, 
     Ok((t0, x0, p0))
 }
 
+/// Index of the first wheel row at or after `t` (binary search; rows are sorted).
+fn first_wheel_at_or_after(w: &Wheels, t: f64) -> usize {
+    let (mut lo, mut hi) = (0, w.len());
+    while lo < hi {
+        let mid = (lo + hi) / 2;
+        if w.t_s(mid) < t {
+            lo = mid + 1;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
+}
+
+/// [`run`] on a drive that has passed [`Drive::validate`] already: the outage
+/// evaluation runs one filter per window, and validating the whole drive each
+/// time made it quadratic in the drive's length.
+pub(crate) fn run_validated(
+    drive: &Drive,
+    params: &Params,
+    opts: &FilterOptions,
+    hook: &mut dyn EpochHook,
+) -> Result<FilterOutput, Error> {
+    let (t0, x0, p0) = start_validated(drive, opts)?;
+    let f = Filter::<CarLayout, 5>::new(&drive.vehicle, params, None, t0, x0, p0)?
+        .with_covariance_form(opts.covariance_form);
+    run_filter(drive, f, opts, hook)
+}
+
 /// The feeder of a filter started at `t0_s` and the drive's events it needs
 /// (from the wheel row before the first one at or after `t0_s`).
 pub fn feed<'a>(drive: &'a Drive, opts: &FilterOptions, t0_s: f64) -> (Feeder, DriveEvents<'a>) {
     let w = &drive.wheels;
-    let k0 = (0..w.len()).find(|&k| w.t_s(k) >= t0_s).unwrap_or(w.len());
+    let k0 = first_wheel_at_or_after(w, t0_s);
     let before_first = if k0 > 0 {
         w.t_s(k0 - 1)
     } else {
@@ -1061,7 +1095,9 @@ pub fn run_filter<L: Layout<N>, const N: usize>(
             });
         }
     };
-    for ev in events {
+    // Events after `end_s` are never used: stop reading there.
+    let end = opts.end_s.unwrap_or(f64::INFINITY);
+    for ev in events.take_while(|e| e.t_s <= end) {
         feeder.push(&mut f, ev, &mut record)?;
     }
     feeder.finish(&mut f, &mut record)?;

@@ -176,7 +176,8 @@ pub fn evaluate(
             ..base.clone()
         };
         let mut hook = Collect(Vec::new());
-        ekf::run(drive, params, &opts, &mut hook)?;
+        // Validated by the aided run above.
+        ekf::run_validated(drive, params, &opts, &mut hook)?;
         if let Some(w) = window_errors(drive, truth.as_ref(), &hook.0, e0.t_s, start, end) {
             windows.push(w);
         }
@@ -225,7 +226,8 @@ fn window_errors(
                 states.iter().map(|s| s.0).collect(),
                 states.iter().map(|s| s.1).collect(),
             );
-            for g in drive.gnss.iter().filter(|g| g.t_s > t0 && g.t_s <= end) {
+            let first = drive.gnss.partition_point(|g| g.t_s <= t0);
+            for g in drive.gnss[first..].iter().take_while(|g| g.t_s <= end) {
                 if let Some(x) = traj.state_at(g.t_s) {
                     let (ae, an) = (x[X] + lever * x[YAW].cos(), x[Y] + lever * x[YAW].sin());
                     errors.push((g.t_s - t0, (ae - g.east_m).hypot(an - g.north_m)));
