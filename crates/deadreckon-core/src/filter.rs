@@ -472,11 +472,11 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
         } else {
             z - h
         };
-        let s = kalman::scalar_innovation_variance(&self.p, &row, r, y, self.t_s)?;
-        let nis = y * y / s;
+        let pre = kalman::ScalarInnovation::new(&self.p, &row, r, y, self.t_s)?;
+        let (s, nis) = (pre.s, pre.nis());
         let (accepted, _) = self.decide(sensor, nis);
         if accepted {
-            kalman::update_scalar(&mut self.x, &mut self.p, y, &row, r, self.form, self.t_s)?;
+            pre.apply(&mut self.x, &mut self.p, self.form);
             self.refresh_params();
         }
         Ok(Update {

@@ -42,31 +42,6 @@ pub fn predict_covariance<const N: usize>(
     (pp + pp.transpose()) * 0.5
 }
 
-/// Eq. (14) for one scalar measurement without updating: `S = H P Hᵀ + R`,
-/// checked usable (finite, positive, with a finite innovation `y`), so the
-/// caller can gate before [`update_scalar`].
-pub fn scalar_innovation_variance<const N: usize>(
-    p: &SMatrix<f64, N, N>,
-    h: &SVector<f64, N>,
-    r: f64,
-    y: f64,
-    t_s: f64,
-) -> Result<f64, Error> {
-    let mut s = r;
-    for (j, &hj) in h.iter().enumerate() {
-        if hj != 0.0 {
-            s += hj * h.dot(&p.column(j));
-        }
-    }
-    if !(s.is_finite() && s > 0.0 && y.is_finite()) {
-        return Err(Error::Numerical {
-            t_s,
-            what: format!("innovation variance {s} or innovation {y} is not usable"),
-        });
-    }
-    Ok(s)
-}
-
 /// Eq. (13)–(17) for one scalar measurement with innovation `y = z − h(x)`,
 /// Jacobian row `h` and variance `r`. Updates `x` and `p` in place.
 pub fn update_scalar<const N: usize>(
@@ -78,45 +53,86 @@ pub fn update_scalar<const N: usize>(
     form: CovarianceForm,
     t_s: f64,
 ) -> Result<Innovation, Error> {
-    // P Hᵀ, using only the non-zero entries of H (observation rows are sparse).
-    let mut ph = SVector::<f64, N>::zeros();
-    for (j, &hj) in h.iter().enumerate() {
-        if hj != 0.0 {
-            ph.axpy(hj, &p.column(j), 1.0);
+    let pre = ScalarInnovation::new(p, h, r, y, t_s)?;
+    pre.apply(x, p, form);
+    Ok(pre.innovation())
+}
+
+/// Eq. (14) for one scalar measurement, before the update: `P Hᵀ` and
+/// `S = H P Hᵀ + R`, checked usable, so the caller can gate on the NIS and
+/// then [`ScalarInnovation::apply`] without computing them again.
+#[derive(Debug, Clone, Copy)]
+pub struct ScalarInnovation<const N: usize> {
+    ph: SVector<f64, N>,
+    /// Innovation.
+    pub y: f64,
+    /// Innovation variance S.
+    pub s: f64,
+}
+
+impl<const N: usize> ScalarInnovation<N> {
+    /// `P Hᵀ` (using only the non-zero entries of H) and `S`, with the innovation `y`.
+    pub fn new(
+        p: &SMatrix<f64, N, N>,
+        h: &SVector<f64, N>,
+        r: f64,
+        y: f64,
+        t_s: f64,
+    ) -> Result<Self, Error> {
+        let mut ph = SVector::<f64, N>::zeros();
+        for (j, &hj) in h.iter().enumerate() {
+            if hj != 0.0 {
+                ph.axpy(hj, &p.column(j), 1.0);
+            }
+        }
+        // S = H P Hᵀ + R   (14)
+        let s = h.dot(&ph) + r;
+        if !(s.is_finite() && s > 0.0 && y.is_finite()) {
+            return Err(Error::Numerical {
+                t_s,
+                what: format!("innovation variance {s} or innovation {y} is not usable"),
+            });
+        }
+        Ok(ScalarInnovation { ph, y, s })
+    }
+
+    /// The normalised innovation squared ỹ² / S.
+    pub fn nis(&self) -> f64 {
+        self.y * self.y / self.s
+    }
+
+    /// The diagnostics of this innovation.
+    pub fn innovation(&self) -> Innovation {
+        Innovation {
+            y: self.y,
+            s: self.s,
+            nis: self.nis(),
         }
     }
-    // S = H P Hᵀ + R   (14)
-    let s = h.dot(&ph) + r;
-    if !(s.is_finite() && s > 0.0 && y.is_finite()) {
-        return Err(Error::Numerical {
-            t_s,
-            what: format!("innovation variance {s} or innovation {y} is not usable"),
-        });
-    }
-    // K = P Hᵀ S⁻¹   (15)
-    let k = ph / s;
-    // x̂ = x̂⁻ + K ỹ   (16)
-    x.axpy(y, &k, 1.0);
-    // Covariance, on the upper triangle then mirrored (exactly symmetric):
-    // Joseph form (I − K H) P (I − K H)ᵀ + K R Kᵀ, expanded for a scalar
-    // measurement into rank-one terms: P − K (P H)ᵀ − (P H) Kᵀ + S K Kᵀ;
-    // or eq. (17), P = (I − K H) P⁻ = P − K (P H)ᵀ.
-    for i in 0..N {
-        for j in i..N {
-            let d = match form {
-                CovarianceForm::Joseph => -k[i] * ph[j] - ph[i] * k[j] + s * k[i] * k[j],
-                CovarianceForm::Simple => -0.5 * (k[i] * ph[j] + ph[i] * k[j]),
-            };
-            let v = p[(i, j)] + d;
-            p[(i, j)] = v;
-            p[(j, i)] = v;
+
+    /// Eq. (15)–(17): updates `x` and `p` in place.
+    pub fn apply(&self, x: &mut SVector<f64, N>, p: &mut SMatrix<f64, N, N>, form: CovarianceForm) {
+        let (ph, s, y) = (&self.ph, self.s, self.y);
+        // K = P Hᵀ S⁻¹   (15)
+        let k = ph / s;
+        // x̂ = x̂⁻ + K ỹ   (16)
+        x.axpy(y, &k, 1.0);
+        // Covariance, on the upper triangle then mirrored (exactly symmetric):
+        // Joseph form (I − K H) P (I − K H)ᵀ + K R Kᵀ, expanded for a scalar
+        // measurement into rank-one terms: P − K (P H)ᵀ − (P H) Kᵀ + S K Kᵀ;
+        // or eq. (17), P = (I − K H) P⁻ = P − K (P H)ᵀ.
+        for i in 0..N {
+            for j in i..N {
+                let d = match form {
+                    CovarianceForm::Joseph => -k[i] * ph[j] - ph[i] * k[j] + s * k[i] * k[j],
+                    CovarianceForm::Simple => -0.5 * (k[i] * ph[j] + ph[i] * k[j]),
+                };
+                let v = p[(i, j)] + d;
+                p[(i, j)] = v;
+                p[(j, i)] = v;
+            }
         }
     }
-    Ok(Innovation {
-        y,
-        s,
-        nis: y * y / s,
-    })
 }
 
 /// Innovation statistics of an `M`-dimensional measurement without updating:

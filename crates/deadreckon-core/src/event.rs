@@ -1,0 +1,224 @@
+//! Measurements as time-ordered events: the unit the filter consumes online
+//! ([`crate::ekf::Feeder`], [`crate::online::Online`]) and the JSON-lines schema
+//! of `deadreckon events` / `deadreckon stream` (`docs/events.md`), and
+//! [`DriveEvents`], a recorded drive's streams merged lazily in time order.
+
+use serde::{Deserialize, Serialize};
+
+use crate::drive::{Drive, GnssFix, Wheels};
+
+/// One measurement, as a drive or a live stream delivers it. The serde form is
+/// the JSON-lines event schema of `deadreckon events` (see `docs/events.md`):
+/// a `sensor` tag and the drive format's column names.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "sensor", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Measurement {
+    /// Ticks of each wheel since the previous wheel row.
+    WheelTicks {
+        /// Front left.
+        fl: i64,
+        /// Front right.
+        fr: i64,
+        /// Rear left.
+        rl: i64,
+        /// Rear right.
+        rr: i64,
+    },
+    /// Wheel speeds, m/s.
+    WheelSpeeds {
+        /// Front left, m/s.
+        fl_mps: f64,
+        /// Front right, m/s.
+        fr_mps: f64,
+        /// Rear left, m/s.
+        rl_mps: f64,
+        /// Rear right, m/s.
+        rr_mps: f64,
+    },
+    /// Raw gyro yaw rate, rad/s.
+    YawRate {
+        /// rad/s, counter-clockwise positive.
+        yaw_rate_rps: f64,
+    },
+    /// CAN vehicle speed, m/s.
+    Speed {
+        /// m/s.
+        speed_mps: f64,
+    },
+    /// Steering wheel angle, rad.
+    Steering {
+        /// rad, left positive.
+        steering_wheel_rad: f64,
+    },
+    /// A GNSS fix of the antenna.
+    Gnss {
+        /// m east of the origin.
+        east_m: f64,
+        /// m north of the origin.
+        north_m: f64,
+        /// Horizontal standard deviation, m.
+        std_m: f64,
+        /// Course, degrees clockwise from north.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        course_deg: Option<f64>,
+        /// Ground speed, m/s.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        speed_mps: Option<f64>,
+    },
+}
+
+/// A measurement with its timestamp.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Event {
+    /// Timestamp, s (the drive's clock).
+    pub t_s: f64,
+    /// The measurement.
+    #[serde(flatten)]
+    pub measurement: Measurement,
+}
+
+impl Event {
+    /// Order of events with equal timestamps: wheels, gyro, speed, steering,
+    /// GNSS (the per-measurement scheme processes them in this order).
+    pub(crate) fn rank(&self) -> u8 {
+        match self.measurement {
+            Measurement::WheelTicks { .. } | Measurement::WheelSpeeds { .. } => 0,
+            Measurement::YawRate { .. } => 1,
+            Measurement::Speed { .. } => 2,
+            Measurement::Steering { .. } => 3,
+            Measurement::Gnss { .. } => 4,
+        }
+    }
+
+    pub(crate) fn is_wheel(&self) -> bool {
+        self.rank() == 0
+    }
+
+    /// The fix of a GNSS event.
+    pub fn gnss_fix(&self) -> Option<GnssFix> {
+        match self.measurement {
+            Measurement::Gnss {
+                east_m,
+                north_m,
+                std_m,
+                course_deg,
+                speed_mps,
+            } => Some(GnssFix {
+                t_s: self.t_s,
+                east_m,
+                north_m,
+                std_m,
+                course_deg,
+                speed_mps,
+            }),
+            _ => None,
+        }
+    }
+}
+
+/// The streams of a drive merged into time order (ties in [`Event`] rank
+/// order), lazily, from `after_s` (exclusive) to the last wheel row: readings
+/// after the last wheel row are never used.
+#[derive(Debug, Clone)]
+pub struct DriveEvents<'a> {
+    drive: &'a Drive,
+    next: [usize; 5],
+    t_end: f64,
+}
+
+impl<'a> DriveEvents<'a> {
+    /// Events of `drive` with `t > after_s`.
+    pub fn new(drive: &'a Drive, after_s: f64) -> Self {
+        let w = &drive.wheels;
+        let first_wheel = (0..w.len())
+            .find(|&k| w.t_s(k) > after_s)
+            .unwrap_or(w.len());
+        DriveEvents {
+            drive,
+            next: [
+                first_wheel,
+                drive.yaw_rate.partition_point(|s| s.t_s <= after_s),
+                drive.speed.partition_point(|s| s.t_s <= after_s),
+                drive.steering.partition_point(|s| s.t_s <= after_s),
+                drive.gnss.partition_point(|s| s.t_s <= after_s),
+            ],
+            t_end: if w.is_empty() {
+                f64::NEG_INFINITY
+            } else {
+                w.t_s(w.len() - 1)
+            },
+        }
+    }
+
+    /// Every event of `drive`.
+    pub fn all(drive: &'a Drive) -> Self {
+        Self::new(drive, f64::NEG_INFINITY)
+    }
+
+    fn time(&self, stream: usize) -> Option<f64> {
+        let d = self.drive;
+        let i = self.next[stream];
+        let t = match stream {
+            0 => (i < d.wheels.len()).then(|| d.wheels.t_s(i)),
+            1 => d.yaw_rate.get(i).map(|s| s.t_s),
+            2 => d.speed.get(i).map(|s| s.t_s),
+            3 => d.steering.get(i).map(|s| s.t_s),
+            _ => d.gnss.get(i).map(|s| s.t_s),
+        }?;
+        (t <= self.t_end).then_some(t)
+    }
+}
+
+impl Iterator for DriveEvents<'_> {
+    type Item = Event;
+    fn next(&mut self) -> Option<Event> {
+        let mut best: Option<(f64, usize)> = None;
+        for k in 0..5 {
+            if let Some(t) = self.time(k) {
+                if best.is_none_or(|(bt, _)| t < bt) {
+                    best = Some((t, k));
+                }
+            }
+        }
+        let (t_s, k) = best?;
+        let i = self.next[k];
+        self.next[k] += 1;
+        let d = self.drive;
+        let measurement = match k {
+            0 => match &d.wheels {
+                Wheels::Ticks(v) => Measurement::WheelTicks {
+                    fl: v[i].fl,
+                    fr: v[i].fr,
+                    rl: v[i].rl,
+                    rr: v[i].rr,
+                },
+                Wheels::Speeds(v) => Measurement::WheelSpeeds {
+                    fl_mps: v[i].fl_mps,
+                    fr_mps: v[i].fr_mps,
+                    rl_mps: v[i].rl_mps,
+                    rr_mps: v[i].rr_mps,
+                },
+            },
+            1 => Measurement::YawRate {
+                yaw_rate_rps: d.yaw_rate[i].value,
+            },
+            2 => Measurement::Speed {
+                speed_mps: d.speed[i].value,
+            },
+            3 => Measurement::Steering {
+                steering_wheel_rad: d.steering[i].value,
+            },
+            _ => {
+                let g = d.gnss[i];
+                Measurement::Gnss {
+                    east_m: g.east_m,
+                    north_m: g.north_m,
+                    std_m: g.std_m,
+                    course_deg: g.course_deg,
+                    speed_mps: g.speed_mps,
+                }
+            }
+        };
+        Some(Event { t_s, measurement })
+    }
+}
