@@ -89,14 +89,7 @@ pub fn smooth_car_states<L: Layout<N>, const N: usize>(
             (cp.filter.clone(), cp.feeder.clone(), cp.events.clone());
         buf.clear();
         let mut record = |f: &mut Filter<L, N>, e: ekf::EpochOut<'_, N>| {
-            buf.push(Epoch {
-                t_s: f.time_s(),
-                x_pred: e.prediction.x,
-                p_pred: e.prediction.p,
-                f: e.prediction.f,
-                x: *f.state(),
-                p: *f.covariance(),
-            });
+            buf.push(Epoch::after(f, &e.prediction));
         };
         while feeder.stats().epochs < end {
             match events.next() {

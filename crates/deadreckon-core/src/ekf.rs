@@ -163,6 +163,20 @@ pub use crate::event::{DriveEvents, Event, Measurement};
 pub use crate::filter::{GateCounts, SensorKind, Update, AUG_BIAS, AUG_INV_CIRC, AUG_SCALE, N_AUG};
 pub use crate::init::{initial_state, truth_state, GnssInit};
 
+impl<const N: usize> Epoch<N> {
+    /// The epoch a filter has just run: its prediction and its updated state.
+    pub fn after<L: Layout<N>>(f: &Filter<L, N>, prediction: &Prediction<N>) -> Self {
+        Epoch {
+            t_s: f.time_s(),
+            x_pred: prediction.x,
+            p_pred: prediction.p,
+            f: prediction.f,
+            x: *f.state(),
+            p: *f.covariance(),
+        }
+    }
+}
+
 /// One recorded innovation.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct InnovationRecord {
@@ -765,14 +779,7 @@ pub fn run_filter<L: Layout<N>, const N: usize>(
                 }));
         }
         if opts.record_epochs {
-            out.epochs.push(Epoch {
-                t_s: f.time_s(),
-                x_pred: e.prediction.x,
-                p_pred: e.prediction.p,
-                f: e.prediction.f,
-                x: *f.state(),
-                p: *f.covariance(),
-            });
+            out.epochs.push(Epoch::after(f, &e.prediction));
         }
     };
     // Events after `end_s` are never used: stop reading there.
