@@ -431,3 +431,42 @@ fn stream_learns_the_parameters_and_the_next_drive_starts_from_them() {
         assert!(b[i] <= a[i], "{}: {} then {}", Params::NAMES[i], a[i], b[i]);
     }
 }
+
+#[test]
+fn the_rts_calibration_does_not_read_truth_csv() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("d");
+    let sim = simulate(
+        &Scenario::builtin("evaluation")
+            .unwrap()
+            .with_duration_s(60.0),
+        29,
+    )
+    .unwrap();
+    deadreckon_io::write_drive(&dir, &sim.drive).unwrap();
+    let opts = deadreckon_io::ReadOptions::default().without_truth();
+    let d = deadreckon_io::read_drive_with(&dir, &opts).unwrap();
+    assert!(d.truth.is_empty());
+    assert_eq!(d.gnss, deadreckon_io::read_drive(&dir).unwrap().gnss);
+    // A truth.csv that does not parse stops only the commands that read it.
+    std::fs::write(dir.join("truth.csv"), "not,a,truth\n1,2\n").unwrap();
+    let rts = bin()
+        .arg("calibrate")
+        .arg(&dir)
+        .args(["--method", "rts", "--json"])
+        .output()
+        .unwrap();
+    assert!(
+        rts.status.success(),
+        "{}",
+        String::from_utf8_lossy(&rts.stderr)
+    );
+    let truth = bin()
+        .arg("calibrate")
+        .arg(&dir)
+        .args(["--method", "truth"])
+        .output()
+        .unwrap();
+    assert!(!truth.status.success());
+    assert!(String::from_utf8_lossy(&truth.stderr).contains("truth.csv"));
+}

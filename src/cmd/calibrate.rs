@@ -42,8 +42,15 @@ pub struct CalibrateArgs {
 
 /// Runs `calibrate`.
 pub fn run(a: CalibrateArgs) -> Result<()> {
-    let drive = common::load_drive(&a.dir)?;
     let method: Method = a.method.parse()?;
+    // Only the truth calibration reads truth.csv.
+    let read = deadreckon_io::ReadOptions::default();
+    let read = if method == Method::Truth {
+        read
+    } else {
+        read.without_truth()
+    };
+    let drive = common::load_drive_with(&a.dir, &read)?;
     let iteration = match a.iteration.as_str() {
         "anderson" => Iteration::Anderson,
         "plain" => Iteration::Plain,

@@ -11,6 +11,12 @@ use deadreckon_core::{Drive, Params, ParamsWithStd};
 /// reader understands: a comma2k19 segment directory, a ROS1 `.bag`, a ROS2
 /// `.mcap` (with the built-in mapping) or a tricycle `dataset.txt`.
 pub fn load_drive(path: &Path) -> Result<Drive> {
+    load_drive_with(path, &deadreckon_io::ReadOptions::default())
+}
+
+/// [`load_drive`] with reading options for drive directories (recordings are
+/// read whole).
+pub fn load_drive_with(path: &Path, options: &deadreckon_io::ReadOptions) -> Result<Drive> {
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
     if path.is_dir() && !path.join("vehicle.toml").exists() && path.join("processed_log").is_dir() {
         return deadreckon_import::read_comma2k19(path, None)
@@ -28,7 +34,8 @@ pub fn load_drive(path: &Path) -> Result<Drive> {
             _ => anyhow::bail!("{}: not a drive directory and not a recording this tool reads (.bag, .mcap, comma2k19 segment, tricycle .txt)", path.display()),
         }
     }
-    deadreckon_io::read_drive(path).with_context(|| format!("reading drive {}", path.display()))
+    deadreckon_io::read_drive_with(path, options)
+        .with_context(|| format!("reading drive {}", path.display()))
 }
 
 /// `--params nominal` or a `params.toml` path.

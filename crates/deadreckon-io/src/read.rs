@@ -36,9 +36,18 @@ pub struct ReadOptions {
     /// The wheel file to use when a directory has both (`None`: having both is
     /// an error). When only one exists, that one is used whatever this says.
     pub prefer_wheels: Option<WheelFile>,
+    /// Do not read `truth.csv` (commands that never use it: the RTS and ZUPT
+    /// calibrations); the drive's `truth` is then empty.
+    pub skip_truth: bool,
 }
 
 impl ReadOptions {
+    /// Leaves `truth.csv` unread.
+    pub fn without_truth(mut self) -> Self {
+        self.skip_truth = true;
+        self
+    }
+
     /// Uses `wheels` when both wheel files exist.
     pub fn prefer_wheels(mut self, wheels: WheelFile) -> Self {
         self.prefer_wheels = Some(wheels);
@@ -123,7 +132,12 @@ pub fn read_drive_with(dir: &Path, options: &ReadOptions) -> Result<Drive, IoErr
         None => (Vec::new(), false),
     };
     let truth_path = dir.join(files::TRUTH);
-    let (mut truth, truth_geo) = match read_optional(&truth_path)? {
+    let truth_bytes = if options.skip_truth {
+        None
+    } else {
+        read_optional(&truth_path)?
+    };
+    let (mut truth, truth_geo) = match truth_bytes {
         Some(b) => parse_truth(&truth_path, &b)?,
         None => (Vec::new(), false),
     };
