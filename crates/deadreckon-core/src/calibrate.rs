@@ -301,45 +301,93 @@ fn anderson(xs: &[DVector<f64>], gs: &[DVector<f64>]) -> DVector<f64> {
     }
 }
 
-/// Lag-1 autocorrelation of residuals, clamped to [0, 0.99].
-fn lag1(res: &[f64]) -> f64 {
-    if res.len() < 3 {
-        return 0.0;
-    }
-    let m = res.iter().sum::<f64>() / res.len() as f64;
-    let den: f64 = res.iter().map(|r| (r - m).powi(2)).sum();
-    if den <= 0.0 {
-        return 0.0;
-    }
-    let num: f64 = res.windows(2).map(|w| (w[0] - m) * (w[1] - m)).sum();
-    (num / den).clamp(0.0, 0.99)
+/// A one-dimensional least-squares fit `z ≈ θ·r` with the residuals' lag-1
+/// autocorrelation folded into its standard error.
+#[derive(Debug, Clone, Copy)]
+struct Fit1d {
+    theta: f64,
+    /// Σ r².
+    srr: f64,
+    /// Residual variance Σe²/(n−1).
+    s2: f64,
+    /// Effective-sample-size inflation sqrt(n / n_eff) = sqrt((1+ρ)/(1−ρ)),
+    /// ρ the residuals' lag-1 autocorrelation clamped to [0, 0.99].
+    inflation: f64,
+    n: usize,
 }
 
-/// Effective-sample-size inflation factor sqrt(n / n_eff) = sqrt((1+ρ)/(1−ρ)).
-fn inflation(res: &[f64]) -> f64 {
-    let r = lag1(res);
-    ((1.0 + r) / (1.0 - r)).sqrt()
+/// Eq. (26) for `M` independent series at once without storing them: `visit`
+/// calls its argument with `(series, z, r)` for every sample, in the same order
+/// each time, and is called three times (θ; residual mean and variance; their
+/// autocorrelation). Every sum runs in sample order, so the result is
+/// bit-identical to summing stored vectors. A series with fewer than 3 samples
+/// or Σr² ≤ 0 has no fit.
+fn fit_streamed<const M: usize>(
+    visit: impl Fn(&mut dyn FnMut(usize, f64, f64)),
+) -> [Option<Fit1d>; M] {
+    let mut n = [0usize; M];
+    let (mut srr, mut szr) = ([0.0f64; M], [0.0f64; M]);
+    visit(&mut |i, z, r| {
+        n[i] += 1;
+        srr[i] += r * r;
+        szr[i] += z * r;
+    });
+    let ok: [bool; M] = std::array::from_fn(|i| n[i] >= 3 && srr[i] > 0.0);
+    let theta: [f64; M] = std::array::from_fn(|i| szr[i] / srr[i]);
+    let (mut se, mut se2) = ([0.0f64; M], [0.0f64; M]);
+    visit(&mut |i, z, r| {
+        let e = z - theta[i] * r;
+        se[i] += e;
+        se2[i] += e * e;
+    });
+    let m: [f64; M] = std::array::from_fn(|i| se[i] / n[i] as f64);
+    let (mut num, mut den) = ([0.0f64; M], [0.0f64; M]);
+    let mut prev: [Option<f64>; M] = [None; M];
+    visit(&mut |i, z, r| {
+        let d = z - theta[i] * r - m[i];
+        den[i] += d * d;
+        if let Some(p) = prev[i] {
+            num[i] += p * d;
+        }
+        prev[i] = Some(d);
+    });
+    std::array::from_fn(|i| {
+        if !ok[i] {
+            return None;
+        }
+        let rho = if den[i] <= 0.0 {
+            0.0
+        } else {
+            (num[i] / den[i]).clamp(0.0, 0.99)
+        };
+        Some(Fit1d {
+            theta: theta[i],
+            srr: srr[i],
+            s2: se2[i] / (n[i] - 1) as f64,
+            inflation: ((1.0 + rho) / (1.0 - rho)).sqrt(),
+            n: n[i],
+        })
+    })
 }
 
-/// One-dimensional least squares `z ≈ θ·r` (eq. 26): θ, its standard error, n.
-fn ls_1d(pairs: &[(f64, f64)]) -> Option<(f64, f64, usize)> {
-    let n = pairs.len();
-    if n < 3 {
-        return None;
+impl Fit1d {
+    /// θ, its standard error, n (eq. 26).
+    fn through_origin(self) -> (f64, f64, usize) {
+        (
+            self.theta,
+            (self.s2 / self.srr).sqrt() * self.inflation,
+            self.n,
+        )
     }
-    let srr: f64 = pairs.iter().map(|(_, r)| r * r).sum();
-    if srr <= 0.0 {
-        return None;
-    }
-    let theta = pairs.iter().map(|(z, r)| z * r).sum::<f64>() / srr;
-    let res: Vec<f64> = pairs.iter().map(|(z, r)| z - theta * r).collect();
-    let s2 = res.iter().map(|e| e * e).sum::<f64>() / (n - 1) as f64;
-    Some((theta, (s2 / srr).sqrt() * inflation(&res), n))
 }
 
 /// Eq. (23)–(26): the least-squares parameters from reference states (smoothed or
 /// true). `mid_interval` evaluates the state at the middle of each wheel
 /// counting interval (for the truth) instead of at its end (the filter's model).
+///
+/// Nothing per sample is stored: each series is visited three times (see
+/// `fit_streamed`), so the memory of a calibration is the drive and the
+/// reference.
 pub fn least_squares(
     drive: &Drive,
     reference: &Reference,
@@ -352,34 +400,29 @@ pub fn least_squares(
     let mut std = Params::from_array([0.0; 6]);
     let mut samples = [0usize; 6];
 
-    // Gyro bias, eq. (25): mean of gyro − ψ̇.
-    let res: Vec<f64> = drive
-        .yaw_rate
-        .iter()
-        .filter_map(|s| reference.state_at(s.t_s).map(|x| s.value - x[YAW_RATE]))
-        .collect();
-    if res.len() >= 3 {
-        let n = res.len() as f64;
-        let mean = res.iter().sum::<f64>() / n;
-        let centred: Vec<f64> = res.iter().map(|r| r - mean).collect();
-        let sd = (centred.iter().map(|e| e * e).sum::<f64>() / (n - 1.0)).sqrt();
-        est.gyro_bias_rps = mean;
-        std.gyro_bias_rps = sd / n.sqrt() * inflation(&centred);
-        samples[0] = res.len();
+    // Gyro bias, eq. (25): mean of gyro − ψ̇ (a fit with r = 1).
+    let [bias] = fit_streamed::<1>(|f| {
+        for s in &drive.yaw_rate {
+            if let Some(x) = reference.state_at(s.t_s) {
+                f(0, s.value - x[YAW_RATE], 1.0);
+            }
+        }
+    });
+    if let Some(b) = bias {
+        est.gyro_bias_rps = b.theta;
+        std.gyro_bias_rps = b.s2.sqrt() / (b.n as f64).sqrt() * b.inflation;
+        samples[0] = b.n;
     }
 
     // Speed scale, eq. (26).
-    let pairs: Vec<(f64, f64)> = drive
-        .speed
-        .iter()
-        .filter_map(|s| {
-            reference
-                .state_at(s.t_s)
-                .filter(|x| x[V] >= min_speed)
-                .map(|x| (s.value, x[V]))
-        })
-        .collect();
-    if let Some((a, sa, n)) = ls_1d(&pairs) {
+    let [scale] = fit_streamed::<1>(|f| {
+        for s in &drive.speed {
+            if let Some(x) = reference.state_at(s.t_s).filter(|x| x[V] >= min_speed) {
+                f(0, s.value, x[V]);
+            }
+        }
+    });
+    if let Some((a, sa, n)) = scale.map(Fit1d::through_origin) {
         est.speed_scale = a;
         std.speed_scale = sa;
         samples[1] = n;
@@ -387,49 +430,50 @@ pub fn least_squares(
 
     // Inverse circumferences: z = (1/ρ)·r with r = N·T·g (ticks) or ρ_nom·g (speeds).
     let sensors = Sensors::new(v, &nominal);
-    let mut pairs: [Vec<(f64, f64)>; 4] = Default::default();
     let n_wheel = drive.wheels.len();
-    for k in 1..n_wheel {
-        let (t0, t1) = (drive.wheels.t_s(k - 1), drive.wheels.t_s(k));
-        let t_eval = if mid_interval { 0.5 * (t0 + t1) } else { t1 };
-        let Some(x) = reference.state_at(t_eval) else {
-            continue;
-        };
-        if x[V] < min_speed {
-            continue;
-        }
-        let x: State = x;
-        match &drive.wheels {
-            Wheels::Ticks(rows) => {
-                let r = rows[k];
-                let interval = t1 - t0;
-                if interval > 0.5 {
-                    continue;
+    let fits = fit_streamed::<4>(|f| {
+        for k in 1..n_wheel {
+            let (t0, t1) = (drive.wheels.t_s(k - 1), drive.wheels.t_s(k));
+            let t_eval = if mid_interval { 0.5 * (t0 + t1) } else { t1 };
+            let Some(x) = reference.state_at(t_eval) else {
+                continue;
+            };
+            if x[V] < min_speed {
+                continue;
+            }
+            let x: State = x;
+            match &drive.wheels {
+                Wheels::Ticks(rows) => {
+                    let r = rows[k];
+                    let interval = t1 - t0;
+                    if interval > 0.5 {
+                        continue;
+                    }
+                    for (i, z) in [r.fl, r.fr, r.rl, r.rr].into_iter().enumerate() {
+                        let g = sensors.wheel_ground_speed(i, x[V], x[YAW_RATE]).0;
+                        f(i, z as f64, sensors.ticks_per_rev * interval * g);
+                    }
                 }
-                for (i, z) in [r.fl, r.fr, r.rl, r.rr].into_iter().enumerate() {
-                    let g = sensors.wheel_ground_speed(i, x[V], x[YAW_RATE]).0;
-                    pairs[i].push((z as f64, sensors.ticks_per_rev * interval * g));
+                Wheels::Speeds(rows) => {
+                    let r = rows[k];
+                    for (i, z) in [r.fl_mps, r.fr_mps, r.rl_mps, r.rr_mps]
+                        .into_iter()
+                        .enumerate()
+                    {
+                        let g = sensors.wheel_ground_speed(i, x[V], x[YAW_RATE]).0;
+                        f(i, z, sensors.nominal_circumference_m * g);
+                    }
                 }
             }
-            Wheels::Speeds(rows) => {
-                let r = rows[k];
-                for (i, z) in [r.fl_mps, r.fr_mps, r.rl_mps, r.rr_mps]
-                    .into_iter()
-                    .enumerate()
-                {
-                    let g = sensors.wheel_ground_speed(i, x[V], x[YAW_RATE]).0;
-                    pairs[i].push((z, sensors.nominal_circumference_m * g));
-                }
-            }
         }
-    }
+    });
     let mut circ = nominal.circumferences();
     let mut circ_std = [0.0; 4];
     for i in 0..4 {
         if !v.wheels_present[i] {
             continue;
         }
-        if let Some((k, sk, n)) = ls_1d(&pairs[i]) {
+        if let Some((k, sk, n)) = fits[i].map(Fit1d::through_origin) {
             if k > 0.0 {
                 circ[i] = 1.0 / k;
                 circ_std[i] = sk / (k * k);

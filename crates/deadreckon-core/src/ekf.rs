@@ -418,9 +418,11 @@ impl Feeder {
         // Equal timestamps: the paper's scheme takes the other readings into the
         // wheel epoch of the same time, so they go first; the per-measurement
         // scheme runs wheels first.
-        match self.timing {
-            Timing::WheelEpochs => batch.sort_by_key(|e| (e.is_wheel(), e.rank())),
-            Timing::EachMeasurement => batch.sort_by_key(|e| e.rank()),
+        if batch.len() > 1 {
+            match self.timing {
+                Timing::WheelEpochs => batch.sort_by_key(|e| (e.is_wheel(), e.rank())),
+                Timing::EachMeasurement => batch.sort_by_key(|e| e.rank()),
+            }
         }
         let result = batch.iter().try_for_each(|ev| self.event(f, *ev, epoch));
         batch.clear();

@@ -123,6 +123,8 @@ impl Event {
 pub struct DriveEvents<'a> {
     drive: &'a Drive,
     next: [usize; 5],
+    /// The time of each stream's next reading (+∞ when it has none left).
+    next_t: [f64; 5],
     t_end: f64,
 }
 
@@ -133,7 +135,7 @@ impl<'a> DriveEvents<'a> {
         let first_wheel = (0..w.len())
             .find(|&k| w.t_s(k) > after_s)
             .unwrap_or(w.len());
-        DriveEvents {
+        let mut events = DriveEvents {
             drive,
             next: [
                 first_wheel,
@@ -142,12 +144,17 @@ impl<'a> DriveEvents<'a> {
                 drive.steering.partition_point(|s| s.t_s <= after_s),
                 drive.gnss.partition_point(|s| s.t_s <= after_s),
             ],
+            next_t: [f64::INFINITY; 5],
             t_end: if w.is_empty() {
                 f64::NEG_INFINITY
             } else {
                 w.t_s(w.len() - 1)
             },
+        };
+        for k in 0..5 {
+            events.next_t[k] = events.time(k).unwrap_or(f64::INFINITY);
         }
+        events
     }
 
     /// Every event of `drive`.
@@ -172,17 +179,20 @@ impl<'a> DriveEvents<'a> {
 impl Iterator for DriveEvents<'_> {
     type Item = Event;
     fn next(&mut self) -> Option<Event> {
-        let mut best: Option<(f64, usize)> = None;
-        for k in 0..5 {
-            if let Some(t) = self.time(k) {
-                if best.is_none_or(|(bt, _)| t < bt) {
-                    best = Some((t, k));
-                }
+        // The earliest next reading; ties go to the lower stream (rank order).
+        let mut k = 0;
+        for j in 1..5 {
+            if self.next_t[j] < self.next_t[k] {
+                k = j;
             }
         }
-        let (t_s, k) = best?;
+        let t_s = self.next_t[k];
+        if t_s == f64::INFINITY {
+            return None;
+        }
         let i = self.next[k];
         self.next[k] += 1;
+        self.next_t[k] = self.time(k).unwrap_or(f64::INFINITY);
         let d = self.drive;
         let measurement = match k {
             0 => match &d.wheels {

@@ -460,11 +460,21 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
         param: Option<(usize, f64)>,
     ) -> Result<Update, Error> {
         let (h, row5) = pred;
-        let mut row = SVector::<f64, N>::zeros();
-        row.fixed_rows_mut::<5>(0).copy_from(&row5);
+        // H by its non-zero entries: the car states, then the parameter.
+        let mut row = [(0usize, 0.0f64); 6];
+        let mut n = 0;
+        for (j, &d) in row5.iter().enumerate() {
+            if d != 0.0 {
+                row[n] = (j, d);
+                n += 1;
+            }
+        }
         if let Some((j, d)) = param {
             if let Some(i) = L::param_index(j) {
-                row[i] = d;
+                if d != 0.0 {
+                    row[n] = (i, d);
+                    n += 1;
+                }
             }
         }
         let y = if sensor == SensorKind::Course {
@@ -472,7 +482,7 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
         } else {
             z - h
         };
-        let pre = kalman::ScalarInnovation::new(&self.p, &row, r, y, self.t_s)?;
+        let pre = kalman::ScalarInnovation::sparse(&self.p, &row[..n], r, y, self.t_s)?;
         let (s, nis) = (pre.s, pre.nis());
         let (accepted, _) = self.decide(sensor, nis);
         if accepted {

@@ -79,21 +79,46 @@ impl<const N: usize> ScalarInnovation<N> {
         y: f64,
         t_s: f64,
     ) -> Result<Self, Error> {
-        let mut ph = SVector::<f64, N>::zeros();
+        let mut nz = [(0usize, 0.0f64); N];
+        let mut n = 0;
         for (j, &hj) in h.iter().enumerate() {
             if hj != 0.0 {
-                ph.axpy(hj, &p.column(j), 1.0);
+                nz[n] = (j, hj);
+                n += 1;
+            }
+        }
+        Self::sparse(p, &nz[..n], r, y, t_s)
+    }
+
+    /// As [`ScalarInnovation::new`] with H given by its non-zero entries
+    /// `(column, value)`, in increasing column order (each once).
+    pub fn sparse(
+        p: &SMatrix<f64, N, N>,
+        h: &[(usize, f64)],
+        r: f64,
+        y: f64,
+        t_s: f64,
+    ) -> Result<Self, Error> {
+        let mut ph = [0.0f64; N];
+        let m = p.as_slice();
+        for &(j, hj) in h {
+            for (o, &c) in ph.iter_mut().zip(&m[j * N..(j + 1) * N]) {
+                *o += hj * c;
             }
         }
         // S = H P Hᵀ + R   (14)
-        let s = h.dot(&ph) + r;
+        let s = h.iter().map(|&(j, hj)| hj * ph[j]).sum::<f64>() + r;
         if !(s.is_finite() && s > 0.0 && y.is_finite()) {
             return Err(Error::Numerical {
                 t_s,
                 what: format!("innovation variance {s} or innovation {y} is not usable"),
             });
         }
-        Ok(ScalarInnovation { ph, y, s })
+        Ok(ScalarInnovation {
+            ph: SVector::<f64, N>::from(ph),
+            y,
+            s,
+        })
     }
 
     /// The normalised innovation squared ỹ² / S.
@@ -111,25 +136,35 @@ impl<const N: usize> ScalarInnovation<N> {
     }
 
     /// Eq. (15)–(17): updates `x` and `p` in place.
-    pub fn apply(&self, x: &mut SVector<f64, N>, p: &mut SMatrix<f64, N, N>, form: CovarianceForm) {
+    ///
+    /// For a scalar measurement with the optimal gain K = P Hᵀ / S, the Joseph
+    /// form (I − K H) P (I − K H)ᵀ + K R Kᵀ and eq. (17) (I − K H) P are the
+    /// same matrix, P − (P H)(P H)ᵀ / S; both [`CovarianceForm`]s compute it
+    /// that way (one product per entry, computed identically for (i, j) and
+    /// (j, i), so P stays exactly symmetric). The forms differ for vector
+    /// measurements ([`update_vector`]).
+    pub fn apply(
+        &self,
+        x: &mut SVector<f64, N>,
+        p: &mut SMatrix<f64, N, N>,
+        _form: CovarianceForm,
+    ) {
         let (ph, s, y) = (&self.ph, self.s, self.y);
-        // K = P Hᵀ S⁻¹   (15)
-        let k = ph / s;
-        // x̂ = x̂⁻ + K ỹ   (16)
-        x.axpy(y, &k, 1.0);
-        // Covariance, on the upper triangle then mirrored (exactly symmetric):
-        // Joseph form (I − K H) P (I − K H)ᵀ + K R Kᵀ, expanded for a scalar
-        // measurement into rank-one terms: P − K (P H)ᵀ − (P H) Kᵀ + S K Kᵀ;
-        // or eq. (17), P = (I − K H) P⁻ = P − K (P H)ᵀ.
-        for i in 0..N {
-            for j in i..N {
-                let d = match form {
-                    CovarianceForm::Joseph => -k[i] * ph[j] - ph[i] * k[j] + s * k[i] * k[j],
-                    CovarianceForm::Simple => -0.5 * (k[i] * ph[j] + ph[i] * k[j]),
-                };
-                let v = p[(i, j)] + d;
-                p[(i, j)] = v;
-                p[(j, i)] = v;
+        // K = P Hᵀ S⁻¹   (15);  x̂ = x̂⁻ + K ỹ   (16)
+        x.axpy(y / s, ph, 1.0);
+        let inv_s = 1.0 / s;
+        let ph: &[f64] = ph.as_slice();
+        // The lower triangle down contiguous columns, then mirrored.
+        let m = p.as_mut_slice();
+        for j in 0..N {
+            let phj = ph[j] * inv_s;
+            for (c, &phi) in m[j * N + j..(j + 1) * N].iter_mut().zip(&ph[j..]) {
+                *c -= phi * phj;
+            }
+        }
+        for j in 0..N {
+            for i in j + 1..N {
+                m[i * N + j] = m[j * N + i];
             }
         }
     }

@@ -147,7 +147,10 @@ impl<'a> Table<'a> {
         mut f: impl FnMut(&Row<'_>) -> Result<T, IoError>,
     ) -> Result<Vec<T>, IoError> {
         let t_col = self.col("t_s")?;
-        let mut out = Vec::new();
+        // One row a line: sized once (no doubling), so a drive in memory is
+        // what its rows need.
+        let lines = self.bytes.iter().filter(|&&b| b == b'\n').count();
+        let mut out = Vec::with_capacity(lines + 1);
         let mut record = csv::ByteRecord::new();
         let mut prev_t: Option<f64> = None;
         loop {
