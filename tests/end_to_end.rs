@@ -115,6 +115,11 @@ fn simulate_calibrate_evaluate_run() {
         "calibrated drift {c}% vs nominal {n}%"
     );
     assert!(d_cal["std_pct"].as_f64().unwrap() > 0.0);
+    // The gate counters of the dead reckoning: every sensor but GNSS.
+    let g = &d_cal["gates"];
+    assert!(g["gyro"]["accepted"].as_u64().unwrap() > 1000, "{g}");
+    assert!(g["wheel_fl"]["accepted"].as_u64().unwrap() > 1000, "{g}");
+    assert!(g.get("gnss").is_none(), "dead reckoning gated GNSS: {g}");
     let r = json(&run_ok(&[
         "evaluate",
         eval.to_str().unwrap(),
@@ -142,6 +147,12 @@ fn simulate_calibrate_evaluate_run() {
         "--json",
     ]));
     assert_eq!(o["reference"], "truth");
+    let g = &o["gates"];
+    assert!(g["gnss"]["accepted"].as_u64().unwrap() > 100, "{g}");
+    assert!(
+        g["wheel_rr"]["accepted"].as_u64().unwrap() > g["gnss"]["accepted"].as_u64().unwrap(),
+        "{g}"
+    );
     assert!(o["windows"].as_u64().unwrap() >= 15, "{o}");
     let fe = &o["final_error_m"];
     assert!(

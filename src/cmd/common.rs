@@ -155,13 +155,6 @@ pub fn gates_json(g: &deadreckon_core::filter::GateCounts) -> serde_json::Value 
 
 /// A one-line account of what the filter used and gated.
 pub fn stats_line(st: &deadreckon_core::ekf::FilterStats) -> String {
-    let gated: Vec<String> = st
-        .gates
-        .rows()
-        .into_iter()
-        .filter(|r| r.2 > 0)
-        .map(|(name, a, r, _)| format!("{name} {r}/{}", a + r))
-        .collect();
     format!(
         "filter: {} epochs, GNSS {} used / {} rejected by the gate ({} recoveries) / {} hidden, {} wheel gaps skipped; rejected by the χ² gates: {}",
         st.epochs,
@@ -170,6 +163,22 @@ pub fn stats_line(st: &deadreckon_core::ekf::FilterStats) -> String {
         st.gnss_recoveries,
         st.gnss_hidden,
         st.wheel_gaps,
-        if gated.is_empty() { "none".to_string() } else { gated.join(", ") }
+        gated_text(&st.gates)
     )
+}
+
+/// The sensors the χ² gates rejected something of, as `name rejected/total`,
+/// or `none`.
+pub fn gated_text(g: &deadreckon_core::filter::GateCounts) -> String {
+    let gated: Vec<String> = g
+        .rows()
+        .into_iter()
+        .filter(|r| r.2 > 0)
+        .map(|(name, a, r, _)| format!("{name} {r}/{}", a + r))
+        .collect();
+    if gated.is_empty() {
+        "none".to_string()
+    } else {
+        gated.join(", ")
+    }
 }

@@ -87,6 +87,7 @@ pub fn run(a: EvaluateArgs) -> Result<()> {
                 "drift_pct": summary_json(&dr),
                 "distance_to_1m_m": summary_json(&d1),
                 "windows_reaching_1m": ev.windows.iter().filter(|w| w.reached_1m).count(),
+                "gates": common::gates_json(&ev.gates),
             });
             println!("{}", serde_json::to_string_pretty(&v)?);
         } else {
@@ -109,6 +110,10 @@ pub fn run(a: EvaluateArgs) -> Result<()> {
                     name, s.mean, s.median, s.p95, s.max
                 );
             }
+            println!(
+                "rejected by the χ² gates: {}",
+                common::gated_text(&ev.gates)
+            );
         }
         return Ok(());
     }
@@ -119,10 +124,11 @@ pub fn run(a: EvaluateArgs) -> Result<()> {
             let s = Summary::of(&r.errors_pct());
             if a.json {
                 let v = json!({"metric": "drift", "mean_pct": s.mean, "std_pct": s.std, "n": s.n,
-                    "median_pct": s.median, "p95_pct": s.p95, "max_pct": s.max, "segment_m": a.segment_m, "errors_m": r.errors_m});
+                    "median_pct": s.median, "p95_pct": s.p95, "max_pct": s.max, "segment_m": a.segment_m, "errors_m": r.errors_m, "gates": common::gates_json(&r.gates)});
                 println!("{}", serde_json::to_string_pretty(&v)?);
             } else {
                 println!("drift per {} m over {} segments: mean {:.3}%, std {:.3}%, median {:.3}%, max {:.3}%", a.segment_m, s.n, s.mean, s.std, s.median, s.max);
+                println!("rejected by the χ² gates: {}", common::gated_text(&r.gates));
             }
         }
         "reset-1m" => {
@@ -130,13 +136,14 @@ pub fn run(a: EvaluateArgs) -> Result<()> {
             let s = Summary::of(&r.distances_m);
             if a.json {
                 let v = json!({"metric": "reset-1m", "mean_m": s.mean, "median_m": s.median, "min_m": s.min, "max_m": s.max, "n": s.n,
-                    "threshold_m": a.threshold_m, "distances_m": r.distances_m});
+                    "threshold_m": a.threshold_m, "distances_m": r.distances_m, "gates": common::gates_json(&r.gates)});
                 println!("{}", serde_json::to_string_pretty(&v)?);
             } else {
                 println!(
                     "distance before {} m of error over {} resets: mean {:.1} m, median {:.1} m, min {:.1} m, max {:.1} m",
                     a.threshold_m, s.n, s.mean, s.median, s.min, s.max
                 );
+                println!("rejected by the χ² gates: {}", common::gated_text(&r.gates));
             }
         }
         m => anyhow::bail!("unknown metric `{m}` (drift, reset-1m)"),

@@ -211,6 +211,18 @@ impl GateCounts {
     pub fn recovered(&self, k: SensorKind) -> u64 {
         self.recovered[k.slot()]
     }
+    /// Adds the counts of another run (e.g. of every outage window).
+    pub fn add(&mut self, other: &GateCounts) {
+        for i in 0..self.accepted.len() {
+            self.accepted[i] += other.accepted[i];
+            self.rejected[i] += other.rejected[i];
+            self.recovered[i] += other.recovered[i];
+        }
+    }
+    /// Rejected measurements of every sensor.
+    pub fn total_rejected(&self) -> u64 {
+        self.rejected.iter().sum()
+    }
     /// `(name, accepted, rejected, recovered)` for every sensor with any measurement.
     pub fn rows(&self) -> Vec<(&'static str, u64, u64, u64)> {
         SensorKind::ALL

@@ -13,6 +13,7 @@
 
 use crate::drive::Drive;
 use crate::ekf::{self, EpochHook, FilterOptions, Init, SensorSet, Timing};
+use crate::filter::GateCounts;
 use crate::model::{Mat, State, X, Y, YAW};
 use crate::reference::Reference;
 use crate::vehicle::Params;
@@ -84,6 +85,8 @@ pub struct DriftResult {
     pub errors_m: Vec<f64>,
     /// Time of the end of each segment, s.
     pub times_s: Vec<f64>,
+    /// The χ² gate counters of the dead-reckoning run.
+    pub gates: GateCounts,
 }
 
 impl DriftResult {
@@ -105,6 +108,8 @@ pub struct ResetResult {
     pub distances_m: Vec<f64>,
     /// Time of each reset, s.
     pub times_s: Vec<f64>,
+    /// The χ² gate counters of the dead-reckoning run.
+    pub gates: GateCounts,
 }
 
 enum Rule {
@@ -178,7 +183,7 @@ fn run_with_resets(
     params: &Params,
     timing: Timing,
     rule: Rule,
-) -> Result<(Vec<f64>, Vec<f64>), Error> {
+) -> Result<(Vec<f64>, Vec<f64>, GateCounts), Error> {
     let reference = Reference::from_truth(&drive.truth).ok_or_else(|| {
         Error::Insufficient("evaluation needs truth.csv with at least 3 poses".into())
     })?;
@@ -197,8 +202,8 @@ fn run_with_resets(
         record_epochs: false,
         ..Default::default()
     };
-    ekf::run(drive, params, &opts, &mut hook)?;
-    Ok((hook.values, hook.times))
+    let out = ekf::run(drive, params, &opts, &mut hook)?;
+    Ok((hook.values, hook.times, out.stats.gates))
 }
 
 /// Table IV / figure 4: horizontal error after every `segment_m` of dead reckoning.
@@ -208,11 +213,13 @@ pub fn drift(
     segment_m: f64,
     timing: Timing,
 ) -> Result<DriftResult, Error> {
-    let (errors_m, times_s) = run_with_resets(drive, params, timing, Rule::Every(segment_m))?;
+    let (errors_m, times_s, gates) =
+        run_with_resets(drive, params, timing, Rule::Every(segment_m))?;
     Ok(DriftResult {
         segment_m,
         errors_m,
         times_s,
+        gates,
     })
 }
 
@@ -223,12 +230,13 @@ pub fn reset_on_error(
     threshold_m: f64,
     timing: Timing,
 ) -> Result<ResetResult, Error> {
-    let (distances_m, times_s) =
+    let (distances_m, times_s, gates) =
         run_with_resets(drive, params, timing, Rule::OnError(threshold_m))?;
     Ok(ResetResult {
         threshold_m,
         distances_m,
         times_s,
+        gates,
     })
 }
 

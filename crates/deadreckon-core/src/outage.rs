@@ -11,6 +11,7 @@
 
 use crate::drive::Drive;
 use crate::ekf::{self, EpochHook, FilterOptions, Init, SensorSet};
+use crate::filter::GateCounts;
 use crate::metrics::Summary;
 use crate::model::{Mat, State, X, Y, YAW};
 use crate::reference::Reference;
@@ -66,6 +67,9 @@ pub struct OutageEvaluation {
     pub reference: ReferenceKind,
     /// Every window.
     pub windows: Vec<Window>,
+    /// The χ² gate counters summed over every filter run of the evaluation:
+    /// the GNSS-aided run and the dead reckoning through every window.
+    pub gates: GateCounts,
 }
 
 impl OutageEvaluation {
@@ -158,6 +162,7 @@ pub fn evaluate(
         end_limit = end_limit.min(g.t_s);
     }
     let mut windows = Vec::new();
+    let mut gates = aided.stats.gates;
     let mut start = first.t_s + warmup_s;
     while start + outage_s <= end_limit {
         let end = start + outage_s;
@@ -177,7 +182,8 @@ pub fn evaluate(
         };
         let mut hook = Collect(Vec::new());
         // Validated by the aided run above.
-        ekf::run_validated(drive, params, &opts, &mut hook)?;
+        let out = ekf::run_validated(drive, params, &opts, &mut hook)?;
+        gates.add(&out.stats.gates);
         if let Some(w) = window_errors(drive, truth.as_ref(), &hook.0, e0.t_s, start, end) {
             windows.push(w);
         }
@@ -192,6 +198,7 @@ pub fn evaluate(
         outage_s,
         reference,
         windows,
+        gates,
     })
 }
 
@@ -281,7 +288,7 @@ pub fn through_windows(
         ..base.clone()
     };
     let mut hook = Collect(Vec::new());
-    ekf::run(drive, params, &opts, &mut hook)?;
+    let run = ekf::run(drive, params, &opts, &mut hook)?;
     let mut out = Vec::new();
     for &(a, b) in windows {
         // Dead reckoning starts at the last epoch before the window.
@@ -295,5 +302,6 @@ pub fn through_windows(
         outage_s: windows.iter().map(|w| w.1 - w.0).fold(0.0, f64::max),
         reference,
         windows: out,
+        gates: run.stats.gates,
     })
 }

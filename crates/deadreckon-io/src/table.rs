@@ -94,7 +94,6 @@ impl<'a> Table<'a> {
         let mut reader = csv::ReaderBuilder::new()
             .has_headers(true)
             .flexible(true)
-            .trim(csv::Trim::All)
             .from_reader(bytes);
         let header = reader
             .byte_headers()
@@ -102,7 +101,7 @@ impl<'a> Table<'a> {
             .clone();
         let mut columns = HashMap::new();
         for (i, name) in header.iter().enumerate() {
-            let name = String::from_utf8_lossy(name).into_owned();
+            let name = String::from_utf8_lossy(name.trim_ascii()).into_owned();
             if name.is_empty() {
                 continue;
             }
@@ -208,8 +207,19 @@ pub(crate) struct Row<'r> {
 }
 
 impl Row<'_> {
+    /// The field's bytes without surrounding ASCII whitespace (trimmed here,
+    /// not by the CSV reader, whose trimming copies every record).
+    fn bytes(&self, col: Col) -> &[u8] {
+        self.record.get(col.index).unwrap_or_default().trim_ascii()
+    }
+
+    /// The field as text, for numbers and messages.
     fn text(&self, col: Col) -> Cow<'_, str> {
-        String::from_utf8_lossy(self.record.get(col.index).unwrap_or_default())
+        let bytes = self.bytes(col);
+        match std::str::from_utf8(bytes) {
+            Ok(s) => Cow::Borrowed(s),
+            Err(_) => String::from_utf8_lossy(bytes),
+        }
     }
 
     fn bad(&self, col: Col, expected: &'static str) -> IoError {
@@ -259,7 +269,7 @@ impl Row<'_> {
         limit: Limit,
     ) -> Result<Option<f64>, IoError> {
         match col {
-            Some(c) if !self.text(c).is_empty() => self.checked(c, limit).map(Some),
+            Some(c) if !self.bytes(c).is_empty() => self.checked(c, limit).map(Some),
             _ => Ok(None),
         }
     }

@@ -247,6 +247,33 @@ fn error_missing_vehicle_toml() {
 }
 
 #[test]
+fn whitespace_around_fields_is_trimmed_and_a_blank_optional_field_is_empty() {
+    let drive = small_drive();
+    let dir = written(&drive);
+    put(
+        dir.path(),
+        files::WHEEL_TICKS,
+        " t_s ,\tfl, fr ,rl,rr\n 0.5 ,0, 1 ,\t0,3\n0.52 , 1,2,-1 , 3\n",
+    );
+    put(
+        dir.path(),
+        files::GNSS,
+        "t_s,east_m,north_m,std_m,course_deg\n0.5, 1.5 ,2,0.8,  \n0.6,1.6,2, 0.8 ,\t90 \n",
+    );
+    let back = read_drive(dir.path()).expect("padded fields");
+    match back.wheels {
+        Wheels::Ticks(v) => assert_eq!(
+            (v[1].t_s, v[1].fl, v[1].fr, v[1].rl, v[1].rr),
+            (0.52, 1, 2, -1, 3)
+        ),
+        Wheels::Speeds(_) => panic!("ticks expected"),
+    }
+    assert_eq!(back.gnss.len(), 2);
+    assert_eq!((back.gnss[0].east_m, back.gnss[0].course_deg), (1.5, None));
+    assert_eq!(back.gnss[1].course_deg, Some(90.0));
+}
+
+#[test]
 fn error_bad_number() {
     let dir = written(&small_drive());
     put(
