@@ -37,6 +37,7 @@
 //! ```
 #![deny(missing_docs)]
 
+pub mod family;
 pub mod profile;
 pub mod route;
 pub mod scenario;
@@ -48,7 +49,10 @@ use deadreckon_core::{Drive, Params};
 pub use profile::SpeedSpec;
 pub use route::{RouteSpec, Segment};
 pub use scenario::Scenario;
-pub use sensors::{GnssSpec, ScalarSpec, SensorsSpec, SteeringSpec, WheelKind, WheelsSpec};
+pub use sensors::{
+    CourseConvention, GnssSpec, LowSpeedCourse, ScalarSpec, SensorsSpec, SteeringSpec, WheelKind,
+    WheelsSpec,
+};
 
 /// Errors of the simulator. Every variant says where the problem is.
 #[derive(Debug, thiserror::Error)]

@@ -277,15 +277,7 @@ impl Scenario {
     pub fn with_gnss_std_m(mut self, std_m: f64) -> Self {
         match &mut self.sensors.gnss {
             Some(g) => g.std_m = std_m,
-            None => {
-                self.sensors.gnss = Some(GnssSpec {
-                    rate_hz: 1.0,
-                    offset_s: 0.0,
-                    std_m,
-                    velocity_std_mps: None,
-                    min_course_speed_mps: 0.5,
-                })
-            }
+            None => self.sensors.gnss = Some(GnssSpec::white(1.0, std_m)),
         }
         self
     }

@@ -110,13 +110,75 @@ pub struct GnssSpec {
     /// velocity, so the course noise grows as the speed falls (≈ std / v rad).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub velocity_std_mps: Option<f64>,
-    /// Below this measured speed the course is not reported, m/s (default 0.5).
+    /// Below this measured speed the course is not reported, m/s (default
+    /// 0.5), or reported as `low_speed_course` says.
     #[serde(default = "default_min_course_speed")]
     pub min_course_speed_mps: f64,
+    /// What the receiver reports as course below `min_course_speed_mps`
+    /// (default `dropped`).
+    #[serde(default)]
+    pub low_speed_course: LowSpeedCourse,
+    /// What the course is the direction of (default `antenna_velocity`).
+    #[serde(default)]
+    pub course_convention: CourseConvention,
+    /// A slowly wandering position error added to the white noise: a first-order
+    /// Gauss–Markov process per coordinate with this standard deviation, m
+    /// (default 0: none), and the correlation time `markov_tau_s`.
+    #[serde(default)]
+    pub markov_std_m: f64,
+    /// Correlation time of the Gauss–Markov position error, s (default 60).
+    #[serde(default = "default_markov_tau")]
+    pub markov_tau_s: f64,
+}
+
+impl GnssSpec {
+    /// A receiver at `rate_hz` with white position noise `std_m` and no course.
+    pub fn white(rate_hz: f64, std_m: f64) -> Self {
+        GnssSpec {
+            rate_hz,
+            offset_s: 0.0,
+            std_m,
+            velocity_std_mps: None,
+            min_course_speed_mps: default_min_course_speed(),
+            low_speed_course: LowSpeedCourse::default(),
+            course_convention: CourseConvention::default(),
+            markov_std_m: 0.0,
+            markov_tau_s: default_markov_tau(),
+        }
+    }
 }
 
 fn default_min_course_speed() -> f64 {
     0.5
+}
+fn default_markov_tau() -> f64 {
+    60.0
+}
+
+/// What a receiver reports as course when it moves too slowly to measure one.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+#[non_exhaustive]
+pub enum LowSpeedCourse {
+    /// No course (an empty `course_deg`).
+    #[default]
+    Dropped,
+    /// A random course, uniform over the circle (many receivers at a standstill).
+    Random,
+    /// The last course reported at speed, repeated.
+    Frozen,
+}
+
+/// What a receiver's course is the direction of.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+#[non_exhaustive]
+pub enum CourseConvention {
+    /// The antenna's velocity: the body yaw plus atan(l·ψ̇/v) in turns.
+    #[default]
+    AntennaVelocity,
+    /// The body yaw (a receiver fusing a dual antenna or an IMU).
+    BodyYaw,
 }
 
 /// All the streams of a scenario (the `[sensors]` table). Absent tables are
@@ -190,6 +252,8 @@ impl SensorsSpec {
                 g.velocity_std_mps.unwrap_or(0.0),
             ));
             v.push(("sensors.gnss.min_course_speed_mps", g.min_course_speed_mps));
+            v.push(("sensors.gnss.markov_std_m", g.markov_std_m));
+            v.push(("sensors.gnss.markov_tau_s", g.markov_tau_s));
         }
         v
     }
@@ -232,6 +296,21 @@ impl Noise {
         let z: f64 = StandardNormal.sample(&mut self.0);
         std * z
     }
+    /// Uniform in [0, 1).
+    fn uniform(&mut self) -> f64 {
+        rand::RngExt::random::<f64>(&mut self.0)
+    }
+}
+
+/// The receiver's memory between fixes.
+#[derive(Debug, Default)]
+struct GnssState {
+    /// Time of the previous fix, s.
+    last_t: Option<f64>,
+    /// The Gauss–Markov position error, east and north, m.
+    markov: (f64, f64),
+    /// The last course reported at speed, degrees.
+    last_course_deg: Option<f64>,
 }
 
 #[derive(Debug)]
@@ -267,6 +346,7 @@ pub(crate) struct Suite {
     speed: Vec<Scalar>,
     steering: Vec<Scalar>,
     gnss: Vec<GnssFix>,
+    gnss_state: GnssState,
     truth: Vec<TruthPose>,
 }
 
@@ -331,6 +411,7 @@ impl Suite {
             speed: Vec::new(),
             steering: Vec::new(),
             gnss: Vec::new(),
+            gnss_state: GnssState::default(),
             truth: Vec::new(),
         }
     }
@@ -452,17 +533,45 @@ impl Suite {
         let (sin, cos) = st.psi.sin_cos();
         let l = self.lever_arm;
         let n = &mut self.noise[GNSS];
-        let east_m = st.x + l * cos + n.gauss(spec.std_m);
-        let north_m = st.y + l * sin + n.gauss(spec.std_m);
+        let gs = &mut self.gnss_state;
+        let mut east_m = st.x + l * cos + n.gauss(spec.std_m);
+        let mut north_m = st.y + l * sin + n.gauss(spec.std_m);
+        if spec.markov_std_m > 0.0 {
+            // First-order Gauss–Markov, stationary from the first fix.
+            let (e, nn) = match gs.last_t {
+                None => (n.gauss(spec.markov_std_m), n.gauss(spec.markov_std_m)),
+                Some(t0) => {
+                    let a = (-(st.t - t0) / spec.markov_tau_s).exp();
+                    let q = spec.markov_std_m * (1.0 - a * a).sqrt();
+                    (a * gs.markov.0 + n.gauss(q), a * gs.markov.1 + n.gauss(q))
+                }
+            };
+            gs.markov = (e, nn);
+            east_m += e;
+            north_m += nn;
+        }
+        gs.last_t = Some(st.t);
         let (mut course_deg, mut speed_mps) = (None, None);
         if let Some(vstd) = spec.velocity_std_mps {
             // Antenna velocity: v·(cos ψ, sin ψ) + l·ψ̇·(−sin ψ, cos ψ).
-            let ve = st.v * cos - l * st.yaw_rate * sin + n.gauss(vstd);
-            let vn = st.v * sin + l * st.yaw_rate * cos + n.gauss(vstd);
+            let lat = match spec.course_convention {
+                CourseConvention::AntennaVelocity => l * st.yaw_rate,
+                CourseConvention::BodyYaw => 0.0,
+            };
+            let ve = st.v * cos - lat * sin + n.gauss(vstd);
+            let vn = st.v * sin + lat * cos + n.gauss(vstd);
             let sp = ve.hypot(vn);
             speed_mps = Some(sp);
             if sp >= spec.min_course_speed_mps {
-                course_deg = Some(yaw_rad_to_course_deg(vn.atan2(ve)));
+                let c = yaw_rad_to_course_deg(vn.atan2(ve));
+                gs.last_course_deg = Some(c);
+                course_deg = Some(c);
+            } else {
+                course_deg = match spec.low_speed_course {
+                    LowSpeedCourse::Dropped => None,
+                    LowSpeedCourse::Random => Some(360.0 * n.uniform()),
+                    LowSpeedCourse::Frozen => gs.last_course_deg,
+                };
             }
         }
         self.gnss.push(GnssFix {

@@ -110,6 +110,11 @@ pub struct TedrisConfig {
     pub history_samples: usize,
     /// Wheel speed below which the GNSS course is not trusted for training, m/s (default 1.0).
     pub min_course_speed_mps: f64,
+    /// Largest disagreement between a course's change since the previous course
+    /// and the wheels' turn over the same interval for the course to be used,
+    /// rad (default 0.2). Catches the random courses receivers report at low
+    /// speed and course jumps; the speed gate alone does not.
+    pub course_consistency_rad: f64,
     /// Largest gap between two reference headings that is still interpolated, s (default 1.0).
     pub max_heading_gap_s: f64,
     /// No reference heading for this long means GNSS (or gyro) lost, s (default 1.0).
@@ -162,6 +167,19 @@ pub struct TedrisConfig {
     pub joint_calibration: bool,
     /// Window of the joint calibration, s (default 600).
     pub calibration_window_s: f64,
+    /// With a GNSS course reference and the joint calibration: the
+    /// straight-line heading rate is estimated per metre only, with no
+    /// per-sample DCF (default true). A per-sample rate has no physical cause
+    /// in wheels, and at a speed unlike the calibration's it adds heading.
+    pub per_metre_straight: bool,
+    /// Reference heading needed in the window before a joint calibration may
+    /// replace the current values, s (default 120).
+    pub min_calibration_span_s: f64,
+    /// Largest rear-radius mismatch the distance term may express, relative
+    /// (default 0.01: tyres of one axle are within 1 %); a fit beyond it is refused.
+    pub max_radius_mismatch: f64,
+    /// Largest turn gain error, relative (default 0.05); a fit beyond it is refused.
+    pub max_gain_error: f64,
     /// Window over which the straight-line detector measures the heading change, s (default 3).
     pub slt_window_s: f64,
     /// Largest reference heading change over `slt_window_s` on a straight line, degrees (default 1).
@@ -192,6 +210,7 @@ impl Default for TedrisConfig {
             min_ccf_peak: 0.3,
             history_samples: 30_000,
             min_course_speed_mps: 1.0,
+            course_consistency_rad: 0.2,
             max_heading_gap_s: 1.0,
             reference_timeout_s: 1.0,
             heading_anchor_window_s: 10.0,
@@ -211,6 +230,10 @@ impl Default for TedrisConfig {
             dcf_bound_factor: 2.0,
             joint_calibration: true,
             calibration_window_s: 600.0,
+            per_metre_straight: true,
+            min_calibration_span_s: 120.0,
+            max_radius_mismatch: 0.01,
+            max_gain_error: 0.05,
             slt_window_s: 3.0,
             slt_max_change_deg: 1.0,
             portmanteau_lags: 10,
@@ -292,6 +315,10 @@ impl TedrisConfig {
             ("calibration_window_s", self.calibration_window_s),
             ("slt_window_s", self.slt_window_s),
             ("slt_max_change_deg", self.slt_max_change_deg),
+            ("course_consistency_rad", self.course_consistency_rad),
+            ("min_calibration_span_s", self.min_calibration_span_s),
+            ("max_radius_mismatch", self.max_radius_mismatch),
+            ("max_gain_error", self.max_gain_error),
         ] {
             if !(v.is_finite() && v > 0.0) {
                 return bad(k, v.to_string());

@@ -30,6 +30,48 @@ pub struct Sample {
     pub theta_rad: Option<f64>,
     /// DR heading (before the anchor offset) after this sample, rad.
     pub theta_dr_rad: f64,
+    /// The heading segment `theta_rad` belongs to: a continuous run of usable
+    /// reference headings, never unwrapped across a gap, a stop, an unusable
+    /// course or an outage. Heading fits give each segment its own intercept.
+    #[serde(default)]
+    pub segment: u32,
+}
+
+impl Sample {
+    /// True when the wheels turned in this sample (more than 5 mm/s on
+    /// average): the model turns the heading only then, as wheels do.
+    pub fn moving(&self) -> bool {
+        moving(self.omega_m, self.dist_m, self.dt_s)
+    }
+}
+
+/// True when rear wheel distances (ω = right − left, d = mean) over `dt_s`
+/// show motion: more than 5 mm/s at either wheel.
+pub fn moving(omega_m: f64, dist_m: f64, dt_s: f64) -> bool {
+    dist_m.abs() + 0.5 * omega_m.abs() > 0.005 * dt_s.max(1e-3)
+}
+
+/// Subtracts, in place, the mean of each column over the rows of each segment
+/// (`segments[i]` is row i's segment): the least squares on the result equals
+/// the one with an intercept per segment. Returns the number of segments.
+pub fn centre_per_segment(rows: &mut [Vec<f64>], segments: &[u32]) -> usize {
+    use std::collections::HashMap;
+    let mut sums: HashMap<u32, (Vec<f64>, f64)> = HashMap::new();
+    for (r, &g) in rows.iter().zip(segments) {
+        let e = sums.entry(g).or_insert_with(|| (vec![0.0; r.len()], 0.0));
+        for (a, v) in e.0.iter_mut().zip(r) {
+            *a += v;
+        }
+        e.1 += 1.0;
+    }
+    for (r, g) in rows.iter_mut().zip(segments) {
+        if let Some((s, n)) = sums.get(g) {
+            for (v, a) in r.iter_mut().zip(s) {
+                *v -= a / n;
+            }
+        }
+    }
+    sums.len()
 }
 
 /// A bounded window of samples with contiguous indices.

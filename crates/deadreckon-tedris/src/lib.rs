@@ -142,6 +142,7 @@
 //! | [`config`] | every parameter with unit and default |
 #![deny(missing_docs)]
 
+pub mod baseline;
 pub mod ccf;
 pub mod config;
 pub mod gain;

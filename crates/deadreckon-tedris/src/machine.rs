@@ -22,7 +22,7 @@ use std::collections::VecDeque;
 use serde::{Deserialize, Serialize};
 
 use crate::config::TedrisConfig;
-use crate::history::{masked_ccf, BlockFormer, History, Sample};
+use crate::history::{centre_per_segment, masked_ccf, BlockFormer, History, Sample};
 use crate::minimise::brent;
 use crate::model::{design_row, TedrisModel};
 use crate::predict::Predictor;
@@ -144,6 +144,16 @@ pub struct Tedris {
     last_refit_t: f64,
     last_init_try_t: f64,
     rejected: u64,
+    /// The current heading segment (see [`Sample::segment`]).
+    #[serde(default)]
+    segment: u32,
+    /// Reference headings refused as inconsistent with the wheels' turn.
+    #[serde(default)]
+    inconsistent_headings: u64,
+    /// Calibrations refused: worse out of sample than the model they would
+    /// replace, or at a physical bound.
+    #[serde(default)]
+    refused_calibrations: u64,
 }
 
 impl Tedris {
@@ -185,6 +195,9 @@ impl Tedris {
             last_refit_t: f64::MIN,
             last_init_try_t: f64::MIN,
             rejected: 0,
+            segment: 0,
+            inconsistent_headings: 0,
+            refused_calibrations: 0,
         })
     }
 
@@ -241,6 +254,23 @@ impl Tedris {
         self.rejected
     }
 
+    /// Reference headings not used because their change since the previous one
+    /// disagreed with the wheels' turn (a random course at low speed, a jump).
+    pub fn inconsistent_headings(&self) -> u64 {
+        self.inconsistent_headings
+    }
+
+    /// Calibrations refused (worse on held-back data than the current model,
+    /// or reaching a physical bound).
+    pub fn refused_calibrations(&self) -> u64 {
+        self.refused_calibrations
+    }
+
+    /// Heading segments started so far.
+    pub fn segments(&self) -> u32 {
+        self.segment
+    }
+
     /// The state as JSON.
     pub fn to_json(&self) -> Result<String, Error> {
         serde_json::to_string(self).map_err(|e| Error::Json(e.to_string()))
@@ -279,10 +309,18 @@ impl Tedris {
         self.last_t = Some(w.t_s);
         let omega = w.right_m - w.left_m;
         let dist = 0.5 * (w.left_m + w.right_m);
+        let moving = crate::history::moving(omega, dist, dt);
         let rate = match &self.model {
             Some(m) => {
-                let dcf = m.dcf_rad + m.dcf_distance_rad_per_m * dist;
-                self.predictor.step(m, omega, dist, dcf).total_rad
+                let per_sample = if m.per_metre_straight { 0.0 } else { m.dcf_rad };
+                let dcf = per_sample + m.dcf_distance_rad_per_m * dist;
+                let r = self.predictor.step(m, omega, dist, dcf).total_rad;
+                // Wheels at rest do not turn the car.
+                if moving {
+                    r
+                } else {
+                    0.0
+                }
             }
             None => omega / self.geometry.track_rear_m,
         };
@@ -302,6 +340,7 @@ impl Tedris {
             dist_m: dist,
             theta_rad: None,
             theta_dr_rad: self.theta_dr,
+            segment: 0,
         });
         self.flush_headings(w.t_s);
         if !self.deferred_pairs.is_empty() {
@@ -450,17 +489,31 @@ impl Tedris {
         }
     }
 
+    /// The wheels' heading change over samples with `a < t ≤ b`, rad (nominal track).
+    fn wheel_turn(&self, a: f64, b: f64) -> f64 {
+        let mut w = 0.0;
+        for s in self.history.iter().rev() {
+            if s.t_s <= a {
+                break;
+            }
+            if s.t_s <= b {
+                w += s.omega_m;
+            }
+        }
+        w / self.geometry.track_rear_m
+    }
+
     fn process_heading(&mut self, hs: HeadingSample) {
         let prev = self.last_heading;
-        let theta = match prev {
-            Some((_, th, raw, _, _)) => th + wrap(hs.yaw_rad - raw),
-            None => hs.yaw_rad,
-        };
+        let gap_ok = |p: &(f64, f64, f64, f64, bool)| hs.t_s - p.0 <= self.config.max_heading_gap_s;
         // A GNSS course is the antenna's: the antenna moves at atan(l ψ̇ / v) from the
         // rear-axle heading. ψ̇ and v are the wheels' over the fix interval centred
         // on the course's time (samples whose mid-time lies within ± half the
-        // interval since the previous heading); slow courses are not used.
-        let (mut theta_m, mut usable) = (theta, true);
+        // interval since the previous heading); slow courses are not used, nor
+        // courses whose change since the previous one disagrees with the wheels'
+        // turn (receivers report random courses at low speed).
+        let mut usable = true;
+        let mut lever = 0.0;
         if self.geometry.heading_is_course {
             let hw = self.half_window(hs.t_s);
             let (w0, w1) = (hs.t_s - hw, hs.t_s + hw);
@@ -481,9 +534,33 @@ impl Tedris {
                 usable = false;
             } else {
                 let yaw_rate = sw / self.geometry.track_rear_m / st;
-                theta_m -= (self.geometry.lever_arm_m * yaw_rate / v).atan();
+                lever = (self.geometry.lever_arm_m * yaw_rate / v).atan();
+                let consistent = prev.is_some_and(|p| {
+                    gap_ok(&p)
+                        && (wrap(hs.yaw_rad - p.2) - self.wheel_turn(p.0, hs.t_s)).abs()
+                            <= self.config.course_consistency_rad
+                });
+                if !consistent {
+                    usable = false;
+                    self.inconsistent_headings += 1;
+                }
             }
         }
+        // Unwrap only within a segment; a new segment starts on the branch
+        // nearest the dead-reckoned heading, so a stop or an outage never adds
+        // whole turns.
+        let continuing = prev.is_some_and(|p| p.4 && usable && gap_ok(&p));
+        let theta = match prev {
+            Some((_, th, raw, _, _)) if continuing => th + wrap(hs.yaw_rad - raw),
+            _ => {
+                let near = self.heading_out() + lever;
+                near + wrap(hs.yaw_rad - near)
+            }
+        };
+        if usable && !continuing {
+            self.segment += 1;
+        }
+        let theta_m = theta - lever;
         self.last_heading = Some((hs.t_s, theta, hs.yaw_rad, theta_m, usable));
         if self.good_since.is_none() {
             self.good_since = Some(hs.t_s);
@@ -517,6 +594,7 @@ impl Tedris {
             let th = thp + a * (theta_m - thp);
             if let Some(m) = self.history.get_mut(idx) {
                 m.theta_rad = Some(th);
+                m.segment = self.segment;
             }
             assigned.push((idx, s.t_s, th));
         }
@@ -681,8 +759,12 @@ impl Tedris {
         for tu in &tuples {
             repos.insert(*tu);
         }
+        let per_metre =
+            c.per_metre_straight && c.joint_calibration && self.geometry.heading_is_course;
         match TedrisModel::fit(c.clone(), period, lag, ccf, repos) {
-            Ok(model) => {
+            Ok(mut model) => {
+                model.per_metre_straight = per_metre;
+                model.settle_kind();
                 self.recent = tuples.iter().rev().take(32).rev().copied().collect();
                 self.model = Some(model);
                 self.estimate_gain();
@@ -723,7 +805,13 @@ impl Tedris {
             }
         }
         let Some(old) = &self.model else { return };
-        let gain = old.turn_gain;
+        let (gain, per_metre, dist, dcf, joint) = (
+            old.turn_gain,
+            old.per_metre_straight,
+            old.dcf_distance_rad_per_m,
+            old.dcf_rad,
+            old.config.joint_calibration,
+        );
         if let Ok(mut m) = TedrisModel::fit(
             old.config.clone(),
             old.sample_period_s,
@@ -732,6 +820,13 @@ impl Tedris {
             old.repositories.clone(),
         ) {
             m.turn_gain = gain;
+            m.per_metre_straight = per_metre;
+            m.settle_kind();
+            if joint {
+                // The calibrated values stand until a calibration beats them.
+                m.dcf_distance_rad_per_m = dist;
+                m.dcf_rad = dcf;
+            }
             self.model = Some(m);
         }
         self.estimate_gain();
@@ -777,16 +872,19 @@ impl Tedris {
         let warm = first.saturating_sub(tau);
         let mut p = Predictor::default();
         let mut cum = Vec::with_capacity(samples.len() - warm);
-        let mut acc = 0.0;
+        let (mut acc, mut n) = (0.0, 0.0);
         for (k, s) in samples[warm..].iter().enumerate() {
             let r = p.step(model, s.omega_m, s.dist_m, 0.0);
-            if warm + k >= first {
+            if warm + k >= first && s.moving() {
                 acc += r.base_rad;
-                cum.push(acc);
+                n += 1.0;
+            }
+            if warm + k >= first {
+                cum.push((acc, n));
             }
         }
         let win = &samples[first..];
-        let pairs: Vec<(usize, f64)> = win
+        let pairs: Vec<(usize, f64, u32)> = win
             .iter()
             .enumerate()
             .filter_map(|(j, s)| {
@@ -794,25 +892,33 @@ impl Tedris {
                 let src = usize::try_from(j as i64 - lag)
                     .ok()
                     .filter(|&i| i < cum.len())?;
-                Some((src, th))
+                Some((src, th, s.segment))
             })
             .collect();
         if pairs.len() < 2 * tau.max(10) {
             return;
         }
+        let segs: Vec<u32> = pairs.iter().map(|p| p.2).collect();
+        // The RMS difference with an offset per heading segment.
         let cost = |dcf: f64| {
-            let d: Vec<f64> = pairs
+            let mut d: Vec<Vec<f64>> = pairs
                 .iter()
-                .map(|&(i, th)| th - (cum[i] + dcf * (i + 1) as f64))
+                .map(|&(i, th, _)| vec![th - (cum[i].0 + dcf * cum[i].1)])
                 .collect();
-            let m = crate::stats::mean(&d);
-            (d.iter().map(|v| (v - m).powi(2)).sum::<f64>() / d.len() as f64).sqrt()
+            centre_per_segment(&mut d, &segs);
+            (d.iter().map(|v| v[0] * v[0]).sum::<f64>() / d.len() as f64).sqrt()
         };
         let (lo, hi) = (
             model.dcf0_rad - model.dcf_bound_rad,
             model.dcf0_rad + model.dcf_bound_rad,
         );
         let (x, _) = brent(cost, lo, hi, model.dcf_bound_rad * 1e-6, 200);
+        // A minimum at the bound of the search is refused, not kept.
+        let edge = 1e-3 * model.dcf_bound_rad;
+        if !(x > lo + edge && x < hi - edge) {
+            self.refused_calibrations += 1;
+            return;
+        }
         if x.is_finite() && model.config.dcf_update {
             // dcf_smoothing = 1 is eq. (6) as in the paper; below 1 the new
             // estimate is blended into the previous one.
@@ -823,160 +929,223 @@ impl Tedris {
 }
 
 impl Tedris {
-    /// The joint calibration (when `joint_calibration` is on), the update phase of
-    /// eq. (6) generalised. The model (turn gain 1, no DCF) is replayed over the
-    /// last `calibration_window_s`; with Σb, Σd, ΣT its cumulative heading,
-    /// distance and turning part (γ̂(ω) − γ̂(straight line)) up to sample k − h,
-    ///
-    /// `θ_ref(k) − Σb = c + DCF·(k + 1) + DCF_d·Σd + (g − 1)·ΣT`
-    ///
-    /// is solved by least squares: DCF (rad per sample), the distance term DCF_d
-    /// (rad per metre: the speed-proportional bias of unequal rear radii, which
-    /// the block regression resolves poorly) and the turn gain g. Over minutes the
-    /// reference heading is far more accurate than in 30 s windows or block
-    /// increments, so these three numbers, which decide the drift during an
-    /// outage, come out 10–100 times more precise. Columns without support
-    /// (speed too constant, too little turning) are left out and keep their values.
-    fn calibration_fit(&self, model: &TedrisModel, t: f64) -> Option<Calibration> {
+    /// The rows of the joint calibration over the last `calibration_window_s`
+    /// for `model` (see [`Tedris::calibrate`]). Over minutes the reference
+    /// heading is far more accurate than in 30 s windows or block increments,
+    /// so the numbers that decide the drift in an outage come out 10–100 times
+    /// more precise.
+    fn calibration_rows(&self, model: &TedrisModel, t: f64) -> CalibrationRows {
         let mut unit = model.clone();
         unit.turn_gain = 1.0;
         let lag = model.lag_samples;
         let t0 = t - model.config.calibration_window_s;
         let samples: Vec<&Sample> = self.history.iter().filter(|s| s.t_s >= t0).collect();
         let mut p = Predictor::default();
-        let (mut b, mut d, mut tr) = (0.0, 0.0, 0.0);
+        let (mut k, mut b, mut d, mut tr) = (0.0, 0.0, 0.0, 0.0);
         let mut cum = Vec::with_capacity(samples.len());
         for s in &samples {
             let r = p.step(&unit, s.omega_m, s.dist_m, 0.0);
-            b += r.base_rad;
-            d += s.dist_m;
-            tr += r.turn_rad;
-            cum.push((b, d, tr));
+            // Only moving samples turn the heading (as in `push_wheel`).
+            if s.moving() {
+                k += 1.0;
+                b += r.base_rad;
+                d += s.dist_m;
+                tr += r.turn_rad;
+            }
+            cum.push((k, b, d, tr));
         }
-        // (k + 1, Σd, ΣT, θ − Σb) at each sample with a reference heading.
-        let rows: Vec<[f64; 4]> = samples
-            .iter()
-            .enumerate()
-            .skip(model.config.tau_samples)
-            .filter_map(|(j, s)| {
-                let th = s.theta_rad?;
-                let src = usize::try_from(j as i64 - lag).ok()?;
-                let &(cb, cd, ct) = cum.get(src)?;
-                Some([(src + 1) as f64, cd, ct, th - cb])
-            })
-            .collect();
+        let mut out = CalibrationRows::default();
+        for (j, s) in samples.iter().enumerate().skip(model.config.tau_samples) {
+            let Some(th) = s.theta_rad else { continue };
+            let Some(src) = usize::try_from(j as i64 - lag).ok() else {
+                continue;
+            };
+            let Some(&(ck, cb, cd, ct)) = cum.get(src) else {
+                continue;
+            };
+            out.rows.push([ck, cd, ct, th - cb]);
+            out.segments.push(s.segment);
+            out.times.push(s.t_s);
+        }
+        out
+    }
+
+    /// The joint calibration fitted on `rows` (see [`Tedris::calibrate`]);
+    /// `None` without enough support, or when an estimate reaches a physical
+    /// bound (the fit is then refused, not clamped).
+    fn calibration_fit(
+        &self,
+        model: &TedrisModel,
+        rows: &[[f64; 4]],
+        segments: &[u32],
+    ) -> Option<Calibration> {
         if rows.len() < 200 {
             return None;
         }
-        let n = rows.len() as f64;
-        let mut m = [0.0; 4];
-        for r in &rows {
-            for (a, v) in m.iter_mut().zip(r) {
-                *a += v / n;
-            }
-        }
-        let spread = |i: usize| {
-            let (lo, hi) = rows.iter().fold((f64::MAX, f64::MIN), |(lo, hi), r| {
-                (lo.min(r[i]), hi.max(r[i]))
-            });
-            hi - lo
-        };
+        let mut cols_all: Vec<Vec<f64>> = rows.iter().map(|r| r.to_vec()).collect();
+        centre_per_segment(&mut cols_all, segments);
+        let col = |i: usize| cols_all.iter().map(move |r| r[i]);
+        let ss = |i: usize| col(i).map(|v| v * v).sum::<f64>();
         // The distance column must differ from the sample count: speed must vary.
-        let mean_step = m[1] / m[0].max(1.0);
-        let dev: f64 = rows
-            .iter()
-            .map(|r| (r[1] - mean_step * r[0]).abs())
-            .fold(0.0, f64::max);
-        let use_d = dev > 20.0;
-        let use_g = model.config.turn_gain && spread(2) > 1.0;
-        let mut cols = vec![0usize];
+        let (skk, sdd) = (ss(0), ss(1));
+        let skd: f64 = cols_all.iter().map(|r| r[0] * r[1]).sum();
+        let use_d = skk > 0.0 && sdd > 0.0 && skd * skd / (skk * sdd) < 0.999;
+        let (lo, hi) = col(2).fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(v), h.max(v)));
+        let use_g = model.config.turn_gain && hi - lo > 1.0;
+        let per_metre = model.per_metre_straight;
+        // In the per-metre form the distance term is the whole straight-line rate.
+        let use_d = use_d || (per_metre && sdd > 0.0);
+        let mut cols = if per_metre { vec![] } else { vec![0usize] };
         if use_d {
             cols.push(1);
         }
         if use_g {
             cols.push(2);
         }
-        let x: Vec<Vec<f64>> = rows
+        let x: Vec<Vec<f64>> = cols_all
             .iter()
-            .map(|r| {
-                let mut v = vec![1.0];
-                v.extend(cols.iter().map(|&i| r[i] - m[i]));
-                v
-            })
+            .map(|r| cols.iter().map(|&i| r[i]).collect())
             .collect();
         // A term left out keeps its current value.
         let (old_d, old_g) = (model.dcf_distance_rad_per_m, model.turn_gain);
-        let y: Vec<f64> = rows
+        let y: Vec<f64> = cols_all
             .iter()
             .map(|r| {
                 r[3] - if use_d { 0.0 } else { old_d * r[1] }
                     - if use_g { 0.0 } else { (old_g - 1.0) * r[2] }
             })
             .collect();
-        let mut names = vec!["c", "dcf"];
+        let mut names = if per_metre { vec![] } else { vec!["dcf"] };
         if use_d {
             names.push("dcf_distance");
         }
         if use_g {
             names.push("gain");
         }
-        let Ok(fit) = crate::stats::ols(&x, &y, &names) else {
+        if names.is_empty() {
             return None;
-        };
+        }
+        let fit = crate::stats::ols(&x, &y, &names).ok()?;
         let beta = fit.beta();
         if !beta.iter().all(|v| v.is_finite()) {
             return None;
         }
-        let bound = model.dcf_bound_rad;
-        let mut k = 2;
+        let b = &model.config;
         let mut c = Calibration {
-            dcf_rad: beta[1].clamp(model.dcf0_rad - bound, model.dcf0_rad + bound),
+            dcf_rad: if per_metre { 0.0 } else { beta[0] },
             distance_rad_per_m: None,
             gain: None,
-            rms_rad: fit.sigma2.sqrt(),
         };
+        let mut k = usize::from(!per_metre);
         if use_d {
-            c.distance_rad_per_m = Some(beta[k].clamp(-0.05, 0.05));
+            c.distance_rad_per_m = Some(beta[k]);
             k += 1;
         }
         if use_g {
-            c.gain = Some((1.0 + beta[k]).clamp(0.8, 1.2));
+            c.gain = Some(1.0 + beta[k]);
         }
-        Some(c)
+        // Physical bounds: a fit reaching one is refused.
+        let max_d = b.max_radius_mismatch / self.geometry.track_rear_m;
+        let within = (per_metre || (c.dcf_rad - model.dcf0_rad).abs() <= model.dcf_bound_rad)
+            && c.distance_rad_per_m.is_none_or(|d| d.abs() <= max_d)
+            && c.gain.is_none_or(|g| (g - 1.0).abs() <= b.max_gain_error);
+        within.then_some(c)
     }
 
-    /// Applies the joint calibration; with the automatic model choice, the kind
-    /// whose calibrated heading fits the reference best is chosen (the criterion
-    /// that matters for dead reckoning, where the block-level BIC favours ARX,
-    /// which drifts more).
+    /// The joint calibration, the update phase of eq. (6) generalised. The
+    /// model (turn gain 1, no DCF) is replayed over the last
+    /// `calibration_window_s`; with n the count of moving samples, Σb, Σd, ΣT
+    /// its cumulative heading, distance and turning part (γ̂(ω) − γ̂(straight
+    /// line)) up to sample k − h,
+    ///
+    /// `θ_ref(k) − Σb = c_s + DCF·n + DCF_d·Σd + (g − 1)·ΣT`
+    ///
+    /// is solved by least squares with an intercept c_s per heading segment s
+    /// (a course is never unwrapped across a stop or a gap): DCF (rad per
+    /// moving sample), the distance term DCF_d (rad per metre: unequal rear
+    /// radii) and the turn gain g. Columns without support are left out and
+    /// keep their values.
+    ///
+    /// Nothing replaces the current values unless it is better out of sample:
+    /// the fit uses the first three quarters of the window, and is accepted
+    /// only when its heading residual on the last quarter (per-segment
+    /// intercepts) is no larger than the current model's, after at least
+    /// `min_calibration_span_s` of reference heading. With the automatic model
+    /// choice the kind is chosen by the same held-back residual.
     fn calibrate(&mut self, t: f64) {
         let Some(model) = self.model.as_ref() else {
-            return;
-        };
-        let best = if model.config.model == crate::config::ModelChoice::Auto {
-            let mut best: Option<(crate::config::ModelKind, Calibration)> = None;
-            for f in &model.fits {
-                let mut m = model.clone();
-                m.chosen = f.kind;
-                if let Some(c) = self.calibration_fit(&m, t) {
-                    if best.as_ref().is_none_or(|b| c.rms_rad < b.1.rms_rad) {
-                        best = Some((f.kind, c));
-                    }
-                }
-            }
-            best
-        } else {
-            self.calibration_fit(model, t).map(|c| (model.chosen, c))
-        };
-        let Some((kind, c)) = best else {
-            return;
-        };
-        let Some(model) = self.model.as_mut() else {
             return;
         };
         if !model.config.dcf_update {
             return;
         }
+        let kinds: Vec<crate::config::ModelKind> =
+            if model.config.model == crate::config::ModelChoice::Auto {
+                model
+                    .fits
+                    .iter()
+                    .map(|f| f.kind)
+                    .filter(|k| model.kind_usable(*k))
+                    .collect()
+            } else {
+                vec![model.chosen]
+            };
+        let mut current_rms = f64::INFINITY;
+        let mut best: Option<(crate::config::ModelKind, Calibration, f64)> = None;
+        let mut refused = false;
+        for kind in kinds {
+            let mut m = model.clone();
+            m.chosen = kind;
+            let rows = self.calibration_rows(&m, t);
+            let (Some(&first), Some(&last)) = (rows.times.first(), rows.times.last()) else {
+                return;
+            };
+            if last - first < model.config.min_calibration_span_s {
+                return;
+            }
+            let split = rows
+                .times
+                .partition_point(|&x| x < first + 0.75 * (last - first));
+            let (fit_rows, held) = rows.rows.split_at(split);
+            let (fit_segs, held_segs) = rows.segments.split_at(split);
+            if kind == model.chosen {
+                current_rms = held_rms(
+                    held,
+                    held_segs,
+                    model.dcf_rad,
+                    model.dcf_distance_rad_per_m,
+                    model.turn_gain,
+                );
+            }
+            match self.calibration_fit(&m, fit_rows, fit_segs) {
+                Some(c) => {
+                    let rms = held_rms(
+                        held,
+                        held_segs,
+                        c.dcf_rad,
+                        c.distance_rad_per_m.unwrap_or(model.dcf_distance_rad_per_m),
+                        c.gain.unwrap_or(model.turn_gain),
+                    );
+                    if rms.is_finite() && best.as_ref().is_none_or(|b| rms < b.2) {
+                        best = Some((kind, c, rms));
+                    }
+                }
+                None => refused = true,
+            }
+        }
+        let Some((kind, c, rms)) = best else {
+            if refused {
+                self.refused_calibrations += 1;
+            }
+            return;
+        };
+        if rms > current_rms {
+            self.refused_calibrations += 1;
+            return;
+        }
+        let Some(model) = self.model.as_mut() else {
+            return;
+        };
         model.chosen = kind;
         model.dcf_rad = c.dcf_rad;
         if let Some(d) = c.distance_rad_per_m {
@@ -988,14 +1157,35 @@ impl Tedris {
     }
 }
 
+/// The rows of a joint calibration: `[n, Σd, ΣT, θ − Σb]` with each row's
+/// heading segment and time.
+#[derive(Debug, Default)]
+struct CalibrationRows {
+    rows: Vec<[f64; 4]>,
+    segments: Vec<u32>,
+    times: Vec<f64>,
+}
+
+/// The RMS heading residual of calibration values on `rows`, with an
+/// intercept per segment; infinite without rows.
+fn held_rms(rows: &[[f64; 4]], segments: &[u32], dcf: f64, dist: f64, gain: f64) -> f64 {
+    if rows.is_empty() {
+        return f64::INFINITY;
+    }
+    let mut e: Vec<Vec<f64>> = rows
+        .iter()
+        .map(|r| vec![r[3] - dcf * r[0] - dist * r[1] - (gain - 1.0) * r[2]])
+        .collect();
+    centre_per_segment(&mut e, segments);
+    (e.iter().map(|v| v[0] * v[0]).sum::<f64>() / e.len() as f64).sqrt()
+}
+
 /// The result of one joint calibration.
 #[derive(Debug, Clone, Copy)]
 struct Calibration {
     dcf_rad: f64,
     distance_rad_per_m: Option<f64>,
     gain: Option<f64>,
-    /// Residual standard deviation of the reference heading, rad.
-    rms_rad: f64,
 }
 
 /// The heading offset from (t, reference − DR) pairs: their mean, or with
@@ -1037,28 +1227,25 @@ pub fn heading_lag(h: &History, max_lag: usize) -> Option<i64> {
     let ml = max_lag as i64;
     let mut best: Option<(f64, i64)> = None;
     for lag in -ml..=ml {
-        let (x, y): (Vec<Vec<f64>>, Vec<f64>) = samples
-            .iter()
-            .enumerate()
-            .filter_map(|(j, s)| {
-                let th = s.theta_rad?;
-                let src = usize::try_from(j as i64 - lag).ok()?;
-                Some((vec![1.0, *cw.get(src)?, cd[src], j as f64], th))
-            })
-            .unzip();
-        if y.len() < 200 {
+        // Rows [Σω, Σd, k, θ] with an intercept per heading segment.
+        let mut rows = Vec::new();
+        let mut segs = Vec::new();
+        for (j, s) in samples.iter().enumerate() {
+            let Some(th) = s.theta_rad else { continue };
+            let Some(src) = usize::try_from(j as i64 - lag).ok() else {
+                continue;
+            };
+            let Some(&w) = cw.get(src) else { continue };
+            rows.push(vec![w, cd[src], j as f64, th]);
+            segs.push(s.segment);
+        }
+        if rows.len() < 200 {
             return None;
         }
-        // Centre the columns for conditioning.
-        let n = y.len() as f64;
-        let m: Vec<f64> = (1..4)
-            .map(|c| x.iter().map(|r| r[c]).sum::<f64>() / n)
-            .collect();
-        let xc: Vec<Vec<f64>> = x
-            .iter()
-            .map(|r| vec![1.0, r[1] - m[0], r[2] - m[1], r[3] - m[2]])
-            .collect();
-        let fit = crate::stats::ols(&xc, &y, &["c", "omega", "distance", "rate"]).ok()?;
+        centre_per_segment(&mut rows, &segs);
+        let (x, y): (Vec<Vec<f64>>, Vec<f64>) =
+            rows.into_iter().map(|r| (r[..3].to_vec(), r[3])).unzip();
+        let fit = crate::stats::ols(&x, &y, &["omega", "distance", "rate"]).ok()?;
         if best.is_none_or(|b| fit.rss < b.0) {
             best = Some((fit.rss, lag));
         }

@@ -279,6 +279,13 @@ pub struct TedrisModel {
     /// of about 3·10⁻⁴ rad/s on the simulated robot, which becomes heading drift).
     #[serde(default)]
     pub gyro_bias: Option<(f64, usize)>,
+    /// The straight-line part of γ̂ is heading per metre only (`dcf_distance_rad_per_m`),
+    /// with no per-sample rate: what wheels physically do (unequal radii turn the
+    /// car per metre; at rest nothing turns). Set for a GNSS course reference
+    /// with `TedrisConfig::per_metre_straight`; a gyro reference keeps the
+    /// per-sample DCF (its bias is per unit time).
+    #[serde(default)]
+    pub per_metre_straight: bool,
     /// Every required repository reached its minimum fill.
     pub complete: bool,
     /// g: gain on the turning part of γ̂ (1 = the regression as fitted), estimated
@@ -345,6 +352,7 @@ impl TedrisModel {
             dcf_rad: 0.0,
             dcf_distance_rad_per_m: 0.0,
             gyro_bias: None,
+            per_metre_straight: false,
             dcf_bound_rad: 0.0,
             straight_omega,
             straight_sigma_m,
@@ -412,6 +420,27 @@ impl TedrisModel {
         match self.chosen {
             ModelKind::Paper => self.repositories.straight.mu_m,
             _ => self.straight_omega.0 + self.straight_omega.1 * dist_m,
+        }
+    }
+
+    /// False for a kind the model's form cannot use: the ARX kind in the
+    /// per-metre form (its turn is spread over the feedback of previous
+    /// blocks, which the per-metre form's "turn from ω = 0" would cut).
+    pub fn kind_usable(&self, kind: ModelKind) -> bool {
+        !(self.per_metre_straight && kind == ModelKind::Arx)
+    }
+
+    /// Moves the choice off a kind the form cannot use (ARX in the per-metre
+    /// form) to the distance kind, else the paper kind.
+    pub fn settle_kind(&mut self) {
+        if self.kind_usable(self.chosen) {
+            return;
+        }
+        for k in [ModelKind::Distance, ModelKind::Paper] {
+            if self.fits.iter().any(|f| f.kind == k) {
+                self.chosen = k;
+                return;
+            }
         }
     }
 

@@ -172,6 +172,8 @@ pub fn train(
         f.dcf_rad = model.dcf_rad;
         f.dcf_distance_rad_per_m = model.dcf_distance_rad_per_m;
         f.turn_gain = model.turn_gain;
+        f.per_metre_straight = model.per_metre_straight;
+        f.settle_kind();
         f
     })
     .unwrap_or(model);
@@ -258,7 +260,8 @@ pub fn run_outages_with(
     })
 }
 
-fn interp_truth(drive: &Drive, t: f64) -> Option<(f64, f64)> {
+/// The truth's rear-axle position at `t`, linearly interpolated.
+pub(crate) fn truth_at(drive: &Drive, t: f64) -> Option<(f64, f64)> {
     let tr = &drive.truth;
     let i = tr.partition_point(|p| p.t_s < t);
     if i == 0 || i >= tr.len() {
@@ -275,7 +278,8 @@ fn interp_truth(drive: &Drive, t: f64) -> Option<(f64, f64)> {
     ))
 }
 
-fn summarise(
+/// The summary of the errors `(t, m)` over an outage.
+pub(crate) fn summarise_errors(
     o: &Outage,
     errs: &[(f64, f64)],
     predicted: usize,
@@ -321,7 +325,7 @@ fn truth_errors(
         if p.t_s < o.start_s || p.t_s >= o.end_s {
             continue;
         }
-        let Some((te, tn)) = interp_truth(drive, p.t_s) else {
+        let Some((te, tn)) = truth_at(drive, p.t_s) else {
             continue;
         };
         total += 1;
@@ -333,7 +337,7 @@ fn truth_errors(
         };
         errs.push((p.t_s, (p.east_m + oe - te).hypot(p.north_m + on - tn)));
     }
-    summarise(o, &errs, pred, total, threshold)
+    summarise_errors(o, &errs, pred, total, threshold)
 }
 
 fn gnss_errors(
@@ -369,5 +373,5 @@ fn gnss_errors(
                 .hypot(p.north_m + ahead * p.yaw_rad.sin() - mn),
         ));
     }
-    summarise(o, &errs, pred, total, threshold)
+    summarise_errors(o, &errs, pred, total, threshold)
 }

@@ -71,9 +71,21 @@ impl Predictor {
         };
         // γ̂ = γ̂(straight) + g·(γ̂(ω) − γ̂(straight)): the turn gain g scales the part
         // of the increment that comes from turning.
-        let straight = eval(centre);
+        // In the per-metre form the turn is measured from ω = 0 and the
+        // straight-line rate is the calibration's `dcf_distance_rad_per_m · d`
+        // alone (added by the caller as DCF): no rate per sample.
+        let straight = if model.per_metre_straight {
+            eval(0.0)
+        } else {
+            eval(centre)
+        };
         let turn = eval(omega_m) - straight;
-        let base = straight + model.turn_gain * turn;
+        let straight_part = if model.per_metre_straight {
+            0.0
+        } else {
+            straight
+        };
+        let base = straight_part + model.turn_gain * turn;
         let base = if base.is_finite() { base } else { 0.0 };
         let corr = if self.correcting {
             self.correction_rad

@@ -1,0 +1,232 @@
+//! TedriS on drives it was never tuned on: members of the simulator's
+//! randomized car family (`deadreckon_sim::family`: geometry, tyres, wheel
+//! noise kind, GNSS rate, wandering position error, course convention, random
+//! or frozen or dropped courses at low speed, stops). For each car, the model
+//! is trained on one drive and predicts through 80 s outages on another drive
+//! of the same car, one right after a stop and one elsewhere; the plain
+//! least-squares baseline (`deadreckon_tedris::baseline`), fitted on the same
+//! training drive, runs through the same outages.
+//!
+//! The per-pair table: `cargo test --release -p deadreckon-tedris --test
+//! family_outages -- --nocapture`.
+
+use deadreckon_sim::family::CarFamily;
+use deadreckon_sim::simulate;
+use deadreckon_tedris::baseline::Baseline;
+use deadreckon_tedris::{run_outages, train, Outage, TedrisConfig};
+
+/// One train→test pair's results.
+#[derive(Debug, Clone)]
+struct PairResult {
+    outage: Outage,
+    tedris_m: f64,
+    tedris_max_m: f64,
+    paper_m: f64,
+    baseline_m: f64,
+    after_stop: bool,
+}
+
+/// Outages of 80 s on a test drive: one starting 2 s after the end of each of
+/// the first stops that leave room, one in the middle.
+fn outages(stops: &[(f64, f64)], duration_s: f64) -> Vec<(Outage, bool)> {
+    let mut v = Vec::new();
+    for &(s, d) in stops {
+        let start = s + d + 2.0;
+        if start >= 120.0 && start + 85.0 < duration_s && v.len() < 2 {
+            v.push((
+                Outage {
+                    start_s: start,
+                    end_s: start + 80.0,
+                },
+                true,
+            ));
+        }
+    }
+    let mid = (0.5 * duration_s).max(120.0);
+    if mid + 85.0 < duration_s && v.iter().all(|(o, _)| (o.start_s - mid).abs() > 40.0) {
+        v.push((
+            Outage {
+                start_s: mid,
+                end_s: mid + 80.0,
+            },
+            false,
+        ));
+    }
+    v
+}
+
+fn run_car(car_seed: u64) -> Vec<PairResult> {
+    let car = CarFamily::draw(car_seed);
+    let train_drive = simulate(&car.drive(1000 + car_seed, 900.0), 1000 + car_seed)
+        .expect("train drive")
+        .drive;
+    let test_out = simulate(&car.drive(2000 + car_seed, 500.0), 2000 + car_seed).expect("test");
+    let (model, _) = train(&train_drive, TedrisConfig::default(), None).expect("trained");
+    let (paper, _) = train(&train_drive, TedrisConfig::paper(), None).expect("paper trained");
+    let base = Baseline::fit(&train_drive).expect("baseline");
+    let mut out = Vec::new();
+    for (o, after_stop) in outages(&test_out.stats.stops, test_out.stats.duration_s) {
+        let r = run_outages(&test_out.drive, &model, &[o]).expect("run");
+        let p = run_outages(&test_out.drive, &paper, &[o]).expect("paper run");
+        let b = base.run_outage(&test_out.drive, &o).expect("baseline run");
+        out.push(PairResult {
+            outage: o,
+            tedris_m: r.outages[0].mean_error_m,
+            tedris_max_m: r.outages[0].max_error_m,
+            paper_m: p.outages[0].mean_error_m,
+            baseline_m: b.mean_error_m,
+            after_stop,
+        });
+    }
+    out
+}
+
+#[test]
+fn family_train_test_80s_outages() {
+    let mut all = Vec::new();
+    // TEDRIS_FAMILY_FIRST_CAR=101 runs cars 101–112 (never looked at while
+    // developing) instead of 1–12.
+    let first: u64 = std::env::var("TEDRIS_FAMILY_FIRST_CAR")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(1);
+    for car in first..first + 12 {
+        let c = CarFamily::draw(car);
+        eprintln!(
+            "car {car}: track {:.2} m, lever {:.2} m, rear radii {:+.2} % apart, wheels {} Hz {}, GNSS {} Hz σ {:.1} m GM {:.1} m/{:.0} s, course {:?} below {:.1} m/s, {:?}",
+            c.vehicle.track_rear_m,
+            c.vehicle.gnss_lever_arm_m,
+            100.0 * (c.errors.circumference_rr_m / c.errors.circumference_rl_m - 1.0),
+            c.wheel_rate_hz,
+            if c.wheel_noise_mps > 0.0 { format!("white {:.3} m/s", c.wheel_noise_mps) } else { format!("jitter {:.1} mm", 1e3 * c.edge_jitter_m) },
+            c.gnss_rate_hz,
+            c.gnss_std_m,
+            c.gnss_markov.0,
+            c.gnss_markov.1,
+            c.low_speed_course,
+            c.min_course_speed_mps,
+            c.course_convention,
+        );
+        for r in run_car(car) {
+            eprintln!(
+                "  [{:.0}, {:.0}) {}: tedris mean {:.2} m (max {:.2}), paper {:.2} m, baseline {:.2} m",
+                r.outage.start_s,
+                r.outage.end_s,
+                if r.after_stop { "after a stop" } else { "mid-drive   " },
+                r.tedris_m,
+                r.tedris_max_m,
+                r.paper_m,
+                r.baseline_m
+            );
+            all.push(r);
+        }
+    }
+    let mean = |f: fn(&PairResult) -> f64| all.iter().map(f).sum::<f64>() / all.len() as f64;
+    let worst = all.iter().map(|r| r.tedris_m).fold(0.0, f64::max);
+    eprintln!(
+        "{} pairs: tedris mean {:.2} m (worst {:.2}), paper {:.2} m, baseline {:.2} m (worst {:.2})",
+        all.len(),
+        mean(|r| r.tedris_m),
+        worst,
+        mean(|r| r.paper_m),
+        mean(|r| r.baseline_m),
+        all.iter().map(|r| r.baseline_m).fold(0.0, f64::max)
+    );
+    assert!(all.len() >= 20, "{} pairs", all.len());
+    // Measured (cars 1–12, 24 pairs): TedriS 3.26 m mean, worst 8.43 m; the
+    // paper's method alone 63.6 m; the baseline 7.91 m (worst 24.9 m). Cars
+    // 101–112 (28 pairs, not looked at while developing): 2.25 m, worst 5.88 m;
+    // paper 44.0 m; baseline 5.96 m. Before the heading segments, the
+    // consistency check and the per-metre form: 82.3 m mean, worst 390 m.
+    let (t, b, p) = (
+        mean(|r| r.tedris_m),
+        mean(|r| r.baseline_m),
+        mean(|r| r.paper_m),
+    );
+    assert!(t < 3.5, "TedriS mean {t} m");
+    assert!(worst < 9.0, "TedriS worst outage {worst} m");
+    assert!(t < 0.6 * b, "TedriS {t} m against the baseline's {b} m");
+    assert!(t < 0.1 * p, "TedriS {t} m against the paper method's {p} m");
+}
+
+/// The bug of issue 8: a receiver reporting random courses while the car
+/// stands still made the unwrapped reference jump by whole turns at every
+/// stop; the heading fits read the jumps as drift and the trained model
+/// turned the car at −0.17 rad/s while parked.
+#[test]
+fn random_course_at_stops_does_not_turn_the_parked_car() {
+    let mut car = CarFamily::draw(2);
+    car.low_speed_course = deadreckon_sim::LowSpeedCourse::Random;
+    car.min_course_speed_mps = 1.2;
+    let train_drive = simulate(&car.drive(31, 900.0), 31).expect("train").drive;
+    let test = simulate(&car.drive(32, 500.0), 32).expect("test");
+    let (model, _) = train(&train_drive, TedrisConfig::default(), None).expect("trained");
+    assert!(
+        model.per_metre_straight,
+        "a course reference uses the per-metre form"
+    );
+    // An outage over the first stop that leaves room: dead reckoning through it.
+    let &(stop_t, stop_d) = test
+        .stats
+        .stops
+        .iter()
+        .find(|s| s.0 > 60.0 && s.0 + 70.0 < test.stats.duration_s && s.1 > 8.0)
+        .expect("a stop");
+    let o = Outage {
+        start_s: stop_t - 5.0,
+        end_s: stop_t + 75.0,
+    };
+    let r = run_outages(&test.drive, &model, &[o]).expect("run");
+    let yaw_at = |t: f64| {
+        r.track
+            .points
+            .iter()
+            .find(|p| p.t_s >= t)
+            .map(|p| p.yaw_rad)
+            .expect("a point")
+    };
+    let parked = deadreckon_core::angle::wrap(yaw_at(stop_t + stop_d - 1.0) - yaw_at(stop_t + 1.0));
+    assert!(parked.abs() < 1e-3, "the parked car turned by {parked} rad");
+    let e = &r.outages[0];
+    eprintln!(
+        "parked turn {parked:.2e} rad; outage mean {:.2} m, max {:.2} m",
+        e.mean_error_m, e.max_error_m
+    );
+    assert!(e.predicted_fraction > 0.95);
+    // Measured 1.3 m mean.
+    assert!(e.mean_error_m < 3.0, "{e:?}");
+}
+
+/// The baseline's fit is what its model says: the gain is the inverse of the
+/// effective rear track, the per-metre term the rear radius mismatch over the
+/// track (right tyre larger: its wheel speed reads low, ω reads a right turn
+/// on a straight, and the per-metre term turns it back left).
+#[test]
+fn baseline_fit_recovers_track_and_radius_mismatch() {
+    let car = CarFamily::draw(4);
+    let d = simulate(&car.drive(41, 600.0), 41).expect("drive").drive;
+    let b = Baseline::fit(&d).expect("fit");
+    let track = car.vehicle.track_rear_m;
+    let nominal = car.vehicle.wheel_circumference_m;
+    let e = &car.errors;
+    // Wheel speeds report rotation × nominal circumference: distances scale by
+    // true/nominal, so the measured ω and d are off by the tyres' errors.
+    let scale = 0.5 * (e.circumference_rl_m + e.circumference_rr_m) / nominal;
+    let mismatch = (e.circumference_rr_m - e.circumference_rl_m)
+        / (0.5 * (e.circumference_rl_m + e.circumference_rr_m));
+    eprintln!(
+        "baseline gain {:.5} rad/m (1/(track·scale) {:.5}), per metre {:.2e} (mismatch/track {:.2e}), {} pairs",
+        b.gain_rad_per_m,
+        1.0 / (track * scale),
+        b.per_metre_rad,
+        mismatch / track,
+        b.pairs
+    );
+    // Measured: gain 1.7 % low (0.6529 against 0.6642), per metre 2.40e-3
+    // against 2.38e-3.
+    assert!(
+        (b.gain_rad_per_m * track * scale - 1.0).abs() < 0.02,
+        "{b:?}"
+    );
+    assert!((b.per_metre_rad - mismatch / track).abs() < 1e-4, "{b:?}");
+}
