@@ -364,6 +364,23 @@ fn comma2k19_import_calibrate_evaluate_report() {
     ]);
     let c = json(&run_ok(&["calibrate", drive.to_str().unwrap(), "--json"]));
     eprintln!("comma2k19 calibration: {c}");
+    // TedriS cannot train on this 60 s of nearly straight road, and says
+    // which requirement failed and by how much (it used to point at
+    // init_samples, which was not the one).
+    let model = tmp.path().join("model.json");
+    let e = run_err(&[
+        "tedris",
+        "train",
+        drive.to_str().unwrap(),
+        "--out",
+        model.to_str().unwrap(),
+    ]);
+    let msg = String::from_utf8_lossy(&e.stderr);
+    assert!(
+        msg.contains("cross-correlation peak") && msg.contains("min_ccf_peak needs 0.3"),
+        "{msg}"
+    );
+    assert!(!model.exists());
     let mut finals = Vec::new();
     for len in ["20", "40"] {
         let o = json(&run_ok(&[

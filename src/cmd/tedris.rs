@@ -37,7 +37,10 @@ impl Reference {
 /// The regression.
 #[derive(ValueEnum, Clone, Copy, Debug)]
 pub enum Kind {
-    /// Chosen by the residual statistics (smallest BIC with white final innovations).
+    /// Chosen on the data: with the joint calibration (the default), the kind
+    /// whose calibrated heading has the smallest residual on held-back data
+    /// (paper or distance with a GNSS course); without it, the smallest BIC
+    /// among kinds with white final innovations.
     Auto,
     /// The paper's γ = α0 + α1·ω.
     Paper,
@@ -73,7 +76,8 @@ pub enum TedrisCommand {
         /// Fit each repository separately, as in the paper (default: pooled slopes).
         #[arg(long)]
         separate_repositories: bool,
-        /// A TedriS configuration (JSON; missing keys take their defaults).
+        /// A TedriS configuration (JSON; missing keys take their defaults; every
+        /// key with its unit and default: docs/tedris.md).
         #[arg(long)]
         config: Option<PathBuf>,
         /// Train only on data from this time on, s (drive clock).
@@ -232,27 +236,34 @@ pub fn run(c: TedrisCommand) -> Result<()> {
                     "reference heading: {:?}; errors against {}",
                     r.source, r.reference
                 );
+                // The threshold column only when it is not the 1 m one.
+                let extra = (threshold_m != 1.0).then(|| format!("to_{threshold_m}m_s"));
                 println!(
-                    "{:>9} {:>9} {:>10} {:>9} {:>10} {:>12} {:>12}",
+                    "{:>9} {:>9} {:>10} {:>9} {:>10} {:>12}{}",
                     "start_s",
                     "end_s",
                     "mean_m",
                     "max_m",
                     "final_m",
                     "to_1m_s",
-                    format!("to_{threshold_m}m_s")
+                    extra
+                        .as_ref()
+                        .map_or(String::new(), |h| format!(" {h:>12}"))
                 );
                 let opt = |v: Option<f64>| v.map_or("never".to_string(), |x| format!("{x:.1}"));
                 for o in &r.outages {
                     println!(
-                        "{:>9.1} {:>9.1} {:>10.2} {:>9.2} {:>10.2} {:>12} {:>12}",
+                        "{:>9.1} {:>9.1} {:>10.2} {:>9.2} {:>10.2} {:>12}{}",
                         o.start_s,
                         o.end_s,
                         o.mean_error_m,
                         o.max_error_m,
                         o.final_error_m,
                         opt(o.time_to_1m_s),
-                        opt(o.time_to_threshold_s)
+                        extra.as_ref().map_or(String::new(), |_| format!(
+                            " {:>12}",
+                            opt(o.time_to_threshold_s)
+                        ))
                     );
                 }
                 if let Some(p) = &out {
@@ -281,6 +292,8 @@ fn train_json(m: &TedrisModel, source: ReferenceSource) -> serde_json::Value {
         "dcf_distance_rad_per_m": m.dcf_distance_rad_per_m,
         "gyro_bias": m.gyro_bias,
         "turn_gain": m.turn_gain,
+        "per_metre_straight": m.per_metre_straight,
+        "course_convention": m.course_convention,
         "complete": m.complete,
         "fill": m.repositories.fill(m.config.required_bins),
         "fits": m.fits,
@@ -311,10 +324,28 @@ fn print_train(m: &TedrisModel, source: ReferenceSource) {
         s.w_high_m,
         eps
     );
-    println!(
-        "DCF0 = {:.3e} rad/sample, DCF = {:.3e} rad/sample + {:.3e} rad/m, turn gain = {:.4}",
-        m.dcf0_rad, m.dcf_rad, m.dcf_distance_rad_per_m, m.turn_gain
-    );
+    if m.per_metre_straight {
+        // Heading per metre as the rear radius mismatch it is.
+        println!(
+            "straight-line heading {:.3e} rad/m (per metre only: none at rest), turn gain = {:.4}",
+            m.dcf_distance_rad_per_m, m.turn_gain
+        );
+    } else {
+        println!(
+            "DCF0 = {:.3e} rad/sample, DCF = {:.3e} rad/sample + {:.3e} rad/m, turn gain = {:.4}",
+            m.dcf0_rad, m.dcf_rad, m.dcf_distance_rad_per_m, m.turn_gain
+        );
+    }
+    match &m.course_convention {
+        Some(c) => println!(
+            "course convention found on the data: {:?} (residual as body yaw / as antenna course = {:.3})",
+            c.convention, c.rss_ratio
+        ),
+        None if source == ReferenceSource::GnssCourse => {
+            println!("course convention: not decided on the data (taken as the antenna's velocity)")
+        }
+        None => {}
+    }
     for f in &m.fits {
         let mark = if f.kind == m.chosen {
             "  <- chosen"

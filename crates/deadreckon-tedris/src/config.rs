@@ -49,7 +49,9 @@ pub enum ModelChoice {
     /// output, as in dead reckoning) among those whose residuals, after the AR/MA
     /// correction if one was needed, pass Ljung–Box; the smallest overall otherwise.
     /// With `joint_calibration`, each calibration then takes the kind whose
-    /// calibrated heading has the smallest residual against the reference.
+    /// calibrated heading has the smallest residual on the held-back quarter
+    /// of its window (not on the data it was fitted on); in the per-metre form
+    /// (a GNSS course) only the paper and distance kinds are candidates.
     Auto,
     /// Always this kind.
     Fixed(ModelKind),

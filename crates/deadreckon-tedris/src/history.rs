@@ -35,6 +35,10 @@ pub struct Sample {
     /// course or an outage. Heading fits give each segment its own intercept.
     #[serde(default)]
     pub segment: u32,
+    /// The lever-arm angle atan(l·ψ̇/v) taken off the course to make
+    /// `theta_rad` (0 for a gyro reference or a body-yaw course), rad.
+    #[serde(default)]
+    pub lever_rad: f64,
 }
 
 impl Sample {

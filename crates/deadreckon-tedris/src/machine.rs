@@ -154,6 +154,16 @@ pub struct Tedris {
     /// replace, or at a physical bound.
     #[serde(default)]
     refused_calibrations: u64,
+    /// Why no model exists yet: the requirement that failed last, with numbers.
+    #[serde(default)]
+    untrained_because: Option<String>,
+    /// The course convention found on the data (see [`course_convention`]),
+    /// once decided; until then the course is taken as the antenna's.
+    #[serde(default)]
+    convention: Option<CourseConvention>,
+    /// The convention's fit when it was decided before the first model.
+    #[serde(default)]
+    pending_convention: Option<ConventionFit>,
 }
 
 impl Tedris {
@@ -198,6 +208,9 @@ impl Tedris {
             segment: 0,
             inconsistent_headings: 0,
             refused_calibrations: 0,
+            untrained_because: None,
+            convention: None,
+            pending_convention: None,
         })
     }
 
@@ -215,6 +228,7 @@ impl Tedris {
         );
         former.use_mean = c.block_mean;
         m.former = Some(former);
+        m.convention = model.course_convention.map(|c| c.convention);
         m.model = Some(model);
         m.fix_slt_window();
         Ok(m)
@@ -264,6 +278,12 @@ impl Tedris {
     /// or reaching a physical bound).
     pub fn refused_calibrations(&self) -> u64 {
         self.refused_calibrations
+    }
+
+    /// Without a model: the training requirement that failed last, with its
+    /// numbers (e.g. too few synchronised samples, too little turning).
+    pub fn untrained_because(&self) -> Option<&str> {
+        self.untrained_because.as_deref()
     }
 
     /// Heading segments started so far.
@@ -341,6 +361,7 @@ impl Tedris {
             theta_rad: None,
             theta_dr_rad: self.theta_dr,
             segment: 0,
+            lever_rad: 0.0,
         });
         self.flush_headings(w.t_s);
         if !self.deferred_pairs.is_empty() {
@@ -534,7 +555,9 @@ impl Tedris {
                 usable = false;
             } else {
                 let yaw_rate = sw / self.geometry.track_rear_m / st;
-                lever = (self.geometry.lever_arm_m * yaw_rate / v).atan();
+                if self.convention.is_none_or(|c| c.is_antenna()) {
+                    lever = (self.geometry.lever_arm_m * yaw_rate / v).atan();
+                }
                 let consistent = prev.is_some_and(|p| {
                     gap_ok(&p)
                         && (wrap(hs.yaw_rad - p.2) - self.wheel_turn(p.0, hs.t_s)).abs()
@@ -592,9 +615,11 @@ impl Tedris {
                 1.0
             };
             let th = thp + a * (theta_m - thp);
+            let lever_p = prev.map_or(0.0, |p| p.1 - p.3);
             if let Some(m) = self.history.get_mut(idx) {
                 m.theta_rad = Some(th);
                 m.segment = self.segment;
+                m.lever_rad = lever_p + a * (lever - lever_p);
             }
             assigned.push((idx, s.t_s, th));
         }
@@ -681,11 +706,17 @@ impl Tedris {
     fn train(&mut self, t: f64) {
         let final_upto = self.pending_from.saturating_sub(1);
         if self.model.is_none() {
-            if t - self.last_init_try_t >= 1.0
-                && self.history.gamma_count() >= self.config.init_samples
-            {
-                self.last_init_try_t = t;
-                self.init(t, final_upto);
+            if t - self.last_init_try_t >= 1.0 {
+                let n = self.history.gamma_count();
+                if n >= self.config.init_samples {
+                    self.last_init_try_t = t;
+                    self.init(t, final_upto);
+                } else {
+                    self.untrained_because = Some(format!(
+                        "{n} wheel samples have a synchronised reference heading on both sides; init_samples needs {}",
+                        self.config.init_samples
+                    ));
+                }
             }
             return;
         }
@@ -731,8 +762,17 @@ impl Tedris {
         let peak = ccf_peak_value(&ccf);
         let full = self.history.len() >= self.history.capacity();
         if peak < self.config.min_ccf_peak && !full {
+            self.untrained_because = Some(format!(
+                "the cross-correlation peak of ω and γ is {peak:.3}; min_ccf_peak needs {} (too little turning yet)",
+                self.config.min_ccf_peak
+            ));
             return;
         }
+        let ccf = if self.decide_convention() {
+            masked_ccf(&self.history, self.config.max_lag_samples)
+        } else {
+            ccf
+        };
         self.rebuild(t, final_upto, ccf);
     }
 
@@ -753,6 +793,11 @@ impl Tedris {
         former.use_mean = c.block_mean;
         let tuples = former.form(&self.history, final_upto);
         let Some(straight) = straight_line(&tuples, c.epsilon_factor) else {
+            self.untrained_because = Some(format!(
+                "{} blocks of tau_samples = {} are too few for the straight-line parameters",
+                tuples.len(),
+                c.tau_samples
+            ));
             return false;
         };
         let mut repos = Repositories::new(straight, c.min_fill, c.max_fill);
@@ -764,6 +809,11 @@ impl Tedris {
         match TedrisModel::fit(c.clone(), period, lag, ccf, repos) {
             Ok(mut model) => {
                 model.per_metre_straight = per_metre;
+                model.course_convention = self
+                    .model
+                    .as_ref()
+                    .and_then(|m| m.course_convention)
+                    .or(self.pending_convention);
                 model.settle_kind();
                 self.recent = tuples.iter().rev().take(32).rev().copied().collect();
                 self.model = Some(model);
@@ -771,10 +821,54 @@ impl Tedris {
                 self.former = Some(former);
                 self.last_refit_t = t;
                 self.update_dcf(t);
+                self.untrained_because = None;
                 true
             }
-            Err(_) => false,
+            Err(e) => {
+                if self.model.is_none() {
+                    self.untrained_because = Some(format!("the first fit failed: {e}"));
+                }
+                false
+            }
         }
+    }
+
+    /// Decides the course convention on the history once it can
+    /// ([`course_convention`]); with a body-yaw course the lever-arm angle is
+    /// put back on every synchronised heading. True when the headings changed.
+    fn decide_convention(&mut self) -> bool {
+        if !self.geometry.heading_is_course
+            || self.geometry.lever_arm_m == 0.0
+            || self.convention.is_some()
+        {
+            return false;
+        }
+        let Some(fit) = course_convention(&self.history, self.config.max_lag_samples) else {
+            return false;
+        };
+        self.convention = Some(fit.convention);
+        if let Some(m) = self.model.as_mut() {
+            m.course_convention = Some(fit);
+        } else {
+            self.pending_convention = Some(fit);
+        }
+        if fit.convention.is_antenna() {
+            return false;
+        }
+        let idx: Vec<u64> = self.history.iter().map(|s| s.idx).collect();
+        for i in idx {
+            if let Some(s) = self.history.get_mut(i) {
+                if let Some(th) = s.theta_rad.as_mut() {
+                    *th += s.lever_rad;
+                }
+                s.lever_rad = 0.0;
+            }
+        }
+        // The last heading's value too, for the next interpolation.
+        if let Some(h) = self.last_heading.as_mut() {
+            h.3 = h.1;
+        }
+        true
     }
 
     /// The lag h: from the heading fit ([`heading_lag`]) when `lag_from_heading`
@@ -794,6 +888,14 @@ impl Tedris {
     /// regressions are refitted on the repositories as they are.
     fn refit(&mut self, t: f64) {
         self.last_refit_t = t;
+        if self.convention.is_none() && self.decide_convention() {
+            // The history's headings changed: rebuild the blocks on them.
+            let final_upto = self.pending_from.saturating_sub(1);
+            let ccf = masked_ccf(&self.history, self.config.max_lag_samples);
+            if self.rebuild(t, final_upto, ccf) {
+                return;
+            }
+        }
         let Some(old) = &self.model else { return };
         let ccf = masked_ccf(&self.history, self.config.max_lag_samples);
         let better =
@@ -805,6 +907,7 @@ impl Tedris {
             }
         }
         let Some(old) = &self.model else { return };
+        let convention = old.course_convention;
         let (gain, per_metre, dist, dcf, joint) = (
             old.turn_gain,
             old.per_metre_straight,
@@ -821,6 +924,7 @@ impl Tedris {
         ) {
             m.turn_gain = gain;
             m.per_metre_straight = per_metre;
+            m.course_convention = convention;
             m.settle_kind();
             if joint {
                 // The calibrated values stand until a calibration beats them.
@@ -1251,6 +1355,127 @@ pub fn heading_lag(h: &History, max_lag: usize) -> Option<i64> {
         }
     }
     best.map(|b| b.1)
+}
+
+/// What a GNSS course is the direction of.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CourseConvention {
+    /// The antenna's velocity: the rear-axle heading plus atan(l·ψ̇/v).
+    AntennaVelocity,
+    /// The body's yaw (receivers fusing an IMU or two antennas).
+    BodyYaw,
+}
+
+impl CourseConvention {
+    /// True for [`CourseConvention::AntennaVelocity`].
+    pub fn is_antenna(self) -> bool {
+        self == CourseConvention::AntennaVelocity
+    }
+}
+
+/// The convention found on a drive, with its evidence.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ConventionFit {
+    /// The convention chosen.
+    pub convention: CourseConvention,
+    /// Residual sum of squares of the heading fit taking the course as the
+    /// body's yaw over that taking it as the antenna's (each at its best lag).
+    pub rss_ratio: f64,
+}
+
+/// Which convention the synchronised headings of `h` support: the heading
+/// (with the lever-arm angle taken off, as for an antenna course) is fitted on
+/// the wheels' cumulative sums at the best lag within ±`max_lag` plus a column of the lever-arm
+/// angle λ, with an intercept per heading segment. If the course is the
+/// antenna's, λ's coefficient is 0; if it is the body's yaw, taking λ off was
+/// wrong and the coefficient is −1. `None` while the data cannot tell (a
+/// standard error above 0.15: too few turns at low speed).
+pub fn course_convention(h: &History, max_lag: usize) -> Option<ConventionFit> {
+    let samples: Vec<&Sample> = h.iter().collect();
+    let (mut w, mut d) = (0.0, 0.0);
+    let mut cum = Vec::with_capacity(samples.len());
+    for s in &samples {
+        w += s.omega_m;
+        d += s.dist_m;
+        cum.push((w, d));
+    }
+    let ml = max_lag as i64;
+    // The smallest residual over the lags, for the heading as an antenna
+    // course (θ, the lever angle taken off) and as a body yaw (θ + λ): the
+    // heading on [Σω, Σd, k] with an intercept per segment (segments are
+    // runs of consecutive samples), by the normal equations.
+    let best_rss = |body: bool| -> Option<(f64, usize)> {
+        let mut best: Option<(f64, usize)> = None;
+        let mut rows: Vec<([f64; 4], u32)> = Vec::with_capacity(samples.len());
+        for lag in -ml..=ml {
+            rows.clear();
+            for (j, s) in samples.iter().enumerate() {
+                let Some(th) = s.theta_rad else { continue };
+                let Some(&(cw, cd)) = usize::try_from(j as i64 - lag)
+                    .ok()
+                    .and_then(|i| cum.get(i))
+                else {
+                    continue;
+                };
+                let th = if body { th + s.lever_rad } else { th };
+                rows.push(([cw, cd, j as f64, th], s.segment));
+            }
+            if rows.len() < 500 {
+                return None;
+            }
+            let mut xtx = vec![vec![0.0; 3]; 3];
+            let mut xty = [0.0; 3];
+            let mut yty = 0.0;
+            for run in rows.chunk_by(|a, b| a.1 == b.1) {
+                let n = run.len() as f64;
+                let mut m = [0.0; 4];
+                for (r, _) in run {
+                    for (a, v) in m.iter_mut().zip(r) {
+                        *a += v / n;
+                    }
+                }
+                for (r, _) in run {
+                    let c = [r[0] - m[0], r[1] - m[1], r[2] - m[2], r[3] - m[3]];
+                    for i in 0..3 {
+                        xty[i] += c[i] * c[3];
+                        for j in 0..3 {
+                            xtx[i][j] += c[i] * c[j];
+                        }
+                    }
+                    yty += c[3] * c[3];
+                }
+            }
+            let Some(inv) = crate::stats::invert(&xtx) else {
+                continue;
+            };
+            let beta: Vec<f64> = (0..3)
+                .map(|i| (0..3).map(|j| inv[i][j] * xty[j]).sum())
+                .collect();
+            let rss = yty - (0..3).map(|i| beta[i] * xty[i]).sum::<f64>();
+            if rss.is_finite() && best.is_none_or(|b| rss < b.0) {
+                best = Some((rss, rows.len()));
+            }
+        }
+        best
+    };
+    let (antenna, n) = best_rss(false)?;
+    let (body, _) = best_rss(true)?;
+    // Decided only on a clear difference (10 % of the residual): an antenna
+    // course looks like a body yaw delayed by l/v, which a lag imitates at
+    // one speed, so only speed changes in turns tell them apart.
+    let ratio = body / antenna;
+    if (ratio - 1.0).abs() < 0.1 || n < 500 {
+        return None;
+    }
+    Some(ConventionFit {
+        convention: if ratio < 1.0 {
+            CourseConvention::BodyYaw
+        } else {
+            CourseConvention::AntennaVelocity
+        },
+        rss_ratio: ratio,
+    })
 }
 
 fn ccf_peak_value(c: &crate::ccf::CrossCorrelation) -> f64 {

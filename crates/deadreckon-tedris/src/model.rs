@@ -286,6 +286,11 @@ pub struct TedrisModel {
     /// per-sample DCF (its bias is per unit time).
     #[serde(default)]
     pub per_metre_straight: bool,
+    /// The course convention found on the training data (None: a gyro
+    /// reference, no lever arm, or too few turns at low speed to tell; the
+    /// course is then taken as the antenna's).
+    #[serde(default)]
+    pub course_convention: Option<crate::machine::ConventionFit>,
     /// Every required repository reached its minimum fill.
     pub complete: bool,
     /// g: gain on the turning part of γ̂ (1 = the regression as fitted), estimated
@@ -353,6 +358,7 @@ impl TedrisModel {
             dcf_distance_rad_per_m: 0.0,
             gyro_bias: None,
             per_metre_straight: false,
+            course_convention: None,
             dcf_bound_rad: 0.0,
             straight_omega,
             straight_sigma_m,

@@ -152,10 +152,11 @@ pub fn train(
     }
     feed(&mut m, &input.events);
     let model = m.model().cloned().ok_or_else(|| {
-        Error::Insufficient(
-            "not enough synchronised samples with a reference heading to train (see init_samples)"
-                .into(),
-        )
+        Error::Insufficient(format!(
+            "cannot train on this drive: {}",
+            m.untrained_because()
+                .unwrap_or("no reference heading reached the machine")
+        ))
     })?;
     let refit = TedrisModel::fit(
         model.config.clone(),
@@ -173,6 +174,7 @@ pub fn train(
         f.dcf_distance_rad_per_m = model.dcf_distance_rad_per_m;
         f.turn_gain = model.turn_gain;
         f.per_metre_straight = model.per_metre_straight;
+        f.course_convention = model.course_convention;
         f.settle_kind();
         f
     })
