@@ -182,7 +182,7 @@
 //! | [`history`] | wheel-clock samples with the synchronised heading and its segment, block formation, per-segment centring |
 //! | [`gain`] | the turn gain from heading changes over whole segments |
 //! | [`minimise`] | Brent's bounded minimisation (eq. 6) |
-//! | [`machine`] | the state machine of section 3.3, course synchronisation (segments, consistency, convention), the joint calibration with held-back acceptance |
+//! | [`machine`] | the state machine of section 3.3 (`mod.rs`), heading synchronisation (`sync.rs`: segments, consistency, convention, anchor), training (`training.rs`), calibration (`calibration.rs`: eq. 6, the joint calibration with held-back acceptance, the heading lag) |
 //! | [`input`] | drive → events (wheels, reference heading, fixes), outage blanking |
 //! | [`outage`] | batch training and outage runs with their errors |
 //! | [`config`] | every parameter with unit and default |

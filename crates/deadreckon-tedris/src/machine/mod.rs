@@ -1,0 +1,497 @@
+//! The TedriS state machine of section 3.3, fed one sample at a time.
+//!
+//! ```text
+//!            reference heading good                  all repositories filled
+//!  Blind ────────────────────────────▶ Training ────────────────────────────▶ Update
+//!    ▲                                  ▲    │ reference lost                   │ reference lost
+//!    │ no model yet                     │    ▼                                  ▼
+//!    └──────────────────────────────── Predicting ◀─────────────────────────────┘
+//!                reference back: Training again (then Update after `retrain_s`)
+//! ```
+//!
+//! Every wheel sample advances the dead-reckoned heading by γ̂ (eq. 4–5) and the
+//! rear-axle position by the rear wheel distance along that heading. While the
+//! reference is good, the output is anchored to it: the heading offset is the mean
+//! of (reference − DR heading) over `heading_anchor_window_s`, compared at the lag h
+//! (the reference responds h samples after the wheels), and the position offset the
+//! mean of (fix, lever arm removed − DR position) over `position_anchor_window_s`.
+//! When the reference is lost both offsets freeze and the chain runs on the wheels alone.
+
+use std::collections::VecDeque;
+
+use serde::{Deserialize, Serialize};
+
+use crate::config::TedrisConfig;
+use crate::history::{centre_per_segment, masked_ccf, BlockFormer, History, Sample};
+use crate::minimise::brent;
+use crate::model::{design_row, TedrisModel};
+use crate::predict::Predictor;
+use crate::repository::{Repositories, StraightLine, Tuple};
+use crate::Error;
+use deadreckon_core::angle::wrap;
+
+mod calibration;
+mod sync;
+mod training;
+
+pub use calibration::heading_lag;
+pub use sync::{course_convention, ConventionFit, CourseConvention};
+pub use training::straight_line;
+
+/// Rear wheel distances travelled since the previous wheel sample.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct WheelSample {
+    /// Timestamp, s.
+    pub t_s: f64,
+    /// Rear-left wheel distance, m.
+    pub left_m: f64,
+    /// Rear-right wheel distance, m.
+    pub right_m: f64,
+}
+
+/// A reference heading: the GNSS course as a yaw, or the integrated gyro heading.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct HeadingSample {
+    /// Timestamp, s.
+    pub t_s: f64,
+    /// Yaw, rad, counter-clockwise from east (any branch: it is unwrapped here).
+    pub yaw_rad: f64,
+}
+
+/// A GNSS antenna position.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PositionFix {
+    /// Timestamp, s.
+    pub t_s: f64,
+    /// East, m.
+    pub east_m: f64,
+    /// North, m.
+    pub north_m: f64,
+}
+
+/// Geometry the machine needs.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Geometry {
+    /// Rear track width, m (nominal yaw rate ω / track before a model exists).
+    pub track_rear_m: f64,
+    /// GNSS antenna distance forward of the rear-axle centre, m.
+    pub lever_arm_m: f64,
+    /// The reference heading is a GNSS course (of the antenna, gated by speed);
+    /// false for a gyro heading.
+    pub heading_is_course: bool,
+}
+
+/// The phase of section 3.3.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Phase {
+    /// No reference and no model: the heading follows the nominal ω / track.
+    Blind,
+    /// Reference good, repositories not yet filled (or just back after an outage).
+    Training,
+    /// Reference good, repositories filled: DCF updates (eq. 6) and refits.
+    Update,
+    /// Reference lost: dead reckoning with the model.
+    Predicting,
+}
+
+/// The estimate after one wheel sample.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Estimate {
+    /// Timestamp, s.
+    pub t_s: f64,
+    /// Rear-axle centre, east, m.
+    pub east_m: f64,
+    /// Rear-axle centre, north, m.
+    pub north_m: f64,
+    /// Yaw, rad, counter-clockwise from east, wrapped to (−π, π].
+    pub yaw_rad: f64,
+    /// Rear wheel speed, m/s.
+    pub speed_mps: f64,
+    /// Heading rate, rad/s.
+    pub yaw_rate_rps: f64,
+    /// Phase after the sample.
+    pub phase: Phase,
+}
+
+/// The streaming TedriS estimator. Serialises to JSON with its model and buffers.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Tedris {
+    config: TedrisConfig,
+    geometry: Geometry,
+    phase: Phase,
+    model: Option<TedrisModel>,
+    history: History,
+    former: Option<BlockFormer>,
+    predictor: Predictor,
+    recent: VecDeque<Tuple>,
+    next_idx: u64,
+    pending_from: u64,
+    last_t: Option<f64>,
+    /// (time, unwrapped antenna heading, raw yaw, rear-axle heading, usable).
+    last_heading: Option<(f64, f64, f64, f64, bool)>,
+    /// GNSS courses waiting for the wheel samples after them (the lever-arm
+    /// conversion needs the yaw rate centred on the course's time).
+    #[serde(default)]
+    queued_headings: VecDeque<HeadingSample>,
+    /// Time of the last reference heading received (queued or processed).
+    #[serde(default)]
+    last_heading_in_t: Option<f64>,
+    heading_pairs: VecDeque<(f64, f64)>,
+    /// (DR sample index, time, reference heading) waiting for their DR sample.
+    #[serde(default)]
+    deferred_pairs: VecDeque<(u64, f64, f64)>,
+    position_pairs: VecDeque<(f64, f64, f64)>,
+    heading_offset: f64,
+    position_offset: (f64, f64),
+    theta_dr: f64,
+    pos_dr: (f64, f64),
+    speed_mps: f64,
+    good_since: Option<f64>,
+    last_update_t: f64,
+    last_refit_t: f64,
+    last_init_try_t: f64,
+    rejected: u64,
+    /// The current heading segment (see [`Sample::segment`]).
+    #[serde(default)]
+    segment: u32,
+    /// Reference headings refused as inconsistent with the wheels' turn.
+    #[serde(default)]
+    inconsistent_headings: u64,
+    /// Calibrations refused: worse out of sample than the model they would
+    /// replace, or at a physical bound.
+    #[serde(default)]
+    refused_calibrations: u64,
+    /// Why no model exists yet: the requirement that failed last, with numbers.
+    #[serde(default)]
+    untrained_because: Option<String>,
+    /// The course convention found on the data (see [`course_convention`]),
+    /// once decided; until then the course is taken as the antenna's.
+    #[serde(default)]
+    convention: Option<CourseConvention>,
+    /// The convention's fit when it was decided before the first model.
+    #[serde(default)]
+    pending_convention: Option<ConventionFit>,
+}
+
+impl Tedris {
+    /// A machine that trains from scratch.
+    pub fn new(config: TedrisConfig, geometry: Geometry) -> Result<Self, Error> {
+        config.validate()?;
+        if !(geometry.track_rear_m.is_finite()
+            && geometry.track_rear_m > 0.0
+            && geometry.lever_arm_m.is_finite())
+        {
+            return Err(Error::Config(format!("geometry {geometry:?} is not valid")));
+        }
+        let cap = (4 * config.init_samples).max(config.history_samples);
+        Ok(Tedris {
+            history: History::new(cap),
+            config,
+            geometry,
+            phase: Phase::Blind,
+            model: None,
+            former: None,
+            predictor: Predictor::default(),
+            recent: VecDeque::new(),
+            next_idx: 0,
+            pending_from: 0,
+            last_t: None,
+            last_heading: None,
+            queued_headings: VecDeque::new(),
+            last_heading_in_t: None,
+            heading_pairs: VecDeque::new(),
+            deferred_pairs: VecDeque::new(),
+            position_pairs: VecDeque::new(),
+            heading_offset: 0.0,
+            position_offset: (0.0, 0.0),
+            theta_dr: 0.0,
+            pos_dr: (0.0, 0.0),
+            speed_mps: 0.0,
+            good_since: None,
+            last_update_t: f64::MIN,
+            last_refit_t: f64::MIN,
+            last_init_try_t: f64::MIN,
+            rejected: 0,
+            segment: 0,
+            inconsistent_headings: 0,
+            refused_calibrations: 0,
+            untrained_because: None,
+            convention: None,
+            pending_convention: None,
+        })
+    }
+
+    /// A machine that starts from a trained model (and keeps training on new data).
+    pub fn with_model(model: TedrisModel, geometry: Geometry) -> Result<Self, Error> {
+        model.validate()?;
+        let mut m = Tedris::new(model.config.clone(), geometry)?;
+        let c = &model.config;
+        let mut former = BlockFormer::new(
+            c.tau_samples,
+            model.lag_samples,
+            1,
+            c.slt_max_change_deg.to_radians(),
+            0,
+        );
+        former.use_mean = c.block_mean;
+        m.former = Some(former);
+        m.convention = model.course_convention.map(|c| c.convention);
+        m.model = Some(model);
+        m.fix_slt_window();
+        Ok(m)
+    }
+
+    fn fix_slt_window(&mut self) {
+        if let (Some(f), Some(m)) = (self.former.as_mut(), self.model.as_ref()) {
+            f.slt_window = (self.config.slt_window_s / m.sample_period_s)
+                .round()
+                .max(1.0) as u64;
+        }
+    }
+
+    /// Sets the current pose (for drives whose frame is defined by a known start pose).
+    pub fn set_pose(&mut self, east_m: f64, north_m: f64, yaw_rad: f64) {
+        self.position_offset = (east_m - self.pos_dr.0, north_m - self.pos_dr.1);
+        self.heading_offset = yaw_rad - self.theta_dr;
+    }
+
+    /// The phase.
+    pub fn phase(&self) -> Phase {
+        self.phase
+    }
+
+    /// The model, once the first fit is done.
+    pub fn model(&self) -> Option<&TedrisModel> {
+        self.model.as_ref()
+    }
+
+    /// The recent wheel samples with their synchronised reference heading (diagnostics).
+    pub fn history(&self) -> &History {
+        &self.history
+    }
+
+    /// Samples rejected as invalid (non-finite values, time going backwards).
+    pub fn rejected(&self) -> u64 {
+        self.rejected
+    }
+
+    /// Reference headings not used because their change since the previous one
+    /// disagreed with the wheels' turn (a random course at low speed, a jump).
+    pub fn inconsistent_headings(&self) -> u64 {
+        self.inconsistent_headings
+    }
+
+    /// Calibrations refused (worse on held-back data than the current model,
+    /// or reaching a physical bound).
+    pub fn refused_calibrations(&self) -> u64 {
+        self.refused_calibrations
+    }
+
+    /// Without a model: the training requirement that failed last, with its
+    /// numbers (e.g. too few synchronised samples, too little turning).
+    pub fn untrained_because(&self) -> Option<&str> {
+        self.untrained_because.as_deref()
+    }
+
+    /// Heading segments started so far.
+    pub fn segments(&self) -> u32 {
+        self.segment
+    }
+
+    /// The state as JSON.
+    pub fn to_json(&self) -> Result<String, Error> {
+        serde_json::to_string(self).map_err(|e| Error::Json(e.to_string()))
+    }
+
+    /// A state saved by [`Tedris::to_json`].
+    pub fn from_json(s: &str) -> Result<Self, Error> {
+        let m: Tedris = serde_json::from_str(s).map_err(|e| Error::Json(e.to_string()))?;
+        m.config.validate()?;
+        if let Some(model) = &m.model {
+            model.validate()?;
+        }
+        Ok(m)
+    }
+
+    fn heading_out(&self) -> f64 {
+        self.theta_dr + self.heading_offset
+    }
+
+    fn lag(&self) -> i64 {
+        self.model.as_ref().map_or(0, |m| m.lag_samples)
+    }
+
+    /// Feeds one wheel sample; returns the estimate after it.
+    pub fn push_wheel(&mut self, w: WheelSample) -> Result<Estimate, Error> {
+        if !(w.t_s.is_finite() && w.left_m.is_finite() && w.right_m.is_finite())
+            || self.last_t.is_some_and(|t| w.t_s <= t)
+        {
+            self.rejected += 1;
+            return Err(Error::Input(format!(
+                "wheel sample at t={} s is not finite or not after the previous one",
+                w.t_s
+            )));
+        }
+        let dt = self.last_t.map_or(0.0, |t| w.t_s - t);
+        self.last_t = Some(w.t_s);
+        let omega = w.right_m - w.left_m;
+        let dist = 0.5 * (w.left_m + w.right_m);
+        let moving = crate::history::moving(omega, dist, dt);
+        let rate = match &self.model {
+            Some(m) => {
+                let per_sample = if m.per_metre_straight { 0.0 } else { m.dcf_rad };
+                let dcf = per_sample + m.dcf_distance_rad_per_m * dist;
+                let r = self.predictor.step(m, omega, dist, dcf).total_rad;
+                // Wheels at rest do not turn the car.
+                if moving {
+                    r
+                } else {
+                    0.0
+                }
+            }
+            None => omega / self.geometry.track_rear_m,
+        };
+        let before = self.heading_out();
+        self.theta_dr += rate;
+        let mid = before + 0.5 * rate;
+        self.pos_dr.0 += dist * mid.cos();
+        self.pos_dr.1 += dist * mid.sin();
+        self.speed_mps = if dt > 0.0 { dist / dt } else { 0.0 };
+        let idx = self.next_idx;
+        self.next_idx += 1;
+        self.history.push(Sample {
+            idx,
+            t_s: w.t_s,
+            dt_s: dt,
+            omega_m: omega,
+            dist_m: dist,
+            theta_rad: None,
+            theta_dr_rad: self.theta_dr,
+            segment: 0,
+            lever_rad: 0.0,
+        });
+        self.flush_headings(w.t_s);
+        if !self.deferred_pairs.is_empty() {
+            self.resolve_pairs(w.t_s);
+        }
+        self.advance_phase(w.t_s);
+        let (e, n) = (
+            self.pos_dr.0 + self.position_offset.0,
+            self.pos_dr.1 + self.position_offset.1,
+        );
+        Ok(Estimate {
+            t_s: w.t_s,
+            east_m: e,
+            north_m: n,
+            yaw_rad: wrap(self.heading_out()),
+            speed_mps: self.speed_mps,
+            yaw_rate_rps: if dt > 0.0 { rate / dt } else { 0.0 },
+            phase: self.phase,
+        })
+    }
+
+    fn advance_phase(&mut self, t: f64) {
+        let ref_ok = self
+            .last_heading_in_t
+            .is_some_and(|h| t - h <= self.config.reference_timeout_s);
+        match (self.phase, ref_ok) {
+            (Phase::Training | Phase::Update, false) => self.start_outage(),
+            (Phase::Predicting | Phase::Blind, true) => {
+                self.predictor.end_correction();
+                self.good_since = Some(t);
+                self.phase = Phase::Training;
+            }
+            (Phase::Training, true) => {
+                let ready = self.model.as_ref().is_some_and(|m| m.complete);
+                if ready
+                    && self
+                        .good_since
+                        .is_some_and(|g| t - g >= self.config.retrain_s)
+                {
+                    self.phase = Phase::Update;
+                    self.update_dcf(t);
+                }
+            }
+            (Phase::Update, true) => {
+                if self.last_refit_t == f64::MIN {
+                    // A loaded model: the first refit comes one interval from now.
+                    self.last_refit_t = t;
+                }
+                if t - self.last_refit_t >= self.config.refit_interval_s {
+                    self.refit(t);
+                } else if t - self.last_update_t >= self.config.update_interval_s {
+                    self.update_dcf(t);
+                }
+            }
+            (Phase::Predicting | Phase::Blind, false) => {}
+        }
+    }
+
+    fn start_outage(&mut self) {
+        let Some(model) = &self.model else {
+            self.phase = Phase::Blind;
+            return;
+        };
+        let fit = model.chosen_fit();
+        let tau = model.config.tau_samples as u64;
+        // The trailing run of contiguous blocks.
+        let mut run: Vec<&Tuple> = Vec::new();
+        for t in self.recent.iter().rev() {
+            if run.last().is_some_and(|l| l.seq != t.seq + tau) {
+                break;
+            }
+            run.push(t);
+        }
+        run.reverse();
+        let e: Vec<f64> = run
+            .iter()
+            .filter_map(|t| {
+                let r = design_row(fit.kind, t)?;
+                let n = model.straight().bin(t.omega_m)?;
+                Some(t.gamma_rad - fit.beta(n).iter().zip(&r).map(|(a, b)| a * b).sum::<f64>())
+            })
+            .collect();
+        let u = fit.correction().innovations(&e);
+        let skipped = run.last().map_or(0, |l| {
+            (self.next_idx.saturating_sub(l.seq + tau) / tau) as usize
+        });
+        let model = model.clone();
+        self.predictor.begin_correction(&model, e, u, skipped);
+        self.phase = Phase::Predicting;
+    }
+
+    /// Feeds one GNSS antenna position.
+    pub fn push_fix(&mut self, f: PositionFix) -> Result<(), Error> {
+        if !(f.t_s.is_finite() && f.east_m.is_finite() && f.north_m.is_finite()) {
+            self.rejected += 1;
+            return Err(Error::Input(format!("fix at t={} s is not finite", f.t_s)));
+        }
+        let Some(t_last) = self.last_t else {
+            return Ok(());
+        };
+        let yaw = self.heading_out();
+        let ahead = (f.t_s - t_last).clamp(-1.0, 1.0) * self.speed_mps;
+        let (pe, pn) = (
+            self.pos_dr.0 + ahead * yaw.cos(),
+            self.pos_dr.1 + ahead * yaw.sin(),
+        );
+        let l = self.geometry.lever_arm_m;
+        let (me, mn) = (f.east_m - l * yaw.cos(), f.north_m - l * yaw.sin());
+        self.position_pairs.push_back((f.t_s, me - pe, mn - pn));
+        let win = self.config.position_anchor_window_s;
+        while self
+            .position_pairs
+            .front()
+            .is_some_and(|p| f.t_s - p.0 > win)
+        {
+            self.position_pairs.pop_front();
+        }
+        let n = self.position_pairs.len() as f64;
+        self.position_offset = (
+            self.position_pairs.iter().map(|p| p.1).sum::<f64>() / n,
+            self.position_pairs.iter().map(|p| p.2).sum::<f64>() / n,
+        );
+        Ok(())
+    }
+}

@@ -1,0 +1,244 @@
+//! Training: the first fit (lag, blocks, straight line, repositories), the
+//! refits, and the turn gain of module `gain` (without the joint calibration).
+
+use super::*;
+
+impl Tedris {
+    /// Forms blocks and fits, after new samples were synchronised.
+    pub(super) fn train(&mut self, t: f64) {
+        let final_upto = self.pending_from.saturating_sub(1);
+        if self.model.is_none() {
+            if t - self.last_init_try_t >= 1.0 {
+                let n = self.history.gamma_count();
+                if n >= self.config.init_samples {
+                    self.last_init_try_t = t;
+                    self.init(t, final_upto);
+                } else {
+                    self.untrained_because = Some(format!(
+                        "{n} wheel samples have a synchronised reference heading on both sides; init_samples needs {}",
+                        self.config.init_samples
+                    ));
+                }
+            }
+            return;
+        }
+        let Some(former) = self.former.as_mut() else {
+            return;
+        };
+        let tuples = former.form(&self.history, final_upto);
+        let Some(model) = self.model.as_mut() else {
+            return;
+        };
+        for tu in tuples {
+            model.repositories.insert(tu);
+            self.recent.push_back(tu);
+        }
+        while self.recent.len() > 32 {
+            self.recent.pop_front();
+        }
+        if !model.complete && model.repositories.complete(model.config.required_bins) {
+            self.refit(t);
+        }
+    }
+
+    pub(super) fn sample_period(&self) -> f64 {
+        let dts: Vec<f64> = self
+            .history
+            .iter()
+            .map(|s| s.dt_s)
+            .filter(|d| d.is_finite() && *d > 0.0)
+            .collect();
+        let p = crate::stats::median(&dts);
+        if p.is_finite() {
+            p
+        } else {
+            0.04
+        }
+    }
+
+    /// First fit: the lag from the cross-correlation over the history, the blocks,
+    /// the straight-line band and the repositories. Waits (returns) while the
+    /// cross-correlation peak is below `min_ccf_peak` (too little turning yet).
+    pub(super) fn init(&mut self, t: f64, final_upto: u64) {
+        let ccf = masked_ccf(&self.history, self.config.max_lag_samples);
+        let peak = ccf_peak_value(&ccf);
+        let full = self.history.len() >= self.history.capacity();
+        if peak < self.config.min_ccf_peak && !full {
+            self.untrained_because = Some(format!(
+                "the cross-correlation peak of ω and γ is {peak:.3}; min_ccf_peak needs {} (too little turning yet)",
+                self.config.min_ccf_peak
+            ));
+            return;
+        }
+        let ccf = if self.decide_convention() {
+            masked_ccf(&self.history, self.config.max_lag_samples)
+        } else {
+            ccf
+        };
+        self.rebuild(t, final_upto, ccf);
+    }
+
+    /// Rebuilds the repositories from the history with the lag of `ccf`.
+    pub(super) fn rebuild(
+        &mut self,
+        t: f64,
+        final_upto: u64,
+        ccf: crate::ccf::CrossCorrelation,
+    ) -> bool {
+        let c = &self.config;
+        let lag = self.choose_lag(&ccf);
+        let period = self.sample_period();
+        let slt_window = (c.slt_window_s / period).round().max(1.0) as u64;
+        let start = self.history.span().map_or(0, |s| s.0);
+        let mut former = BlockFormer::new(
+            c.tau_samples,
+            lag,
+            slt_window,
+            c.slt_max_change_deg.to_radians(),
+            start,
+        );
+        former.use_mean = c.block_mean;
+        let tuples = former.form(&self.history, final_upto);
+        let Some(straight) = straight_line(&tuples, c.epsilon_factor) else {
+            self.untrained_because = Some(format!(
+                "{} blocks of tau_samples = {} are too few for the straight-line parameters",
+                tuples.len(),
+                c.tau_samples
+            ));
+            return false;
+        };
+        let mut repos = Repositories::new(straight, c.min_fill, c.max_fill);
+        for tu in &tuples {
+            repos.insert(*tu);
+        }
+        let per_metre =
+            c.per_metre_straight && c.joint_calibration && self.geometry.heading_is_course;
+        match TedrisModel::fit(c.clone(), period, lag, ccf, repos) {
+            Ok(mut model) => {
+                model.per_metre_straight = per_metre;
+                model.course_convention = self
+                    .model
+                    .as_ref()
+                    .and_then(|m| m.course_convention)
+                    .or(self.pending_convention);
+                model.settle_kind();
+                self.recent = tuples.iter().rev().take(32).rev().copied().collect();
+                self.model = Some(model);
+                self.estimate_gain();
+                self.former = Some(former);
+                self.last_refit_t = t;
+                self.update_dcf(t);
+                self.untrained_because = None;
+                true
+            }
+            Err(e) => {
+                if self.model.is_none() {
+                    self.untrained_because = Some(format!("the first fit failed: {e}"));
+                }
+                false
+            }
+        }
+    }
+
+    /// The lag h: from the heading fit ([`heading_lag`]) when `lag_from_heading`
+    /// is on and it has the data, else at the cross-correlation peak.
+    pub(super) fn choose_lag(&self, ccf: &crate::ccf::CrossCorrelation) -> i64 {
+        let from_ccf = ccf.peak_lag_within(self.config.lag_tolerance);
+        if self.config.lag_from_heading {
+            heading_lag(&self.history, self.config.max_lag_samples).unwrap_or(from_ccf)
+        } else {
+            from_ccf
+        }
+    }
+
+    /// Refit. Until training first completes, the lag is re-estimated on the
+    /// history, and a different lag with a higher correlation peak rebuilds the
+    /// repositories from the history; otherwise (and always once complete) the
+    /// regressions are refitted on the repositories as they are.
+    pub(super) fn refit(&mut self, t: f64) {
+        self.last_refit_t = t;
+        if self.convention.is_none() && self.decide_convention() {
+            // The history's headings changed: rebuild the blocks on them.
+            let final_upto = self.pending_from.saturating_sub(1);
+            let ccf = masked_ccf(&self.history, self.config.max_lag_samples);
+            if self.rebuild(t, final_upto, ccf) {
+                return;
+            }
+        }
+        let Some(old) = &self.model else { return };
+        let ccf = masked_ccf(&self.history, self.config.max_lag_samples);
+        let better =
+            self.config.lag_from_heading || ccf_peak_value(&ccf) > ccf_peak_value(&old.ccf);
+        if !old.complete && self.choose_lag(&ccf) != old.lag_samples && better {
+            let final_upto = self.pending_from.saturating_sub(1);
+            if self.rebuild(t, final_upto, ccf) {
+                return;
+            }
+        }
+        let Some(old) = &self.model else { return };
+        let convention = old.course_convention;
+        let (gain, per_metre, dist, dcf, joint) = (
+            old.turn_gain,
+            old.per_metre_straight,
+            old.dcf_distance_rad_per_m,
+            old.dcf_rad,
+            old.config.joint_calibration,
+        );
+        if let Ok(mut m) = TedrisModel::fit(
+            old.config.clone(),
+            old.sample_period_s,
+            old.lag_samples,
+            old.ccf.clone(),
+            old.repositories.clone(),
+        ) {
+            m.turn_gain = gain;
+            m.per_metre_straight = per_metre;
+            m.course_convention = convention;
+            m.settle_kind();
+            if joint {
+                // The calibrated values stand until a calibration beats them.
+                m.dcf_distance_rad_per_m = dist;
+                m.dcf_rad = dcf;
+            }
+            self.model = Some(m);
+        }
+        self.estimate_gain();
+        self.update_dcf(t);
+    }
+
+    pub(super) fn estimate_gain(&mut self) {
+        let Some(model) = self.model.as_mut() else {
+            return;
+        };
+        if !model.config.turn_gain || model.config.joint_calibration {
+            return;
+        }
+        let samples: Vec<Sample> = self.history.iter().copied().collect();
+        let seg = (model.config.gain_segment_s / model.sample_period_s).round() as usize;
+        if let Some(g) = crate::gain::estimate_turn_gain(model, &samples, seg) {
+            model.turn_gain = g;
+        }
+    }
+}
+
+pub(super) fn ccf_peak_value(c: &crate::ccf::CrossCorrelation) -> f64 {
+    c.values.iter().copied().fold(f64::MIN, f64::max)
+}
+
+/// The straight-line parameters from the blocks flagged straight; the quietest
+/// tenth of the blocks (smallest |γ|) stand in when fewer than 10 are flagged.
+pub fn straight_line(tuples: &[Tuple], epsilon_factor: Option<f64>) -> Option<StraightLine> {
+    let flagged: Vec<f64> = tuples
+        .iter()
+        .filter(|t| t.straight)
+        .map(|t| t.omega_m)
+        .collect();
+    if flagged.len() >= 10 {
+        return StraightLine::from_omegas(&flagged, epsilon_factor, false);
+    }
+    let mut by_gamma: Vec<&Tuple> = tuples.iter().collect();
+    by_gamma.sort_by(|a, b| a.gamma_rad.abs().total_cmp(&b.gamma_rad.abs()));
+    let k = (tuples.len() / 10).max(3).min(tuples.len());
+    let quiet: Vec<f64> = by_gamma[..k].iter().map(|t| t.omega_m).collect();
+    StraightLine::from_omegas(&quiet, epsilon_factor, true)
+}
