@@ -5,7 +5,7 @@
 //! A member is a **car** (drawn from a car seed: geometry, tyre radii, wheel
 //! speed noise kind and level, wheel rate, the GNSS receiver's rate, noise,
 //! slowly wandering position error, course convention and what it reports at
-//! low speed) driving a **drive** (drawn from a drive seed: a random open route
+//! low speed, latency) driving a **drive** (drawn from a drive seed: a random open route
 //! of straights, turns, roundabouts and stops, its length, the streams' clock
 //! phases). Training on one drive of a car and predicting on another drive of
 //! the same car is the use the TedriS tests make of it.
@@ -55,6 +55,9 @@ pub struct CarFamily {
     pub gnss_std_m: f64,
     /// Gauss–Markov GNSS position error, m, and its correlation time, s.
     pub gnss_markov: (f64, f64),
+    /// GNSS latency (the fixes describe the car this long before their time
+    /// stamps), s.
+    pub gnss_latency_s: f64,
     /// GNSS velocity noise, m/s.
     pub velocity_std_mps: f64,
     /// Speed below which the receiver has no course, m/s.
@@ -134,6 +137,9 @@ impl CarFamily {
             min_course_speed_mps: between(r, 0.3, 1.5),
             low_speed_course,
             course_convention,
+            // Drawn last: the values above are those of the family before
+            // latencies were added.
+            gnss_latency_s: between(r, 0.0, 0.15),
         }
     }
 
@@ -192,6 +198,7 @@ impl CarFamily {
             course_convention: self.course_convention,
             markov_std_m: self.gnss_markov.0,
             markov_tau_s: self.gnss_markov.1,
+            latency_s: self.gnss_latency_s,
         };
         Scenario {
             name: format!("car-family-{}-drive-{seed}", self.seed),

@@ -129,6 +129,10 @@ pub struct GnssSpec {
     /// Correlation time of the Gauss–Markov position error, s (default 60).
     #[serde(default = "default_markov_tau")]
     pub markov_tau_s: f64,
+    /// Latency: each fix describes the vehicle this long before its time
+    /// stamp, s (default 0; u-blox receivers are about 0.1 s late).
+    #[serde(default)]
+    pub latency_s: f64,
 }
 
 impl GnssSpec {
@@ -144,6 +148,7 @@ impl GnssSpec {
             course_convention: CourseConvention::default(),
             markov_std_m: 0.0,
             markov_tau_s: default_markov_tau(),
+            latency_s: 0.0,
         }
     }
 }
@@ -254,6 +259,7 @@ impl SensorsSpec {
             v.push(("sensors.gnss.min_course_speed_mps", g.min_course_speed_mps));
             v.push(("sensors.gnss.markov_std_m", g.markov_std_m));
             v.push(("sensors.gnss.markov_tau_s", g.markov_tau_s));
+            v.push(("sensors.gnss.latency_s", g.latency_s));
         }
         v
     }
@@ -575,7 +581,7 @@ impl Suite {
             }
         }
         self.gnss.push(GnssFix {
-            t_s: st.t,
+            t_s: st.t + spec.latency_s,
             east_m,
             north_m,
             std_m: spec.std_m,

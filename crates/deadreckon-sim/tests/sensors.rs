@@ -219,3 +219,56 @@ fn removing_a_stream_keeps_the_others_noise() {
     assert!(b.drive.gnss.is_empty());
     assert_eq!(a.drive.yaw_rate, b.drive.yaw_rate);
 }
+
+#[test]
+fn gnss_latency_and_wandering_error_follow_their_models() {
+    // Latency: with no noise, each fix is the antenna 0.1 s before its stamp.
+    let mut sc = Scenario::builtin("calibration").unwrap().with_laps(1);
+    if let Some(g) = sc.sensors.gnss.as_mut() {
+        g.std_m = 1e-4;
+        g.latency_s = 0.1;
+    }
+    let out = simulate(&sc, 3).unwrap();
+    let truth = &out.drive.truth;
+    let yaws = yaw(truth);
+    let l = out.drive.vehicle.gnss_lever_arm_m;
+    let mut worst: f64 = 0.0;
+    for g in out.drive.gnss.iter().skip(1).take(500) {
+        let (x, y, psi) = truth_at(truth, &yaws, g.t_s - 0.1);
+        worst = worst.max((g.east_m - (x + l * psi.cos())).hypot(g.north_m - (y + l * psi.sin())));
+    }
+    assert!(worst < 0.02, "latency: {worst} m");
+    // Gauss–Markov: the error's std is as set, and successive errors correlate
+    // as exp(−Δt/τ).
+    let mut sc = Scenario::builtin("calibration").unwrap().with_laps(2);
+    if let Some(g) = sc.sensors.gnss.as_mut() {
+        g.std_m = 1e-4;
+        g.markov_std_m = 1.0;
+        g.markov_tau_s = 30.0;
+    }
+    let out = simulate(&sc, 4).unwrap();
+    let truth = &out.drive.truth;
+    let yaws = yaw(truth);
+    let de: Vec<f64> = out
+        .drive
+        .gnss
+        .iter()
+        .map(|g| {
+            let (x, _, psi) = truth_at(truth, &yaws, g.t_s);
+            g.east_m - (x + l * psi.cos())
+        })
+        .collect();
+    let s = std(&de);
+    let lag = 30; // fixes 30 apart
+    let dt = out.drive.gnss[lag].t_s - out.drive.gnss[0].t_s;
+    let n = de.len() - lag;
+    let m = de.iter().sum::<f64>() / de.len() as f64;
+    let r = (0..n).map(|i| (de[i] - m) * (de[i + lag] - m)).sum::<f64>() / (n as f64 * s * s);
+    eprintln!(
+        "Gauss–Markov: std {s:.3} m, correlation over {dt:.1} s {r:.3} (model {:.3})",
+        (-dt / 30.0).exp()
+    );
+    // Measured: std 0.915 m, correlation 0.573 against 0.607.
+    assert!((s - 1.0).abs() < 0.2, "std {s}");
+    assert!((r - (-dt / 30.0).exp()).abs() < 0.1, "correlation {r}");
+}

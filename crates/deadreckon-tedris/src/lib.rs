@@ -88,12 +88,13 @@
 //!   same outages.
 //!
 //! Measured on 12 cars of the simulator's randomized family
-//! (`deadreckon_sim::family`, `tests/family_outages.rs`), trained on one
-//! drive and tested on another, 24 outages of 80 s (most right after a stop):
-//! mean error 3.13 m (worst 8.04 m) against 82.3 m before these changes; the
-//! paper's method alone 55.7 m; the baseline 7.91 m. On 12 other cars (101–112)
-//! not looked at while developing: 2.19 m (worst 5.61 m), paper 47.3 m,
-//! baseline 5.96 m.
+//! (`deadreckon_sim::family`, `tests/family_outages.rs`; GNSS latencies up to
+//! 0.15 s), trained on one drive and tested on another, 24 outages of 80 s
+//! (most right after a stop): mean error 3.32 m (worst 8.04 m) against 82.3 m
+//! before these changes; the paper's method alone 72.7 m; the baseline 8.12 m.
+//! On 12 other cars (101–112) not looked at while developing: 2.22 m (worst
+//! 5.67 m), paper 45.9 m, baseline 5.16 m. The position anchor does not
+//! correct the GNSS latency (about 1 m at 10 m/s and 0.1 s).
 //!
 //! ## Beyond the paper (each can be switched off in [`TedrisConfig`];
 //! [`TedrisConfig::paper`] is the paper's method alone)
