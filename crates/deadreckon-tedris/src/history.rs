@@ -52,7 +52,7 @@ impl Sample {
 /// True when rear wheel distances (ω = right − left, d = mean) over `dt_s`
 /// show motion: more than 5 mm/s at either wheel.
 pub fn moving(omega_m: f64, dist_m: f64, dt_s: f64) -> bool {
-    dist_m.abs() + 0.5 * omega_m.abs() > 0.005 * dt_s.max(1e-3)
+    dist_m.abs() + 0.5 * omega_m.abs() > crate::tuning::STANDSTILL_SPEED_MPS * dt_s.max(1e-3)
 }
 
 /// Subtracts, in place, the mean of each column over the rows of each segment

@@ -187,6 +187,7 @@
 //! | [`input`] | drive → events (wheels, reference heading, fixes), outage blanking |
 //! | [`outage`] | batch training and outage runs with their errors |
 //! | [`config`] | every parameter with unit and default |
+//! | [`tuning`] | the internal thresholds, named and documented |
 #![deny(missing_docs)]
 
 pub mod baseline;
@@ -203,6 +204,7 @@ pub mod predict;
 pub mod repository;
 pub mod residuals;
 pub mod stats;
+pub mod tuning;
 
 pub use config::{ModelChoice, ModelKind, RepositoryFit, TedrisConfig};
 pub use input::ReferenceSource;

@@ -4,6 +4,7 @@
 //! on held-back data; the heading lag.
 
 use super::*;
+use crate::tuning::*;
 
 impl Tedris {
     /// Eq. (6): the DCF minimising the RMSE between the reference heading and the
@@ -54,7 +55,7 @@ impl Tedris {
                 Some((src, th, s.segment))
             })
             .collect();
-        if pairs.len() < 2 * tau.max(10) {
+        if pairs.len() < 2 * tau.max(MIN_DCF_PAIRS) {
             return;
         }
         let segs: Vec<u32> = pairs.iter().map(|p| p.2).collect();
@@ -71,9 +72,15 @@ impl Tedris {
             model.dcf0_rad - model.dcf_bound_rad,
             model.dcf0_rad + model.dcf_bound_rad,
         );
-        let (x, _) = brent(cost, lo, hi, model.dcf_bound_rad * 1e-6, 200);
+        let (x, _) = brent(
+            cost,
+            lo,
+            hi,
+            model.dcf_bound_rad * BRENT_TOLERANCE,
+            BRENT_ITERATIONS,
+        );
         // A minimum at the bound of the search is refused, not kept.
-        let edge = 1e-3 * model.dcf_bound_rad;
+        let edge = BOUND_EDGE * model.dcf_bound_rad;
         if !(x > lo + edge && x < hi - edge) {
             self.refused_calibrations += 1;
             return;
@@ -136,7 +143,7 @@ impl Tedris {
         rows: &[[f64; 4]],
         segments: &[u32],
     ) -> Option<Calibration> {
-        if rows.len() < 200 {
+        if rows.len() < MIN_HEADING_FIT_ROWS {
             return None;
         }
         let mut cols_all: Vec<Vec<f64>> = rows.iter().map(|r| r.to_vec()).collect();
@@ -146,9 +153,9 @@ impl Tedris {
         // The distance column must differ from the sample count: speed must vary.
         let (skk, sdd) = (ss(0), ss(1));
         let skd: f64 = cols_all.iter().map(|r| r[0] * r[1]).sum();
-        let use_d = skk > 0.0 && sdd > 0.0 && skd * skd / (skk * sdd) < 0.999;
+        let use_d = skk > 0.0 && sdd > 0.0 && skd * skd / (skk * sdd) < MAX_DISTANCE_COLLINEARITY;
         let (lo, hi) = col(2).fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(v), h.max(v)));
-        let use_g = model.config.turn_gain && hi - lo > 1.0;
+        let use_g = model.config.turn_gain && hi - lo > MIN_TURNING_RAD;
         let per_metre = model.per_metre_straight;
         // In the per-metre form the distance term is the whole straight-line rate.
         let use_d = use_d || (per_metre && sdd > 0.0);
@@ -262,7 +269,7 @@ impl Tedris {
             }
             let split = rows
                 .times
-                .partition_point(|&x| x < first + 0.75 * (last - first));
+                .partition_point(|&x| x < first + FIT_SHARE * (last - first));
             let (fit_rows, held) = rows.rows.split_at(split);
             let (fit_segs, held_segs) = rows.segments.split_at(split);
             if kind == model.chosen {
@@ -378,7 +385,7 @@ pub fn heading_lag(h: &History, max_lag: usize) -> Option<i64> {
             rows.push(vec![w, cd[src], j as f64, th]);
             segs.push(s.segment);
         }
-        if rows.len() < 200 {
+        if rows.len() < MIN_HEADING_FIT_ROWS {
             return None;
         }
         centre_per_segment(&mut rows, &segs);

@@ -184,7 +184,8 @@ impl Tedris {
         {
             return Err(Error::Config(format!("geometry {geometry:?} is not valid")));
         }
-        let cap = (4 * config.init_samples).max(config.history_samples);
+        let cap =
+            (crate::tuning::HISTORY_INIT_FACTOR * config.init_samples).max(config.history_samples);
         Ok(Tedris {
             history: History::new(cap),
             config,

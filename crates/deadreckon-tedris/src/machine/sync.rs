@@ -5,6 +5,7 @@
 //! the heading anchor.
 
 use super::*;
+use crate::tuning::*;
 
 impl Tedris {
     /// Feeds one reference heading. A GNSS course (with a lever arm) is held
@@ -31,7 +32,7 @@ impl Tedris {
             while self
                 .queued_headings
                 .front()
-                .is_some_and(|q| hs.t_s - q.t_s > 1.0)
+                .is_some_and(|q| hs.t_s - q.t_s > COURSE_QUEUE_S)
             {
                 if let Some(q) = self.queued_headings.pop_front() {
                     self.process_heading(q);
@@ -48,9 +49,9 @@ impl Tedris {
 
     /// Half-width of the lever-arm window of a course at `t`, s.
     pub(super) fn half_window(&self, t: f64) -> f64 {
-        0.5 * self
-            .last_heading
-            .map_or(0.25, |p| (t - p.0).clamp(0.1, 0.5))
+        0.5 * self.last_heading.map_or(COURSE_INTERVAL_DEFAULT_S, |p| {
+            (t - p.0).clamp(COURSE_INTERVAL_RANGE_S.0, COURSE_INTERVAL_RANGE_S.1)
+        })
     }
 
     /// Processes the queued courses whose window is covered by wheel samples up to `t_wheel`.
@@ -268,7 +269,7 @@ pub(super) fn anchor(pairs: &VecDeque<(f64, f64)>, t_now: f64, trend: bool) -> f
     let n = pairs.len() as f64;
     let mt = pairs.iter().map(|p| p.0).sum::<f64>() / n;
     let md = pairs.iter().map(|p| p.1).sum::<f64>() / n;
-    if !trend || pairs.len() < 10 {
+    if !trend || pairs.len() < ANCHOR_TREND_MIN_PAIRS {
         return md;
     }
     let stt: f64 = pairs.iter().map(|p| (p.0 - mt).powi(2)).sum();
@@ -343,7 +344,7 @@ pub fn course_convention(h: &History, max_lag: usize) -> Option<ConventionFit> {
                 let th = if body { th + s.lever_rad } else { th };
                 rows.push(([cw, cd, j as f64, th], s.segment));
             }
-            if rows.len() < 500 {
+            if rows.len() < MIN_CONVENTION_ROWS {
                 return None;
             }
             let mut xtx = vec![vec![0.0; 3]; 3];
@@ -387,7 +388,7 @@ pub fn course_convention(h: &History, max_lag: usize) -> Option<ConventionFit> {
     // course looks like a body yaw delayed by l/v, which a lag imitates at
     // one speed, so only speed changes in turns tell them apart.
     let ratio = body / antenna;
-    if (ratio - 1.0).abs() < 0.1 || n < 500 {
+    if (ratio - 1.0).abs() < CONVENTION_MARGIN || n < MIN_CONVENTION_ROWS {
         return None;
     }
     Some(ConventionFit {

@@ -2,13 +2,14 @@
 //! refits, and the turn gain of module `gain` (without the joint calibration).
 
 use super::*;
+use crate::tuning::*;
 
 impl Tedris {
     /// Forms blocks and fits, after new samples were synchronised.
     pub(super) fn train(&mut self, t: f64) {
         let final_upto = self.pending_from.saturating_sub(1);
         if self.model.is_none() {
-            if t - self.last_init_try_t >= 1.0 {
+            if t - self.last_init_try_t >= INIT_RETRY_S {
                 let n = self.history.gamma_count();
                 if n >= self.config.init_samples {
                     self.last_init_try_t = t;
@@ -33,7 +34,7 @@ impl Tedris {
             model.repositories.insert(tu);
             self.recent.push_back(tu);
         }
-        while self.recent.len() > 32 {
+        while self.recent.len() > RECENT_BLOCKS {
             self.recent.pop_front();
         }
         if !model.complete && model.repositories.complete(model.config.required_bins) {
@@ -52,7 +53,7 @@ impl Tedris {
         if p.is_finite() {
             p
         } else {
-            0.04
+            DEFAULT_SAMPLE_PERIOD_S
         }
     }
 
@@ -122,7 +123,13 @@ impl Tedris {
                     .and_then(|m| m.course_convention)
                     .or(self.pending_convention);
                 model.settle_kind();
-                self.recent = tuples.iter().rev().take(32).rev().copied().collect();
+                self.recent = tuples
+                    .iter()
+                    .rev()
+                    .take(RECENT_BLOCKS)
+                    .rev()
+                    .copied()
+                    .collect();
                 self.model = Some(model);
                 self.estimate_gain();
                 self.former = Some(former);
@@ -233,12 +240,12 @@ pub fn straight_line(tuples: &[Tuple], epsilon_factor: Option<f64>) -> Option<St
         .filter(|t| t.straight)
         .map(|t| t.omega_m)
         .collect();
-    if flagged.len() >= 10 {
+    if flagged.len() >= MIN_STRAIGHT_BLOCKS {
         return StraightLine::from_omegas(&flagged, epsilon_factor, false);
     }
     let mut by_gamma: Vec<&Tuple> = tuples.iter().collect();
     by_gamma.sort_by(|a, b| a.gamma_rad.abs().total_cmp(&b.gamma_rad.abs()));
-    let k = (tuples.len() / 10).max(3).min(tuples.len());
+    let k = (tuples.len() / 10).max(MIN_QUIET_BLOCKS).min(tuples.len());
     let quiet: Vec<f64> = by_gamma[..k].iter().map(|t| t.omega_m).collect();
     StraightLine::from_omegas(&quiet, epsilon_factor, true)
 }

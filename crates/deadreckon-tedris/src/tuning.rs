@@ -1,0 +1,75 @@
+//! The tuned constants of the machine, in one place: what each is for, and
+//! its unit. The user-facing settings are in [`crate::config::TedrisConfig`];
+//! these are the internal thresholds a user should not need, named so that
+//! no bare literal decides anything in `machine`.
+
+/// Wheels turning less than this (at either wheel, on average over the
+/// sample) are at rest: the model turns the heading only when they move, m/s.
+pub const STANDSTILL_SPEED_MPS: f64 = 0.005;
+
+/// Courses more than this older than the newest are processed with the wheel
+/// samples there are (their centred lever-arm window is incomplete), s.
+pub const COURSE_QUEUE_S: f64 = 1.0;
+
+/// Half the fix interval is the half-width of a course's lever-arm window,
+/// the interval clamped to this range, s; the first course uses the default.
+pub const COURSE_INTERVAL_RANGE_S: (f64, f64) = (0.1, 0.5);
+/// The fix interval assumed for the first course, s.
+pub const COURSE_INTERVAL_DEFAULT_S: f64 = 0.25;
+
+/// Pairs needed before the heading anchor uses a trend (`anchor_trend`).
+pub const ANCHOR_TREND_MIN_PAIRS: usize = 10;
+
+/// Samples with a reference heading needed by the joint calibration and the
+/// heading-lag fit.
+pub const MIN_HEADING_FIT_ROWS: usize = 200;
+
+/// Samples with a reference heading needed to decide the course convention.
+pub const MIN_CONVENTION_ROWS: usize = 500;
+
+/// Relative difference of the residuals (body yaw against antenna course)
+/// below which the course convention is left undecided.
+pub const CONVENTION_MARGIN: f64 = 0.1;
+
+/// Eq. (6) needs this many reference samples, or twice τ if more.
+pub const MIN_DCF_PAIRS: usize = 10;
+
+/// Brent's search of eq. (6): relative tolerance (of the bound) and iterations.
+pub const BRENT_TOLERANCE: f64 = 1e-6;
+/// See [`BRENT_TOLERANCE`].
+pub const BRENT_ITERATIONS: usize = 200;
+
+/// An eq. (6) minimum within this fraction of the bound from it is "at the
+/// bound", and refused.
+pub const BOUND_EDGE: f64 = 1e-3;
+
+/// The distance term of the joint calibration is left out when the distance
+/// column is this collinear with the sample count (r² above it: the speed
+/// hardly varied).
+pub const MAX_DISTANCE_COLLINEARITY: f64 = 0.999;
+
+/// The turn gain is estimated only with at least this much turning in the
+/// window (spread of the cumulative turn), rad.
+pub const MIN_TURNING_RAD: f64 = 1.0;
+
+/// The share of the calibration window the joint calibration is fitted on;
+/// the rest is held back to accept or refuse it.
+pub const FIT_SHARE: f64 = 0.75;
+
+/// Recent training blocks kept for the error correction at an outage start.
+pub const RECENT_BLOCKS: usize = 32;
+
+/// Wheel sample period assumed before any interval is known, s.
+pub const DEFAULT_SAMPLE_PERIOD_S: f64 = 0.04;
+
+/// Straight blocks needed for the straight-line parameters; with fewer, the
+/// quietest tenth of the blocks (at least [`MIN_QUIET_BLOCKS`]) stand in.
+pub const MIN_STRAIGHT_BLOCKS: usize = 10;
+/// See [`MIN_STRAIGHT_BLOCKS`].
+pub const MIN_QUIET_BLOCKS: usize = 3;
+
+/// Interval between attempts at the first fit while waiting for data, s.
+pub const INIT_RETRY_S: f64 = 1.0;
+
+/// The history keeps at least this many times `init_samples`.
+pub const HISTORY_INIT_FACTOR: usize = 4;
