@@ -475,3 +475,53 @@ fn husky_bag_read_directly_through_30_s_outages() {
     let bytes = std::fs::read(&mcap).unwrap();
     assert!(bytes.starts_with(b"\x89MCAP0\r\n"), "not an MCAP file");
 }
+
+/// `tedris train --variant paper` trains the paper's method alone (its
+/// regression, no per-metre form) and says so in the model; the default is
+/// the extended variant, which reports the course convention it found.
+#[test]
+fn tedris_train_variant_paper_and_extended() {
+    let tmp = tempfile::tempdir().unwrap();
+    let drive = tmp.path().join("car");
+    run_ok(&[
+        "simulate",
+        "--scenario",
+        "tedris-car",
+        "--out",
+        drive.to_str().unwrap(),
+    ]);
+    let paper = tmp.path().join("paper.json");
+    let p = json(&run_ok(&[
+        "tedris",
+        "train",
+        drive.to_str().unwrap(),
+        "--variant",
+        "paper",
+        "--out",
+        paper.to_str().unwrap(),
+        "--json",
+    ]));
+    assert_eq!(p["chosen"], "paper", "{p}");
+    assert_eq!(p["per_metre_straight"], false, "{p}");
+    let saved = json(&std::fs::read_to_string(&paper).unwrap());
+    assert_eq!(saved["config"]["variant"], "paper");
+    let ext = tmp.path().join("extended.json");
+    let e = json(&run_ok(&[
+        "tedris",
+        "train",
+        drive.to_str().unwrap(),
+        "--out",
+        ext.to_str().unwrap(),
+        "--json",
+    ]));
+    assert_eq!(e["per_metre_straight"], true, "{e}");
+    // The simulated receiver's course is the antenna's velocity.
+    assert_eq!(
+        e["course_convention"]["convention"], "antenna_velocity",
+        "{e}"
+    );
+    // The rear tyres are 0.2 % apart (right smaller) on a 1.57 m track: the
+    // heading per metre is −0.002/1.57 = −1.27e-3 rad/m.
+    let per_m = e["dcf_distance_rad_per_m"].as_f64().unwrap();
+    assert!((per_m + 1.27e-3).abs() < 5e-5, "{per_m}");
+}

@@ -7,7 +7,7 @@ use anyhow::{bail, Context, Result};
 use clap::{Subcommand, ValueEnum};
 use deadreckon_tedris::{
     run_outages_with, time_range, train, ModelChoice, ModelKind, Outage, ReferenceSource,
-    RepositoryFit, RunOptions, TedrisConfig, TedrisModel,
+    RepositoryFit, RunOptions, TedrisConfig, TedrisModel, Variant,
 };
 
 /// The reference heading the model learns from.
@@ -32,6 +32,15 @@ impl Reference {
             Reference::Gyro => Some(ReferenceSource::Gyro),
         }
     }
+}
+
+/// The method variant.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VariantArg {
+    /// The paper's method alone.
+    Paper,
+    /// With this crate's additions (the default).
+    Extended,
 }
 
 /// The regression.
@@ -76,6 +85,10 @@ pub enum TedrisCommand {
         /// Fit each repository separately, as in the paper (default: pooled slopes).
         #[arg(long)]
         separate_repositories: bool,
+        /// The method: `paper` (the paper's alone: its regression, ε = 1.5,
+        /// separate repositories, eq. 6) or `extended` (default; see docs/tedris.md).
+        #[arg(long, value_enum)]
+        variant: Option<VariantArg>,
         /// A TedriS configuration (JSON; missing keys take their defaults; every
         /// key with its unit and default: docs/tedris.md).
         #[arg(long)]
@@ -127,6 +140,7 @@ pub fn run(c: TedrisCommand) -> Result<()> {
             tau,
             epsilon_k,
             separate_repositories,
+            variant,
             config,
             from_s,
             until_s,
@@ -154,9 +168,16 @@ pub fn run(c: TedrisCommand) -> Result<()> {
                     serde_json::from_str::<TedrisConfig>(&text)
                         .with_context(|| format!("parsing {}", p.display()))?
                 }
+                None if variant == Some(VariantArg::Paper) => TedrisConfig::paper(),
                 None if source == Some(ReferenceSource::Gyro) => TedrisConfig::robot(),
                 None => TedrisConfig::default(),
             };
+            if let Some(v) = variant {
+                cfg.variant = match v {
+                    VariantArg::Paper => Variant::Paper,
+                    VariantArg::Extended => Variant::Extended,
+                };
+            }
             cfg.model = match model {
                 Kind::Auto => cfg.model,
                 Kind::Paper => ModelChoice::Fixed(ModelKind::Paper),

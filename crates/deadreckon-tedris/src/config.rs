@@ -48,7 +48,7 @@ pub enum ModelChoice {
     /// The kind with the smallest BIC of its simulation residuals (ARX fed its own
     /// output, as in dead reckoning) among those whose residuals, after the AR/MA
     /// correction if one was needed, pass Ljung–Box; the smallest overall otherwise.
-    /// With `joint_calibration`, each calibration then takes the kind whose
+    /// In the extended variant, each calibration then takes the kind whose
     /// calibrated heading has the smallest residual on the held-back quarter
     /// of its window (not on the data it was fitted on); in the per-metre form
     /// (a GNSS course) only the paper and distance kinds are candidates.
@@ -69,23 +69,35 @@ pub enum RepositoryFit {
     PooledSlopes,
 }
 
+/// Which method runs: the paper's alone, or with this crate's additions.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Variant {
+    /// The paper's method (section 3): the lag at the cross-correlation peak,
+    /// plain OLS, no turn gain, the DCF of eq. (6) over `update_window_s`.
+    Paper,
+    /// The paper's method with this crate's additions (see the crate docs):
+    /// the lag from the heading fit, the errors-in-variables slope, the joint
+    /// calibration (DCF, heading per metre and turn gain over
+    /// `calibration_window_s`, accepted only when better on held-back data)
+    /// and, with a GNSS course, the per-metre form (no heading at rest).
+    #[default]
+    Extended,
+}
+
 /// TedriS parameters. Units are in the key names; `_samples` counts wheel samples.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct TedrisConfig {
+    /// The method: the paper's alone, or extended (default).
+    pub variant: Variant,
     /// τ: samples per block, the FIFO length (paper: 6).
     pub tau_samples: usize,
-    /// Summarise blocks by their means instead of the paper's medians (default false).
-    pub block_mean: bool,
     /// Half-width of the lag window searched for the cross-correlation peak (default 10).
     pub max_lag_samples: usize,
     /// Relative tolerance on the cross-correlation peak: the shortest lag within it
     /// is taken (default 0.005; 0 = the highest peak, as in the paper).
     pub lag_tolerance: f64,
-    /// Take the lag h from the fit of the reference heading on the cumulative
-    /// wheel sums (`machine::heading_lag`) instead of the cross-correlation peak
-    /// (default true; false: the paper's cross-correlation).
-    pub lag_from_heading: bool,
     /// Model kind, or automatic choice by the residual statistics (default auto).
     pub model: ModelChoice,
     /// Repository regression (default pooled slopes).
@@ -123,9 +135,6 @@ pub struct TedrisConfig {
     pub reference_timeout_s: f64,
     /// Window of the heading anchor (mean reference − DR difference), s (default 10).
     pub heading_anchor_window_s: f64,
-    /// Evaluate the heading anchor on a straight-line trend of the pairs at the
-    /// current time rather than their mean (default false).
-    pub anchor_trend: bool,
     /// Window of the position anchor (mean fix − DR difference), s (default 5).
     pub position_anchor_window_s: f64,
     /// Reference data after an outage before the update phase resumes, s (default 3).
@@ -136,44 +145,13 @@ pub struct TedrisConfig {
     pub update_interval_s: f64,
     /// Interval between regression refits once trained, s (default 60).
     pub refit_interval_s: f64,
-    /// Correct the ω slope for the noise of the block medians (errors in variables,
-    /// noise variance from the straight blocks; default true). Plain OLS
-    /// underestimates the slope by the ratio noise / spread of ω.
-    pub eiv_correction: bool,
-    /// Inside the straight-line band, use the straight-line ω instead of the
-    /// sample's (see `TedrisModel::effective_omega`; default false). A remedy for
-    /// white wheel-speed noise, whose integral is a heading random walk; real
-    /// wheel speeds (tone-ring edges) have a bounded distance error, and the band
-    /// then only clips the start and end of every turn (2.6 m against 1.1 m on
-    /// the simulated car).
-    pub straight_band: bool,
-    /// Half-width of the dead band in robust standard deviations of the straight
-    /// blocks' ω (default 3).
-    pub straight_band_sigmas: f64,
-    /// Estimate the turn gain g (default true): by the joint calibration when it
-    /// is on, else by the segment regression of module `gain` at every fit.
-    pub turn_gain: bool,
-    /// Segment length of the turn-gain estimate, s (default 10).
-    pub gain_segment_s: f64,
-    /// Update the DCF by eq. (6); when false it stays at DCF₀ (default true).
-    pub dcf_update: bool,
     /// Weight of each new DCF estimate against the previous DCF, in (0, 1]
     /// (default 0.2; 1 is eq. (6) as in the paper, whose 30 s estimates are noisy).
     pub dcf_smoothing: f64,
     /// Half-width of the DCF search interval, in units of |α1|·(W_H − W_L) (default 2).
     pub dcf_bound_factor: f64,
-    /// Update the DCF jointly with a distance term and the turn gain, by linear
-    /// least squares of the reference heading on the model's cumulative heading over
-    /// `calibration_window_s` (default true; false: eq. (6) over `update_window_s`).
-    /// See `Tedris` (module `machine`) for the equations.
-    pub joint_calibration: bool,
     /// Window of the joint calibration, s (default 600).
     pub calibration_window_s: f64,
-    /// With a GNSS course reference and the joint calibration: the
-    /// straight-line heading rate is estimated per metre only, with no
-    /// per-sample DCF (default true). A per-sample rate has no physical cause
-    /// in wheels, and at a speed unlike the calibration's it adds heading.
-    pub per_metre_straight: bool,
     /// Reference heading needed in the window before a joint calibration may
     /// replace the current values, s (default 120).
     pub min_calibration_span_s: f64,
@@ -197,11 +175,10 @@ pub struct TedrisConfig {
 impl Default for TedrisConfig {
     fn default() -> Self {
         TedrisConfig {
+            variant: Variant::Extended,
             tau_samples: 6,
-            block_mean: false,
             max_lag_samples: 10,
             lag_tolerance: 0.005,
-            lag_from_heading: true,
             model: ModelChoice::Auto,
             repository_fit: RepositoryFit::PooledSlopes,
             epsilon_factor: None,
@@ -216,23 +193,14 @@ impl Default for TedrisConfig {
             max_heading_gap_s: 1.0,
             reference_timeout_s: 1.0,
             heading_anchor_window_s: 10.0,
-            anchor_trend: false,
             position_anchor_window_s: 5.0,
             retrain_s: 3.0,
             update_window_s: 30.0,
             update_interval_s: 10.0,
             refit_interval_s: 60.0,
-            eiv_correction: true,
-            straight_band: false,
-            straight_band_sigmas: 3.0,
-            turn_gain: true,
-            gain_segment_s: 10.0,
-            dcf_update: true,
             dcf_smoothing: 0.2,
             dcf_bound_factor: 2.0,
-            joint_calibration: true,
             calibration_window_s: 600.0,
-            per_metre_straight: true,
             min_calibration_span_s: 120.0,
             max_radius_mismatch: 0.01,
             max_gain_error: 0.05,
@@ -248,7 +216,7 @@ impl Default for TedrisConfig {
 impl TedrisConfig {
     /// The paper's robot settings: ε = ∞ (one repository), no course speed gate,
     /// only R0 required, 60 s of samples to start; the DCF by the joint
-    /// calibration (or, with `joint_calibration` off, eq. (6) unsmoothed: the gyro
+    /// calibration (or, in the paper variant, eq. (6) unsmoothed: the gyro
     /// reference is smooth enough).
     pub fn robot() -> Self {
         TedrisConfig {
@@ -268,18 +236,40 @@ impl TedrisConfig {
     /// centred lever-arm conversion, stay.)
     pub fn paper() -> Self {
         TedrisConfig {
+            variant: Variant::Paper,
             model: ModelChoice::Fixed(ModelKind::Paper),
-            block_mean: false,
             repository_fit: RepositoryFit::Separate,
             epsilon_factor: Some(1.5),
-            eiv_correction: false,
-            straight_band: false,
-            turn_gain: false,
-            joint_calibration: false,
-            lag_from_heading: false,
             dcf_smoothing: 1.0,
             ..Self::default()
         }
+    }
+
+    /// The lag from the heading fit instead of the cross-correlation peak
+    /// (the extended variant).
+    pub fn lag_from_heading(&self) -> bool {
+        self.variant == Variant::Extended
+    }
+
+    /// The errors-in-variables correction of the ω slope (the extended variant).
+    pub fn eiv_correction(&self) -> bool {
+        self.variant == Variant::Extended
+    }
+
+    /// The joint calibration of the DCF, heading per metre and turn gain
+    /// (the extended variant); eq. (6) otherwise.
+    pub fn joint_calibration(&self) -> bool {
+        self.variant == Variant::Extended
+    }
+
+    /// The turn gain is estimated (by the joint calibration: the extended variant).
+    pub fn turn_gain(&self) -> bool {
+        self.variant == Variant::Extended
+    }
+
+    /// The per-metre form with a GNSS course (the extended variant).
+    pub fn per_metre_straight(&self) -> bool {
+        self.variant == Variant::Extended
     }
 
     /// Checks every value is usable.

@@ -47,7 +47,7 @@
 //!    kind whose calibrated heading fits the reference best.
 //! 5. Update phase: by default the joint calibration (below); eq. (6) (Brent's
 //!    bounded minimisation of the heading RMSE over `update_window_s`, from DCF₀)
-//!    with `joint_calibration` off.
+//!    in the paper variant.
 //! 6. Prediction: eq. (4) per wheel sample, heading by cumulative sum (eq. 5),
 //!    position by the rear-wheel distance along the heading; the AR/MA forecast
 //!    carries the last block errors into the outage.
@@ -67,7 +67,7 @@
 //! - **Courses checked against the wheels**: a course is used only when its
 //!   change since the previous course agrees with the wheels' turn within
 //!   `course_consistency_rad`, not only above a speed.
-//! - **Physical form** (`per_metre_straight`, GNSS course): the straight-line
+//! - **Physical form** (GNSS course, the extended variant): the straight-line
 //!   heading is per metre only, as unequal rear radii make it; the model turns
 //!   the car only when the wheels move ([`history::moving`]); the ARX kind,
 //!   whose turn lives in its feedback, is not used in this form.
@@ -96,10 +96,11 @@
 //! 5.67 m), paper 45.9 m, baseline 5.16 m. The position anchor does not
 //! correct the GNSS latency (about 1 m at 10 m/s and 0.1 s).
 //!
-//! ## Beyond the paper (each can be switched off in [`TedrisConfig`];
-//! [`TedrisConfig::paper`] is the paper's method alone)
+//! ## Beyond the paper ([`config::Variant::Extended`], the default;
+//! [`config::Variant::Paper`] and [`TedrisConfig::paper`] are the paper's
+//! method alone)
 //!
-//! - **Joint calibration** (`joint_calibration`, default on): eq. (6) generalised.
+//! - **Joint calibration**: eq. (6) generalised.
 //!   Over the last `calibration_window_s` (10 min) the reference heading is
 //!   regressed on the model's cumulative heading: DCF (rad per sample), a
 //!   distance term (rad per metre) and the turn gain g by linear least squares.
@@ -108,7 +109,7 @@
 //!   increments of a noisy course, or 30 s windows, give these 10–100 times less
 //!   precisely than the heading over minutes. This is the largest gain (car,
 //!   seeds 7–12: 3.6 m → 1.4 m).
-//! - Lag from the heading (`lag_from_heading`, default on): h minimises the
+//! - Lag from the heading: h minimises the
 //!   residual of the reference heading fitted on the wheels' cumulative sums
 //!   h samples earlier ([`machine::heading_lag`]); the per-sample
 //!   cross-correlation peak is flat and wandered by ±3 samples (0.12 s), which
@@ -119,7 +120,7 @@
 //!   1.5 % on the simulated car (a 90° turn then loses 0.024 rad).
 //! - `Distance` and `Arx` kinds (the paper's future work): the rear-radius bias
 //!   grows with the distance per sample, which a constant DCF cannot follow.
-//! - Errors-in-variables slope correction (`eiv_correction`): block medians of ω
+//! - Errors-in-variables slope correction: block medians of ω
 //!   are noisy, which attenuates an OLS slope.
 //! - Gyro bias pooled over the training and the run drives' standstills
 //!   ([`TedrisModel::gyro_bias`]): the gyro heading's residual bias is learnt as
@@ -130,9 +131,10 @@
 //! - Automatic model choice by the calibrated heading (with the joint
 //!   calibration): the block-level BIC prefers ARX, which drifts more in dead
 //!   reckoning (car, automatic choice: 1.68 m → 0.98 m).
-//! - Straight-line dead band (`straight_band`, default off) and the turn gain of
-//!   module [`gain`] (used when the joint calibration is off): remedies for
-//!   white wheel-speed noise, superseded.
+//! - Removed as superseded (they were switches): a straight-line dead band and
+//!   a turn gain from whole-segment heading changes (remedies for white
+//!   wheel-speed noise the joint calibration handles), block means, a trend in
+//!   the heading anchor, freezing the DCF.
 //!
 //! ## Measured on the simulator (see `tests/sim_outages.rs`)
 //!
@@ -181,7 +183,6 @@
 //! | [`model`] | the fitted regressions of every kind, model choice, DCF₀ |
 //! | [`predict`] | eq. (4) per sample: FIFO median, repository, DCF, correction |
 //! | [`history`] | wheel-clock samples with the synchronised heading and its segment, block formation, per-segment centring |
-//! | [`gain`] | the turn gain from heading changes over whole segments |
 //! | [`minimise`] | Brent's bounded minimisation (eq. 6) |
 //! | [`machine`] | the state machine of section 3.3 (`mod.rs`), heading synchronisation (`sync.rs`: segments, consistency, convention, anchor), training (`training.rs`), calibration (`calibration.rs`: eq. 6, the joint calibration with held-back acceptance, the heading lag) |
 //! | [`input`] | drive → events (wheels, reference heading, fixes), outage blanking |
@@ -193,7 +194,6 @@
 pub mod baseline;
 pub mod ccf;
 pub mod config;
-pub mod gain;
 pub mod history;
 pub mod input;
 pub mod machine;
@@ -206,7 +206,7 @@ pub mod residuals;
 pub mod stats;
 pub mod tuning;
 
-pub use config::{ModelChoice, ModelKind, RepositoryFit, TedrisConfig};
+pub use config::{ModelChoice, ModelKind, RepositoryFit, TedrisConfig, Variant};
 pub use input::ReferenceSource;
 pub use machine::{Estimate, Geometry, HeadingSample, Phase, PositionFix, Tedris, WheelSample};
 pub use model::TedrisModel;

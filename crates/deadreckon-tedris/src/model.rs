@@ -270,8 +270,8 @@ pub struct TedrisModel {
     /// straight blocks' ω on their d (the tyre-radius bias grows with speed).
     pub straight_omega: (f64, f64),
     /// Robust standard deviation (1.4826 × MAD) of the straight blocks' ω about
-    /// `straight_omega`, m per sample: the half-width of the dead band is
-    /// `straight_band_sigmas` times it.
+    /// `straight_omega`, m per sample: the noise of the block medians, used by
+    /// the errors-in-variables slope correction.
     pub straight_sigma_m: f64,
     /// The gyro bias of the training drive's standstills (rad/s, gyro samples), when
     /// trained on the gyro reference: the same gyro's bias, pooled with the
@@ -282,7 +282,7 @@ pub struct TedrisModel {
     /// The straight-line part of γ̂ is heading per metre only (`dcf_distance_rad_per_m`),
     /// with no per-sample rate: what wheels physically do (unequal radii turn the
     /// car per metre; at rest nothing turns). Set for a GNSS course reference
-    /// with `TedrisConfig::per_metre_straight`; a gyro reference keeps the
+    /// in the extended variant; a gyro reference keeps the
     /// per-sample DCF (its bias is per unit time).
     #[serde(default)]
     pub per_metre_straight: bool,
@@ -321,7 +321,7 @@ impl TedrisModel {
             .collect();
         let base = if common.len() > 20 { &common } else { &tuples };
         let (straight_omega, straight_sigma_m) = straight_stats(&repositories);
-        let noise_var = if config.eiv_correction {
+        let noise_var = if config.eiv_correction() {
             straight_sigma_m * straight_sigma_m
         } else {
             0.0
@@ -376,8 +376,7 @@ impl TedrisModel {
             .iter()
             .filter(|t| t.straight)
             .filter_map(|t| {
-                let mut t = *t;
-                t.omega_m = self.effective_omega(t.omega_m, t.omega_m, t.dist_m);
+                let t = *t;
                 let r = design_row(f.kind, &t)?;
                 let n = self.repositories.straight.bin(t.omega_m)?;
                 Some(t.gamma_rad - dot(f.beta(n), &r))
@@ -397,27 +396,6 @@ impl TedrisModel {
         self.dcf_bound_rad =
             (self.config.dcf_bound_factor * slope * (s.w_high_m - s.w_low_m)).max(1e-6);
         self.dcf_rad = self.dcf0_rad;
-    }
-
-    /// The ω used in eq. (4) for a sample: its own, or, when the block median
-    /// `median_m` lies in the straight-line dead band (and `straight_band` is on),
-    /// the straight-line ω: that band is noise around a straight line, so the
-    /// heading advances by the straight-line rate instead of integrating the noise.
-    ///
-    /// The band is the paper's straight-line noise band [W_L, W_H] made robust and
-    /// speed-aware: centred on the expected straight-line ω at this distance per
-    /// sample, `c0 + c1·d` (the Paper kind: µ), half-width `straight_band_sigmas`
-    /// robust standard deviations of the straight blocks.
-    pub fn effective_omega(&self, omega_m: f64, median_m: f64, dist_m: f64) -> f64 {
-        if !self.config.straight_band {
-            return omega_m;
-        }
-        let centre = self.straight_centre(dist_m);
-        if (median_m - centre).abs() <= self.config.straight_band_sigmas * self.straight_sigma_m {
-            centre
-        } else {
-            omega_m
-        }
     }
 
     /// The expected ω on a straight line at `dist_m` per sample, m per sample

@@ -50,7 +50,6 @@ impl Predictor {
         let repository = model.straight().bin(med).unwrap_or(0);
         let beta = fit.beta(repository);
         let centre = model.straight_centre(dist_m);
-        let omega_m = model.effective_omega(omega_m, med, dist_m);
         let prev = self.prev_block;
         let eval = |w: f64| match fit.kind {
             ModelKind::Paper => beta[0] + beta[1] * w,

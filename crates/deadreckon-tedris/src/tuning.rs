@@ -17,9 +17,6 @@ pub const COURSE_INTERVAL_RANGE_S: (f64, f64) = (0.1, 0.5);
 /// The fix interval assumed for the first course, s.
 pub const COURSE_INTERVAL_DEFAULT_S: f64 = 0.25;
 
-/// Pairs needed before the heading anchor uses a trend (`anchor_trend`).
-pub const ANCHOR_TREND_MIN_PAIRS: usize = 10;
-
 /// Samples with a reference heading needed by the joint calibration and the
 /// heading-lag fit.
 pub const MIN_HEADING_FIT_ROWS: usize = 200;

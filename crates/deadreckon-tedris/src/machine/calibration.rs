@@ -14,7 +14,7 @@ impl Tedris {
         if self
             .model
             .as_ref()
-            .is_some_and(|m| m.config.joint_calibration)
+            .is_some_and(|m| m.config.joint_calibration())
         {
             self.calibrate(t);
             return;
@@ -85,7 +85,7 @@ impl Tedris {
             self.refused_calibrations += 1;
             return;
         }
-        if x.is_finite() && model.config.dcf_update {
+        if x.is_finite() {
             // dcf_smoothing = 1 is eq. (6) as in the paper; below 1 the new
             // estimate is blended into the previous one.
             let w = model.config.dcf_smoothing;
@@ -155,7 +155,7 @@ impl Tedris {
         let skd: f64 = cols_all.iter().map(|r| r[0] * r[1]).sum();
         let use_d = skk > 0.0 && sdd > 0.0 && skd * skd / (skk * sdd) < MAX_DISTANCE_COLLINEARITY;
         let (lo, hi) = col(2).fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(v), h.max(v)));
-        let use_g = model.config.turn_gain && hi - lo > MIN_TURNING_RAD;
+        let use_g = model.config.turn_gain() && hi - lo > MIN_TURNING_RAD;
         let per_metre = model.per_metre_straight;
         // In the per-metre form the distance term is the whole straight-line rate.
         let use_d = use_d || (per_metre && sdd > 0.0);
@@ -240,9 +240,6 @@ impl Tedris {
         let Some(model) = self.model.as_ref() else {
             return;
         };
-        if !model.config.dcf_update {
-            return;
-        }
         let kinds: Vec<crate::config::ModelKind> =
             if model.config.model == crate::config::ModelChoice::Auto {
                 model

@@ -228,14 +228,13 @@ impl Tedris {
         model.validate()?;
         let mut m = Tedris::new(model.config.clone(), geometry)?;
         let c = &model.config;
-        let mut former = BlockFormer::new(
+        let former = BlockFormer::new(
             c.tau_samples,
             model.lag_samples,
             1,
             c.slt_max_change_deg.to_radians(),
             0,
         );
-        former.use_mean = c.block_mean;
         m.former = Some(former);
         m.convention = model.course_convention.map(|c| c.convention);
         m.model = Some(model);

@@ -219,7 +219,7 @@ impl Tedris {
             self.heading_pairs.pop_front();
         }
         if !self.heading_pairs.is_empty() {
-            self.heading_offset = anchor(&self.heading_pairs, t_now, self.config.anchor_trend);
+            self.heading_offset = anchor(&self.heading_pairs);
         }
     }
 
@@ -262,22 +262,9 @@ impl Tedris {
     }
 }
 
-/// The heading offset from (t, reference − DR) pairs: their mean, or with
-/// `trend` the least-squares line through them evaluated at `t_now` (the DR
-/// heading may drift within the window, e.g. through a turn).
-pub(super) fn anchor(pairs: &VecDeque<(f64, f64)>, t_now: f64, trend: bool) -> f64 {
-    let n = pairs.len() as f64;
-    let mt = pairs.iter().map(|p| p.0).sum::<f64>() / n;
-    let md = pairs.iter().map(|p| p.1).sum::<f64>() / n;
-    if !trend || pairs.len() < ANCHOR_TREND_MIN_PAIRS {
-        return md;
-    }
-    let stt: f64 = pairs.iter().map(|p| (p.0 - mt).powi(2)).sum();
-    let std: f64 = pairs.iter().map(|p| (p.0 - mt) * (p.1 - md)).sum();
-    if stt <= 0.0 {
-        return md;
-    }
-    md + std / stt * (t_now - mt)
+/// The heading offset from (t, reference − DR) pairs: their mean.
+pub(super) fn anchor(pairs: &VecDeque<(f64, f64)>) -> f64 {
+    pairs.iter().map(|p| p.1).sum::<f64>() / pairs.len() as f64
 }
 
 /// What a GNSS course is the direction of.

@@ -98,7 +98,6 @@ impl Tedris {
             c.slt_max_change_deg.to_radians(),
             start,
         );
-        former.use_mean = c.block_mean;
         let tuples = former.form(&self.history, final_upto);
         let Some(straight) = straight_line(&tuples, c.epsilon_factor) else {
             self.untrained_because = Some(format!(
@@ -113,7 +112,7 @@ impl Tedris {
             repos.insert(*tu);
         }
         let per_metre =
-            c.per_metre_straight && c.joint_calibration && self.geometry.heading_is_course;
+            c.per_metre_straight() && c.joint_calibration() && self.geometry.heading_is_course;
         match TedrisModel::fit(c.clone(), period, lag, ccf, repos) {
             Ok(mut model) => {
                 model.per_metre_straight = per_metre;
@@ -131,7 +130,6 @@ impl Tedris {
                     .copied()
                     .collect();
                 self.model = Some(model);
-                self.estimate_gain();
                 self.former = Some(former);
                 self.last_refit_t = t;
                 self.update_dcf(t);
@@ -147,11 +145,11 @@ impl Tedris {
         }
     }
 
-    /// The lag h: from the heading fit ([`heading_lag`]) when `lag_from_heading`
-    /// is on and it has the data, else at the cross-correlation peak.
+    /// The lag h: from the heading fit ([`heading_lag`]) in the extended variant
+    /// when it has the data, else at the cross-correlation peak.
     pub(super) fn choose_lag(&self, ccf: &crate::ccf::CrossCorrelation) -> i64 {
         let from_ccf = ccf.peak_lag_within(self.config.lag_tolerance);
-        if self.config.lag_from_heading {
+        if self.config.lag_from_heading() {
             heading_lag(&self.history, self.config.max_lag_samples).unwrap_or(from_ccf)
         } else {
             from_ccf
@@ -175,7 +173,7 @@ impl Tedris {
         let Some(old) = &self.model else { return };
         let ccf = masked_ccf(&self.history, self.config.max_lag_samples);
         let better =
-            self.config.lag_from_heading || ccf_peak_value(&ccf) > ccf_peak_value(&old.ccf);
+            self.config.lag_from_heading() || ccf_peak_value(&ccf) > ccf_peak_value(&old.ccf);
         if !old.complete && self.choose_lag(&ccf) != old.lag_samples && better {
             let final_upto = self.pending_from.saturating_sub(1);
             if self.rebuild(t, final_upto, ccf) {
@@ -189,7 +187,7 @@ impl Tedris {
             old.per_metre_straight,
             old.dcf_distance_rad_per_m,
             old.dcf_rad,
-            old.config.joint_calibration,
+            old.config.joint_calibration(),
         );
         if let Ok(mut m) = TedrisModel::fit(
             old.config.clone(),
@@ -209,22 +207,7 @@ impl Tedris {
             }
             self.model = Some(m);
         }
-        self.estimate_gain();
         self.update_dcf(t);
-    }
-
-    pub(super) fn estimate_gain(&mut self) {
-        let Some(model) = self.model.as_mut() else {
-            return;
-        };
-        if !model.config.turn_gain || model.config.joint_calibration {
-            return;
-        }
-        let samples: Vec<Sample> = self.history.iter().copied().collect();
-        let seg = (model.config.gain_segment_s / model.sample_period_s).round() as usize;
-        if let Some(g) = crate::gain::estimate_turn_gain(model, &samples, seg) {
-            model.turn_gain = g;
-        }
     }
 }
 
