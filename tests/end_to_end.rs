@@ -366,7 +366,7 @@ fn comma2k19_import_calibrate_evaluate_report() {
     eprintln!("comma2k19 calibration: {c}");
     // TedriS cannot train on this 60 s of nearly straight road, and says
     // which requirement failed and by how much (it used to point at
-    // init_samples, which was not the one).
+    // the sample count, which was not the one).
     let model = tmp.path().join("model.json");
     let e = run_err(&[
         "tedris",

@@ -85,16 +85,19 @@ pub enum Variant {
     Extended,
 }
 
-/// TedriS parameters. Units are in the key names; `_samples` counts wheel samples.
+/// TedriS parameters. Units are in the key names: times in seconds; only
+/// `tau_samples`, the paper's block length, counts wheel samples.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct TedrisConfig {
     /// The method: the paper's alone, or extended (default).
     pub variant: Variant,
-    /// τ: samples per block, the FIFO length (paper: 6).
+    /// τ: wheel samples per block, the FIFO length (paper: 6; the paper's
+    /// method is defined in samples, so this one setting stays in samples).
     pub tau_samples: usize,
-    /// Half-width of the lag window searched for the cross-correlation peak (default 10).
-    pub max_lag_samples: usize,
+    /// Half-width of the lag window searched for the lag between the wheels and
+    /// the reference heading, s (default 0.4: ±10 samples at 25 Hz).
+    pub max_lag_s: f64,
     /// Relative tolerance on the cross-correlation peak: the shortest lag within it
     /// is taken (default 0.005; 0 = the highest peak, as in the paper).
     pub lag_tolerance: f64,
@@ -113,15 +116,15 @@ pub struct TedrisConfig {
     pub max_fill: usize,
     /// Required repositories: R−n … Rn must reach `min_fill` (default 1).
     pub required_bins: i32,
-    /// Valid synchronised samples needed before the lag and the straight-line
-    /// parameters are estimated (default 1500, 60 s at 25 Hz).
-    pub init_samples: usize,
+    /// Synchronised reference heading needed before the lag and the
+    /// straight-line parameters are estimated, s (default 60).
+    pub init_s: f64,
     /// Smallest cross-correlation peak accepted for the first fit; below it the
     /// machine waits for more turning (or a full history) (default 0.3).
     pub min_ccf_peak: f64,
-    /// Wheel samples kept for the lag, the straight-line band and the DCF update
-    /// (default 30000, 20 min at 25 Hz).
-    pub history_samples: usize,
+    /// Time of wheel samples kept for the lag, the straight-line parameters
+    /// and the calibrations, s (default 1200).
+    pub history_s: f64,
     /// Wheel speed below which the GNSS course is not trusted for training, m/s (default 1.0).
     pub min_course_speed_mps: f64,
     /// Largest disagreement between a course's change since the previous course
@@ -177,7 +180,7 @@ impl Default for TedrisConfig {
         TedrisConfig {
             variant: Variant::Extended,
             tau_samples: 6,
-            max_lag_samples: 10,
+            max_lag_s: 0.4,
             lag_tolerance: 0.005,
             model: ModelChoice::Auto,
             repository_fit: RepositoryFit::PooledSlopes,
@@ -185,9 +188,9 @@ impl Default for TedrisConfig {
             min_fill: 20,
             max_fill: 3000,
             required_bins: 1,
-            init_samples: 1500,
+            init_s: 60.0,
             min_ccf_peak: 0.3,
-            history_samples: 30_000,
+            history_s: 1200.0,
             min_course_speed_mps: 1.0,
             course_consistency_rad: 0.2,
             max_heading_gap_s: 1.0,
@@ -215,7 +218,7 @@ impl Default for TedrisConfig {
 
 impl TedrisConfig {
     /// The paper's robot settings: ε = ∞ (one repository), no course speed gate,
-    /// only R0 required, 60 s of samples to start; the DCF by the joint
+    /// only R0 required, 60 s of reference to start; the DCF by the joint
     /// calibration (or, in the paper variant, eq. (6) unsmoothed: the gyro
     /// reference is smooth enough).
     pub fn robot() -> Self {
@@ -223,7 +226,7 @@ impl TedrisConfig {
             epsilon_factor: None,
             min_course_speed_mps: 0.0,
             required_bins: 0,
-            init_samples: 600,
+            init_s: 60.0,
             dcf_smoothing: 1.0,
             ..Self::default()
         }
@@ -292,11 +295,13 @@ impl TedrisConfig {
         if self.required_bins < 0 {
             return bad("required_bins", self.required_bins.to_string());
         }
-        if self.init_samples < 50 {
-            return bad("init_samples", self.init_samples.to_string());
+        if !(self.init_s.is_finite() && self.init_s >= 2.0) {
+            return bad("init_s", self.init_s.to_string());
         }
         for (k, v) in [
             ("max_heading_gap_s", self.max_heading_gap_s),
+            ("max_lag_s", self.max_lag_s),
+            ("history_s", self.history_s),
             ("reference_timeout_s", self.reference_timeout_s),
             ("heading_anchor_window_s", self.heading_anchor_window_s),
             ("position_anchor_window_s", self.position_anchor_window_s),

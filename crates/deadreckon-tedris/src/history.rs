@@ -78,26 +78,32 @@ pub fn centre_per_segment(rows: &mut [Vec<f64>], segments: &[u32]) -> usize {
     sums.len()
 }
 
-/// A bounded window of samples with contiguous indices.
+/// A window of samples with contiguous indices, the last `span_s` seconds.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct History {
     samples: VecDeque<Sample>,
-    cap: usize,
+    span_s: f64,
 }
 
 impl History {
-    /// An empty history keeping at most `cap` samples.
-    pub fn new(cap: usize) -> Self {
+    /// An empty history keeping the samples of the last `span_s` seconds.
+    pub fn new(span_s: f64) -> Self {
         History {
             samples: VecDeque::new(),
-            cap: cap.max(16),
+            span_s,
         }
     }
 
-    /// Appends a sample (its index must follow the last one).
+    /// Appends a sample (its index must follow the last one) and drops the
+    /// samples older than the span.
     pub fn push(&mut self, s: Sample) {
+        let newest = s.t_s;
         self.samples.push_back(s);
-        while self.samples.len() > self.cap {
+        while self
+            .samples
+            .front()
+            .is_some_and(|f| newest - f.t_s > self.span_s)
+        {
             self.samples.pop_front();
         }
     }
@@ -143,9 +149,18 @@ impl History {
         self.samples.is_empty()
     }
 
-    /// The most samples held.
-    pub fn capacity(&self) -> usize {
-        self.cap
+    /// The time kept, s.
+    pub fn span_s(&self) -> f64 {
+        self.span_s
+    }
+
+    /// True when the samples held cover the whole span (the oldest are
+    /// being dropped).
+    pub fn full(&self) -> bool {
+        match (self.samples.front(), self.samples.back()) {
+            (Some(a), Some(b)) => b.t_s - a.t_s >= self.span_s - b.dt_s.max(0.0),
+            _ => false,
+        }
     }
 
     /// The last sample.

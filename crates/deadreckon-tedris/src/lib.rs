@@ -34,7 +34,7 @@
 //!    the wheel samples after it); the course from chords between fixes or the
 //!    integrated gyro (bias taken at standstill) are the other references.
 //! 2. Cross-correlation of ω and γ; the lag h from the heading fit (below), or,
-//!    as in the paper, at the correlation peak within ±`max_lag_samples` (the
+//!    as in the paper, at the correlation peak within ±`max_lag_s` (the
 //!    shortest lag within `lag_tolerance` of the peak: the peak is flat).
 //! 3. Blocks of τ samples → tuples (median ω, median d, median γ); straight
 //!    blocks (reference heading change < `slt_max_change_deg` over `slt_window_s`)
@@ -73,7 +73,9 @@
 //!   whose turn lives in its feedback, is not used in this form.
 //! - **Bounds refuse, not clamp**: a calibration reaching the radius-mismatch
 //!   (`max_radius_mismatch`), turn-gain (`max_gain_error`) or DCF bound is
-//!   refused and counted ([`Tedris::refused_calibrations`]).
+//!   refused and counted ([`Tedris::refused_calibrations`]); a heading lag at
+//!   the edge of its search (`max_lag_s`) is refused for the
+//!   cross-correlation peak.
 //! - **Nothing replaces a model unless it is better out of sample**: a joint
 //!   calibration is fitted on the first three quarters of its window and
 //!   accepted only if its heading residual on the last quarter is no larger
@@ -90,10 +92,10 @@
 //! Measured on 12 cars of the simulator's randomized family
 //! (`deadreckon_sim::family`, `tests/family_outages.rs`; GNSS latencies up to
 //! 0.15 s), trained on one drive and tested on another, 24 outages of 80 s
-//! (most right after a stop): mean error 3.32 m (worst 8.04 m) against 82.3 m
-//! before these changes; the paper's method alone 72.7 m; the baseline 8.12 m.
+//! (most right after a stop): mean error 3.16 m (worst 8.04 m) against 82.3 m
+//! before these changes; the paper's method alone 72.1 m; the baseline 8.12 m.
 //! On 12 other cars (101–112) not looked at while developing: 2.22 m (worst
-//! 5.67 m), paper 45.9 m, baseline 5.16 m. The position anchor does not
+//! 5.67 m), paper 49.8 m, baseline 5.16 m. The position anchor does not
 //! correct the GNSS latency (about 1 m at 10 m/s and 0.1 s).
 //!
 //! ## Beyond the paper ([`config::Variant::Extended`], the default;

@@ -68,5 +68,5 @@ pub const MIN_QUIET_BLOCKS: usize = 3;
 /// Interval between attempts at the first fit while waiting for data, s.
 pub const INIT_RETRY_S: f64 = 1.0;
 
-/// The history keeps at least this many times `init_samples`.
-pub const HISTORY_INIT_FACTOR: usize = 4;
+/// The history keeps at least this many times `init_s`.
+pub const HISTORY_INIT_FACTOR: f64 = 4.0;

@@ -111,7 +111,7 @@ fn husky_fix_track_reference_runs() {
     // (measured 0.9–6.0 m mean, 10.7 m largest, over 30 s).
     let cfg = TedrisConfig {
         min_course_speed_mps: 0.3,
-        init_samples: 600,
+        init_s: 60.0,
         required_bins: 0,
         min_ccf_peak: 0.0,
         ..TedrisConfig::default()

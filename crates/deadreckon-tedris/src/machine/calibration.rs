@@ -355,7 +355,8 @@ struct Calibration {
 /// cross-correlation of ω with increments of a course interpolated between 4 Hz
 /// fixes has a flat, noisy peak (±3 samples on the simulated car); the heading
 /// itself pins the lag through the shape of every turn. `None` with fewer than
-/// 200 usable samples.
+/// 200 usable samples, or when the best lag is at ±`max_lag` (a fit at its
+/// bound is refused, not kept).
 pub fn heading_lag(h: &History, max_lag: usize) -> Option<i64> {
     let samples: Vec<&Sample> = h.iter().collect();
     let mut cw = Vec::with_capacity(samples.len());
@@ -393,5 +394,7 @@ pub fn heading_lag(h: &History, max_lag: usize) -> Option<i64> {
             best = Some((fit.rss, lag));
         }
     }
-    best.map(|b| b.1)
+    // A lag at the edge of the search is a fit at its bound: refused (the
+    // caller falls back to the cross-correlation peak).
+    best.map(|b| b.1).filter(|l| l.abs() < ml)
 }

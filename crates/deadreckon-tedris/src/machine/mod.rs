@@ -184,10 +184,9 @@ impl Tedris {
         {
             return Err(Error::Config(format!("geometry {geometry:?} is not valid")));
         }
-        let cap =
-            (crate::tuning::HISTORY_INIT_FACTOR * config.init_samples).max(config.history_samples);
+        let span = (crate::tuning::HISTORY_INIT_FACTOR * config.init_s).max(config.history_s);
         Ok(Tedris {
-            history: History::new(cap),
+            history: History::new(span),
             config,
             geometry,
             phase: Phase::Blind,

@@ -233,7 +233,7 @@ impl Tedris {
         {
             return false;
         }
-        let Some(fit) = course_convention(&self.history, self.config.max_lag_samples) else {
+        let Some(fit) = course_convention(&self.history, self.max_lag()) else {
             return false;
         };
         self.convention = Some(fit.convention);

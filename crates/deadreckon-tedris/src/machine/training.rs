@@ -11,13 +11,15 @@ impl Tedris {
         if self.model.is_none() {
             if t - self.last_init_try_t >= INIT_RETRY_S {
                 let n = self.history.gamma_count();
-                if n >= self.config.init_samples {
+                let need = (self.config.init_s / self.sample_period()).round() as usize;
+                if n >= need {
                     self.last_init_try_t = t;
                     self.init(t, final_upto);
                 } else {
                     self.untrained_because = Some(format!(
-                        "{n} wheel samples have a synchronised reference heading on both sides; init_samples needs {}",
-                        self.config.init_samples
+                        "{:.1} s of wheel samples have a synchronised reference heading on both sides; init_s needs {}",
+                        n as f64 * self.sample_period(),
+                        self.config.init_s
                     ));
                 }
             }
@@ -42,6 +44,11 @@ impl Tedris {
         }
     }
 
+    /// `max_lag_s` in wheel samples.
+    pub(super) fn max_lag(&self) -> usize {
+        (self.config.max_lag_s / self.sample_period()).round() as usize
+    }
+
     pub(super) fn sample_period(&self) -> f64 {
         let dts: Vec<f64> = self
             .history
@@ -61,9 +68,9 @@ impl Tedris {
     /// the straight-line band and the repositories. Waits (returns) while the
     /// cross-correlation peak is below `min_ccf_peak` (too little turning yet).
     pub(super) fn init(&mut self, t: f64, final_upto: u64) {
-        let ccf = masked_ccf(&self.history, self.config.max_lag_samples);
+        let ccf = masked_ccf(&self.history, self.max_lag());
         let peak = ccf_peak_value(&ccf);
-        let full = self.history.len() >= self.history.capacity();
+        let full = self.history.full();
         if peak < self.config.min_ccf_peak && !full {
             self.untrained_because = Some(format!(
                 "the cross-correlation peak of ω and γ is {peak:.3}; min_ccf_peak needs {} (too little turning yet)",
@@ -72,7 +79,7 @@ impl Tedris {
             return;
         }
         let ccf = if self.decide_convention() {
-            masked_ccf(&self.history, self.config.max_lag_samples)
+            masked_ccf(&self.history, self.max_lag())
         } else {
             ccf
         };
@@ -150,7 +157,7 @@ impl Tedris {
     pub(super) fn choose_lag(&self, ccf: &crate::ccf::CrossCorrelation) -> i64 {
         let from_ccf = ccf.peak_lag_within(self.config.lag_tolerance);
         if self.config.lag_from_heading() {
-            heading_lag(&self.history, self.config.max_lag_samples).unwrap_or(from_ccf)
+            heading_lag(&self.history, self.max_lag()).unwrap_or(from_ccf)
         } else {
             from_ccf
         }
@@ -165,13 +172,13 @@ impl Tedris {
         if self.convention.is_none() && self.decide_convention() {
             // The history's headings changed: rebuild the blocks on them.
             let final_upto = self.pending_from.saturating_sub(1);
-            let ccf = masked_ccf(&self.history, self.config.max_lag_samples);
+            let ccf = masked_ccf(&self.history, self.max_lag());
             if self.rebuild(t, final_upto, ccf) {
                 return;
             }
         }
         let Some(old) = &self.model else { return };
-        let ccf = masked_ccf(&self.history, self.config.max_lag_samples);
+        let ccf = masked_ccf(&self.history, self.max_lag());
         let better =
             self.config.lag_from_heading() || ccf_peak_value(&ccf) > ccf_peak_value(&old.ccf);
         if !old.complete && self.choose_lag(&ccf) != old.lag_samples && better {
