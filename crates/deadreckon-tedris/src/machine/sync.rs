@@ -126,8 +126,13 @@ impl Tedris {
         }
         // Unwrap only within a segment; a new segment starts on the branch
         // nearest the dead-reckoned heading, so a stop or an outage never adds
-        // whole turns.
-        let continuing = prev.is_some_and(|p| p.4 && usable && gap_ok(&p));
+        // whole turns. A gyro heading is one integral over the whole drive
+        // (the input integrates through gaps and outages): one segment.
+        let continuing = if self.geometry.heading_is_course {
+            prev.is_some_and(|p| p.4 && usable && gap_ok(&p))
+        } else {
+            prev.is_some()
+        };
         let theta = match prev {
             Some((_, th, raw, _, _)) if continuing => th + wrap(hs.yaw_rad - raw),
             _ => {
