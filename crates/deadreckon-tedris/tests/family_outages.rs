@@ -267,3 +267,46 @@ fn baseline_fit_recovers_track_and_radius_mismatch() {
     );
     assert!((b.per_metre_rad - mismatch / track).abs() < 1e-4, "{b:?}");
 }
+
+/// Training drives shorter than the default windows (about 190 s and 430 s of
+/// drive against the 600 s calibration window and 1200 s history): TedriS
+/// still trains on most cars and beats the baseline through an 80 s outage of
+/// another drive; where it cannot train, it says which requirement failed.
+#[test]
+fn short_training_drives() {
+    for len in [150.0, 300.0] {
+        let (mut t, mut b, mut n) = (0.0, 0.0, 0);
+        let mut failures = Vec::new();
+        for car in 1..=12u64 {
+            let c = CarFamily::draw(car);
+            let tr = simulate(&c.drive(1000 + car, len), 1000 + car).expect("train drive");
+            let te = simulate(&c.drive(2000 + car, 500.0), 2000 + car).expect("test drive");
+            let o = Outage {
+                start_s: 300.0,
+                end_s: 380.0,
+            };
+            let base = Baseline::fit(&tr.drive).expect("baseline");
+            match train(&tr.drive, TedrisConfig::default(), None) {
+                Ok((m, _)) => {
+                    t += run_outages(&te.drive, &m, &[o]).expect("run").outages[0].mean_error_m;
+                    b += base
+                        .run_outage(&te.drive, &o)
+                        .expect("baseline run")
+                        .mean_error_m;
+                    n += 1;
+                }
+                Err(e) => failures.push((car, e.to_string())),
+            }
+        }
+        let (t, b) = (t / n as f64, b / n as f64);
+        eprintln!("training drives of {len} s of route: {n} trained, TedriS {t:.2} m, baseline {b:.2} m; not trained: {failures:?}");
+        // Measured: 11 of 12 trained both times (car 11: cross-correlation
+        // peak 0.17 and 0.18 against min_ccf_peak 0.3); TedriS 2.55 m and
+        // 2.64 m, the baseline 4.69 m and 5.75 m.
+        assert!(n >= 11, "{failures:?}");
+        assert!(t < 3.0 && t < 0.7 * b, "TedriS {t} m, baseline {b} m");
+        for (_, e) in &failures {
+            assert!(e.contains("needs"), "{e}");
+        }
+    }
+}
