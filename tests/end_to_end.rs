@@ -524,4 +524,28 @@ fn tedris_train_variant_paper_and_extended() {
     // heading per metre is −0.002/1.57 = −1.27e-3 rad/m.
     let per_m = e["dcf_distance_rad_per_m"].as_f64().unwrap();
     assert!((per_m + 1.27e-3).abs() < 5e-5, "{per_m}");
+    // compare --json: both methods through an outage, with the four-wheel
+    // gate counters and TedriS's course checks (the outage starts a new
+    // heading segment).
+    let c = json(&run_ok(&[
+        "compare",
+        drive.to_str().unwrap(),
+        "--outage",
+        "200:280",
+        "--json",
+    ]));
+    assert!(
+        c["four_wheel_gates"]["gnss"]["accepted"].as_u64().unwrap() > 100,
+        "{c}"
+    );
+    assert!(
+        c["tedris_checks"]["heading_segments"].as_u64().unwrap() >= 2,
+        "{c}"
+    );
+    let o = &c["outages"][0];
+    assert!(o["tedris"]["mean_error_m"].as_f64().unwrap() < 5.0, "{c}");
+    assert!(
+        o["four_wheel"]["mean_error_m"].as_f64().unwrap() < 5.0,
+        "{c}"
+    );
 }

@@ -59,6 +59,11 @@ pub struct Comparison {
     pub rows: Vec<(Outage, Option<Row>, Option<Row>)>,
     /// The TedriS model used.
     pub model: TedrisModel,
+    /// The four-wheel filter's χ² gate counters over the run.
+    pub four_wheel_gates: deadreckon_core::filter::GateCounts,
+    /// TedriS's course checks over the run: (headings refused as inconsistent
+    /// with the wheels, calibrations refused, heading segments).
+    pub tedris_checks: (u64, u64, u32),
 }
 
 /// The drive without GNSS inside the windows.
@@ -132,6 +137,12 @@ pub fn compare(
         tedris_reference: td.reference.clone(),
         rows,
         model,
+        four_wheel_gates: fw.gates,
+        tedris_checks: (
+            td.machine.inconsistent_headings(),
+            td.machine.refused_calibrations(),
+            td.machine.segments(),
+        ),
     })
 }
 
@@ -147,6 +158,12 @@ pub fn to_json(c: &Comparison) -> serde_json::Value {
         "reference": {"four_wheel": c.four_wheel_reference, "tedris": c.tedris_reference},
         "four_wheel_params": c.params_source,
         "tedris_model": c.model_source,
+        "four_wheel_gates": super::common::gates_json(&c.four_wheel_gates),
+        "tedris_checks": {
+            "inconsistent_headings": c.tedris_checks.0,
+            "refused_calibrations": c.tedris_checks.1,
+            "heading_segments": c.tedris_checks.2,
+        },
         "outages": c.rows.iter().map(|(o, f, t)| json!({
             "start_s": o.start_s, "end_s": o.end_s,
             "four_wheel": row_json(f), "tedris": row_json(t),
