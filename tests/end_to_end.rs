@@ -537,6 +537,21 @@ fn tedris_train_variant_paper_and_extended() {
     // heading per metre is −0.002/1.57 = −1.27e-3 rad/m.
     let per_m = e["dcf_distance_rad_per_m"].as_f64().unwrap();
     assert!((per_m + 1.27e-3).abs() < 5e-5, "{per_m}");
+    // A kind the user fixes is kept: ARX, which the per-metre form cannot
+    // use, gets the per-sample form instead of being swapped for another kind.
+    let arx = tmp.path().join("arx.json");
+    let a = json(&run_ok(&[
+        "tedris",
+        "train",
+        drive.to_str().unwrap(),
+        "--model",
+        "arx",
+        "--out",
+        arx.to_str().unwrap(),
+        "--json",
+    ]));
+    assert_eq!(a["chosen"], "arx", "{a}");
+    assert_eq!(a["per_metre_straight"], false, "{a}");
     // compare --json: both methods through an outage, with the four-wheel
     // gate counters and TedriS's course checks (the outage starts a new
     // heading segment).

@@ -414,8 +414,9 @@ impl TedrisModel {
         !(self.per_metre_straight && kind == ModelKind::Arx)
     }
 
-    /// Moves the choice off a kind the form cannot use (ARX in the per-metre
-    /// form) to the distance kind, else the paper kind.
+    /// Moves the automatic choice off a kind the form cannot use (ARX in the
+    /// per-metre form) to the distance kind, else the paper kind. (A kind the
+    /// user fixed is never in that case: fixing ARX keeps the per-sample form.)
     pub fn settle_kind(&mut self) {
         if self.kind_usable(self.chosen) {
             return;

@@ -118,8 +118,12 @@ impl Tedris {
         for tu in &tuples {
             repos.insert(*tu);
         }
-        let per_metre =
-            c.per_metre_straight() && c.joint_calibration() && self.geometry.heading_is_course;
+        // The per-metre form cannot use the ARX kind: a user who fixes ARX
+        // gets the per-sample form instead (what the model reports).
+        let per_metre = c.per_metre_straight()
+            && c.joint_calibration()
+            && self.geometry.heading_is_course
+            && c.model != crate::config::ModelChoice::Fixed(crate::config::ModelKind::Arx);
         match TedrisModel::fit(c.clone(), period, lag, ccf, repos) {
             Ok(mut model) => {
                 model.per_metre_straight = per_metre;
