@@ -528,6 +528,14 @@ fn tedris_train_variant_paper_and_extended() {
         "--json",
     ]));
     assert_eq!(e["per_metre_straight"], true, "{e}");
+    // No heading per sample in that form: not reported as if estimated.
+    assert!(e["dcf_rad"].is_null(), "{e}");
+    assert!(p["dcf_rad"].as_f64().is_some(), "{p}");
+    // The paper's method estimates neither a heading per metre nor a turn gain.
+    assert!(
+        p["dcf_distance_rad_per_m"].is_null() && p["turn_gain"].is_null(),
+        "{p}"
+    );
     // The simulated receiver's course is the antenna's velocity.
     assert_eq!(
         e["course_convention"]["convention"], "antenna_velocity",

@@ -309,10 +309,13 @@ fn train_json(m: &TedrisModel, source: ReferenceSource) -> serde_json::Value {
         "w_high_m": s.w_high_m,
         "epsilon_m": s.epsilon_m,
         "dcf0_rad": m.dcf0_rad,
-        "dcf_rad": m.dcf_rad,
-        "dcf_distance_rad_per_m": m.dcf_distance_rad_per_m,
+        // Not a parameter of the per-metre form (no heading per sample).
+        "dcf_rad": (!m.per_metre_straight).then_some(m.dcf_rad),
+        // Estimated by the joint calibration only (the extended variant):
+        // otherwise not estimated, not a nominal value.
+        "dcf_distance_rad_per_m": m.config.joint_calibration().then_some(m.dcf_distance_rad_per_m),
         "gyro_bias": m.gyro_bias,
-        "turn_gain": m.turn_gain,
+        "turn_gain": m.config.turn_gain().then_some(m.turn_gain),
         "per_metre_straight": m.per_metre_straight,
         "course_convention": m.course_convention,
         "complete": m.complete,
@@ -351,10 +354,16 @@ fn print_train(m: &TedrisModel, source: ReferenceSource) {
             "straight-line heading {:.3e} rad/m (per metre only: none at rest), turn gain = {:.4}",
             m.dcf_distance_rad_per_m, m.turn_gain
         );
-    } else {
+    } else if m.config.joint_calibration() {
         println!(
             "DCF0 = {:.3e} rad/sample, DCF = {:.3e} rad/sample + {:.3e} rad/m, turn gain = {:.4}",
             m.dcf0_rad, m.dcf_rad, m.dcf_distance_rad_per_m, m.turn_gain
+        );
+    } else {
+        // The paper's method: eq. (6) only; no distance term, no turn gain.
+        println!(
+            "DCF0 = {:.3e} rad/sample, DCF = {:.3e} rad/sample (eq. 6; heading per metre and turn gain not estimated)",
+            m.dcf0_rad, m.dcf_rad
         );
     }
     match &m.course_convention {
