@@ -275,8 +275,10 @@ impl Tedris {
         self.rejected
     }
 
-    /// Reference headings not used because their change since the previous one
-    /// disagreed with the wheels' turn (a random course at low speed, a jump).
+    /// Courses at speed not used because their change since the previous
+    /// course disagreed with the wheels' turn (a random course at low speed, a
+    /// jump), or because no course within `max_heading_gap_s` before them
+    /// could confirm them (the first course after a gap).
     pub fn inconsistent_headings(&self) -> u64 {
         self.inconsistent_headings
     }
