@@ -61,9 +61,9 @@ pub struct Comparison {
     pub model: TedrisModel,
     /// The four-wheel filter's χ² gate counters over the run.
     pub four_wheel_gates: deadreckon_core::filter::GateCounts,
-    /// TedriS's course checks over the run: (headings refused as inconsistent
-    /// with the wheels, calibrations refused, heading segments).
-    pub tedris_checks: (u64, u64, u32),
+    /// TedriS's checks over the run: (headings refused as inconsistent with
+    /// the wheels, calibrations refused, heading segments, watchdog alarms).
+    pub tedris_checks: (u64, u64, u32, u64),
 }
 
 /// The drive without GNSS inside the windows.
@@ -142,6 +142,7 @@ pub fn compare(
             td.machine.inconsistent_headings(),
             td.machine.refused_calibrations(),
             td.machine.segments(),
+            td.machine.model_alarms(),
         ),
     })
 }
@@ -163,6 +164,7 @@ pub fn to_json(c: &Comparison) -> serde_json::Value {
             "inconsistent_headings": c.tedris_checks.0,
             "refused_calibrations": c.tedris_checks.1,
             "heading_segments": c.tedris_checks.2,
+            "model_alarms": c.tedris_checks.3,
         },
         "outages": c.rows.iter().map(|(o, f, t)| json!({
             "start_s": o.start_s, "end_s": o.end_s,

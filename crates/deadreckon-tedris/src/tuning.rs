@@ -17,6 +17,16 @@ pub const COURSE_INTERVAL_RANGE_S: (f64, f64) = (0.1, 0.5);
 /// The fix interval assumed for the first course, s.
 pub const COURSE_INTERVAL_DEFAULT_S: f64 = 0.25;
 
+/// The watchdog: a dead-reckoned heading drifting from the reference faster
+/// than this over the anchor window, in the update phase, means the model is
+/// off, rad/s (3.4°/s): a car "turning" at 0.01 rad per metre on a straight
+/// at 6 m/s and above exceeds it.
+pub const MAX_HEADING_DRIFT_RPS: f64 = 0.06;
+/// The watchdog needs this many anchor pairs ...
+pub const WATCH_MIN_PAIRS: usize = 20;
+/// ... spanning this share of the anchor window.
+pub const WATCH_MIN_SPAN: f64 = 0.8;
+
 /// Samples with a reference heading needed by the joint calibration and the
 /// heading-lag fit.
 pub const MIN_HEADING_FIT_ROWS: usize = 200;

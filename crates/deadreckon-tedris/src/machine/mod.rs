@@ -169,6 +169,15 @@ pub struct Tedris {
     /// once decided; until then the course is taken as the antenna's.
     #[serde(default)]
     convention: Option<CourseConvention>,
+    /// Times the watchdog found the model off (see `watch_heading`).
+    #[serde(default)]
+    model_alarms: u64,
+    /// The watchdog's alarm is on.
+    #[serde(default)]
+    alarm_active: bool,
+    /// When the last alarm went off, s.
+    #[serde(default)]
+    last_alarm_t: Option<f64>,
     /// The convention's fit when it was decided before the first model.
     #[serde(default)]
     pending_convention: Option<ConventionFit>,
@@ -217,6 +226,9 @@ impl Tedris {
             inconsistent_headings: 0,
             refused_calibrations: 0,
             untrained_because: None,
+            model_alarms: 0,
+            alarm_active: false,
+            last_alarm_t: None,
             convention: None,
             pending_convention: None,
         })
@@ -293,6 +305,19 @@ impl Tedris {
     /// numbers (e.g. too few synchronised samples, too little turning).
     pub fn untrained_because(&self) -> Option<&str> {
         self.untrained_because.as_deref()
+    }
+
+    /// Times the watchdog found the model off in the update phase: the
+    /// dead-reckoned heading drifted from the reference faster than
+    /// `tuning::MAX_HEADING_DRIFT_RPS` over the anchor window (each time, a
+    /// calibration is due at once).
+    pub fn model_alarms(&self) -> u64 {
+        self.model_alarms
+    }
+
+    /// When the watchdog last found the model off, s.
+    pub fn last_model_alarm_s(&self) -> Option<f64> {
+        self.last_alarm_t
     }
 
     /// Heading segments started so far.

@@ -226,6 +226,49 @@ impl Tedris {
         if !self.heading_pairs.is_empty() {
             self.heading_offset = anchor(&self.heading_pairs);
         }
+        self.watch_heading(t_now);
+    }
+
+    /// The model's watchdog, in the update phase (a complete model, the
+    /// reference good): the dead-reckoned heading must follow the reference.
+    /// When their difference over the anchor window drifts faster than
+    /// [`MAX_HEADING_DRIFT_RPS`], the model is off (a wrong gain or
+    /// straight-line rate): the alarm is counted and a calibration is due at
+    /// once (it replaces the values only if it does better on held-back
+    /// data). The alarm clears below half the threshold.
+    fn watch_heading(&mut self, t_now: f64) {
+        if self.model.is_none() || self.phase != Phase::Update {
+            return;
+        }
+        let pairs = &self.heading_pairs;
+        let (Some(first), Some(last)) = (pairs.front(), pairs.back()) else {
+            return;
+        };
+        if pairs.len() < WATCH_MIN_PAIRS
+            || last.0 - first.0 < WATCH_MIN_SPAN * self.config.heading_anchor_window_s
+        {
+            return;
+        }
+        let n = pairs.len() as f64;
+        let mt = pairs.iter().map(|p| p.0).sum::<f64>() / n;
+        let md = pairs.iter().map(|p| p.1).sum::<f64>() / n;
+        let stt: f64 = pairs.iter().map(|p| (p.0 - mt).powi(2)).sum();
+        let std: f64 = pairs.iter().map(|p| (p.0 - mt) * (p.1 - md)).sum();
+        if stt <= 0.0 {
+            return;
+        }
+        let drift = (std / stt).abs();
+        if drift > MAX_HEADING_DRIFT_RPS {
+            if !self.alarm_active {
+                self.alarm_active = true;
+                self.model_alarms += 1;
+                self.last_alarm_t = Some(t_now);
+                // A calibration at the next wheel sample.
+                self.last_update_t = f64::MIN;
+            }
+        } else if drift < 0.5 * MAX_HEADING_DRIFT_RPS {
+            self.alarm_active = false;
+        }
     }
 
     /// Decides the course convention on the history once it can
