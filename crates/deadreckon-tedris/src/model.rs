@@ -293,8 +293,9 @@ pub struct TedrisModel {
     pub course_convention: Option<crate::machine::ConventionFit>,
     /// Every required repository reached its minimum fill.
     pub complete: bool,
-    /// g: gain on the turning part of γ̂ (1 = the regression as fitted), estimated
-    /// from the heading change over whole segments (see [`crate::gain`]).
+    /// g: gain on the turning part of γ̂ (1 = the regression as fitted),
+    /// estimated by the joint calibration (the extended variant; 1 in the
+    /// paper variant, where it is not estimated).
     #[serde(default = "one")]
     pub turn_gain: f64,
 }
