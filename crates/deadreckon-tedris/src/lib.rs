@@ -98,7 +98,7 @@
 //! Measured on 12 cars of the simulator's randomized family
 //! (`deadreckon_sim::family`, `tests/family_outages.rs`; GNSS latencies up to
 //! 0.15 s), trained on one drive and tested on another, 24 outages of 80 s
-//! (most right after a stop): mean error 3.16 m (worst 8.04 m) against 82.3 m
+//! (most right after a stop): mean error 3.20 m (worst 8.04 m) against 82.3 m
 //! before these changes; the paper's method alone 72.1 m; the baseline 8.12 m.
 //! On 12 other cars (101–112) not looked at while developing: 2.22 m (worst
 //! 5.67 m), paper 49.8 m, baseline 5.16 m. The position anchor does not

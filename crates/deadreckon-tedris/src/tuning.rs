@@ -75,6 +75,10 @@ pub const MIN_STRAIGHT_BLOCKS: usize = 10;
 /// See [`MIN_STRAIGHT_BLOCKS`].
 pub const MIN_QUIET_BLOCKS: usize = 3;
 
+/// The extended variant's first fit waits for this much turning of the
+/// reference (one full turn's worth, in one-second steps), rad.
+pub const MIN_TRAINING_TURN_RAD: f64 = 2.0 * std::f64::consts::PI;
+
 /// Interval between attempts at the first fit while waiting for data, s.
 pub const INIT_RETRY_S: f64 = 1.0;
 

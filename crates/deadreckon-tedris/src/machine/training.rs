@@ -44,6 +44,22 @@ impl Tedris {
         }
     }
 
+    /// The reference heading's turning in the history: the sum of |Δθ| over
+    /// one-second steps within heading segments, rad.
+    pub(super) fn reference_turning(&self) -> f64 {
+        let step = (1.0 / self.sample_period()).round().max(1.0) as usize;
+        let pts: Vec<(f64, u32)> = self
+            .history
+            .iter()
+            .step_by(step)
+            .filter_map(|s| Some((s.theta_rad?, s.segment)))
+            .collect();
+        pts.windows(2)
+            .filter(|w| w[0].1 == w[1].1)
+            .map(|w| (w[1].0 - w[0].0).abs())
+            .sum()
+    }
+
     /// `max_lag_s` in wheel samples.
     pub(super) fn max_lag(&self) -> usize {
         (self.config.max_lag_s / self.sample_period()).round() as usize
@@ -66,14 +82,29 @@ impl Tedris {
 
     /// First fit: the lag from the cross-correlation over the history, the blocks,
     /// the straight-line band and the repositories. Waits (returns) while the
-    /// cross-correlation peak is below `min_ccf_peak` (too little turning yet).
+    /// cross-correlation peak is below `min_ccf_peak` and, in the extended
+    /// variant, the reference has turned less than `MIN_TRAINING_TURN_RAD`
+    /// (too little turning yet).
     pub(super) fn init(&mut self, t: f64, final_upto: u64) {
         let ccf = masked_ccf(&self.history, self.max_lag());
         let peak = ccf_peak_value(&ccf);
         let full = self.history.full();
-        if peak < self.config.min_ccf_peak && !full {
+        // The extended variant asks for turning itself (rate-independent);
+        // the per-sample correlation peak falls with the wheel rate's noise.
+        let turned = self.config.variant == crate::config::Variant::Extended
+            && self.reference_turning() >= MIN_TRAINING_TURN_RAD;
+        if peak < self.config.min_ccf_peak && !full && !turned {
+            let turning = if self.config.variant == crate::config::Variant::Extended {
+                format!(
+                    ", and the reference turned {:.2} rad of the {:.2} that would do instead",
+                    self.reference_turning(),
+                    MIN_TRAINING_TURN_RAD
+                )
+            } else {
+                String::new()
+            };
             self.untrained_because = Some(format!(
-                "the cross-correlation peak of ω and γ is {peak:.3}; min_ccf_peak needs {} (too little turning yet)",
+                "the cross-correlation peak of ω and γ is {peak:.3}; min_ccf_peak needs {}{turning} (too little turning yet)",
                 self.config.min_ccf_peak
             ));
             return;
