@@ -57,25 +57,50 @@ pub fn moving(omega_m: f64, dist_m: f64, dt_s: f64) -> bool {
 
 /// Subtracts, in place, the mean of each column over the rows of each segment
 /// (`segments[i]` is row i's segment): the least squares on the result equals
-/// the one with an intercept per segment. Returns the number of segments.
+/// the one with an intercept per segment. Rows are in time order, so each
+/// segment is one run of rows (segment numbers only grow). Returns the number
+/// of segments.
 pub fn centre_per_segment(rows: &mut [Vec<f64>], segments: &[u32]) -> usize {
-    use std::collections::HashMap;
-    let mut sums: HashMap<u32, (Vec<f64>, f64)> = HashMap::new();
-    for (r, &g) in rows.iter().zip(segments) {
-        let e = sums.entry(g).or_insert_with(|| (vec![0.0; r.len()], 0.0));
-        for (a, v) in e.0.iter_mut().zip(r) {
-            *a += v;
-        }
-        e.1 += 1.0;
-    }
-    for (r, g) in rows.iter_mut().zip(segments) {
-        if let Some((s, n)) = sums.get(g) {
-            for (v, a) in r.iter_mut().zip(s) {
-                *v -= a / n;
+    let mut runs = 0;
+    let mut start = 0;
+    while start < rows.len().min(segments.len()) {
+        let end = start
+            + segments[start..]
+                .iter()
+                .take_while(|&&g| g == segments[start])
+                .count();
+        let run = &mut rows[start..end];
+        let n = run.len() as f64;
+        let width = run[0].len();
+        for c in 0..width {
+            let mean = run.iter().map(|r| r[c]).sum::<f64>() / n;
+            for r in run.iter_mut() {
+                r[c] -= mean;
             }
         }
+        runs += 1;
+        start = end;
     }
-    sums.len()
+    runs
+}
+
+/// The RMS of `values` about the mean of each segment's run (as
+/// [`centre_per_segment`] on one column); NaN without values.
+pub fn rms_about_segment_means(values: &[f64], segments: &[u32]) -> f64 {
+    let mut sum_sq = 0.0;
+    let mut start = 0;
+    while start < values.len().min(segments.len()) {
+        let end = start
+            + segments[start..]
+                .iter()
+                .take_while(|&&g| g == segments[start])
+                .count();
+        let run = &values[start..end];
+        let mean = run.iter().sum::<f64>() / run.len() as f64;
+        sum_sq += run.iter().map(|v| (v - mean).powi(2)).sum::<f64>();
+        start = end;
+    }
+    (sum_sq / values.len() as f64).sqrt()
 }
 
 /// A window of samples with contiguous indices, the last `span_s` seconds.
@@ -310,4 +335,36 @@ pub fn masked_ccf(h: &History, max_lag: usize) -> crate::ccf::CrossCorrelation {
         });
     }
     crate::ccf::CrossCorrelation { lags, values }
+}
+
+#[cfg(test)]
+mod segment_tests {
+    use super::*;
+
+    #[test]
+    fn each_segment_run_is_centred_on_its_own_mean() {
+        let mut rows = vec![
+            vec![1.0, 10.0],
+            vec![3.0, 30.0],
+            vec![5.0, 0.0],
+            vec![7.0, 4.0],
+        ];
+        let segs = [1, 1, 4, 4];
+        assert_eq!(centre_per_segment(&mut rows, &segs), 2);
+        assert_eq!(
+            rows,
+            vec![
+                vec![-1.0, -10.0],
+                vec![1.0, 10.0],
+                vec![-1.0, -2.0],
+                vec![1.0, 2.0]
+            ]
+        );
+        // The same about-the-mean residuals, as an RMS: (1 + 1 + 1 + 1) / 4.
+        let rms = rms_about_segment_means(&[1.0, 3.0, 5.0, 7.0], &segs);
+        assert!((rms - 1.0).abs() < 1e-15, "{rms}");
+        // One segment: the plain standard deviation about the mean.
+        let rms = rms_about_segment_means(&[1.0, 3.0, 5.0, 7.0], &[2, 2, 2, 2]);
+        assert!((rms - 5.0f64.sqrt()).abs() < 1e-15, "{rms}");
+    }
 }

@@ -61,12 +61,11 @@ impl Tedris {
         let segs: Vec<u32> = pairs.iter().map(|p| p.2).collect();
         // The RMS difference with an offset per heading segment.
         let cost = |dcf: f64| {
-            let mut d: Vec<Vec<f64>> = pairs
+            let d: Vec<f64> = pairs
                 .iter()
-                .map(|&(i, th, _)| vec![th - (cum[i].0 + dcf * cum[i].1)])
+                .map(|&(i, th, _)| th - (cum[i].0 + dcf * cum[i].1))
                 .collect();
-            centre_per_segment(&mut d, &segs);
-            (d.iter().map(|v| v[0] * v[0]).sum::<f64>() / d.len() as f64).sqrt()
+            rms_about_segment_means(&d, &segs)
         };
         let (lo, hi) = (
             model.dcf0_rad - model.dcf_bound_rad,
@@ -333,12 +332,11 @@ pub(super) fn held_rms(rows: &[[f64; 4]], segments: &[u32], dcf: f64, dist: f64,
     if rows.is_empty() {
         return f64::INFINITY;
     }
-    let mut e: Vec<Vec<f64>> = rows
+    let e: Vec<f64> = rows
         .iter()
-        .map(|r| vec![r[3] - dcf * r[0] - dist * r[1] - (gain - 1.0) * r[2]])
+        .map(|r| r[3] - dcf * r[0] - dist * r[1] - (gain - 1.0) * r[2])
         .collect();
-    centre_per_segment(&mut e, segments);
-    (e.iter().map(|v| v[0] * v[0]).sum::<f64>() / e.len() as f64).sqrt()
+    rms_about_segment_means(&e, segments)
 }
 
 /// The result of one joint calibration.

@@ -22,7 +22,9 @@ use std::collections::VecDeque;
 use serde::{Deserialize, Serialize};
 
 use crate::config::TedrisConfig;
-use crate::history::{centre_per_segment, masked_ccf, BlockFormer, History, Sample};
+use crate::history::{
+    centre_per_segment, masked_ccf, rms_about_segment_means, BlockFormer, History, Sample,
+};
 use crate::minimise::brent;
 use crate::model::{design_row, TedrisModel};
 use crate::predict::Predictor;
