@@ -38,7 +38,9 @@ pub fn smooth_car_states<L: Layout<N>, const N: usize>(
     f: Filter<L, N>,
     opts: &FilterOptions,
 ) -> Result<(Vec<(f64, State)>, FilterStats), Error> {
-    let (feeder, events) = ekf::feed(drive, opts, f.time_s());
+    let (mut feeder, events) = ekf::feed(drive, opts, f.time_s());
+    // The forward pass keeps no predictions; the re-runs do.
+    feeder.keep_predictions(false);
     let total_events = drive.wheels.len()
         + drive.yaw_rate.len()
         + drive.speed.len()
@@ -87,9 +89,12 @@ pub fn smooth_car_states<L: Layout<N>, const N: usize>(
         let cp = &cps[j];
         let (mut f, mut feeder, mut events) =
             (cp.filter.clone(), cp.feeder.clone(), cp.events.clone());
+        feeder.keep_predictions(true);
         buf.clear();
         let mut record = |f: &mut Filter<L, N>, e: ekf::EpochOut<'_, N>| {
-            buf.push(Epoch::after(f, &e.prediction));
+            if let Some(prediction) = e.prediction {
+                buf.push(Epoch::after(f, prediction));
+            }
         };
         while feeder.stats().epochs < end {
             match events.next() {

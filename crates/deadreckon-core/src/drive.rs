@@ -181,7 +181,7 @@ impl Drive {
                 "the wheel stream needs at least two epochs".into(),
             ));
         }
-        let check = |name: &str, ts: &mut dyn Iterator<Item = f64>| -> Result<(), Error> {
+        fn check(name: &str, ts: impl Iterator<Item = f64>) -> Result<(), Error> {
             let mut prev = f64::NEG_INFINITY;
             for (i, t) in ts.enumerate() {
                 if !t.is_finite() {
@@ -197,11 +197,11 @@ impl Drive {
                 prev = t;
             }
             Ok(())
-        };
+        }
         match &self.wheels {
-            Wheels::Ticks(v) => check("wheel_ticks", &mut v.iter().map(|s| s.t_s))?,
+            Wheels::Ticks(v) => check("wheel_ticks", v.iter().map(|s| s.t_s))?,
             Wheels::Speeds(v) => {
-                check("wheel_speeds", &mut v.iter().map(|s| s.t_s))?;
+                check("wheel_speeds", v.iter().map(|s| s.t_s))?;
                 if v.iter().any(|s| {
                     !(s.fl_mps.is_finite()
                         && s.fr_mps.is_finite()
@@ -217,12 +217,12 @@ impl Drive {
             ("speed", &self.speed),
             ("steering", &self.steering),
         ] {
-            check(name, &mut s.iter().map(|s| s.t_s))?;
+            check(name, s.iter().map(|s| s.t_s))?;
             if s.iter().any(|s| !s.value.is_finite()) {
                 return Err(Error::InvalidDrive(format!("{name}: non-finite value")));
             }
         }
-        check("gnss", &mut self.gnss.iter().map(|s| s.t_s))?;
+        check("gnss", self.gnss.iter().map(|s| s.t_s))?;
         if self.gnss.iter().any(|g| {
             !(g.east_m.is_finite() && g.north_m.is_finite() && g.std_m.is_finite() && g.std_m > 0.0)
         }) {
@@ -230,7 +230,7 @@ impl Drive {
                 "gnss: non-finite position or non-positive std_m".into(),
             ));
         }
-        check("truth", &mut self.truth.iter().map(|s| s.t_s))?;
+        check("truth", self.truth.iter().map(|s| s.t_s))?;
         Ok(())
     }
 }

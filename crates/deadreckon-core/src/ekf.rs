@@ -303,12 +303,21 @@ pub struct Feeder {
     stats: FilterStats,
     #[serde(skip)]
     updates: Vec<Update>,
+    /// Whether epochs carry their prediction (a copy of the predicted state and
+    /// covariance, which a run that records no epochs does without).
+    #[serde(default = "yes")]
+    predictions: bool,
+}
+
+fn yes() -> bool {
+    true
 }
 
 /// What one epoch did: the prediction and the updates.
 pub struct EpochOut<'a, const N: usize> {
-    /// The prediction to the epoch's time.
-    pub prediction: Prediction<N>,
+    /// The prediction to the epoch's time (`None` unless the feeder keeps
+    /// predictions: [`Feeder::keep_predictions`]).
+    pub prediction: Option<&'a Prediction<N>>,
     /// The updates applied (or rejected) at the epoch.
     pub updates: &'a [Update],
 }
@@ -334,6 +343,26 @@ impl Feeder {
             pending_gnss: None,
             stats: FilterStats::default(),
             updates: Vec::new(),
+            predictions: opts.record_epochs,
+        }
+    }
+
+    /// Whether the epochs passed to the callback carry their prediction (by
+    /// default when `record_epochs` is set). Does not change the filtering.
+    pub fn keep_predictions(&mut self, keep: bool) {
+        self.predictions = keep;
+    }
+
+    fn predict<L: Layout<N>, const N: usize>(
+        &self,
+        f: &mut Filter<L, N>,
+        t: f64,
+    ) -> Option<Prediction<N>> {
+        if self.predictions {
+            Some(f.predict_to(t))
+        } else {
+            f.advance_to(t);
+            None
         }
     }
 
@@ -541,31 +570,34 @@ impl Feeder {
                     let Some((interval, gap)) = self.wheel_interval(t) else {
                         return Ok(());
                     };
-                    let prediction = f.predict_to(t);
-                    if use_.wheels {
-                        if gap {
-                            self.stats.wheel_gaps += 1;
-                        } else {
-                            self.wheel_updates(f, &ev.measurement, interval)?;
+                    let prediction = self.predict(f, t);
+                    f.deferring_symmetry(|f| -> Result<(), Error> {
+                        if use_.wheels {
+                            if gap {
+                                self.stats.wheel_gaps += 1;
+                            } else {
+                                self.wheel_updates(f, &ev.measurement, interval)?;
+                            }
                         }
-                    }
-                    if let Some(v) = self.pending_gyro.take() {
-                        self.updates.push(f.update_gyro(v)?);
-                    }
-                    if let Some(v) = self.pending_speed.take() {
-                        self.updates.push(f.update_speed(v)?);
-                    }
-                    if let Some(v) = self.pending_steering.take() {
-                        self.updates.push(f.update_steering(v)?);
-                    }
-                    if let Some(fix) = self.pending_gnss.take() {
-                        self.gnss_update(f, &fix)?;
-                    }
+                        if let Some(v) = self.pending_gyro.take() {
+                            self.updates.push(f.update_gyro(v)?);
+                        }
+                        if let Some(v) = self.pending_speed.take() {
+                            self.updates.push(f.update_speed(v)?);
+                        }
+                        if let Some(v) = self.pending_steering.take() {
+                            self.updates.push(f.update_steering(v)?);
+                        }
+                        if let Some(fix) = self.pending_gnss.take() {
+                            self.gnss_update(f, &fix)?;
+                        }
+                        Ok(())
+                    })?;
                     self.stats.epochs += 1;
                     epoch(
                         f,
                         EpochOut {
-                            prediction,
+                            prediction: prediction.as_ref(),
                             updates: &self.updates,
                         },
                     );
@@ -599,14 +631,16 @@ impl Feeder {
                 if !used {
                     return Ok(());
                 }
-                let prediction = f.predict_to(t);
+                let prediction = self.predict(f, t);
                 match ev.measurement {
                     Measurement::WheelTicks { .. } | Measurement::WheelSpeeds { .. } => {
                         if let Some((interval, gap)) = wheel {
                             if gap {
                                 self.stats.wheel_gaps += 1;
                             } else {
-                                self.wheel_updates(f, &ev.measurement, interval)?;
+                                f.deferring_symmetry(|f| {
+                                    self.wheel_updates(f, &ev.measurement, interval)
+                                })?;
                             }
                         }
                     }
@@ -629,7 +663,7 @@ impl Feeder {
                 epoch(
                     f,
                     EpochOut {
-                        prediction,
+                        prediction: prediction.as_ref(),
                         updates: &self.updates,
                     },
                 );
@@ -780,8 +814,8 @@ pub fn run_filter<L: Layout<N>, const N: usize>(
                     accepted: u.accepted,
                 }));
         }
-        if opts.record_epochs {
-            out.epochs.push(Epoch::after(f, &e.prediction));
+        if let Some(prediction) = e.prediction {
+            out.epochs.push(Epoch::after(f, prediction));
         }
     };
     // Events after `end_s` are never used: stop reading there.

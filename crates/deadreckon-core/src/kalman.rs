@@ -106,6 +106,10 @@ impl<const N: usize> ScalarInnovation<N> {
                 *o += hj * c;
             }
         }
+        Self::finish(ph, h, r, y, t_s)
+    }
+
+    fn finish(ph: [f64; N], h: &[(usize, f64)], r: f64, y: f64, t_s: f64) -> Result<Self, Error> {
         // S = H P Hᵀ + R   (14)
         let s = h.iter().map(|&(j, hj)| hj * ph[j]).sum::<f64>() + r;
         if !(s.is_finite() && s > 0.0 && y.is_finite()) {
@@ -119,6 +123,32 @@ impl<const N: usize> ScalarInnovation<N> {
             y,
             s,
         })
+    }
+
+    /// As [`ScalarInnovation::sparse`], reading only the lower triangle of `p`
+    /// (entry (i, j) as (max, min)): the upper one may be out of date after
+    /// [`ScalarInnovation::apply_lower`]. Equal to `sparse` on a symmetric `p`.
+    pub fn sparse_lower(
+        p: &SMatrix<f64, N, N>,
+        h: &[(usize, f64)],
+        r: f64,
+        y: f64,
+        t_s: f64,
+    ) -> Result<Self, Error> {
+        let mut ph = [0.0f64; N];
+        let cols: &[[f64; N]; N] = &p.data.0;
+        for &(j, hj) in h {
+            let Some(col_j) = cols.get(j) else {
+                continue;
+            };
+            // Rows above the diagonal from row j of the earlier columns, from
+            // the diagonal down column j itself (a fixed-length loop, unrolled).
+            for (i, o) in ph.iter_mut().enumerate() {
+                let c = if i < j { cols[i][j] } else { col_j[i] };
+                *o += hj * c;
+            }
+        }
+        Self::finish(ph, h, r, y, t_s)
     }
 
     /// The normalised innovation squared ỹ² / S.
@@ -149,12 +179,20 @@ impl<const N: usize> ScalarInnovation<N> {
         p: &mut SMatrix<f64, N, N>,
         _form: CovarianceForm,
     ) {
+        self.apply_lower(x, p);
+        mirror_lower(p);
+    }
+
+    /// [`ScalarInnovation::apply`] on the lower triangle of `p` only (the
+    /// upper one is left out of date until [`mirror_lower`]), which saves the
+    /// mirroring when several scalar updates follow each other.
+    pub fn apply_lower(&self, x: &mut SVector<f64, N>, p: &mut SMatrix<f64, N, N>) {
         let (ph, s, y) = (&self.ph, self.s, self.y);
         // K = P Hᵀ S⁻¹   (15);  x̂ = x̂⁻ + K ỹ   (16)
         x.axpy(y / s, ph, 1.0);
         let inv_s = 1.0 / s;
         let ph: &[f64] = ph.as_slice();
-        // The lower triangle down contiguous columns, then mirrored.
+        // The lower triangle, down contiguous columns.
         let m = p.as_mut_slice();
         for j in 0..N {
             let phj = ph[j] * inv_s;
@@ -162,10 +200,15 @@ impl<const N: usize> ScalarInnovation<N> {
                 *c -= phi * phj;
             }
         }
-        for j in 0..N {
-            for i in j + 1..N {
-                m[i * N + j] = m[j * N + i];
-            }
+    }
+}
+
+/// Copies the lower triangle of `p` onto the upper one.
+pub fn mirror_lower<const N: usize>(p: &mut SMatrix<f64, N, N>) {
+    let m = p.as_mut_slice();
+    for j in 0..N {
+        for i in j + 1..N {
+            m[i * N + j] = m[j * N + i];
         }
     }
 }
@@ -205,14 +248,17 @@ pub fn update_vector<const N: usize, const M: usize>(
     t_s: f64,
 ) -> Result<Innovation, Error> {
     let (s, s_inv, nis) = innovation_stats(p, y, h, r, t_s)?;
-    let k = *p * h.transpose() * s_inv;
+    // H P, then K = P Hᵀ S⁻¹ = (H P)ᵀ S⁻¹ (P symmetric).
+    let hp = h * *p;
+    let k = hp.transpose() * s_inv;
     *x += k * y;
+    // (I − K H) P = P − K (H P): M·N² products instead of N³.
+    let b = *p - k * hp;
     *p = match form {
-        CovarianceForm::Joseph => {
-            let a = SMatrix::<f64, N, N>::identity() - k * h;
-            a * *p * a.transpose() + k * r * k.transpose()
-        }
-        CovarianceForm::Simple => (SMatrix::<f64, N, N>::identity() - k * h) * *p,
+        // (I − K H) P (I − K H)ᵀ + K R Kᵀ, the right factor applied as
+        // B − (B Hᵀ) Kᵀ: the same products in another order.
+        CovarianceForm::Joseph => b - (b * h.transpose()) * k.transpose() + k * r * k.transpose(),
+        CovarianceForm::Simple => b,
     };
     *p = (*p + p.transpose()) * 0.5;
     Ok(Innovation {
