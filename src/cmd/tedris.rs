@@ -48,7 +48,7 @@ pub enum VariantArg {
 pub enum Kind {
     /// Chosen on the data: with the joint calibration (the default), the kind
     /// whose calibrated heading has the smallest residual on held-back data
-    /// (paper or distance with a GNSS course); without it, the smallest BIC
+    /// (paper, distance or baseline with a GNSS course); without it, the smallest BIC
     /// among kinds with white final innovations.
     Auto,
     /// The paper's γ = α0 + α1·ω.
@@ -57,6 +57,9 @@ pub enum Kind {
     Distance,
     /// ARX(1,1) over consecutive blocks.
     Arx,
+    /// The plain least-squares model: γ = α1·ω + α2·d, one global fit, no
+    /// intercept, no repositories.
+    Baseline,
 }
 
 /// TedriS subcommands.
@@ -183,6 +186,7 @@ pub fn run(c: TedrisCommand) -> Result<()> {
                 Kind::Paper => ModelChoice::Fixed(ModelKind::Paper),
                 Kind::Distance => ModelChoice::Fixed(ModelKind::Distance),
                 Kind::Arx => ModelChoice::Fixed(ModelKind::Arx),
+                Kind::Baseline => ModelChoice::Fixed(ModelKind::Baseline),
             };
             if let Some(t) = tau {
                 cfg.tau_samples = t;

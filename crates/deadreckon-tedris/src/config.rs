@@ -16,11 +16,22 @@ pub enum ModelKind {
     /// ARX(1,1) over consecutive blocks: `γ_k = α0 + α1·ω_k + α2·d_k + b1·ω_{k−1} + a1·γ_{k−1}`;
     /// in prediction `γ_{k−1}` is the model's own previous output.
     Arx,
+    /// The plain least-squares model a user writes in an afternoon (see
+    /// [`crate::baseline`]): `γ = α1·ω + α2·d`, one global fit with no
+    /// intercept and no repositories, i.e. heading per metre of rear-wheel
+    /// difference and per metre travelled. A candidate of the automatic choice,
+    /// so that TedriS falls back to it where its richer kinds do worse.
+    Baseline,
 }
 
 impl ModelKind {
     /// All kinds, in report order.
-    pub const ALL: [ModelKind; 3] = [ModelKind::Paper, ModelKind::Distance, ModelKind::Arx];
+    pub const ALL: [ModelKind; 4] = [
+        ModelKind::Paper,
+        ModelKind::Distance,
+        ModelKind::Arx,
+        ModelKind::Baseline,
+    ];
 
     /// Names of the regressors, in design-column order.
     pub fn regressors(self) -> &'static [&'static str] {
@@ -28,6 +39,7 @@ impl ModelKind {
             ModelKind::Paper => &["alpha0", "alpha1"],
             ModelKind::Distance => &["alpha0", "alpha1", "distance"],
             ModelKind::Arx => &["alpha0", "alpha1", "distance", "omega_prev", "gamma_prev"],
+            ModelKind::Baseline => &["alpha1", "distance"],
         }
     }
 
@@ -37,6 +49,7 @@ impl ModelKind {
             ModelKind::Paper => "paper",
             ModelKind::Distance => "distance",
             ModelKind::Arx => "arx",
+            ModelKind::Baseline => "baseline",
         }
     }
 }
@@ -51,7 +64,7 @@ pub enum ModelChoice {
     /// In the extended variant, each calibration then takes the kind whose
     /// calibrated heading has the smallest residual on the held-back quarter
     /// of its window (not on the data it was fitted on); in the per-metre form
-    /// (a GNSS course) only the paper and distance kinds are candidates.
+    /// (a GNSS course) the paper, distance and baseline kinds are candidates.
     Auto,
     /// Always this kind.
     Fixed(ModelKind),

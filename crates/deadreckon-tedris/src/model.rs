@@ -30,6 +30,7 @@ pub fn design_row(kind: ModelKind, t: &Tuple) -> Option<Vec<f64>> {
             let (wp, gp) = t.prev?;
             vec![1.0, t.omega_m, t.dist_m, wp, gp]
         }
+        ModelKind::Baseline => vec![t.omega_m, t.dist_m],
     })
 }
 
@@ -130,7 +131,13 @@ pub fn fit_kind(
         .and_then(|c| joint_refit(&x, &y, &e, &c.correction, names));
     let beta_g = global.beta();
     let mut repositories = BTreeMap::new();
-    for (&n, q) in &repos.bins {
+    // The baseline is one global fit: no repositories.
+    let bins = if kind == ModelKind::Baseline {
+        None
+    } else {
+        Some(&repos.bins)
+    };
+    for (&n, q) in bins.into_iter().flatten() {
         let tq: Vec<&Tuple> = q.iter().collect();
         let rows: Vec<(Vec<f64>, f64)> = tq
             .iter()
@@ -386,7 +393,8 @@ impl TedrisModel {
         let slope = f
             .global
             .coefficients
-            .get(1)
+            .iter()
+            .find(|c| c.name == "alpha1")
             .map_or(0.0, |c| c.estimate.abs());
         self.dcf0_rad = if straight.is_empty() {
             0.0
@@ -534,4 +542,65 @@ fn choose(fits: &[KindFit]) -> ModelKind {
     best(&white)
         .or_else(|| best(&|_| true))
         .unwrap_or(ModelKind::Paper)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::repository::StraightLine;
+
+    /// γ = 0.66·ω + 2.4e-3·d exactly (no intercept), on blocks at several
+    /// speeds and turn rates, binned into repositories.
+    fn tuples() -> (Vec<Tuple>, Repositories) {
+        let straight = StraightLine::from_omegas(&[-0.001, 0.001], Some(1.5), false).unwrap();
+        let mut repos = Repositories::new(straight, 3, 1000);
+        let mut out = Vec::new();
+        for k in 0..200u64 {
+            let omega_m = 0.02 * ((k % 17) as f64 - 8.0) / 8.0;
+            let dist_m = 0.1 + 0.05 * (k % 5) as f64;
+            let t = Tuple {
+                seq: 10 * k,
+                omega_m,
+                dist_m,
+                gamma_rad: 0.66 * omega_m + 2.4e-3 * dist_m,
+                prev: None,
+                straight: omega_m.abs() < 1e-3,
+            };
+            repos.insert(t);
+            out.push(t);
+        }
+        (out, repos)
+    }
+
+    #[test]
+    fn the_baseline_kind_is_one_global_fit_without_intercept() {
+        let (t, repos) = tuples();
+        assert!(repos.bins.len() > 1, "the tuples fill several repositories");
+        let f = fit_kind(
+            ModelKind::Baseline,
+            &t,
+            &repos,
+            &TedrisConfig::default(),
+            0.0,
+        )
+        .unwrap();
+        assert!(f.repositories.is_empty());
+        assert_eq!(f.global_beta.len(), 2);
+        assert!(
+            (f.global_beta[0] - 0.66).abs() < 1e-9,
+            "{:?}",
+            f.global_beta
+        );
+        assert!(
+            (f.global_beta[1] - 2.4e-3).abs() < 1e-9,
+            "{:?}",
+            f.global_beta
+        );
+        // Every repository falls back to the global coefficients.
+        assert_eq!(f.beta(3), &f.global_beta[..]);
+        assert_eq!(
+            design_row(ModelKind::Baseline, &t[5]),
+            Some(vec![t[5].omega_m, t[5].dist_m])
+        );
+    }
 }

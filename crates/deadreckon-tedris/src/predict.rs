@@ -67,6 +67,7 @@ impl Predictor {
                 });
                 lin + beta[3] * wp + beta[4] * gp
             }
+            ModelKind::Baseline => beta[0] * w + beta[1] * dist_m,
         };
         // γ̂ = γ̂(straight) + g·(γ̂(ω) − γ̂(straight)): the turn gain g scales the part
         // of the increment that comes from turning.
