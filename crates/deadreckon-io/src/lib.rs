@@ -3,7 +3,8 @@
 //! Reads and writes the drive directory format of deadreckon (specified in
 //! `docs/drive-format.md`): a directory of CSV files with a header row, one per
 //! sensor stream, plus `vehicle.toml`; and the files around it: calibrated
-//! parameters (`params.toml`, `truth_params.toml`) and estimated tracks (one CSV, GeoJSON for
+//! parameters (`params.toml`, `truth_params.toml`, and the files Autoware and
+//! Eagleye read, [`stack_params`]) and estimated tracks (one CSV, GeoJSON for
 //! maps, one track as TUM or KITTI for trajectory tools such as `evo`). Everything it reads is checked, and every error names
 //! the file, the 1-based line (the header is line 1) and the column.
 //!
@@ -41,6 +42,7 @@ mod track_out;
 mod track_text;
 mod write;
 
+pub mod stack_params;
 
 pub mod events;
 pub use atomic::atomic_write;
