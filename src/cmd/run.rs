@@ -32,6 +32,12 @@ pub struct RunArgs {
     /// track, so two KITTI files line up pose for pose.
     #[arg(long)]
     pub sync_with: Option<String>,
+    /// What an .mcap file carries: foxglove (JSON, Foxglove's schemas), ros2
+    /// (nav_msgs/msg/Odometry in CDR, `ros2` profile: what ros2 bag, rosbags
+    /// and evo read) or both (read by Foxglove and MCAP libraries, not by ROS
+    /// tools, which want the ros2 profile).
+    #[arg(long, value_enum, default_value_t = McapContent::Foxglove)]
+    pub mcap: McapContent,
     /// Largest time difference of associated poses for --sync-with, s (evo's --t_max_diff).
     #[arg(long, default_value_t = evo::DEFAULT_MAX_DIFF_S)]
     pub max_diff_s: f64,
@@ -41,6 +47,17 @@ pub struct RunArgs {
     /// Initial pose for dead reckoning `EAST_M,NORTH_M,YAW_RAD` (default: the truth, else the smoothed GNSS track).
     #[arg(long)]
     pub init_pose: Option<String>,
+}
+
+/// What `run --out x.mcap` writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum McapContent {
+    /// Foxglove's JSON messages (foxglove.PoseInFrame, foxglove.LocationFix).
+    Foxglove,
+    /// ROS 2 nav_msgs/msg/Odometry in CDR, `ros2` profile (for ros2 bag, rosbags, evo).
+    Ros2,
+    /// Both in one file.
+    Both,
 }
 
 /// The tracks to write: those named (in the order given), or every estimated
@@ -77,13 +94,25 @@ fn select(all: &[Track], a: &RunArgs, format: TrackFormat) -> Result<Vec<Track>>
 }
 
 /// Writes tracks in the format of the file's extension.
-pub fn write_tracks(path: &Path, format: TrackFormat, tracks: &[Track]) -> Result<()> {
+pub fn write_tracks(
+    path: &Path,
+    format: TrackFormat,
+    tracks: &[Track],
+    mcap: McapContent,
+) -> Result<()> {
     match format {
         TrackFormat::Csv => deadreckon_io::write_track_csv(path, tracks)?,
         TrackFormat::GeoJson => deadreckon_io::write_track_geojson(path, tracks)?,
         TrackFormat::Tum => deadreckon_io::write_track_tum(path, &tracks[0])?,
         TrackFormat::Kitti => deadreckon_io::write_track_kitti(path, &tracks[0])?,
-        TrackFormat::Mcap => super::write_mcap(path, tracks)?,
+        TrackFormat::Mcap => {
+            let options = match mcap {
+                McapContent::Foxglove => deadreckon_ros::McapOptions::FOXGLOVE,
+                McapContent::Ros2 => deadreckon_ros::McapOptions::ROS2,
+                McapContent::Both => deadreckon_ros::McapOptions::BOTH,
+            };
+            deadreckon_ros::write_mcap_with(path, tracks, None, options)?
+        }
         f => anyhow::bail!("{}: format {f:?} is not written by run", path.display()),
     }
     Ok(())
@@ -115,7 +144,8 @@ pub fn run(a: RunArgs) -> Result<()> {
     let format = TrackFormat::from_path(&a.out)?;
     let all = common::all_tracks(&drive, &params, &opts, init_pose)?;
     let t = select(&all, &a, format)?;
-    write_tracks(&a.out, format, &t).with_context(|| format!("writing {}", a.out.display()))?;
+    write_tracks(&a.out, format, &t, a.mcap)
+        .with_context(|| format!("writing {}", a.out.display()))?;
     for tr in &t {
         println!("{:<14} {:>7} poses", tr.name, tr.points.len());
     }
