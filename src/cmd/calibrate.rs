@@ -9,6 +9,17 @@ use deadreckon_core::ekf::FilterOptions;
 
 use super::common;
 
+/// What `calibrate --out` writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum OutFormat {
+    /// deadreckon's params.toml.
+    Params,
+    /// Autoware's imu_corrector.param.yaml and vehicle_velocity_converter.param.yaml.
+    Autoware,
+    /// Eagleye's eagleye_config.yaml keys and velocity_scale_factor.txt.
+    Eagleye,
+}
+
 /// Arguments of `calibrate`.
 #[derive(Args, Debug)]
 pub struct CalibrateArgs {
@@ -32,9 +43,15 @@ pub struct CalibrateArgs {
     /// Speed below which epochs are dropped for speed-dependent parameters, m/s.
     #[arg(long, default_value_t = 2.0)]
     pub min_speed: f64,
-    /// Write the parameters here (params.toml).
+    /// Write the parameters here: a params.toml, or with --format autoware or
+    /// eagleye a directory (created if missing).
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// What --out holds: params (params.toml), autoware (imu_corrector and
+    /// vehicle_velocity_converter parameter files) or eagleye (configuration
+    /// keys and the saved velocity scale factor); see docs/stack-params.md.
+    #[arg(long, value_enum, default_value_t = OutFormat::Params)]
+    pub format: OutFormat,
     /// Print JSON instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -75,13 +92,48 @@ pub fn run(a: CalibrateArgs) -> Result<()> {
     };
     let c = calibrate::calibrate(&drive, &opts)
         .with_context(|| format!("calibrating {}", a.dir.display()))?;
+    let mut written = Vec::new();
     if let Some(out) = &a.out {
-        let mut extra = toml::Table::new();
-        extra.insert("method".into(), a.method.clone().into());
-        extra.insert("iterations".into(), (c.iterations as i64).into());
-        extra.insert("converged".into(), c.converged.into());
-        deadreckon_io::write_params(out, &c.estimate, Some(&extra))
-            .with_context(|| format!("writing {}", out.display()))?;
+        let export = || deadreckon_io::stack_params::StackExport {
+            estimate: &c.estimate,
+            samples: c.samples,
+            noise: &drive.vehicle.noise,
+            provenance: format!(
+                "Calibrated on {} with --method {} ({} passes, {}).",
+                a.dir.display(),
+                a.method,
+                c.iterations,
+                if c.converged {
+                    "converged"
+                } else {
+                    "NOT converged"
+                }
+            ),
+        };
+        let context = || format!("writing {}", out.display());
+        match a.format {
+            OutFormat::Params => {
+                let mut extra = toml::Table::new();
+                extra.insert("method".into(), a.method.clone().into());
+                extra.insert("iterations".into(), (c.iterations as i64).into());
+                extra.insert("converged".into(), c.converged.into());
+                deadreckon_io::write_params(out, &c.estimate, Some(&extra))
+                    .with_context(context)?;
+                written.push(out.clone());
+            }
+            OutFormat::Autoware => written.extend(
+                deadreckon_io::stack_params::write_autoware(out, &export())
+                    .with_context(context)?,
+            ),
+            OutFormat::Eagleye => written.extend(
+                deadreckon_io::stack_params::write_eagleye(out, &export()).with_context(context)?,
+            ),
+        }
+    } else if a.format != OutFormat::Params {
+        anyhow::bail!(
+            "--format {} needs --out DIR",
+            format!("{:?}", a.format).to_lowercase()
+        );
     }
     if a.json {
         println!(
@@ -107,8 +159,8 @@ pub fn run(a: CalibrateArgs) -> Result<()> {
         if let Some(st) = &c.filter_stats {
             println!("{}", common::stats_line(st));
         }
-        if let Some(out) = &a.out {
-            println!("wrote {}", out.display());
+        for w in &written {
+            println!("wrote {}", w.display());
         }
     }
     Ok(())

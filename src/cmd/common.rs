@@ -182,3 +182,16 @@ pub fn gated_text(g: &deadreckon_core::filter::GateCounts) -> String {
         gated.join(", ")
     }
 }
+
+/// Every track of a drive: the estimated ones
+/// ([`deadreckon_core::track::drive_tracks`]) and, with truth, `truth`.
+pub fn all_tracks(
+    drive: &deadreckon_core::Drive,
+    params: &deadreckon_core::Params,
+    opts: &deadreckon_core::ekf::FilterOptions,
+    init_pose: Option<(f64, f64, f64)>,
+) -> Result<Vec<deadreckon_core::Track>> {
+    let mut t = deadreckon_core::track::drive_tracks(drive, params, opts, init_pose)?;
+    t.extend(deadreckon_core::Track::from_truth(drive));
+    Ok(t)
+}

@@ -1,5 +1,6 @@
 //! `deadreckon evaluate`: dead-reckoning accuracy with the papers' metrics
-//! (drift per 100 m, distance before 1 m) or over sliding GNSS outages.
+//! (drift per 100 m, distance before 1 m), evo's (relative pose error per
+//! 100 m, absolute pose error) or over sliding GNSS outages.
 
 use std::path::PathBuf;
 
@@ -9,6 +10,7 @@ use deadreckon_core::calibrate::{self, CalibrationOptions};
 use deadreckon_core::ekf::FilterOptions;
 use deadreckon_core::metrics::{self, Summary};
 use deadreckon_core::outage;
+use deadreckon_core::{evo, track};
 use serde_json::json;
 
 use super::common;
@@ -21,9 +23,26 @@ pub struct EvaluateArgs {
     /// `nominal` or a params.toml. Without it, `--outage` calibrates with RTS on the drive itself.
     #[arg(long)]
     pub params: Option<String>,
-    /// drift (reset to the truth every 100 m) or reset-1m (reset when the error reaches 1 m).
+    /// drift (reset to the truth every 100 m), reset-1m (reset when the error
+    /// reaches 1 m), rpe (evo's relative pose error per --delta-m of path,
+    /// translation part) or ape (evo's absolute pose error, no alignment).
     #[arg(long, default_value = "drift")]
     pub metric: String,
+    /// rpe/ape: the estimated track (dead-reckoned, filtered, smoothed).
+    #[arg(long, default_value = "dead-reckoned")]
+    pub track: String,
+    /// rpe/ape: the reference track (truth, or an estimated one).
+    #[arg(long, default_value = "truth")]
+    pub reference: String,
+    /// rpe: path length between the poses of a pair, m (evo's --delta with --delta_unit m).
+    #[arg(long, default_value_t = 100.0)]
+    pub delta_m: f64,
+    /// rpe: whose travelled path chooses the pairs: estimate (evo's default) or reference (evo's --pairs_from_reference).
+    #[arg(long, default_value = "estimate")]
+    pub pairs_from: String,
+    /// rpe/ape: largest time difference of associated poses, s (evo's --t_max_diff).
+    #[arg(long, default_value_t = evo::DEFAULT_MAX_DIFF_S)]
+    pub max_diff_s: f64,
     /// Segment length of the drift metric, m.
     #[arg(long, default_value_t = 100.0)]
     pub segment_m: f64,
@@ -146,7 +165,77 @@ pub fn run(a: EvaluateArgs) -> Result<()> {
                 println!("rejected by the χ² gates: {}", common::gated_text(&r.gates));
             }
         }
-        m => anyhow::bail!("unknown metric `{m}` (drift, reset-1m)"),
+        "rpe" | "ape" => {
+            let opts = FilterOptions {
+                timing,
+                ..Default::default()
+            };
+            let all = common::all_tracks(&drive, &params, &opts, None)?;
+            // On the values the TUM/KITTI files carry, so evo on the files agrees.
+            let reference = &evo::as_written(track::find(&all, &a.reference)?);
+            let estimate = &evo::as_written(track::find(&all, &a.track)?);
+            let pairs_from = match a.pairs_from.as_str() {
+                "estimate" => evo::PairsFrom::Estimate,
+                "reference" => evo::PairsFrom::Reference,
+                s => anyhow::bail!("unknown --pairs-from `{s}` (estimate, reference)"),
+            };
+            let r = if a.metric == "rpe" {
+                evo::rpe(
+                    reference,
+                    estimate,
+                    &evo::RpeOptions {
+                        delta_m: a.delta_m,
+                        max_diff_s: a.max_diff_s,
+                        pairs_from,
+                    },
+                )
+            } else {
+                evo::ape(reference, estimate, a.max_diff_s)
+            }
+            .with_context(|| format!("{} of `{}` against `{}`", a.metric, a.track, a.reference))?;
+            if a.json {
+                let mut v = json!({
+                    "metric": a.metric,
+                    "track": a.track,
+                    "reference": a.reference,
+                    "matched": r.matched,
+                    "n": r.errors_m.len(),
+                    "stats_m": r.stats,
+                    "errors_m": r.errors_m,
+                    "t_s": r.t_s,
+                    "evo_version": evo::EVO_VERSION,
+                    "max_diff_s": a.max_diff_s,
+                });
+                if a.metric == "rpe" {
+                    v["delta_m"] = json!(a.delta_m);
+                    v["pairs_from"] = json!(a.pairs_from);
+                }
+                println!("{}", serde_json::to_string_pretty(&v)?);
+            } else {
+                let what = if a.metric == "rpe" {
+                    format!(
+                        "RPE per {} m (translation, pairs from the {})",
+                        a.delta_m, a.pairs_from
+                    )
+                } else {
+                    "APE (translation, no alignment)".to_string()
+                };
+                let s = r.stats;
+                println!(
+                    "{what} of `{}` against `{}`: {} errors over {} associated poses (as evo {})",
+                    a.track,
+                    a.reference,
+                    r.errors_m.len(),
+                    r.matched,
+                    evo::EVO_VERSION
+                );
+                println!(
+                    "rmse {:.4} m, mean {:.4} m, median {:.4} m, std {:.4} m, min {:.4} m, max {:.4} m",
+                    s.rmse, s.mean, s.median, s.std, s.min, s.max
+                );
+            }
+        }
+        m => anyhow::bail!("unknown metric `{m}` (drift, reset-1m, rpe, ape)"),
     }
     Ok(())
 }

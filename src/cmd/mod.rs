@@ -13,13 +13,6 @@ pub mod simulate;
 pub mod stream;
 pub mod tedris;
 
-/// Writes tracks as MCAP with Foxglove schemas (`foxglove.PoseInFrame`,
-/// `foxglove.LocationFix` where the drive has a geodetic origin).
-pub fn write_mcap(path: &std::path::Path, tracks: &[deadreckon_core::Track]) -> anyhow::Result<()> {
-    deadreckon_ros::write_tracks_mcap(path, tracks)?;
-    Ok(())
-}
-
 /// The `--mapping` file given on the command line, for ROS recordings.
 pub static ROS_MAPPING: std::sync::OnceLock<std::path::PathBuf> = std::sync::OnceLock::new();
 

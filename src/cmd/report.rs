@@ -12,7 +12,8 @@ use deadreckon_core::metrics;
 use deadreckon_core::{outage, Drive, Params, ParamsWithStd, Track};
 use deadreckon_report as rp;
 
-use super::{common, progress::Steps, run as runcmd};
+use super::{common, progress::Steps};
+use deadreckon_core::track as tracks;
 
 /// Arguments of `report`.
 #[derive(Args, Debug)]
@@ -274,8 +275,8 @@ pub fn four_wheel_input(
     let opts = FilterOptions::default();
     for m in methods {
         steps.step(&format!("dead reckoning with {}", m.name));
-        let init = runcmd::dead_reckoning_init(drive, None, None);
-        if let Ok(dr) = init.and_then(|i| runcmd::dead_reckoned(drive, &m.params.params, &opts, i))
+        let init = tracks::dead_reckoning_init(drive, None, None);
+        if let Ok(dr) = init.and_then(|i| tracks::dead_reckoned(drive, &m.params.params, &opts, i))
         {
             traj.dead_reckoned.push(rp::MethodPath {
                 method: m.name.clone(),

@@ -1,13 +1,14 @@
 //! `deadreckon run`: write the dead-reckoned track (and, with GNSS, the filtered
-//! and smoothed ones) with covariances.
+//! and smoothed ones, and the truth) with covariances, or one of them as TUM or
+//! KITTI for `evo`.
 
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use clap::Args;
-use deadreckon_core::ekf::{self, FilterOptions, Init, SensorSet};
-use deadreckon_core::model::{Mat, State};
-use deadreckon_core::{rts, Drive, Params, Track};
+use deadreckon_core::ekf::FilterOptions;
+use deadreckon_core::{evo, track, Track};
+use deadreckon_io::TrackFormat;
 
 use super::common;
 
@@ -19,9 +20,27 @@ pub struct RunArgs {
     /// `nominal` or a params.toml.
     #[arg(long, default_value = "nominal")]
     pub params: String,
-    /// Output file: .csv, .geojson or .mcap (by extension).
+    /// Output file, by extension: .csv, .geojson, .mcap (every track), .tum or
+    /// .kitti (one track; KITTI's timestamps go to <stem>.times.txt).
     #[arg(long)]
     pub out: PathBuf,
+    /// A track to write (repeatable): dead-reckoned, filtered, smoothed, truth.
+    /// Default: every estimated track; TUM and KITTI need exactly one.
+    #[arg(long)]
+    pub track: Vec<String>,
+    /// TUM/KITTI: keep only the poses evo's time association pairs with this
+    /// track, so two KITTI files line up pose for pose.
+    #[arg(long)]
+    pub sync_with: Option<String>,
+    /// What an .mcap file carries: foxglove (JSON, Foxglove's schemas), ros2
+    /// (nav_msgs/msg/Odometry in CDR, `ros2` profile: what ros2 bag, rosbags
+    /// and evo read) or both (read by Foxglove and MCAP libraries, not by ROS
+    /// tools, which want the ros2 profile).
+    #[arg(long, value_enum, default_value_t = McapContent::Foxglove)]
+    pub mcap: McapContent,
+    /// Largest time difference of associated poses for --sync-with, s (evo's --t_max_diff).
+    #[arg(long, default_value_t = evo::DEFAULT_MAX_DIFF_S)]
+    pub max_diff_s: f64,
     /// Filter timing: wheel or each.
     #[arg(long, default_value = "wheel")]
     pub timing: String,
@@ -30,93 +49,71 @@ pub struct RunArgs {
     pub init_pose: Option<String>,
 }
 
-/// The tracks of a drive: dead-reckoned, and with GNSS the filtered and smoothed.
-pub fn tracks(
-    drive: &Drive,
-    params: &Params,
-    opts: &FilterOptions,
-    init_pose: Option<(f64, f64, f64)>,
-) -> Result<Vec<Track>> {
-    let origin = drive.vehicle.origin;
-    let mut out = Vec::new();
-    let mut smoothed_start = None;
-    if drive.gnss.len() >= 2 {
-        let f = ekf::run(
-            drive,
-            params,
-            &FilterOptions {
-                record_epochs: true,
-                ..opts.clone()
-            },
-            &mut (),
-        )?;
-        let s = rts::smooth(&f.epochs)?;
-        smoothed_start = s.first().map(|s| (s.t_s, s.x, s.p));
-        out.push(Track::from_epochs("filtered", &f.epochs, origin));
-        out.push(Track::from_smoothed("smoothed", &s, origin));
-    }
-    let init = dead_reckoning_init(drive, init_pose, smoothed_start)?;
-    out.insert(0, dead_reckoned(drive, params, opts, init)?);
-    Ok(out)
+/// What `run --out x.mcap` writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum McapContent {
+    /// Foxglove's JSON messages (foxglove.PoseInFrame, foxglove.LocationFix).
+    Foxglove,
+    /// ROS 2 nav_msgs/msg/Odometry in CDR, `ros2` profile (for ros2 bag, rosbags, evo).
+    Ros2,
+    /// Both in one file.
+    Both,
 }
 
-/// Where dead reckoning starts: the given pose, else the truth, else the
-/// start of the smoothed GNSS-aided track.
-pub fn dead_reckoning_init(
-    drive: &Drive,
-    init_pose: Option<(f64, f64, f64)>,
-    smoothed_start: Option<(f64, State, Mat)>,
-) -> Result<Init> {
-    Ok(if let Some((e, n, y)) = init_pose {
-        Init::Given {
-            t_s: drive.wheels.t_s(0),
-            x: State::from([e, n, y, 0.0, 0.0]),
-            p: Mat::from_diagonal(&State::from([1e-4, 1e-4, 1e-6, 4.0, 0.25])),
-        }
-    } else if !drive.truth.is_empty() {
-        Init::Truth
-    } else if let Some((t_s, x, p)) = smoothed_start {
-        Init::Given { t_s, x, p }
+/// The tracks to write: those named (in the order given), or every estimated
+/// track; for TUM and KITTI exactly one, optionally synced with another.
+fn select(all: &[Track], a: &RunArgs, format: TrackFormat) -> Result<Vec<Track>> {
+    let mut chosen: Vec<Track> = if a.track.is_empty() {
+        all.iter()
+            .filter(|t| t.name != track::names::TRUTH)
+            .cloned()
+            .collect()
     } else {
-        anyhow::bail!("dead reckoning needs an initial pose: truth.csv, gnss.csv or --init-pose");
-    })
+        a.track
+            .iter()
+            .map(|n| track::find(all, n).cloned())
+            .collect::<Result<_, _>>()?
+    };
+    if format.holds_one_track() && chosen.len() != 1 {
+        let have: Vec<&str> = all.iter().map(|t| t.name.as_str()).collect();
+        anyhow::bail!(
+            "{} holds one track: choose it with --track NAME ({})",
+            a.out.display(),
+            have.join(", ")
+        );
+    }
+    if let Some(with) = &a.sync_with {
+        anyhow::ensure!(
+            format.holds_one_track(),
+            "--sync-with is for TUM and KITTI files (one track)"
+        );
+        let other = track::find(all, with)?;
+        chosen[0] = evo::synced(&chosen[0], other, a.max_diff_s)?;
+    }
+    Ok(chosen)
 }
 
-/// The dead-reckoned track (proprioceptive sensors only) from `init`.
-pub fn dead_reckoned(
-    drive: &Drive,
-    params: &Params,
-    opts: &FilterOptions,
-    init: Init,
-) -> Result<Track> {
-    let dr = ekf::run(
-        drive,
-        params,
-        &FilterOptions {
-            init,
-            sensors: SensorSet::dead_reckoning(),
-            record_epochs: true,
-            ..opts.clone()
-        },
-        &mut (),
-    )?;
-    Ok(Track::from_epochs(
-        "dead-reckoned",
-        &dr.epochs,
-        drive.vehicle.origin,
-    ))
-}
-
-/// Writes tracks by the file's extension.
-pub fn write_tracks(path: &Path, tracks: &[Track]) -> Result<()> {
-    match path.extension().and_then(|e| e.to_str()) {
-        Some("csv") => deadreckon_io::write_track_csv(path, tracks)?,
-        Some("geojson") | Some("json") => deadreckon_io::write_track_geojson(path, tracks)?,
-        Some("mcap") => super::write_mcap(path, tracks)?,
-        _ => anyhow::bail!(
-            "unknown output format for {} (use .csv, .geojson or .mcap)",
-            path.display()
-        ),
+/// Writes tracks in the format of the file's extension.
+pub fn write_tracks(
+    path: &Path,
+    format: TrackFormat,
+    tracks: &[Track],
+    mcap: McapContent,
+) -> Result<()> {
+    match format {
+        TrackFormat::Csv => deadreckon_io::write_track_csv(path, tracks)?,
+        TrackFormat::GeoJson => deadreckon_io::write_track_geojson(path, tracks)?,
+        TrackFormat::Tum => deadreckon_io::write_track_tum(path, &tracks[0])?,
+        TrackFormat::Kitti => deadreckon_io::write_track_kitti(path, &tracks[0])?,
+        TrackFormat::Mcap => {
+            let options = match mcap {
+                McapContent::Foxglove => deadreckon_ros::McapOptions::FOXGLOVE,
+                McapContent::Ros2 => deadreckon_ros::McapOptions::ROS2,
+                McapContent::Both => deadreckon_ros::McapOptions::BOTH,
+            };
+            deadreckon_ros::write_mcap_with(path, tracks, None, options)?
+        }
+        f => anyhow::bail!("{}: format {f:?} is not written by run", path.display()),
     }
     Ok(())
 }
@@ -144,11 +141,20 @@ pub fn run(a: RunArgs) -> Result<()> {
         timing: common::parse_timing(&a.timing)?,
         ..Default::default()
     };
-    let t = tracks(&drive, &params, &opts, init_pose)?;
-    write_tracks(&a.out, &t).with_context(|| format!("writing {}", a.out.display()))?;
+    let format = TrackFormat::from_path(&a.out)?;
+    let all = common::all_tracks(&drive, &params, &opts, init_pose)?;
+    let t = select(&all, &a, format)?;
+    write_tracks(&a.out, format, &t, a.mcap)
+        .with_context(|| format!("writing {}", a.out.display()))?;
     for tr in &t {
         println!("{:<14} {:>7} poses", tr.name, tr.points.len());
     }
     println!("wrote {}", a.out.display());
+    if format == TrackFormat::Kitti {
+        println!(
+            "wrote {} (the poses' timestamps)",
+            deadreckon_io::kitti_times_path(&a.out).display()
+        );
+    }
     Ok(())
 }

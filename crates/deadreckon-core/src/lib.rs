@@ -23,6 +23,7 @@ pub mod checkpoint;
 pub mod drive;
 pub mod ekf;
 pub mod event;
+pub mod evo;
 pub mod filter;
 pub mod geo;
 pub mod init;

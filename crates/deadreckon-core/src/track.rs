@@ -1,6 +1,23 @@
-//! An estimated trajectory: what `deadreckon run` writes and every exporter reads.
+//! An estimated trajectory: what `deadreckon run` writes and every exporter
+//! reads; and the tracks of a drive ([`drive_tracks`]): dead-reckoned, with GNSS
+//! the filtered and smoothed ones, and the truth as a track of its own.
 
+use crate::ekf::{self, FilterOptions, Init, SensorSet};
+use crate::model::{Mat, State};
 use crate::vehicle::Origin;
+use crate::{rts, Drive, Error, Params};
+
+/// The names of the tracks [`drive_tracks`] builds, in its order.
+pub mod names {
+    /// Proprioceptive sensors only, from the initial pose.
+    pub const DEAD_RECKONED: &str = "dead-reckoned";
+    /// The filter with GNSS (causal).
+    pub const FILTERED: &str = "filtered";
+    /// The RTS-smoothed filter with GNSS.
+    pub const SMOOTHED: &str = "smoothed";
+    /// The drive's reference trajectory (`truth.csv`), at its own timestamps.
+    pub const TRUTH: &str = "truth";
+}
 
 /// One estimated pose with its uncertainty.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -98,4 +115,135 @@ impl Track {
             origin,
         }
     }
+}
+
+impl Track {
+    /// The drive's reference trajectory as a track named `truth`, at its own
+    /// timestamps, with a zero covariance. Speed and yaw rate are derived from
+    /// the poses (as the truth calibration does), or NaN where they cannot be.
+    /// `None` without truth.
+    pub fn from_truth(drive: &Drive) -> Option<Track> {
+        if drive.truth.is_empty() {
+            return None;
+        }
+        let reference = crate::reference::Reference::from_truth(&drive.truth);
+        let points = drive
+            .truth
+            .iter()
+            .map(|p| {
+                let derived = reference.as_ref().and_then(|r| r.state_at(p.t_s));
+                TrackPoint {
+                    t_s: p.t_s,
+                    east_m: p.east_m,
+                    north_m: p.north_m,
+                    yaw_rad: crate::angle::wrap(p.yaw_rad),
+                    speed_mps: p
+                        .speed_mps
+                        .or(derived.map(|x| x[crate::model::V]))
+                        .unwrap_or(f64::NAN),
+                    yaw_rate_rps: derived.map_or(f64::NAN, |x| x[crate::model::YAW_RATE]),
+                    cov_pose: [0.0; 9],
+                }
+            })
+            .collect();
+        Some(Track {
+            name: names::TRUTH.into(),
+            points,
+            origin: drive.vehicle.origin,
+        })
+    }
+}
+
+/// The estimated tracks of a drive with `params`: dead-reckoned first, then,
+/// with at least two GNSS fixes, the filtered and the smoothed track.
+///
+/// Dead reckoning starts from `init_pose` (east m, north m, yaw rad) when
+/// given, else from the truth, else from the start of the smoothed track.
+pub fn drive_tracks(
+    drive: &Drive,
+    params: &Params,
+    opts: &FilterOptions,
+    init_pose: Option<(f64, f64, f64)>,
+) -> Result<Vec<Track>, Error> {
+    let origin = drive.vehicle.origin;
+    let mut out = Vec::new();
+    let mut smoothed_start = None;
+    if drive.gnss.len() >= 2 {
+        let f = ekf::run(
+            drive,
+            params,
+            &FilterOptions {
+                record_epochs: true,
+                ..opts.clone()
+            },
+            &mut (),
+        )?;
+        let s = rts::smooth(&f.epochs)?;
+        smoothed_start = s.first().map(|s| (s.t_s, s.x, s.p));
+        out.push(Track::from_epochs(names::FILTERED, &f.epochs, origin));
+        out.push(Track::from_smoothed(names::SMOOTHED, &s, origin));
+    }
+    let init = dead_reckoning_init(drive, init_pose, smoothed_start)?;
+    out.insert(0, dead_reckoned(drive, params, opts, init)?);
+    Ok(out)
+}
+
+/// Where dead reckoning starts: the given pose, else the truth, else the
+/// start of the smoothed GNSS-aided track.
+pub fn dead_reckoning_init(
+    drive: &Drive,
+    init_pose: Option<(f64, f64, f64)>,
+    smoothed_start: Option<(f64, State, Mat)>,
+) -> Result<Init, Error> {
+    Ok(if let Some((e, n, y)) = init_pose {
+        Init::Given {
+            t_s: drive.wheels.t_s(0),
+            x: State::from([e, n, y, 0.0, 0.0]),
+            p: Mat::from_diagonal(&State::from([1e-4, 1e-4, 1e-6, 4.0, 0.25])),
+        }
+    } else if !drive.truth.is_empty() {
+        Init::Truth
+    } else if let Some((t_s, x, p)) = smoothed_start {
+        Init::Given { t_s, x, p }
+    } else {
+        return Err(Error::Insufficient(
+            "dead reckoning needs an initial pose: truth.csv, gnss.csv or --init-pose".into(),
+        ));
+    })
+}
+
+/// The dead-reckoned track (proprioceptive sensors only) from `init`.
+pub fn dead_reckoned(
+    drive: &Drive,
+    params: &Params,
+    opts: &FilterOptions,
+    init: Init,
+) -> Result<Track, Error> {
+    let dr = ekf::run(
+        drive,
+        params,
+        &FilterOptions {
+            init,
+            sensors: SensorSet::dead_reckoning(),
+            record_epochs: true,
+            ..opts.clone()
+        },
+        &mut (),
+    )?;
+    Ok(Track::from_epochs(
+        names::DEAD_RECKONED,
+        &dr.epochs,
+        drive.vehicle.origin,
+    ))
+}
+
+/// The track named `name` among `tracks`, or an error listing the names there are.
+pub fn find<'a>(tracks: &'a [Track], name: &str) -> Result<&'a Track, Error> {
+    tracks.iter().find(|t| t.name == name).ok_or_else(|| {
+        let have: Vec<&str> = tracks.iter().map(|t| t.name.as_str()).collect();
+        Error::Insufficient(format!(
+            "no track named `{name}` (this drive has: {})",
+            have.join(", ")
+        ))
+    })
 }

@@ -3,8 +3,9 @@
 //! Reads and writes the drive directory format of deadreckon (specified in
 //! `docs/drive-format.md`): a directory of CSV files with a header row, one per
 //! sensor stream, plus `vehicle.toml`; and the files around it: calibrated
-//! parameters (`params.toml`, `truth_params.toml`) and estimated tracks (one CSV,
-//! or GeoJSON for maps). Everything it reads is checked, and every error names
+//! parameters (`params.toml`, `truth_params.toml`, and the files Autoware and
+//! Eagleye read, [`stack_params`]) and estimated tracks (one CSV, GeoJSON for
+//! maps, one track as TUM or KITTI for trajectory tools such as `evo`). Everything it reads is checked, and every error names
 //! the file, the 1-based line (the header is line 1) and the column.
 //!
 //! ## Conventions
@@ -38,7 +39,10 @@ mod read;
 mod table;
 mod toml_files;
 mod track_out;
+mod track_text;
 mod write;
+
+pub mod stack_params;
 
 pub mod events;
 pub use atomic::atomic_write;
@@ -53,6 +57,10 @@ pub use toml_files::{
 pub use track_out::{
     write_track_csv, write_track_geojson, write_track_geojson_with, GeoJsonOptions,
     TRACK_CSV_COLUMNS,
+};
+pub use track_text::{
+    kitti_line, kitti_times_path, tum_line, write_track_kitti, write_track_tum, TrackFormat,
+    TUM_HEADER,
 };
 pub use write::write_drive;
 

@@ -9,6 +9,8 @@
 //!   east/north covariance), when the track has a geodetic origin.
 //!
 //! With GNSS fixes, `/deadreckon/gnss/fix` carries them as `foxglove.LocationFix`.
+//! [`write_mcap_with`] can add, or write instead, each track as ROS 2
+//! `nav_msgs/msg/Odometry` on `/deadreckon/<name>/odom` (see [`crate::ros2_out`]).
 //! The file is written next to its destination and renamed into place, so a
 //! reader never sees half a file.
 
@@ -158,6 +160,34 @@ fn location_fix(
     })
 }
 
+/// What an MCAP file of tracks carries.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct McapOptions {
+    /// Foxglove's JSON messages (`foxglove.PoseInFrame`, `foxglove.LocationFix`).
+    pub foxglove: bool,
+    /// ROS 2 `nav_msgs/msg/Odometry` in CDR ([`crate::ros2_out`]). Alone, the
+    /// file has the `ros2` profile, as `ros2 bag` expects.
+    pub ros2_odometry: bool,
+}
+
+impl McapOptions {
+    /// Foxglove's messages only (what [`write_mcap`] writes).
+    pub const FOXGLOVE: McapOptions = McapOptions {
+        foxglove: true,
+        ros2_odometry: false,
+    };
+    /// ROS 2 Odometry only, `ros2` profile.
+    pub const ROS2: McapOptions = McapOptions {
+        foxglove: false,
+        ros2_odometry: true,
+    };
+    /// Both.
+    pub const BOTH: McapOptions = McapOptions {
+        foxglove: true,
+        ros2_odometry: true,
+    };
+}
+
 /// Writes tracks to an MCAP file for Foxglove (see the module doc).
 pub fn write_tracks_mcap(path: impl AsRef<Path>, tracks: &[Track]) -> Result<(), RosError> {
     write_mcap(path, tracks, None)
@@ -170,7 +200,26 @@ pub fn write_mcap(
     tracks: &[Track],
     gnss: Option<(&[GnssFix], Origin)>,
 ) -> Result<(), RosError> {
+    write_mcap_with(path, tracks, gnss, McapOptions::FOXGLOVE)
+}
+
+/// [`write_mcap`] choosing what the file carries: Foxglove's messages, ROS 2
+/// Odometry (one `/deadreckon/<name>/odom` per track), or both. GNSS fixes
+/// are written as Foxglove messages only.
+pub fn write_mcap_with(
+    path: impl AsRef<Path>,
+    tracks: &[Track],
+    gnss: Option<(&[GnssFix], Origin)>,
+    options: McapOptions,
+) -> Result<(), RosError> {
     let path = path.as_ref();
+    if !(options.foxglove || options.ros2_odometry) {
+        return Err(RosError::Write {
+            file: path.display().to_string(),
+            what: "an MCAP file of tracks needs Foxglove or ROS 2 messages".into(),
+        });
+    }
+    let gnss = gnss.filter(|_| options.foxglove);
     let file = path.display().to_string();
     let mut names: Vec<String> = Vec::new();
     for t in tracks {
@@ -199,7 +248,7 @@ pub fn write_mcap(
     let result = (|| -> Result<(), RosError> {
         let f = std::fs::File::create(&tmp).map_err(io)?;
         let mut w = BufWriter::new(f);
-        write_into(&mut w, tracks, &names, gnss, &file)?;
+        write_into(&mut w, tracks, &names, gnss, options, &file)?;
         let f = w.into_inner().map_err(|e| io(e.into_error()))?;
         f.sync_all().map_err(io)?;
         Ok(())
@@ -218,15 +267,17 @@ fn write_into<W: Write + std::io::Seek>(
     tracks: &[Track],
     names: &[String],
     gnss: Option<(&[GnssFix], Origin)>,
+    options: McapOptions,
     file: &str,
 ) -> Result<(), RosError> {
     let werr = |e: mcap::McapError| RosError::Write {
         file: file.into(),
         what: e.to_string(),
     };
+    let profile = if options.foxglove { "" } else { "ros2" };
     let opts = mcap::WriteOptions::new()
         .compression(None)
-        .profile("")
+        .profile(profile)
         .library("deadreckon-ros");
     let mut out = opts.create(w).map_err(werr)?;
     let pose_schema = serde_json::to_vec(&pose_in_frame_schema()).map_err(|e| RosError::Write {
@@ -237,24 +288,48 @@ fn write_into<W: Write + std::io::Seek>(
         file: file.into(),
         what: e.to_string(),
     })?;
-    let pose_id = out
-        .add_schema("foxglove.PoseInFrame", "jsonschema", &pose_schema)
-        .map_err(werr)?;
-    // Schemas first, then channels, then messages: add every channel up front.
-    let fix_sid = if tracks.iter().any(|t| t.origin.is_some()) || gnss.is_some() {
+    let pose_id = if options.foxglove {
         Some(
-            out.add_schema("foxglove.LocationFix", "jsonschema", &fix_schema)
+            out.add_schema("foxglove.PoseInFrame", "jsonschema", &pose_schema)
                 .map_err(werr)?,
+        )
+    } else {
+        None
+    };
+    // Schemas first, then channels, then messages: add every channel up front.
+    let fix_sid =
+        if options.foxglove && (tracks.iter().any(|t| t.origin.is_some()) || gnss.is_some()) {
+            Some(
+                out.add_schema("foxglove.LocationFix", "jsonschema", &fix_schema)
+                    .map_err(werr)?,
+            )
+        } else {
+            None
+        };
+    let odom_sid = if options.ros2_odometry {
+        Some(
+            out.add_schema(
+                crate::ros2_out::ODOMETRY_SCHEMA_NAME,
+                "ros2msg",
+                crate::ros2_out::odometry_schema().as_bytes(),
+            )
+            .map_err(werr)?,
         )
     } else {
         None
     };
     let mut plans = Vec::new();
     let meta = BTreeMap::new();
+    // The ros2 profile requires the QoS metadata; empty means the defaults.
+    let ros2_meta = BTreeMap::from([("offered_qos_profiles".to_string(), String::new())]);
     for (t, n) in tracks.iter().zip(names) {
-        let pose_ch = out
-            .add_channel(pose_id, &format!("/deadreckon/{n}/pose"), "json", &meta)
-            .map_err(werr)?;
+        let pose_ch = match pose_id {
+            Some(sid) => Some(
+                out.add_channel(sid, &format!("/deadreckon/{n}/pose"), "json", &meta)
+                    .map_err(werr)?,
+            ),
+            None => None,
+        };
         let fix_ch = match (t.origin, fix_sid) {
             (Some(_), Some(sid)) => Some(
                 out.add_channel(sid, &format!("/deadreckon/{n}/fix"), "json", &meta)
@@ -262,7 +337,14 @@ fn write_into<W: Write + std::io::Seek>(
             ),
             _ => None,
         };
-        plans.push((t, pose_ch, fix_ch));
+        let odom_ch = match odom_sid {
+            Some(sid) => Some(
+                out.add_channel(sid, &format!("/deadreckon/{n}/odom"), "cdr", &ros2_meta)
+                    .map_err(werr)?,
+            ),
+            None => None,
+        };
+        plans.push((t, pose_ch, fix_ch, odom_ch));
     }
     let gnss_ch = match (gnss, fix_sid) {
         (Some(_), Some(sid)) => Some(
@@ -275,7 +357,7 @@ fn write_into<W: Write + std::io::Seek>(
         file: file.into(),
         what: e.to_string(),
     };
-    for (t, pose_ch, fix_ch) in plans {
+    for (t, pose_ch, fix_ch, odom_ch) in plans {
         for (seq, p) in t.points.iter().enumerate() {
             let (ns, ts) = stamp(p.t_s, file)?;
             let half = 0.5 * p.yaw_rad;
@@ -293,8 +375,25 @@ fn write_into<W: Write + std::io::Seek>(
                 log_time: ns,
                 publish_time: ns,
             };
-            out.write_to_known_channel(&header(pose_ch), &serde_json::to_vec(&msg).map_err(jerr)?)
-                .map_err(werr)?;
+            if let Some(ch) = pose_ch {
+                out.write_to_known_channel(&header(ch), &serde_json::to_vec(&msg).map_err(jerr)?)
+                    .map_err(werr)?;
+            }
+            if let Some(ch) = odom_ch {
+                let odom = crate::ros2_out::odometry(p).ok_or_else(|| RosError::Write {
+                    file: file.into(),
+                    what: format!(
+                        "track `{}`: time {} s has no ROS 2 stamp (int32 seconds)",
+                        t.name, p.t_s
+                    ),
+                })?;
+                let data = crate::ros2::encode_cdr(&odom).map_err(|e| RosError::Write {
+                    file: file.into(),
+                    what: e,
+                })?;
+                out.write_to_known_channel(&header(ch), &data)
+                    .map_err(werr)?;
+            }
             if let (Some(ch), Some(origin)) = (fix_ch, t.origin) {
                 let c = p.cov_pose;
                 let data = location_fix(

@@ -5,7 +5,8 @@
 //! a [`Mapping`] that says which topic feeds which stream, with an
 //! [`ImportReport`] of what was used and dropped; [`list_topics`] lists what a
 //! file holds; estimated [`Track`]s are written to MCAP with Foxglove's JSON
-//! schemas (`foxglove.PoseInFrame`, `foxglove.LocationFix`, see [`foxglove`]).
+//! schemas (`foxglove.PoseInFrame`, `foxglove.LocationFix`, see [`foxglove`])
+//! and, for ROS tools, as ROS 2 `nav_msgs/msg/Odometry` in CDR ([`ros2_out`]).
 //!
 //! Readers take a path, any `Read`, or a byte slice. The containers are decoded
 //! here with every length checked; `mcap` parses MCAP record bodies and writes
@@ -52,6 +53,7 @@ pub mod mapping;
 mod mcap_read;
 mod msgs;
 pub mod ros2;
+pub mod ros2_out;
 mod rosbag;
 
 use std::path::Path;
@@ -60,7 +62,7 @@ use serde::Serialize;
 
 pub use deadreckon_core::{Drive, Track};
 pub use error::{Location, RosError};
-pub use foxglove::{write_mcap, write_tracks_mcap};
+pub use foxglove::{write_mcap, write_mcap_with, write_tracks_mcap, McapOptions};
 pub use ingest::{ImportReport, StreamReport};
 pub use mapping::{Mapping, StreamKind, StreamSpec, TimeSource, YawAxis};
 pub use mcap_read::{list_mcap_topics_bytes, read_mcap_bytes};
