@@ -36,18 +36,22 @@ pub fn write_track_csv(path: &Path, tracks: &[Track]) -> Result<(), IoError> {
     w.write_record(TRACK_CSV_COLUMNS).map_err(csv_err)?;
     for track in tracks {
         for p in &track.points {
+            // Fixed precision per column (the shortest round-trip form of a
+            // tiny number runs to 40 digits): times, positions and angles to
+            // 1e-9 (what `events | stream` is checked against), speeds to
+            // 1e-6 m/s, uncertainties to 7 significant digits.
             w.write_record([
-                format!("{}", p.t_s),
+                format!("{:.9}", p.t_s),
                 track.name.clone(),
-                format!("{}", p.east_m),
-                format!("{}", p.north_m),
-                format!("{}", p.yaw_rad),
-                format!("{}", p.speed_mps),
-                format!("{}", p.yaw_rate_rps),
-                format!("{}", p.std_east_m()),
-                format!("{}", p.std_north_m()),
-                format!("{}", p.std_yaw_rad()),
-                format!("{}", p.cov_pose[1]),
+                format!("{:.9}", p.east_m),
+                format!("{:.9}", p.north_m),
+                format!("{:.9}", p.yaw_rad),
+                format!("{:.6}", p.speed_mps),
+                format!("{:.9}", p.yaw_rate_rps),
+                format!("{:.6e}", p.std_east_m()),
+                format!("{:.6e}", p.std_north_m()),
+                format!("{:.6e}", p.std_yaw_rad()),
+                format!("{:.6e}", p.cov_pose[1]),
             ])
             .map_err(csv_err)?;
         }
@@ -115,7 +119,7 @@ pub fn write_track_geojson_with(
                     ),
                 });
             }
-            coords.push(Position::from([lon, lat]));
+            coords.push(Position::from([degrees(lon), degrees(lat)]));
         }
         let mut props = JsonObject::new();
         props.insert("name".into(), JsonValue::from(track.name.clone()));
@@ -151,7 +155,7 @@ pub fn write_track_geojson_with(
                 props.insert("std_east_m".into(), number(Some(p.std_east_m())));
                 props.insert("std_north_m".into(), number(Some(p.std_north_m())));
                 features.push(Feature {
-                    geometry: Some(Geometry::new_point([lon, lat])),
+                    geometry: Some(Geometry::new_point([degrees(lon), degrees(lat)])),
                     properties: Some(props),
                     ..Feature::default()
                 });
@@ -159,7 +163,8 @@ pub fn write_track_geojson_with(
         }
     }
     let collection = FeatureCollection::new(features);
-    let text = serde_json::to_string_pretty(&collection).map_err(|e| IoError::Unwritable {
+    // Compact: one line (an hour at 50 Hz is a few MB, not tens).
+    let text = serde_json::to_string(&collection).map_err(|e| IoError::Unwritable {
         path: path.to_path_buf(),
         message: e.to_string(),
     })?;
@@ -167,6 +172,12 @@ pub fn write_track_geojson_with(
         w.write_all(text.as_bytes())?;
         w.write_all(b"\n")
     })
+}
+
+/// Degrees rounded to 1e-8° (about 1 mm): the shortest form of the result
+/// prints at most 8 decimals.
+fn degrees(v: f64) -> f64 {
+    (v * 1e8).round() / 1e8
 }
 
 /// A JSON number, or null for `None` and non-finite values.

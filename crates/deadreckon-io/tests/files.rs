@@ -247,10 +247,29 @@ fn track_csv_has_the_contract_columns() {
     );
     assert_eq!(
         lines.next(),
-        Some("0,smoothed,0,-0,0.1,20,0.01,2,3,0.01,0.5")
+        Some(
+            "0.000000000,smoothed,0.000000000,-0.000000000,0.100000000,20.000000,0.010000000,\
+             2.000000e0,3.000000e0,1.000000e-2,5.000000e-1"
+        )
     );
     assert_eq!(text.lines().count(), 6);
     assert!(text.contains("\"dead, reckoned\""), "{text}");
+}
+
+#[test]
+fn track_csv_wrote_tiny_numbers_with_40_digits() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("track.csv");
+    let mut t = track("filtered", None, 1);
+    t.points[0].east_m = 3.0938451861793925e-23;
+    t.points[0].yaw_rate_rps = -1.5e-30;
+    write_track_csv(&path, &[t]).expect("written");
+    let text = std::fs::read_to_string(&path).expect("read");
+    let row = text.lines().nth(1).expect("a row");
+    let fields: Vec<&str> = row.split(',').collect();
+    assert_eq!(fields[2], "0.000000000", "{row}");
+    assert_eq!(fields[6], "-0.000000000", "{row}");
+    assert!(fields.iter().all(|f| f.len() <= 14), "{row}");
 }
 
 #[test]
@@ -286,11 +305,22 @@ fn track_geojson_line_strings_and_points() {
         last[1].as_f64().expect("lat"),
     );
     let (e, n) = geo::geodetic_to_en(&origin, lat, lon);
+    // Coordinates are rounded to 1e-8 degrees: within 1.2 mm.
     assert!(
-        (e - 40.0).abs() < 1e-6 && (n + 20.0).abs() < 1e-6,
+        (e - 40.0).abs() < 1.2e-3 && (n + 20.0).abs() < 1.2e-3,
         "{e} {n}"
     );
     assert_eq!(features[1]["geometry"]["type"], "Point");
+    // Compact, with at most 8 decimals per coordinate.
+    let text = std::fs::read_to_string(&path).expect("read");
+    assert_eq!(text.lines().count(), 1);
+    let coords = &text[text.find("\"coordinates\"").expect("coordinates")..];
+    let coords = &coords[..coords.find(']').expect("end")];
+    for number in coords.split(|c: char| !(c.is_ascii_digit() || c == '.')) {
+        if let Some((_, decimals)) = number.split_once('.') {
+            assert!(decimals.len() <= 8, "{number} in {coords}");
+        }
+    }
 
     let opts = GeoJsonOptions::default().point_every_s(1.0);
     write_track_geojson_with(&path, &tracks[..1], &opts).expect("written");
