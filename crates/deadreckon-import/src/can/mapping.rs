@@ -35,6 +35,10 @@ struct WheelSection {
     rl: String,
     rr: String,
     scale: Option<f64>,
+    /// Width of cumulative pulse counters (`[wheel_ticks]`): each step is taken
+    /// modulo 2^bits in (−2^(bits−1), 2^(bits−1)], so a counter that steps back
+    /// gives negative ticks; the frame rate must keep steps well below half the
+    /// range.
     counter_bits: Option<u32>,
 }
 
@@ -393,8 +397,18 @@ pub fn decode_frames(
                     b.reject(i, f.t_s, r)?;
                     continue;
                 }
+                // The step modulo the counter's range, taken in
+                // (−range/2, range/2]: a counter that steps back (reversing,
+                // or jitter by one) gives negative ticks, not a wrap.
                 let d = |k: usize| -> i64 {
-                    prev.map_or(0, |p| (cur[k] - p[k]).rem_euclid(modulus) as i64)
+                    prev.map_or(0, |p| {
+                        let step = (cur[k] - p[k]).rem_euclid(modulus);
+                        (if step > modulus / 2 {
+                            step - modulus
+                        } else {
+                            step
+                        }) as i64
+                    })
                 };
                 let row = WheelTicks {
                     t_s: f.t_s,
@@ -532,6 +546,41 @@ mod tests {
         };
         assert_eq!((t[0].fl, t[1].fl, t[2].fl), (0, 10, 5));
         assert_eq!((t[1].rr, t[2].fr, t[1].rl), (4, 1, 10));
+    }
+
+    #[test]
+    fn a_counter_stepping_back_by_one_was_255_ticks() {
+        let db = counter_db();
+        let map = "[wheel_ticks]\nmessage=\"PULSES\"\nfl=\"FL\"\nfr=\"FR\"\nrl=\"RL\"\nrr=\"RR\"\ncounter_bits=8\n";
+        let m = Mapping::parse(map, &db, Path::new("m.toml")).unwrap();
+        let f = |t: f64, d: [u8; 4]| CanFrame {
+            t_s: t,
+            bus: "can0".into(),
+            id: 256,
+            extended: false,
+            rtr: false,
+            data: d.to_vec(),
+        };
+        // FL steps back by one, RR steps back across the wrap, FR reverses.
+        let frames = [
+            f(0.0, [10, 100, 0, 1]),
+            f(0.1, [9, 97, 0, 254]),
+            f(0.2, [11, 93, 0, 2]),
+        ];
+        let imp = decode_frames(
+            &frames,
+            &m,
+            crate::profiles::toyota_rav4(),
+            TimeOrderPolicy::Error,
+            Path::new("x"),
+        )
+        .unwrap();
+        let Wheels::Ticks(t) = &imp.drive.wheels else {
+            panic!()
+        };
+        assert_eq!((t[1].fl, t[2].fl), (-1, 2));
+        assert_eq!((t[1].fr, t[2].fr), (-3, -4));
+        assert_eq!((t[1].rr, t[2].rr), (-3, 4));
     }
 
     #[test]
