@@ -9,7 +9,8 @@ use deadreckon_core::{Drive, Params, ParamsWithStd};
 
 /// Reads a drive from a drive directory or, directly, from a recording that a
 /// reader understands: a comma2k19 segment directory, a ROS1 `.bag`, a ROS2
-/// `.mcap` (with the built-in mapping) or a tricycle `dataset.txt`.
+/// `.mcap` (with the built-in mapping) or a rosbag2 directory holding one, or a
+/// tricycle `dataset.txt`.
 pub fn load_drive(path: &Path) -> Result<Drive> {
     load_drive_with(path, &deadreckon_io::ReadOptions::default())
 }
@@ -21,6 +22,9 @@ pub fn load_drive_with(path: &Path, options: &deadreckon_io::ReadOptions) -> Res
     if path.is_dir() && !path.join("vehicle.toml").exists() && path.join("processed_log").is_dir() {
         return deadreckon_import::read_comma2k19(path, None)
             .with_context(|| format!("reading comma2k19 segment {}", path.display()));
+    }
+    if path.is_dir() && path.join("metadata.yaml").is_file() {
+        return super::load_ros(path);
     }
     if path.is_file() {
         match ext {

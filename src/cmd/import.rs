@@ -18,7 +18,8 @@ use deadreckon_import::TimeOrderPolicy;
 #[derive(Args, Debug)]
 pub struct ImportArgs {
     /// Input format: comma2k19 (segment directory), can (candump log or
-    /// comma2k19 raw_can directory), tricycle (dataset.txt).
+    /// comma2k19 raw_can directory), tricycle (dataset.txt), rosbag (ROS1
+    /// .bag), mcap (ROS2 .mcap file, or a rosbag2 directory holding one).
     pub format: String,
     /// Source file or directory.
     pub source: PathBuf,

@@ -1,6 +1,7 @@
 //! Chunk decompression for both containers, pure Rust: bz2 (`bzip2` on
 //! `libbz2-rs-sys`), lz4 frames (`lz4_flex`, feature `lz4`), zstd frames
 //! (`ruzstd`, feature `zstd`). Output is bounded by the size the chunk declares.
+//! Also messages compressed one by one (rosbag2's per-message mode).
 
 use std::io::Read;
 
@@ -70,4 +71,54 @@ pub(crate) fn decompress(
         )));
     }
     Ok(out)
+}
+
+/// Largest uncompressed message accepted from a per-message compressed file.
+const MAX_MESSAGE_BYTES: u64 = 64 << 20;
+
+/// zstd frame magic number (RFC 8878).
+const ZSTD_MAGIC: [u8; 4] = [0x28, 0xb5, 0x2f, 0xfd];
+/// lz4 frame magic number (lz4 frame format).
+const LZ4_MAGIC: [u8; 4] = [0x04, 0x22, 0x4d, 0x18];
+
+/// The payload of a message that rosbag2 compressed on its own
+/// (`compression_mode: message`: each message's data is one zstd or lz4
+/// frame, told apart from CDR, which starts with `00`, by its magic number),
+/// or `None` when the data is not compressed.
+pub(crate) fn message_payload(data: &[u8], loc: &Location) -> Result<Option<Vec<u8>>, RosError> {
+    let compression = match data.get(..4) {
+        Some(m) if m == ZSTD_MAGIC => "zstd",
+        Some(m) if m == LZ4_MAGIC => "lz4",
+        _ => return Ok(None),
+    };
+    let err = |what: String| RosError::Compression {
+        at: Box::new(loc.clone()),
+        compression: format!("per-message {compression}"),
+        what,
+    };
+    let missing = |feature: &str| {
+        err(format!(
+            "this build cannot read it (enable the `{feature}` feature of deadreckon-ros)"
+        ))
+    };
+    let mut out = Vec::new();
+    let read = match compression {
+        #[cfg(feature = "lz4")]
+        "lz4" => lz4_flex::frame::FrameDecoder::new(data)
+            .take(MAX_MESSAGE_BYTES + 1)
+            .read_to_end(&mut out),
+        #[cfg(feature = "zstd")]
+        "zstd" => match ruzstd::decoding::StreamingDecoder::new(data) {
+            Ok(d) => d.take(MAX_MESSAGE_BYTES + 1).read_to_end(&mut out),
+            Err(e) => return Err(err(e.to_string())),
+        },
+        c => return Err(missing(c)),
+    };
+    read.map_err(|e| err(e.to_string()))?;
+    if out.len() as u64 > MAX_MESSAGE_BYTES {
+        return Err(err(format!(
+            "a message decompresses to more than {MAX_MESSAGE_BYTES} bytes"
+        )));
+    }
+    Ok(Some(out))
 }

@@ -185,12 +185,21 @@ pub fn read_mcap_from(
     read_mcap_bytes(&read_all(reader, file)?, file, mapping)
 }
 
-/// Reads a bag or an MCAP file, whichever `path` holds.
+/// Reads a bag or an MCAP file, whichever `path` holds, or the MCAP file of a
+/// rosbag2 directory ([`rosbag2_storage`]).
 pub fn read_log(
     path: impl AsRef<Path>,
     mapping: &Mapping,
 ) -> Result<(Drive, ImportReport), RosError> {
-    let (bytes, file) = read_file(path.as_ref())?;
+    let path = path.as_ref();
+    let storage;
+    let path = if path.is_dir() {
+        storage = rosbag2_storage(path)?;
+        storage.as_path()
+    } else {
+        path
+    };
+    let (bytes, file) = read_file(path)?;
     match Format::detect(&bytes) {
         Some(Format::Rosbag) => read_rosbag_bytes(&bytes, &file, mapping),
         Some(Format::Mcap) => read_mcap_bytes(&bytes, &file, mapping),
@@ -198,6 +207,51 @@ pub fn read_log(
             Location::file(&file).at(0),
             "neither a ROS bag nor an MCAP file",
         )),
+    }
+}
+
+/// The storage file of a rosbag2 directory (a `metadata.yaml` beside the
+/// recorded files): its one `.mcap` file. A bag stored in SQLite (`.db3`) or
+/// split over several files is refused, saying so.
+pub fn rosbag2_storage(dir: &Path) -> Result<std::path::PathBuf, RosError> {
+    let name = dir.display().to_string();
+    let refuse = |what: String| RosError::format(Location::file(&name).at(0), what);
+    if !dir.join("metadata.yaml").is_file() {
+        return Err(refuse(
+            "a directory without metadata.yaml is not a rosbag2 bag".into(),
+        ));
+    }
+    let entries = std::fs::read_dir(dir).map_err(|source| RosError::Io {
+        file: name.clone(),
+        source,
+    })?;
+    let mut mcap = Vec::new();
+    let mut db3 = 0;
+    for e in entries {
+        let p = e
+            .map_err(|source| RosError::Io {
+                file: name.clone(),
+                source,
+            })?
+            .path();
+        match p.extension().and_then(|x| x.to_str()) {
+            Some("mcap") => mcap.push(p),
+            Some("db3") => db3 += 1,
+            _ => {}
+        }
+    }
+    match (mcap.len(), db3) {
+        (1, _) => Ok(mcap.remove(0)),
+        (0, n) if n > 0 => Err(refuse(
+            "a rosbag2 bag stored in SQLite (.db3) is not read: convert it with \
+             `ros2 bag convert` to the mcap storage"
+                .into(),
+        )),
+        (0, _) => Err(refuse("the rosbag2 directory holds no .mcap file".into())),
+        (n, _) => Err(refuse(format!(
+            "a rosbag2 bag split over {n} .mcap files is not read: merge them with \
+             `ros2 bag convert` into one file"
+        ))),
     }
 }
 

@@ -255,9 +255,11 @@ pub fn read_mcap_bytes(
             ..loc.on(&ch.topic).at(msg.offset)
         };
         let t: MsgType = ingest.msg_type(i);
+        let payload = crate::compress::message_payload(&msg.data, &at)?;
+        let data = payload.as_deref().unwrap_or(&msg.data);
         let decoded = match ch.message_encoding.as_str() {
-            "cdr" => crate::ros2::decode(t, &msg.data),
-            "ros1" => decode_ros1(t, &msg.data),
+            "cdr" => crate::ros2::decode(t, data),
+            "ros1" => decode_ros1(t, data),
             other => Err(format!(
                 "message encoding '{other}' is not read (only cdr and ros1)"
             )),

@@ -14,11 +14,13 @@ const CLEAN: Quirks = Quirks {
     duplicate_odom: false,
     zero_stamp_imu: false,
     no_fix: false,
+    message_compression: None,
 };
 const QUIRKY: Quirks = Quirks {
     duplicate_odom: true,
     zero_stamp_imu: true,
     no_fix: true,
+    message_compression: None,
 };
 
 #[test]
@@ -324,6 +326,45 @@ fn ros1_messages_in_mcap() {
 }
 
 #[test]
+fn per_message_compression_of_rosbag2_was_not_plain_cdr() {
+    // rosbag2 with `compression_mode: message` stores each message as one
+    // zstd (or lz4) frame: it failed with "encapsulation 28b5 is not plain CDR".
+    let mapping = Mapping::from_toml_str(MAPPING).unwrap();
+    let (want, _) = read_mcap_bytes(&ros2_mcap(true, &CLEAN), "plain.mcap", &mapping).unwrap();
+    for c in ["zstd", "lz4"] {
+        let q = Quirks {
+            message_compression: Some(c),
+            ..CLEAN
+        };
+        let bytes = ros2_mcap(true, &q);
+        let (got, _) = read_mcap_bytes(&bytes, "packed.mcap", &mapping).unwrap();
+        assert_eq!(got, want, "{c}");
+    }
+    // A damaged frame: an error naming the file, the topic and the compression.
+    let mut m = ros2_mcap(
+        false,
+        &Quirks {
+            message_compression: Some("zstd"),
+            ..CLEAN
+        },
+    );
+    let at = m
+        .windows(4)
+        .rposition(|w| w == [0x28, 0xb5, 0x2f, 0xfd])
+        .unwrap();
+    for b in &mut m[at + 4..at + 12] {
+        *b = 0xff;
+    }
+    let e = read_mcap_bytes(&m, "bad.mcap", &mapping)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("bad.mcap") && e.contains("per-message zstd"),
+        "{e}"
+    );
+}
+
+#[test]
 fn compressed_chunks() {
     let mapping = Mapping::from_toml_str(MAPPING).unwrap();
     let plain = ros2_mcap(true, &CLEAN);
@@ -356,4 +397,32 @@ fn compressed_chunks() {
             Ok((d, _)) => assert_ne!(d, want, "{c}: corruption went unnoticed"),
         }
     }
+}
+
+#[test]
+fn a_rosbag2_directory_is_read_through_its_mcap_file() {
+    let mapping = Mapping::from_toml_str(MAPPING).unwrap();
+    let bytes = ros2_mcap(true, &CLEAN);
+    let (want, _) = read_mcap_bytes(&bytes, "plain.mcap", &mapping).unwrap();
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("run1");
+    std::fs::create_dir(&dir).unwrap();
+    // Not a bag yet: no metadata.yaml.
+    let e = deadreckon_ros::read_log(&dir, &mapping)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("metadata.yaml"), "{e}");
+    std::fs::write(dir.join("metadata.yaml"), "rosbag2_bagfile_information:\n").unwrap();
+    let e = deadreckon_ros::read_log(&dir, &mapping)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("no .mcap"), "{e}");
+    std::fs::write(dir.join("run1_0.mcap"), &bytes).unwrap();
+    let (got, _) = deadreckon_ros::read_log(&dir, &mapping).unwrap();
+    assert_eq!(got, want);
+    std::fs::write(dir.join("run1_1.mcap"), &bytes).unwrap();
+    let e = deadreckon_ros::read_log(&dir, &mapping)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("split over 2"), "{e}");
 }

@@ -10,6 +10,7 @@ const CLEAN: Quirks = Quirks {
     duplicate_odom: false,
     zero_stamp_imu: false,
     no_fix: false,
+    message_compression: None,
 };
 
 fn husky() -> Vec<u8> {
@@ -124,6 +125,7 @@ fn fuzz_seeds() {
         duplicate_odom: true,
         zero_stamp_imu: false,
         no_fix: false,
+        message_compression: None,
     };
     std::fs::create_dir_all(dir.join("mcap")).unwrap();
     std::fs::create_dir_all(dir.join("rosbag")).unwrap();

@@ -72,6 +72,24 @@ pub struct Quirks {
     pub zero_stamp_imu: bool,
     /// A fix with status -1 (dropped, counted).
     pub no_fix: bool,
+    /// Each message's data compressed on its own (`lz4` or `zstd`), as rosbag2
+    /// writes with `compression_mode: message`.
+    pub message_compression: Option<&'static str>,
+}
+
+/// `data` as one frame of `compression` (`lz4` or `zstd`).
+pub fn compress_frame(data: &[u8], compression: &str) -> Vec<u8> {
+    match compression {
+        "lz4" => {
+            let mut e = lz4_flex::frame::FrameEncoder::new(Vec::new());
+            std::io::Write::write_all(&mut e, data).unwrap();
+            e.finish().unwrap()
+        }
+        "zstd" => {
+            ruzstd::encoding::compress_to_vec(data, ruzstd::encoding::CompressionLevel::Fastest)
+        }
+        c => panic!("{c}"),
+    }
 }
 
 /// Position on the fixture's circle at time `t` after T0 (east, north, yaw).
@@ -111,6 +129,10 @@ pub fn ros2_mcap_for(chunked: bool, q: &Quirks, duration_s: f64) -> Vec<u8> {
     let mut seq = 0u32;
     let mut put = |w: &mut mcap::Writer<_>, channel_id: u16, t: f64, data: Vec<u8>| {
         seq += 1;
+        let data = match q.message_compression {
+            Some(c) => compress_frame(&data, c),
+            None => data,
+        };
         let h = mcap::records::MessageHeader {
             channel_id,
             sequence: seq,
