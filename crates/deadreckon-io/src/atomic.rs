@@ -46,7 +46,7 @@ where
         .prefix(&format!(".{name}."))
         .suffix(".tmp")
         .tempfile_in(parent)
-        .map_err(|e| IoError::io(path, e))?;
+        .map_err(|e| IoError::io(path, in_dir(parent, e)))?;
     let previous_permissions = fs::metadata(path).ok().map(|m| m.permissions());
     {
         let mut w = BufWriter::new(tmp.as_file());
@@ -78,4 +78,16 @@ fn default_permissions() -> Option<fs::Permissions> {
 #[cfg(not(unix))]
 fn default_permissions() -> Option<fs::Permissions> {
     None
+}
+
+/// The error of creating the temporary file in `dir`, said of the directory:
+/// `tempfile`'s own text names the temporary file, which the user never asked
+/// for.
+fn in_dir(dir: &Path, e: std::io::Error) -> std::io::Error {
+    let text = e.to_string();
+    let os = text.find(" at path ").map_or(text.as_str(), |i| &text[..i]);
+    std::io::Error::new(
+        e.kind(),
+        format!("cannot create a file in {}: {os}", dir.display()),
+    )
 }
