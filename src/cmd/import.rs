@@ -186,32 +186,9 @@ fn print_counts(d: &Drive) {
     );
 }
 
-/// Writes `drive` into `out`: a new directory appears whole (written beside it
-/// under a temporary name, then renamed); an existing one is updated file by
-/// file, each file atomically.
+/// Writes `drive` into `out` whole (written beside it under a temporary name,
+/// then renamed): a failure leaves the old drive or nothing, never a mixture.
 fn write_new_or_update(out: &Path, drive: &Drive) -> Result<()> {
-    if out.exists() {
-        return deadreckon_io::write_drive(out, drive)
-            .with_context(|| format!("writing drive {}", out.display()));
-    }
-    let parent = match out.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    std::fs::create_dir_all(&parent).with_context(|| format!("creating {}", parent.display()))?;
-    let name = out
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "drive".into());
-    let tmp = parent.join(format!(".{name}.import-{}", std::process::id()));
-    std::fs::create_dir(&tmp).with_context(|| format!("creating {}", tmp.display()))?;
-    let result = deadreckon_io::write_drive(&tmp, drive)
-        .with_context(|| format!("writing drive {}", tmp.display()))
-        .and_then(|()| {
-            std::fs::rename(&tmp, out).with_context(|| format!("renaming into {}", out.display()))
-        });
-    if result.is_err() {
-        let _ = std::fs::remove_dir_all(&tmp);
-    }
-    result
+    deadreckon_io::write_drive_whole(out, drive, |_| Ok(()))
+        .with_context(|| format!("writing drive {}", out.display()))
 }

@@ -39,6 +39,10 @@ pub struct SimulateArgs {
     /// Drive duration, s (laps repeat until then).
     #[arg(long)]
     pub duration: Option<f64>,
+    /// Geodetic origin LAT,LON (degrees, WGS84) written into vehicle.toml, so
+    /// that tracks can be written as GeoJSON.
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+    pub origin: Option<Vec<f64>>,
 }
 
 /// Applies the command-line overrides to a scenario.
@@ -72,6 +76,13 @@ fn with_overrides(mut sc: Scenario, a: &SimulateArgs) -> Result<Scenario> {
     if let Some(d) = a.duration {
         sc = sc.with_duration_s(d);
     }
+    if let Some(o) = &a.origin {
+        let &[lat_deg, lon_deg] = o.as_slice() else {
+            anyhow::bail!("--origin takes LAT,LON in degrees, got {} values", o.len());
+        };
+        sc.vehicle.origin = Some(deadreckon_core::vehicle::Origin { lat_deg, lon_deg });
+        sc.vehicle.validate().context("--origin")?;
+    }
     sc.validate()?;
     Ok(sc)
 }
@@ -101,10 +112,11 @@ fn write_scenario(
     dir: &std::path::Path,
 ) -> Result<deadreckon_sim::SimOutput> {
     let out = deadreckon_sim::simulate(&sc, seed).with_context(|| format!("simulating {spec}"))?;
-    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    deadreckon_io::write_drive(dir, &out.drive)
-        .with_context(|| format!("writing {}", dir.display()))?;
-    deadreckon_io::write_truth_params(&dir.join("truth_params.toml"), &out.truth_params)?;
+    // Written whole: a failure leaves no partial drive.
+    deadreckon_io::write_drive_whole(dir, &out.drive, |tmp| {
+        deadreckon_io::write_truth_params(&tmp.join("truth_params.toml"), &out.truth_params)
+    })
+    .with_context(|| format!("writing {}", dir.display()))?;
     Ok(out)
 }
 

@@ -162,6 +162,20 @@ impl Vehicle {
 
     /// Checks every value is finite and physically meaningful.
     pub fn validate(&self) -> Result<(), Error> {
+        if let Some(o) = &self.origin {
+            if !(o.lat_deg.is_finite() && o.lat_deg.abs() <= 90.0) {
+                return Err(Error::InvalidVehicle(format!(
+                    "origin latitude must be within ±90°, got {}",
+                    o.lat_deg
+                )));
+            }
+            if !(o.lon_deg.is_finite() && o.lon_deg.abs() <= 180.0) {
+                return Err(Error::InvalidVehicle(format!(
+                    "origin longitude must be within ±180°, got {}",
+                    o.lon_deg
+                )));
+            }
+        }
         let pos = [
             ("wheelbase_m", self.wheelbase_m),
             ("track_front_m", self.track_front_m),

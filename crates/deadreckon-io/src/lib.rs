@@ -40,6 +40,7 @@ mod table;
 mod toml_files;
 mod track_out;
 mod track_text;
+mod whole;
 mod write;
 
 pub mod stack_params;
@@ -62,6 +63,7 @@ pub use track_text::{
     kitti_line, kitti_times_path, tum_line, write_track_kitti, write_track_tum, TrackFormat,
     TUM_HEADER,
 };
+pub use whole::write_drive_whole;
 pub use write::write_drive;
 
 /// File names of the drive directory contract.

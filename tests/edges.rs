@@ -1,0 +1,144 @@
+//! The edges a user hits: what the command line prints when it fails (each
+//! cause once, the file the user named, not a temporary file), values refused
+//! with the reason, outputs written whole.
+
+use std::process::Command;
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_deadreckon"))
+}
+
+fn vehicle_dir() -> tempfile::TempDir {
+    let tmp = tempfile::tempdir().unwrap();
+    let st = bin()
+        .args([
+            "simulate",
+            "--scenario",
+            "evaluation",
+            "--seed",
+            "3",
+            "--duration",
+            "30",
+            "--out",
+        ])
+        .arg(tmp.path().join("d"))
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    tmp
+}
+
+#[test]
+fn a_write_into_a_missing_directory_named_the_os_error_twice_and_the_temp_file() {
+    let tmp = vehicle_dir();
+    let out = bin()
+        .arg("run")
+        .arg(tmp.path().join("d"))
+        .arg("--out")
+        .arg(tmp.path().join("missing/x.csv"))
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.matches("os error 2").count(), 1, "{err}");
+    assert!(!err.contains(".x.csv."), "{err}");
+    assert!(
+        err.contains("missing/x.csv") && err.contains("No such file"),
+        "{err}"
+    );
+}
+
+#[test]
+fn a_missing_parameters_file_is_named_once() {
+    let tmp = vehicle_dir();
+    let out = bin()
+        .arg("run")
+        .arg(tmp.path().join("d"))
+        .args(["--params", "/nonexistent/p.toml", "--out"])
+        .arg(tmp.path().join("t.csv"))
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("/nonexistent/p.toml"), "{err}");
+    assert!(err.matches("os error 2").count() <= 1, "{err}");
+}
+
+#[test]
+fn geojson_of_a_simulated_drive_failed_for_want_of_an_origin() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path().join("d");
+    let sim = |origin: &str, out: &std::path::Path| {
+        bin()
+            .args([
+                "simulate",
+                "--scenario",
+                "evaluation",
+                "--duration",
+                "30",
+                "--origin",
+                origin,
+                "--out",
+            ])
+            .arg(out)
+            .output()
+            .unwrap()
+    };
+    // An origin off the globe is refused and nothing is written.
+    let st = sim("95,11.6", &d);
+    assert!(!st.status.success());
+    assert!(String::from_utf8_lossy(&st.stderr).contains("latitude"));
+    assert!(!d.exists());
+    let st = sim("48.1,11.6", &d);
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let g = tmp.path().join("t.geojson");
+    let st = bin()
+        .arg("run")
+        .arg(&d)
+        .arg("--out")
+        .arg(&g)
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let text = std::fs::read_to_string(&g).unwrap();
+    assert!(
+        text.starts_with("{\"type\":\"FeatureCollection\""),
+        "{}",
+        &text[..80]
+    );
+    assert!(text.contains("[11.6,48.1]"), "{}", &text[..200]);
+}
+
+#[test]
+fn simulate_into_a_directory_of_other_files_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::write(tmp.path().join("notes.txt"), "mine").unwrap();
+    let st = bin()
+        .args([
+            "simulate",
+            "--scenario",
+            "evaluation",
+            "--duration",
+            "30",
+            "--out",
+        ])
+        .arg(tmp.path())
+        .output()
+        .unwrap();
+    assert!(!st.status.success());
+    assert!(String::from_utf8_lossy(&st.stderr).contains("not replacing"));
+    let names: Vec<_> = std::fs::read_dir(tmp.path()).unwrap().collect();
+    assert_eq!(names.len(), 1);
+}
