@@ -142,3 +142,36 @@ fn simulate_into_a_directory_of_other_files_is_refused() {
     let names: Vec<_> = std::fs::read_dir(tmp.path()).unwrap().collect();
     assert_eq!(names.len(), 1);
 }
+
+#[test]
+fn run_out_onto_an_input_file_overwrote_it() {
+    let tmp = vehicle_dir();
+    let d = tmp.path().join("d");
+    let before = std::fs::read(d.join("wheel_ticks.csv")).unwrap();
+    for out in [d.join("wheel_ticks.csv"), d.join("vehicle.toml")] {
+        let st = bin()
+            .arg("run")
+            .arg(&d)
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert!(!st.status.success());
+        assert!(String::from_utf8_lossy(&st.stderr).contains("refusing to write over it"));
+    }
+    assert_eq!(std::fs::read(d.join("wheel_ticks.csv")).unwrap(), before);
+    // A file beside the drive's own, in capitals, is fine.
+    let st = bin()
+        .arg("run")
+        .arg(&d)
+        .arg("--out")
+        .arg(d.join("TRACK.CSV"))
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    assert!(d.join("TRACK.CSV").is_file());
+}

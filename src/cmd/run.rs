@@ -120,6 +120,7 @@ pub fn write_tracks(
 
 /// Runs `run`.
 pub fn run(a: RunArgs) -> Result<()> {
+    deadreckon_io::check_not_an_input(&a.out, &a.dir)?;
     let drive = common::load_drive(&a.dir)?;
     let params = common::load_params(&a.params, &drive)?;
     let init_pose = match &a.init_pose {

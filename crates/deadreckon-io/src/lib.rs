@@ -99,3 +99,43 @@ pub mod files {
     /// The true parameters of a simulated drive.
     pub const TRUTH_PARAMS: &str = "truth_params.toml";
 }
+
+/// Refuses an output path that is one of a command's inputs: the input file
+/// itself (`run x.mcap --out x.mcap`) or, for a drive directory, one of the
+/// files it is read from (`calibrate D --out D/vehicle.toml`). Other files in
+/// the directory (`D/params.toml`, `D/track.csv`) are fine.
+pub fn check_not_an_input(out: &std::path::Path, input: &std::path::Path) -> Result<(), IoError> {
+    let refuse = |what: String| IoError::Unwritable {
+        path: out.to_path_buf(),
+        message: what,
+    };
+    let Ok(input) = input.canonicalize() else {
+        return Ok(());
+    };
+    // The output may not exist yet: its directory does, or writing fails anyway.
+    let dir = match out.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => std::path::Path::new("."),
+    };
+    let (Ok(dir), Some(name)) = (dir.canonicalize(), out.file_name()) else {
+        return Ok(());
+    };
+    let target = dir.join(name);
+    if target == input {
+        return Err(refuse(format!(
+            "is the input {}: refusing to write over it",
+            input.display()
+        )));
+    }
+    let drive_file = [files::VEHICLE]
+        .iter()
+        .chain(files::STREAMS.iter())
+        .any(|f| std::ffi::OsStr::new(f) == name);
+    if input.is_dir() && dir == input && drive_file {
+        return Err(refuse(format!(
+            "is one of the files the drive {} is read from: refusing to write over it",
+            input.display()
+        )));
+    }
+    Ok(())
+}

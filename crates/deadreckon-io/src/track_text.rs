@@ -35,7 +35,12 @@ impl TrackFormat {
     /// The format of `path` by its extension; an unknown extension is an error
     /// naming the ones known.
     pub fn from_path(path: &Path) -> Result<TrackFormat, IoError> {
-        match path.extension().and_then(|e| e.to_str()) {
+        // Extensions in any case (`track.CSV`).
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        match ext.as_deref() {
             Some("csv") => Ok(TrackFormat::Csv),
             Some("geojson") | Some("json") => Ok(TrackFormat::GeoJson),
             Some("tum") => Ok(TrackFormat::Tum),
