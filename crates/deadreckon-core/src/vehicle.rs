@@ -224,6 +224,17 @@ impl Vehicle {
                 )));
             }
         }
+        // 0 would take every rejected reading as a recovery: the gate off.
+        for (k, v) in [
+            ("noise.gnss_max_rejections", n.gnss_max_rejections),
+            ("noise.max_rejections", n.max_rejections),
+        ] {
+            if v == 0 {
+                return Err(Error::InvalidVehicle(format!(
+                    "{k} must be at least 1 (0 would switch the gate off; set the gate to inf for that)"
+                )));
+            }
+        }
         // A gate may be infinite (switched off), never zero, negative or NaN.
         for (k, v) in [
             ("noise.gnss_gate_chi2", n.gnss_gate_chi2),
