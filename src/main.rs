@@ -15,6 +15,10 @@ struct Cli {
     /// Topic-to-stream mapping (TOML) for ROS bags and MCAP files (default: built-in Husky/Jackal).
     #[arg(long, global = true)]
     mapping: Option<std::path::PathBuf>,
+    /// Read drives without the cross-stream plausibility checks (units,
+    /// clocks, signs: see the README's "What the tool checks").
+    #[arg(long, global = true)]
+    skip_checks: bool,
     #[command(subcommand)]
     command: Command,
 }
@@ -73,6 +77,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
     if let Some(m) = &cli.mapping {
         let _ = cmd::ROS_MAPPING.set(m.clone());
     }
+    let _ = cmd::SKIP_CHECKS.set(cli.skip_checks);
     match cli.command {
         Command::Simulate(a) => cmd::simulate::run(a),
         Command::Calibrate(a) => cmd::calibrate::run(a),

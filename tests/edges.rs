@@ -175,3 +175,35 @@ fn run_out_onto_an_input_file_overwrote_it() {
     );
     assert!(d.join("TRACK.CSV").is_file());
 }
+
+#[test]
+fn a_flipped_gyro_sign_calibrated_to_a_confident_wrong_answer() {
+    let tmp = vehicle_dir();
+    let d = tmp.path().join("d");
+    let text = std::fs::read_to_string(d.join("yaw_rate.csv")).unwrap();
+    let mut lines = text.lines();
+    let mut out = format!("{}\n", lines.next().unwrap());
+    for l in lines {
+        let (t, v) = l.split_once(',').unwrap();
+        out.push_str(&format!("{t},{}\n", -v.parse::<f64>().unwrap()));
+    }
+    std::fs::write(d.join("yaw_rate.csv"), out).unwrap();
+    let st = bin().arg("calibrate").arg(&d).output().unwrap();
+    assert!(!st.status.success());
+    let err = String::from_utf8_lossy(&st.stderr);
+    assert!(
+        err.contains("other way") && err.contains("gyro_vs_wheel_yaw_rate"),
+        "{err}"
+    );
+    assert!(err.contains("--skip-checks"), "{err}");
+    let st = bin()
+        .args(["--skip-checks", "calibrate"])
+        .arg(&d)
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+}

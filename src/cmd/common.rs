@@ -18,6 +18,38 @@ pub fn load_drive(path: &Path) -> Result<Drive> {
 /// [`load_drive`] with reading options for drive directories (recordings are
 /// read whole).
 pub fn load_drive_with(path: &Path, options: &deadreckon_io::ReadOptions) -> Result<Drive> {
+    let drive = read_drive_any(path, options)?;
+    if !super::SKIP_CHECKS.get().copied().unwrap_or(false) {
+        plausible(path, &drive)?;
+    }
+    Ok(drive)
+}
+
+/// The cross-stream plausibility checks: warnings on standard error, errors
+/// refuse the drive (all of them listed).
+pub fn plausible(path: &Path, drive: &Drive) -> Result<()> {
+    use deadreckon_core::plausibility::{check, Severity};
+    let findings = check(drive);
+    let mut errors = Vec::new();
+    for f in findings {
+        match f.severity {
+            Severity::Warning => {
+                eprintln!("warning: {}: {} ({})", path.display(), f.message, f.check)
+            }
+            Severity::Error => errors.push(format!("  {} ({})", f.message, f.check)),
+        }
+    }
+    anyhow::ensure!(
+        errors.is_empty(),
+        "{}: the streams disagree (a mistake of units, clocks or signs?):\n{}\n\
+         (--skip-checks reads the drive anyway)",
+        path.display(),
+        errors.join("\n")
+    );
+    Ok(())
+}
+
+fn read_drive_any(path: &Path, options: &deadreckon_io::ReadOptions) -> Result<Drive> {
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
     if path.is_dir() && !path.join("vehicle.toml").exists() && path.join("processed_log").is_dir() {
         return deadreckon_import::read_comma2k19(path, None)

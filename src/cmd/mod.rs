@@ -16,6 +16,9 @@ pub mod tedris;
 /// The `--mapping` file given on the command line, for ROS recordings.
 pub static ROS_MAPPING: std::sync::OnceLock<std::path::PathBuf> = std::sync::OnceLock::new();
 
+/// `--skip-checks`: read drives without the cross-stream plausibility checks.
+pub static SKIP_CHECKS: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+
 /// Reads a ROS1 bag or ROS2 MCAP recording with the `--mapping` file, or the
 /// built-in mapping (Husky, or Jackal when the file name says so).
 pub fn load_ros(path: &std::path::Path) -> anyhow::Result<deadreckon_core::Drive> {

@@ -33,6 +33,7 @@ pub mod model;
 pub mod observation;
 pub mod online;
 pub mod outage;
+pub mod plausibility;
 pub mod reference;
 pub mod rts;
 pub mod track;

@@ -1,0 +1,540 @@
+//! Plausibility checks across the streams of a drive: the mistakes of units
+//! and clocks that no single file shows (each file is valid on its own) but
+//! that make a calibration converge to a confident wrong answer.
+//!
+//! Each check compares two things that must agree on a real vehicle and says
+//! what disagrees and by how much:
+//!
+//! | check | compares | catches |
+//! |---|---|---|
+//! | `vehicle_lengths` | geometry with what vehicles measure | lengths in millimetres |
+//! | `time_overlap` | each stream's time span with the wheels' | milliseconds, another clock |
+//! | `wheel_speed_range` | the speed the wheel rows imply with 90 m/s | cumulative counters, wrong `ticks_per_rev` |
+//! | `can_vs_wheel_speed` | CAN speed with the wheel speed | km/h, mph |
+//! | `gnss_vs_wheel_distance` | GNSS displacement with the wheels' distance | wrong circumference or ticks, km/h wheel speeds, swapped lat/lon |
+//! | `gyro_vs_wheel_yaw_rate` | gyro with the rear wheels' yaw rate | a flipped sign, deg/s (skid steering turns less than the wheels say: only a gyro below 0.1 times them is suspicious) |
+//! | `course_vs_track` | GNSS course with the direction of the GNSS track | radians, counter-clockwise from east |
+//! | `stuck_gnss` | GNSS position with wheel motion | a receiver repeating its last fix |
+//!
+//! A finding is an [`Severity::Error`] when the data cannot be right (the
+//! commands refuse the drive), a [`Severity::Warning`] when it is suspicious.
+//! The checks need motion (speed, turns) to say anything: a drive that
+//! never moves passes them all.
+
+use crate::drive::{Drive, Wheels};
+
+/// How bad a finding is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Severity {
+    /// The data cannot be right: refuse it.
+    Error,
+    /// Suspicious: say so and go on.
+    Warning,
+}
+
+/// One failed check.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Finding {
+    /// The check's name (see the module table).
+    pub check: &'static str,
+    /// Error or warning.
+    pub severity: Severity,
+    /// What disagrees and by how much.
+    pub message: String,
+}
+
+/// Speeds below this do not enter the ratios, m/s.
+const MIN_SPEED_MPS: f64 = 2.0;
+/// A ratio of two speeds (or distances) outside [1/RATIO_TOLERANCE, RATIO_TOLERANCE]
+/// is a units mistake (scale errors of real sensors are a few per cent).
+const RATIO_TOLERANCE: f64 = 1.25;
+/// The fastest a wheel of any vehicle here turns, m/s.
+const MAX_WHEEL_SPEED_MPS: f64 = 90.0;
+
+/// Runs every check on `drive`.
+pub fn check(drive: &Drive) -> Vec<Finding> {
+    let mut out = Vec::new();
+    vehicle_lengths(drive, &mut out);
+    time_overlap(drive, &mut out);
+    let speed = wheel_speed(drive);
+    wheel_speed_range(&speed, &mut out);
+    // The ratios mean nothing when the wheel speed itself is impossible.
+    if !out.iter().any(|f| f.check == "wheel_speed_range") {
+        can_vs_wheel_speed(drive, &speed, &mut out);
+        gnss_vs_wheel_distance(drive, &speed, &mut out);
+        gyro_vs_wheel_yaw_rate(drive, &mut out);
+    }
+    course_vs_track(drive, &mut out);
+    stuck_gnss(drive, &speed, &mut out);
+    out
+}
+
+/// The `q` quantile of unsorted values.
+fn quantile_of(v: &[f64], q: f64) -> f64 {
+    let mut s = v.to_vec();
+    s.sort_by(f64::total_cmp);
+    crate::metrics::quantile(&s, q)
+}
+
+fn error(check: &'static str, message: String) -> Finding {
+    Finding {
+        check,
+        severity: Severity::Error,
+        message,
+    }
+}
+
+fn vehicle_lengths(d: &Drive, out: &mut Vec<Finding>) {
+    let v = &d.vehicle;
+    for (key, value, max) in [
+        ("wheelbase_m", v.wheelbase_m, 20.0),
+        ("track_front_m", v.track_front_m, 5.0),
+        ("track_rear_m", v.track_rear_m, 5.0),
+        ("wheel_circumference_m", v.wheel_circumference_m, 10.0),
+    ] {
+        if value > max {
+            out.push(error(
+                "vehicle_lengths",
+                format!(
+                    "vehicle.toml: {key} = {value} m is more than {max} m \
+                     (millimetres? {} m)",
+                    value / 1000.0
+                ),
+            ));
+        }
+    }
+}
+
+fn time_overlap(d: &Drive, out: &mut Vec<Finding>) {
+    let (Some(a), Some(b)) = (
+        d.wheels.len().checked_sub(1).map(|_| d.wheels.t_s(0)),
+        d.wheels.len().checked_sub(1).map(|i| d.wheels.t_s(i)),
+    ) else {
+        return;
+    };
+    let spans = [
+        (
+            "yaw_rate",
+            d.yaw_rate
+                .first()
+                .zip(d.yaw_rate.last())
+                .map(|(x, y)| (x.t_s, y.t_s)),
+        ),
+        (
+            "speed",
+            d.speed
+                .first()
+                .zip(d.speed.last())
+                .map(|(x, y)| (x.t_s, y.t_s)),
+        ),
+        (
+            "steering",
+            d.steering
+                .first()
+                .zip(d.steering.last())
+                .map(|(x, y)| (x.t_s, y.t_s)),
+        ),
+        (
+            "gnss",
+            d.gnss
+                .first()
+                .zip(d.gnss.last())
+                .map(|(x, y)| (x.t_s, y.t_s)),
+        ),
+    ];
+    for (name, span) in spans {
+        let Some((c, e)) = span else { continue };
+        let overlap = (b.min(e) - a.max(c)).max(0.0);
+        let shorter = (b - a).min(e - c).max(1e-9);
+        let ratio = (e - c) / (b - a).max(1e-9);
+        if !(1.0 / 20.0..=20.0).contains(&ratio) {
+            let unit = if (ratio / 1000.0 - 1.0).abs() < 0.2 {
+                " (milliseconds?)"
+            } else if (ratio * 1000.0 - 1.0).abs() < 0.2 {
+                " (the wheels in milliseconds?)"
+            } else {
+                ""
+            };
+            out.push(error(
+                "time_overlap",
+                format!(
+                    "{name} spans {:.3} s ({c:.3}..{e:.3}) and the wheels {:.3} s ({a:.3}..{b:.3}): \
+                     {ratio:.1} times as long — another time unit{unit}",
+                    e - c,
+                    b - a
+                ),
+            ));
+        } else if overlap < 0.5 * shorter {
+            out.push(error(
+                "time_overlap",
+                format!(
+                    "{name} spans {c:.3}..{e:.3} s and the wheels {a:.3}..{b:.3} s: they overlap \
+                     for {:.0}% of the shorter — another clock?",
+                    100.0 * overlap / shorter
+                ),
+            ));
+        }
+    }
+}
+
+/// The vehicle speed the wheel rows imply, `(t, m/s)`: the mean of the present
+/// wheels (ticks over the row interval with the nominal circumference).
+fn wheel_speed(d: &Drive) -> Vec<(f64, f64)> {
+    let v = &d.vehicle;
+    let present: Vec<usize> = (0..4).filter(|&i| v.wheels_present[i]).collect();
+    if present.is_empty() {
+        return Vec::new();
+    }
+    let mean = |w: [f64; 4]| present.iter().map(|&i| w[i]).sum::<f64>() / present.len() as f64;
+    match &d.wheels {
+        Wheels::Ticks(rows) => {
+            let per_tick = v.wheel_circumference_m / v.ticks_per_rev as f64;
+            rows.windows(2)
+                .filter_map(|p| {
+                    let dt = p[1].t_s - p[0].t_s;
+                    let r = &p[1];
+                    (dt > 0.0).then(|| {
+                        let w = [r.fl, r.fr, r.rl, r.rr].map(|k| k as f64 * per_tick / dt);
+                        (r.t_s, mean(w))
+                    })
+                })
+                .collect()
+        }
+        Wheels::Speeds(rows) => rows
+            .iter()
+            .map(|r| (r.t_s, mean([r.fl_mps, r.fr_mps, r.rl_mps, r.rr_mps])))
+            .collect(),
+    }
+}
+
+fn wheel_speed_range(speed: &[(f64, f64)], out: &mut Vec<Finding>) {
+    let v: Vec<f64> = speed.iter().map(|s| s.1.abs()).collect();
+    if v.len() < 10 {
+        return;
+    }
+    // The 99th percentile, so that one bad row does not decide.
+    let p99 = quantile_of(&v, 0.99);
+    if p99 > MAX_WHEEL_SPEED_MPS {
+        out.push(error(
+            "wheel_speed_range",
+            format!(
+                "the wheel rows imply {p99:.0} m/s (99th percentile; no wheel turns faster \
+                 than {MAX_WHEEL_SPEED_MPS} m/s): cumulative tick counters written as counts \
+                 per row, a wrong ticks_per_rev, or speeds in the wrong unit?"
+            ),
+        ));
+    }
+}
+
+/// Linear interpolation of `(t, v)` samples at `t` (`None` outside).
+fn interpolate(s: &[(f64, f64)], t: f64) -> Option<f64> {
+    let i = s.partition_point(|p| p.0 < t);
+    if i == 0 || i >= s.len() {
+        return None;
+    }
+    let (a, b) = (s[i - 1], s[i]);
+    let f = (t - a.0) / (b.0 - a.0);
+    Some(a.1 + f * (b.1 - a.1))
+}
+
+/// An error when `ratio` (of `what` to the wheels') is not near 1, with the
+/// likely mistake when it is near one of `hints`' factors.
+fn ratio_finding(
+    check: &'static str,
+    what: &str,
+    ratio: f64,
+    hints: &[(f64, &str)],
+    otherwise: &str,
+) -> Option<Finding> {
+    if (1.0 / RATIO_TOLERANCE..=RATIO_TOLERANCE).contains(&ratio) {
+        return None;
+    }
+    let hint = hints
+        .iter()
+        .find(|(k, _)| (ratio / k - 1.0).abs() < 0.1)
+        .map_or(otherwise, |(_, h)| h);
+    Some(error(
+        check,
+        format!("{what} is {ratio:.3} times the wheels' ({hint})"),
+    ))
+}
+
+fn can_vs_wheel_speed(d: &Drive, speed: &[(f64, f64)], out: &mut Vec<Finding>) {
+    let r: Vec<f64> = d
+        .speed
+        .iter()
+        .filter_map(|c| {
+            let w = interpolate(speed, c.t_s)?;
+            (w.abs() > MIN_SPEED_MPS).then(|| c.value / w)
+        })
+        .collect();
+    if r.len() < 20 {
+        return;
+    }
+    let ratio = quantile_of(&r, 0.5);
+    out.extend(ratio_finding(
+        "can_vs_wheel_speed",
+        "the CAN speed",
+        ratio,
+        &[
+            (3.6, "CAN speed in km/h?"),
+            (2.237, "CAN speed in mph?"),
+            (1.0 / 3.6, "wheel speeds in km/h?"),
+        ],
+        "a wrong wheel_circumference_m or ticks_per_rev?",
+    ));
+}
+
+fn gnss_vs_wheel_distance(d: &Drive, speed: &[(f64, f64)], out: &mut Vec<Finding>) {
+    // Chords between fixes far enough apart for the position noise not to
+    // lengthen them (the wheels travel 20 standard deviations), compared with
+    // the wheels' distance over the same time; the median ratio (curves make
+    // a few chords shorter than the path).
+    let distance = |a: f64, b: f64| -> Option<f64> {
+        let i = speed.partition_point(|p| p.0 <= a);
+        let j = speed.partition_point(|p| p.0 <= b);
+        if i == 0 || j >= speed.len() {
+            return None;
+        }
+        let moving = speed[i..j].iter().all(|p| p.1.abs() > MIN_SPEED_MPS);
+        moving.then(|| {
+            speed[i..=j]
+                .windows(2)
+                .map(|p| p[1].1.abs() * (p[1].0 - p[0].0))
+                .sum()
+        })
+    };
+    let mut ratios = Vec::new();
+    let mut k = 0;
+    while k < d.gnss.len() {
+        let a = &d.gnss[k];
+        let need = 20.0 * a.std_m;
+        let mut next = k + 1;
+        for j in k + 1..d.gnss.len() {
+            let b = &d.gnss[j];
+            next = j + 1;
+            if b.t_s - a.t_s > 10.0 {
+                break;
+            }
+            let Some(w) = distance(a.t_s, b.t_s) else {
+                break;
+            };
+            if w >= need {
+                ratios.push((b.east_m - a.east_m).hypot(b.north_m - a.north_m) / w);
+                break;
+            }
+        }
+        k = next.max(k + 1);
+    }
+    if ratios.len() < 10 {
+        return;
+    }
+    out.extend(ratio_finding(
+        "gnss_vs_wheel_distance",
+        "the GNSS displacement",
+        quantile_of(&ratios, 0.5),
+        &[
+            (1.0 / 3.6, "wheel speeds in km/h?"),
+            (0.001, "wheel_circumference_m in millimetres?"),
+            (1000.0, "GNSS positions in millimetres?"),
+        ],
+        "a wrong wheel_circumference_m or ticks_per_rev, or latitude and longitude swapped?",
+    ));
+}
+
+fn gyro_vs_wheel_yaw_rate(d: &Drive, out: &mut Vec<Finding>) {
+    let v = &d.vehicle;
+    // The yaw rate of an axle whose two wheels carry sensors: (right − left) / track.
+    let pair = if v.wheels_present[2] && v.wheels_present[3] {
+        Some((2, 3, v.track_rear_m))
+    } else if v.wheels_present[0] && v.wheels_present[1] {
+        Some((0, 1, v.track_front_m))
+    } else {
+        None
+    };
+    let Some((l, r, track)) = pair else { return };
+    let rate: Vec<(f64, f64)> = match &d.wheels {
+        Wheels::Ticks(rows) => {
+            let per_tick = v.wheel_circumference_m / v.ticks_per_rev as f64;
+            rows.windows(2)
+                .filter_map(|p| {
+                    let dt = p[1].t_s - p[0].t_s;
+                    let w = [p[1].fl, p[1].fr, p[1].rl, p[1].rr];
+                    (dt > 0.0).then(|| (p[1].t_s, (w[r] - w[l]) as f64 * per_tick / dt / track))
+                })
+                .collect()
+        }
+        Wheels::Speeds(rows) => rows
+            .iter()
+            .map(|s| {
+                let w = [s.fl_mps, s.fr_mps, s.rl_mps, s.rr_mps];
+                (s.t_s, (w[r] - w[l]) / track)
+            })
+            .collect(),
+    };
+    // Smooth the wheel rate over about 0.5 s (ticks are coarse), then regress
+    // the gyro on it through the origin after removing both means (the bias).
+    let smooth: Vec<(f64, f64)> = rate
+        .iter()
+        .map(|&(t, _)| {
+            let i = rate.partition_point(|p| p.0 < t - 0.25);
+            let j = rate.partition_point(|p| p.0 <= t + 0.25);
+            let s = &rate[i..j];
+            (
+                t,
+                s.iter().map(|p| p.1).sum::<f64>() / s.len().max(1) as f64,
+            )
+        })
+        .collect();
+    let pairs: Vec<(f64, f64)> = d
+        .yaw_rate
+        .iter()
+        .filter_map(|g| Some((interpolate(&smooth, g.t_s)?, g.value)))
+        .collect();
+    if pairs.len() < 50 {
+        return;
+    }
+    let n = pairs.len() as f64;
+    let (mx, my) = pairs
+        .iter()
+        .fold((0.0, 0.0), |(a, b), p| (a + p.0 / n, b + p.1 / n));
+    let (mut sxx, mut sxy) = (0.0, 0.0);
+    for p in &pairs {
+        sxx += (p.0 - mx) * (p.0 - mx);
+        sxy += (p.0 - mx) * (p.1 - my);
+    }
+    // Enough turning to tell: a standard deviation of 0.03 rad/s.
+    if sxx / n < 0.03f64.powi(2) {
+        return;
+    }
+    let slope = sxy / sxx;
+    if slope < -0.5 {
+        out.push(error(
+            "gyro_vs_wheel_yaw_rate",
+            format!(
+                "the gyro turns the other way from the wheels (slope {slope:.2} against the \
+                 rear wheels' yaw rate): yaw_rate_rps must be counter-clockwise positive"
+            ),
+        ));
+    } else if slope > 2.0 {
+        let hint = if (slope / 57.2958 - 1.0).abs() < 0.15 {
+            " (degrees per second?)"
+        } else {
+            ""
+        };
+        out.push(error(
+            "gyro_vs_wheel_yaw_rate",
+            format!("the gyro is {slope:.3} times the rear wheels' yaw rate{hint}"),
+        ));
+    } else if slope < 0.1 {
+        // Skid-steered robots turn far less than their wheels say (the Jackal:
+        // 0.2), so only a gyro that hardly follows at all is suspicious.
+        out.push(Finding {
+            check: "gyro_vs_wheel_yaw_rate",
+            severity: Severity::Warning,
+            message: format!(
+                "the gyro follows the wheels' yaw rate only {slope:.3} times: another axis, \
+                 or a rate in another unit?"
+            ),
+        });
+    }
+}
+
+/// Smallest absolute difference of two angles, degrees.
+fn angle_diff_deg(a: f64, b: f64) -> f64 {
+    let d = (a - b).rem_euclid(360.0);
+    d.min(360.0 - d)
+}
+
+fn course_vs_track(d: &Drive, out: &mut Vec<Finding>) {
+    let mut given = Vec::new();
+    let mut radians = Vec::new();
+    let mut ccw_east = Vec::new();
+    // Chords between fixes at least 20 standard deviations apart (within
+    // 10 s), against the course of the fix in the middle.
+    let g = &d.gnss;
+    let mut k = 0;
+    while k < g.len() {
+        let need = 20.0 * g[k].std_m;
+        let mut next = k + 1;
+        for j in k + 1..g.len() {
+            next = j + 1;
+            if g[j].t_s - g[k].t_s > 10.0 {
+                break;
+            }
+            let (de, dn) = (g[j].east_m - g[k].east_m, g[j].north_m - g[k].north_m);
+            if de.hypot(dn) < need {
+                continue;
+            }
+            let mid = &g[(k + j) / 2];
+            if let (Some(c), Some(v)) = (mid.course_deg, mid.speed_mps) {
+                if v >= 3.0 {
+                    let track = de.atan2(dn).to_degrees(); // clockwise from north
+                    given.push(angle_diff_deg(c, track));
+                    radians.push(angle_diff_deg(c.to_degrees(), track));
+                    ccw_east.push(angle_diff_deg(90.0 - c, track));
+                }
+            }
+            break;
+        }
+        k = next.max(k + 1);
+    }
+    if given.len() < 20 {
+        return;
+    }
+    let m = quantile_of(&given, 0.5);
+    if m < 30.0 {
+        return;
+    }
+    let hint = if quantile_of(&radians, 0.5) < 15.0 {
+        " (radians? course_deg is degrees)"
+    } else if quantile_of(&ccw_east, 0.5) < 15.0 {
+        " (counter-clockwise from east? course_deg is clockwise from north)"
+    } else {
+        ""
+    };
+    out.push(error(
+        "course_vs_track",
+        format!(
+            "the GNSS course differs from the direction of the GNSS track by {m:.0}° \
+             (median){hint}"
+        ),
+    ));
+}
+
+fn stuck_gnss(d: &Drive, speed: &[(f64, f64)], out: &mut Vec<Finding>) {
+    // The longest run of fixes at one position while the wheels travel.
+    let mut worst: Option<(f64, f64, f64)> = None;
+    let mut start = 0;
+    for k in 1..=d.gnss.len() {
+        let same = k < d.gnss.len()
+            && d.gnss[k].east_m == d.gnss[start].east_m
+            && d.gnss[k].north_m == d.gnss[start].north_m;
+        if same {
+            continue;
+        }
+        let (a, b) = (d.gnss[start].t_s, d.gnss[k - 1].t_s);
+        if b - a > 30.0 {
+            let i = speed.partition_point(|p| p.0 < a);
+            let j = speed.partition_point(|p| p.0 <= b);
+            let travelled: f64 = speed[i..j]
+                .windows(2)
+                .map(|p| p[1].1.abs() * (p[1].0 - p[0].0))
+                .sum();
+            if travelled > 50.0 && worst.is_none_or(|w| b - a > w.1 - w.0) {
+                worst = Some((a, b, travelled));
+            }
+        }
+        start = k;
+    }
+    if let Some((a, b, m)) = worst {
+        out.push(error(
+            "stuck_gnss",
+            format!(
+                "the GNSS position stays the same from {a:.1} to {b:.1} s while the wheels \
+                 travel {m:.0} m: a receiver repeating its last fix?"
+            ),
+        ));
+    }
+}
