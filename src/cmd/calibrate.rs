@@ -1,4 +1,6 @@
-//! `deadreckon calibrate`: RTS, ZUPT or truth calibration of the six parameters.
+//! `deadreckon calibrate`: RTS, ZUPT or truth calibration of the six
+//! parameters of the four-wheel car; for a tricycle log, the kinematic
+//! calibration of its seven parameters against the tracker.
 
 use std::path::PathBuf;
 
@@ -7,12 +9,14 @@ use clap::Args;
 use deadreckon_core::calibrate::{self, CalibrationOptions, Iteration, Method, PassState};
 use deadreckon_core::ekf::FilterOptions;
 
-use super::common;
+use deadreckon_core::kinematics::{self, KinematicOptions, Shape};
+
+use super::{common, kinematic};
 
 /// Arguments of `calibrate`.
 #[derive(Args, Debug)]
 pub struct CalibrateArgs {
-    /// The drive directory.
+    /// The drive directory or recording (a tricycle `dataset.txt` is calibrated through its own kinematics).
     pub dir: PathBuf,
     /// rts (smoothed states, needs GNSS), zupt (standstill gyro bias), truth (needs truth.csv).
     #[arg(long, default_value = "rts")]
@@ -29,9 +33,18 @@ pub struct CalibrateArgs {
     /// Filter timing: wheel (the paper's, one epoch per wheel row) or each (every reading at its time).
     #[arg(long, default_value = "wheel")]
     pub timing: String,
-    /// Speed below which epochs are dropped for speed-dependent parameters, m/s.
+    /// Speed below which epochs (car) or windows (tricycle) are dropped for speed-dependent parameters, m/s (default: 2 for a car, 0.05 for a tricycle).
+    #[arg(long)]
+    pub min_speed: Option<f64>,
+    /// Use only data from this time on, s (drive clock).
+    #[arg(long = "from")]
+    pub from_s: Option<f64>,
+    /// Use only data before this time, s (drive clock).
+    #[arg(long = "until")]
+    pub until_s: Option<f64>,
+    /// Tricycle: length of the relative-motion windows of the fit, s.
     #[arg(long, default_value_t = 2.0)]
-    pub min_speed: f64,
+    pub window: f64,
     /// Write the parameters here (params.toml).
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -42,6 +55,10 @@ pub struct CalibrateArgs {
 
 /// Runs `calibrate`.
 pub fn run(a: CalibrateArgs) -> Result<()> {
+    kinematic::check_range(a.from_s, a.until_s)?;
+    if kinematic::is_tricycle_log(&a.dir) {
+        return run_tricycle(&a);
+    }
     let method: Method = a.method.parse()?;
     // Only the truth calibration reads truth.csv.
     let read = deadreckon_io::ReadOptions::default();
@@ -51,6 +68,11 @@ pub fn run(a: CalibrateArgs) -> Result<()> {
         read.without_truth()
     };
     let drive = common::load_drive_with(&a.dir, &read)?;
+    let drive = if a.from_s.is_some() || a.until_s.is_some() {
+        drive.time_range(a.from_s, a.until_s)
+    } else {
+        drive
+    };
     let iteration = match a.iteration.as_str() {
         "anderson" => Iteration::Anderson,
         "plain" => Iteration::Plain,
@@ -66,7 +88,9 @@ pub fn run(a: CalibrateArgs) -> Result<()> {
         state,
         iteration,
         max_iterations: a.max_iterations,
-        min_speed_mps: a.min_speed,
+        min_speed_mps: a
+            .min_speed
+            .unwrap_or(Shape::FourWheel.default_min_speed_mps()),
         filter: FilterOptions {
             timing: common::parse_timing(&a.timing)?,
             ..Default::default()
@@ -107,6 +131,39 @@ pub fn run(a: CalibrateArgs) -> Result<()> {
         if let Some(st) = &c.filter_stats {
             println!("{}", common::stats_line(st));
         }
+        if let Some(out) = &a.out {
+            println!("wrote {}", out.display());
+        }
+    }
+    Ok(())
+}
+
+/// The tricycle: the seven kinematic parameters against the tracker.
+fn run_tricycle(a: &CalibrateArgs) -> Result<()> {
+    anyhow::ensure!(
+        a.method == "truth",
+        "a tricycle log has no GNSS and no gyro: it is calibrated against its tracker with --method truth (got `{}`)",
+        a.method
+    );
+    let drive = kinematic::load_tricycle(&a.dir, a.from_s, a.until_s)?;
+    let shape = Shape::Tricycle;
+    let opts = KinematicOptions {
+        window_s: a.window,
+        min_speed_mps: a.min_speed.unwrap_or(shape.default_min_speed_mps()),
+        ..Default::default()
+    };
+    let c = kinematics::calibrate(&drive, &opts)
+        .with_context(|| format!("calibrating {}", a.dir.display()))?;
+    if let Some(out) = &a.out {
+        kinematic::write_params(out, shape, &a.method, &c)?;
+    }
+    if a.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&kinematic::calibration_json(shape, &a.method, &c))?
+        );
+    } else {
+        kinematic::print_table(&c);
         if let Some(out) = &a.out {
             println!("wrote {}", out.display());
         }

@@ -11,12 +11,14 @@ use deadreckon_core::metrics::{self, Summary};
 use deadreckon_core::outage;
 use serde_json::json;
 
-use super::common;
+use deadreckon_core::kinematics::{self, KinematicOptions, Shape};
+
+use super::{common, kinematic};
 
 /// Arguments of `evaluate`.
 #[derive(Args, Debug)]
 pub struct EvaluateArgs {
-    /// The drive directory.
+    /// The drive directory or recording (a tricycle `dataset.txt` is dead-reckoned through its own kinematics).
     pub dir: PathBuf,
     /// `nominal` or a params.toml. Without it, `--outage` calibrates with RTS on the drive itself.
     #[arg(long)]
@@ -45,6 +47,12 @@ pub struct EvaluateArgs {
     /// Print JSON instead of text.
     #[arg(long)]
     pub json: bool,
+    /// Evaluate only data from this time on, s (drive clock).
+    #[arg(long = "from")]
+    pub from_s: Option<f64>,
+    /// Evaluate only data before this time, s (drive clock).
+    #[arg(long = "until")]
+    pub until_s: Option<f64>,
 }
 
 fn summary_json(s: &Summary) -> serde_json::Value {
@@ -53,7 +61,16 @@ fn summary_json(s: &Summary) -> serde_json::Value {
 
 /// Runs `evaluate`.
 pub fn run(a: EvaluateArgs) -> Result<()> {
+    kinematic::check_range(a.from_s, a.until_s)?;
+    if kinematic::is_tricycle_log(&a.dir) {
+        return run_tricycle(&a);
+    }
     let drive = common::load_drive(&a.dir)?;
+    let drive = if a.from_s.is_some() || a.until_s.is_some() {
+        drive.time_range(a.from_s, a.until_s)
+    } else {
+        drive
+    };
     let timing = common::parse_timing(&a.timing)?;
     if let Some(len) = a.outage {
         let (params, source) = match &a.params {
@@ -147,6 +164,54 @@ pub fn run(a: EvaluateArgs) -> Result<()> {
             }
         }
         m => anyhow::bail!("unknown metric `{m}` (drift, reset-1m)"),
+    }
+    Ok(())
+}
+
+/// The tricycle: sliding outages from the tracker pose, scored at the
+/// tracked point with the calibrated mounting.
+fn run_tricycle(a: &EvaluateArgs) -> Result<()> {
+    let Some(len) = a.outage else {
+        anyhow::bail!(
+            "a tricycle log is evaluated over sliding outages: give --outage LEN (and --step S)"
+        );
+    };
+    let shape = Shape::Tricycle;
+    let drive = kinematic::load_tricycle(&a.dir, a.from_s, a.until_s)?;
+    let (params, source) = match &a.params {
+        Some(p) => kinematic::load_params(p, shape, &drive)?,
+        None => {
+            let o = KinematicOptions {
+                min_speed_mps: shape.default_min_speed_mps(),
+                ..Default::default()
+            };
+            let c = kinematics::calibrate(&drive, &o).context("calibrating against the tracker")?;
+            (
+                c.values(),
+                "truth (calibrated on the evaluated range)".to_string(),
+            )
+        }
+    };
+    let ev = kinematics::evaluate(&drive, &params, len, a.step.unwrap_or(len / 2.0))?;
+    if a.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&kinematic::outages_json(shape, &ev, &source))?
+        );
+    } else {
+        let s = ev.final_error();
+        println!(
+            "{} outage windows of {len} s from the reference pose (parameters: {source})",
+            ev.windows.len()
+        );
+        println!(
+            "{:<28} {:>9} {:>9} {:>9} {:>9}",
+            "", "mean", "median", "p95", "max"
+        );
+        println!(
+            "{:<28} {:>9.3} {:>9.3} {:>9.3} {:>9.3}",
+            "final error (m)", s.mean, s.median, s.p95, s.max
+        );
     }
     Ok(())
 }

@@ -9,7 +9,10 @@ use deadreckon_core::ekf::{self, FilterOptions, Init, SensorSet};
 use deadreckon_core::model::{Mat, State};
 use deadreckon_core::{rts, Drive, Params, Track};
 
-use super::common;
+use deadreckon_core::kinematics::tricycle::TricycleParams;
+use deadreckon_core::kinematics::Shape;
+
+use super::{common, kinematic};
 
 /// Arguments of `run`.
 #[derive(Args, Debug)]
@@ -123,6 +126,25 @@ pub fn write_tracks(path: &Path, tracks: &[Track]) -> Result<()> {
 
 /// Runs `run`.
 pub fn run(a: RunArgs) -> Result<()> {
+    if kinematic::is_tricycle_log(&a.dir) {
+        // The tricycle is dead-reckoned through its own kinematics (the car
+        // filter's wheel and steering observations oscillate at its steering
+        // angles near 1.1 rad), from the first tracker pose.
+        anyhow::ensure!(
+            a.init_pose.is_none(),
+            "a tricycle log starts from its first tracker pose: --init-pose is not used"
+        );
+        let drive = kinematic::load_tricycle(&a.dir, None, None)?;
+        let (p, _) = kinematic::load_params(&a.params, Shape::Tricycle, &drive)?;
+        let params = TricycleParams::from_slice(&p)?;
+        let t = drive.tracks(&params)?;
+        write_tracks(&a.out, &t).with_context(|| format!("writing {}", a.out.display()))?;
+        for tr in &t {
+            println!("{:<14} {:>7} poses", tr.name, tr.points.len());
+        }
+        println!("wrote {}", a.out.display());
+        return Ok(());
+    }
     let drive = common::load_drive(&a.dir)?;
     let params = common::load_params(&a.params, &drive)?;
     let init_pose = match &a.init_pose {

@@ -38,6 +38,8 @@ mod read;
 mod table;
 mod toml_files;
 mod track_out;
+
+pub mod kinematic_toml;
 mod write;
 
 pub mod events;
@@ -45,6 +47,7 @@ pub use atomic::atomic_write;
 /// Latitude/longitude ↔ local east-north (re-exported from `deadreckon-core`).
 pub use deadreckon_core::geo;
 pub use error::IoError;
+pub use kinematic_toml::{read_kinematic_params, write_kinematic_params, KinematicParamsFile};
 pub use read::{read_drive, read_drive_with, ReadOptions, WheelFile};
 pub use toml_files::{
     read_params, read_params_with_extra, read_truth_params, read_vehicle, write_params,
