@@ -21,7 +21,9 @@
 //!    (the drive leaves it free, usually through a correlation near ±1 with
 //!    another parameter, which the reason names).
 //!
-//! Cases 2 and 3 remove one parameter at a time (the worst) and fit again.
+//! Cases 2 and 3 remove one parameter at a time (the worst) and fit again;
+//! an undetermined parameter is removed before bounds are checked (it may be
+//! the one that wandered off, dragging a determined one with it).
 //! Standard errors are `σ̂²(JᵀJ)⁻¹` with `σ̂² = RSS / (m − n)` at the
 //! solution; `converged` is true only when the solver reports success and
 //! at least one parameter was estimated.
@@ -314,20 +316,6 @@ pub fn calibrate<M: KinematicModel>(
         if let Some(k) = names.iter().position(|n| *n == "mount_yaw_rad") {
             full[k] = wrap(full[k]);
         }
-        // A fit at or beyond a physical bound is rejected.
-        let at_bound = free.iter().copied().find(|&k| {
-            let (lo, hi) = bounds[k];
-            let margin = 1e-6 * (hi - lo);
-            !(full[k] > lo + margin && full[k] < hi - margin)
-        });
-        if let Some(k) = at_bound {
-            let (lo, hi) = bounds[k];
-            reason[k] = Some(format!(
-                "rejected: the fit went to {:.6}, at or beyond the physical bound [{lo}, {hi}]",
-                full[k]
-            ));
-            continue;
-        }
         let fit = Problem {
             model,
             windows: &windows,
@@ -356,7 +344,23 @@ pub fn calibrate<M: KinematicModel>(
                 .filter(|x| x.2 > 1.0)
                 .max_by(|a, b| a.2.total_cmp(&b.2)),
         };
-        let Some((ci, k, _)) = worst else { break };
+        let Some((ci, k, _)) = worst else {
+            // A fit at or beyond a physical bound is rejected.
+            let at_bound = free.iter().copied().find(|&k| {
+                let (lo, hi) = bounds[k];
+                let margin = 1e-6 * (hi - lo);
+                !(full[k] > lo + margin && full[k] < hi - margin)
+            });
+            if let Some(k) = at_bound {
+                let (lo, hi) = bounds[k];
+                reason[k] = Some(format!(
+                    "rejected: the fit went to {:.6}, at or beyond the physical bound [{lo}, {hi}]",
+                    full[k]
+                ));
+                continue;
+            }
+            break;
+        };
         let detail = match &cov {
             None => "the normal equations are singular".to_string(),
             Some(c) => {
@@ -437,4 +441,133 @@ pub fn calibrate<M: KinematicModel>(
         converged: success && cov.is_some() && !free.is_empty(),
         termination,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kinematics::PoseJacobian;
+
+    /// A toy shape moving along x at speed `p0 + p1` (so only the sum is
+    /// determined), with a reference moving at `true_speed`.
+    struct Toy {
+        true_speed: f64,
+        bounds: Vec<(f64, f64)>,
+        n_params: usize,
+    }
+
+    impl KinematicModel for Toy {
+        fn names(&self) -> &'static [&'static str] {
+            &["a_mps", "b_mps"][..self.n_params]
+        }
+        fn nominal(&self) -> Vec<f64> {
+            vec![0.5; self.n_params]
+        }
+        fn bounds(&self) -> Vec<(f64, f64)> {
+            self.bounds.clone()
+        }
+        fn determination_tolerance(&self, _: &[f64]) -> Vec<f64> {
+            vec![0.01; self.n_params]
+        }
+        fn len(&self) -> usize {
+            500
+        }
+        fn time(&self, i: usize) -> f64 {
+            i as f64 * 0.1
+        }
+        fn reference(&self, i: usize) -> Option<Pose2> {
+            // A deterministic wiggle as "noise".
+            let noise = 0.01 * ((i * 7919) % 13) as f64 / 13.0;
+            Some(Pose2::new(self.true_speed * self.time(i) + noise, 0.0, 0.0))
+        }
+        fn path_m(&self, a: usize, b: usize) -> f64 {
+            0.5 * (self.time(b) - self.time(a))
+        }
+        fn predict(
+            &self,
+            p: &[f64],
+            start: &Pose2,
+            a: usize,
+            b: usize,
+            jac: bool,
+        ) -> (Pose2, Option<PoseJacobian>) {
+            let dt = self.time(b) - self.time(a);
+            let v: f64 = p.iter().sum();
+            let out = Pose2::new(start.x_m + v * dt, start.y_m, start.yaw_rad);
+            let j = jac.then(|| {
+                let mut j = PoseJacobian::zeros(self.n_params);
+                for q in 0..self.n_params {
+                    j[(0, q)] = dt;
+                }
+                j
+            });
+            (out, j)
+        }
+        fn unexcited(&self, _: &[(usize, usize)], _: usize) -> Option<String> {
+            None
+        }
+    }
+
+    #[test]
+    fn a_fit_beyond_a_physical_bound_is_rejected_not_reported() {
+        let toy = Toy {
+            true_speed: -1.0,
+            bounds: vec![(0.0, 10.0)],
+            n_params: 1,
+        };
+        let c = calibrate(&toy, &KinematicOptions::default()).unwrap();
+        let p = &c.params[0];
+        assert!(!p.estimated && p.std.is_none(), "{p:?}");
+        assert!(
+            p.reason.as_deref().unwrap().contains("physical bound"),
+            "{p:?}"
+        );
+        assert_eq!(p.value, 0.5, "the nominal value is kept");
+        assert!(!c.converged);
+    }
+
+    #[test]
+    fn a_parameter_the_drive_cannot_separate_is_not_estimated() {
+        let toy = Toy {
+            true_speed: 1.2,
+            bounds: vec![(-10.0, 10.0); 2],
+            n_params: 2,
+        };
+        let c = calibrate(&toy, &KinematicOptions::default()).unwrap();
+        let est: Vec<_> = c.params.iter().filter(|p| p.estimated).collect();
+        assert_eq!(est.len(), 1, "{c:?}");
+        let other = c.params.iter().find(|p| !p.estimated).unwrap();
+        assert!(
+            other.reason.as_deref().unwrap().contains("not determined"),
+            "{other:?}"
+        );
+        // The one left carries the sum: 1.2 − 0.5.
+        assert!((est[0].value - 0.7).abs() < 1e-3, "{c:?}");
+        assert!(c.converged);
+    }
+
+    #[test]
+    fn bad_options_are_errors() {
+        let toy = Toy {
+            true_speed: 1.0,
+            bounds: vec![(-10.0, 10.0)],
+            n_params: 1,
+        };
+        for o in [
+            KinematicOptions {
+                window_s: 0.0,
+                ..Default::default()
+            },
+            KinematicOptions {
+                min_speed_mps: f64::NAN,
+                ..Default::default()
+            },
+            KinematicOptions {
+                heading_weight_m: -1.0,
+                ..Default::default()
+            },
+        ] {
+            assert!(calibrate(&toy, &o).is_err(), "{o:?}");
+        }
+    }
 }

@@ -55,9 +55,13 @@ pub mod tuning {
     /// Path the used windows must travel for the traction scale and the
     /// mounting yaw, m.
     pub const MIN_PATH_M: f64 = 1.0;
-    /// Reference turning (sum of |Δψ| over the used windows) needed for the
-    /// steering parameters, the axle length and the mounting position, rad.
-    pub const MIN_TURN_RAD: f64 = 0.5;
+    /// A window turns when its reference heading changes by this much from
+    /// its start to its end, rad (about 6°: far above the tracker's heading
+    /// noise of a few mrad).
+    pub const MIN_TURN_RAD: f64 = 0.1;
+    /// Turning windows needed for the steering parameters, the axle length
+    /// and the mounting position.
+    pub const MIN_TURNING_WINDOWS: usize = 3;
     /// Spread (standard deviation) of the steering-encoder angle while moving
     /// needed to separate `Ksteer` from the offset, rad.
     pub const MIN_STEER_SPREAD_RAD: f64 = 0.02;
@@ -458,21 +462,23 @@ impl KinematicModel for TricycleDrive {
     fn unexcited(&self, windows: &[(usize, usize)], k: usize) -> Option<String> {
         use tuning::*;
         let path: f64 = windows.iter().map(|&(a, b)| self.path_m(a, b)).sum();
-        let turn: f64 = windows
+        // Windows in which the reference turns clearly (net, start to end:
+        // robust to the reference's heading noise, which a sum of |Δψ| over
+        // samples would add up).
+        let turning = windows
             .iter()
-            .flat_map(|&(a, b)| a + 1..=b)
-            .filter_map(|i| Some((self.reference(i)?, self.reference(i - 1)?)))
-            .map(|(r1, r0)| crate::angle::wrap(r1.yaw_rad - r0.yaw_rad).abs())
-            .sum();
+            .filter_map(|&(a, b)| Some((self.reference(a)?, self.reference(b)?)))
+            .filter(|(r0, r1)| crate::angle::wrap(r1.yaw_rad - r0.yaw_rad).abs() >= MIN_TURN_RAD)
+            .count();
         if path < MIN_PATH_M {
             return Some(format!(
                 "the used windows travel {path:.2} m (needs {MIN_PATH_M} m)"
             ));
         }
         let needs_turns = matches!(k, KSTEER | STEER_OFFSET | AXLE | MOUNT_X | MOUNT_Y);
-        if needs_turns && turn < MIN_TURN_RAD {
+        if needs_turns && turning < MIN_TURNING_WINDOWS {
             return Some(format!(
-                "no turns: the reference turns {turn:.2} rad in the used windows (needs {MIN_TURN_RAD} rad)"
+                "no turns: {turning} of the used windows turn by {MIN_TURN_RAD} rad or more (needs {MIN_TURNING_WINDOWS})"
             ));
         }
         if k == KSTEER {
