@@ -8,6 +8,8 @@ use anyhow::{Context, Result};
 use clap::Args;
 use deadreckon_core::calibrate::{self, CalibrationOptions, Iteration, Method, PassState};
 use deadreckon_core::ekf::FilterOptions;
+use deadreckon_core::kinematics::steering::{calibrate_steering, SteeringCalibration};
+use deadreckon_core::reference::Reference;
 
 use deadreckon_core::kinematics::{self, KinematicOptions, Shape};
 
@@ -99,22 +101,76 @@ pub fn run(a: CalibrateArgs) -> Result<()> {
     };
     let c = calibrate::calibrate(&drive, &opts)
         .with_context(|| format!("calibrating {}", a.dir.display()))?;
+    // Parameters no sample above the threshold informed keep their nominal
+    // value: say so instead of reporting them as calibrated.
+    let not_estimated: Vec<(&str, String)> = deadreckon_core::Params::NAMES
+        .iter()
+        .zip(c.samples)
+        .filter(|(_, n)| *n == 0)
+        .map(|(name, _)| {
+            (
+                *name,
+                format!(
+                    "0 samples above the speed threshold {} m/s: nominal kept",
+                    opts.min_speed_mps
+                ),
+            )
+        })
+        .collect();
+    // With the truth, the steering ratio and offset too.
+    let steering = match (method, Reference::from_truth(&drive.truth)) {
+        (Method::Truth, Some(r)) if !drive.steering.is_empty() => Some(
+            calibrate_steering(&drive, &r, opts.min_speed_mps)
+                .context("calibrating the steering")?,
+        ),
+        _ => None,
+    };
     if let Some(out) = &a.out {
         let mut extra = toml::Table::new();
         extra.insert("method".into(), a.method.clone().into());
         extra.insert("iterations".into(), (c.iterations as i64).into());
         extra.insert("converged".into(), c.converged.into());
+        if !not_estimated.is_empty() {
+            let t: toml::Table = not_estimated
+                .iter()
+                .map(|(k, why)| (k.to_string(), why.clone().into()))
+                .collect();
+            extra.insert("not_estimated".into(), t.into());
+        }
+        if let Some(st) = &steering {
+            extra.insert("steering".into(), steering_toml(st).into());
+        }
         deadreckon_io::write_params(out, &c.estimate, Some(&extra))
             .with_context(|| format!("writing {}", out.display()))?;
     }
     if a.json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&common::calibration_json(&a.method, &c))?
-        );
+        let mut v = common::calibration_json(&a.method, &c);
+        v["not_estimated"] = not_estimated
+            .iter()
+            .map(|(k, why)| (k.to_string(), serde_json::Value::from(why.clone())))
+            .collect::<serde_json::Map<_, _>>()
+            .into();
+        if let Some(st) = &steering {
+            v["steering"] = serde_json::json!({
+                "ratio": st.ratio, "offset_rad": st.offset, "samples": st.samples, "rms_rad": st.rms_rad,
+            });
+        }
+        println!("{}", serde_json::to_string_pretty(&v)?);
     } else {
         println!("{}", common::params_header());
         println!("{}", common::params_row(&a.method, &c.estimate));
+        for (k, why) in &not_estimated {
+            println!("{k}: NOT ESTIMATED ({why})");
+        }
+        if let Some(st) = &steering {
+            for p in [&st.ratio, &st.offset] {
+                match (&p.reason, p.std) {
+                    (None, Some(s)) => println!("{}: {:.5} ± {s:.5}", p.name, p.value),
+                    (Some(r), _) => println!("{}: NOT ESTIMATED ({r}), {} kept", p.name, p.value),
+                    (None, None) => println!("{}: {:.5}", p.name, p.value),
+                }
+            }
+        }
         if method == Method::Rts {
             println!(
                 "{} smoothing passes ({} state, {} iteration), {}",
@@ -169,4 +225,24 @@ fn run_tricycle(a: &CalibrateArgs) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// The steering calibration as a params.toml table: value, std (when
+/// estimated) and the reason when not.
+fn steering_toml(st: &SteeringCalibration) -> toml::Table {
+    let mut t = toml::Table::new();
+    for p in [&st.ratio, &st.offset] {
+        let mut e = toml::Table::new();
+        e.insert("value".into(), p.value.into());
+        e.insert("estimated".into(), p.estimated.into());
+        if let Some(s) = p.std {
+            e.insert("std".into(), s.into());
+        }
+        if let Some(r) = &p.reason {
+            e.insert("reason".into(), r.clone().into());
+        }
+        t.insert(p.name.clone(), e.into());
+    }
+    t.insert("samples".into(), (st.samples as i64).into());
+    t
 }

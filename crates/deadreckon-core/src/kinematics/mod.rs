@@ -4,7 +4,9 @@
 //! A [`Shape`] names the kinematics of a vehicle:
 //!
 //! - [`Shape::FourWheel`]: the four-wheel Ackermann car of the paper, filtered
-//!   by [`crate::filter`] and calibrated by [`crate::calibrate`] (unchanged);
+//!   by [`crate::filter`] and calibrated by [`crate::calibrate`] (unchanged),
+//!   with its steering ratio and steering-wheel offset calibrated against a
+//!   reference by [`steering`];
 //! - [`Shape::Tricycle`]: one steered, driven front wheel with a steering
 //!   encoder and a traction encoder ([`tricycle`]);
 //! - [`Shape::DiffDrive`]: left/right wheels, or the odometry twist they give.
@@ -28,6 +30,7 @@
 
 pub mod calibrate;
 pub mod evaluate;
+pub mod steering;
 pub mod tricycle;
 
 use serde::{Deserialize, Serialize};
