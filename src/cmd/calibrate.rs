@@ -11,8 +11,10 @@ use deadreckon_core::ekf::FilterOptions;
 use deadreckon_core::kinematics::steering::{calibrate_steering, SteeringCalibration};
 use deadreckon_core::reference::Reference;
 
+use deadreckon_core::kinematics::diff_drive::{calibrate_diff_drive, DiffDriveOptions};
 use deadreckon_core::kinematics::{self, KinematicOptions, Shape};
 
+use super::kinematic::{ShapeArg, YawArg};
 use super::{common, kinematic};
 
 /// Arguments of `calibrate`.
@@ -20,9 +22,15 @@ use super::{common, kinematic};
 pub struct CalibrateArgs {
     /// The drive directory or recording (a tricycle `dataset.txt` is calibrated through its own kinematics).
     pub dir: PathBuf,
-    /// rts (smoothed states, needs GNSS), zupt (standstill gyro bias), truth (needs truth.csv).
-    #[arg(long, default_value = "rts")]
-    pub method: String,
+    /// rts (smoothed states, needs GNSS), zupt (standstill gyro bias), truth (needs truth.csv); a tricycle: truth (its tracker); a differential drive: gnss (default: rts, truth, gnss by shape).
+    #[arg(long)]
+    pub method: Option<String>,
+    /// The vehicle shape: car (four wheels, the default) or diff-drive (odometry twist, calibrated against GNSS). A tricycle log is recognised by itself.
+    #[arg(long, value_enum, default_value_t = ShapeArg::Car)]
+    pub shape: ShapeArg,
+    /// Differential drive: the yaw rate integrated, gyro or odometry.
+    #[arg(long, value_enum, default_value_t = YawArg::Gyro)]
+    pub yaw: YawArg,
     /// What each smoothing pass carries: augmented (car state + the six parameters) or paper (5-state, parameters fixed).
     #[arg(long, default_value = "augmented")]
     pub state: String,
@@ -44,9 +52,9 @@ pub struct CalibrateArgs {
     /// Use only data before this time, s (drive clock).
     #[arg(long = "until")]
     pub until_s: Option<f64>,
-    /// Tricycle: length of the relative-motion windows of the fit, s.
-    #[arg(long, default_value_t = 2.0)]
-    pub window: f64,
+    /// Tricycle and differential drive: length of the windows of the fit, s (default 2 for a tricycle, 60 for a differential drive).
+    #[arg(long)]
+    pub window: Option<f64>,
     /// Write the parameters here (params.toml).
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -61,7 +69,11 @@ pub fn run(a: CalibrateArgs) -> Result<()> {
     if kinematic::is_tricycle_log(&a.dir) {
         return run_tricycle(&a);
     }
-    let method: Method = a.method.parse()?;
+    if a.shape == ShapeArg::DiffDrive {
+        return run_diff_drive(&a);
+    }
+    let method_name = a.method.clone().unwrap_or_else(|| "rts".into());
+    let method: Method = method_name.parse()?;
     // Only the truth calibration reads truth.csv.
     let read = deadreckon_io::ReadOptions::default();
     let read = if method == Method::Truth {
@@ -127,7 +139,7 @@ pub fn run(a: CalibrateArgs) -> Result<()> {
     };
     if let Some(out) = &a.out {
         let mut extra = toml::Table::new();
-        extra.insert("method".into(), a.method.clone().into());
+        extra.insert("method".into(), method_name.clone().into());
         extra.insert("iterations".into(), (c.iterations as i64).into());
         extra.insert("converged".into(), c.converged.into());
         if !not_estimated.is_empty() {
@@ -144,7 +156,7 @@ pub fn run(a: CalibrateArgs) -> Result<()> {
             .with_context(|| format!("writing {}", out.display()))?;
     }
     if a.json {
-        let mut v = common::calibration_json(&a.method, &c);
+        let mut v = common::calibration_json(&method_name, &c);
         v["not_estimated"] = not_estimated
             .iter()
             .map(|(k, why)| (k.to_string(), serde_json::Value::from(why.clone())))
@@ -158,7 +170,7 @@ pub fn run(a: CalibrateArgs) -> Result<()> {
         println!("{}", serde_json::to_string_pretty(&v)?);
     } else {
         println!("{}", common::params_header());
-        println!("{}", common::params_row(&a.method, &c.estimate));
+        println!("{}", common::params_row(&method_name, &c.estimate));
         for (k, why) in &not_estimated {
             println!("{k}: NOT ESTIMATED ({why})");
         }
@@ -196,27 +208,27 @@ pub fn run(a: CalibrateArgs) -> Result<()> {
 
 /// The tricycle: the seven kinematic parameters against the tracker.
 fn run_tricycle(a: &CalibrateArgs) -> Result<()> {
+    let method = a.method.as_deref().unwrap_or("truth");
     anyhow::ensure!(
-        a.method == "truth",
-        "a tricycle log has no GNSS and no gyro: it is calibrated against its tracker with --method truth (got `{}`)",
-        a.method
+        method == "truth",
+        "a tricycle log has no GNSS and no gyro: it is calibrated against its tracker with --method truth (got `{method}`)"
     );
     let drive = kinematic::load_tricycle(&a.dir, a.from_s, a.until_s)?;
     let shape = Shape::Tricycle;
     let opts = KinematicOptions {
-        window_s: a.window,
+        window_s: a.window.unwrap_or(2.0),
         min_speed_mps: a.min_speed.unwrap_or(shape.default_min_speed_mps()),
         ..Default::default()
     };
     let c = kinematics::calibrate(&drive, &opts)
         .with_context(|| format!("calibrating {}", a.dir.display()))?;
     if let Some(out) = &a.out {
-        kinematic::write_params(out, shape, &a.method, &c)?;
+        kinematic::write_params(out, shape, method, None, &c)?;
     }
     if a.json {
         println!(
             "{}",
-            serde_json::to_string_pretty(&kinematic::calibration_json(shape, &a.method, &c))?
+            serde_json::to_string_pretty(&kinematic::calibration_json(shape, method, &c))?
         );
     } else {
         kinematic::print_table(&c);
@@ -245,4 +257,37 @@ fn steering_toml(st: &SteeringCalibration) -> toml::Table {
     }
     t.insert("samples".into(), (st.samples as i64).into());
     t
+}
+
+/// The differential drive: five parameters against the GNSS fixes.
+fn run_diff_drive(a: &CalibrateArgs) -> Result<()> {
+    let method = a.method.as_deref().unwrap_or("gnss");
+    anyhow::ensure!(
+        method == "gnss",
+        "a differential drive is calibrated against its GNSS fixes with --method gnss (got `{method}`)"
+    );
+    let drive = common::load_drive(&a.dir)?;
+    let dd = kinematic::diff_drive(&drive, a.yaw, a.from_s, a.until_s)?;
+    let shape = Shape::DiffDrive;
+    let opts = DiffDriveOptions {
+        window_s: a.window.unwrap_or(DiffDriveOptions::default().window_s),
+        min_speed_mps: a.min_speed.unwrap_or(shape.default_min_speed_mps()),
+        ..Default::default()
+    };
+    let c = calibrate_diff_drive(&dd, &opts)
+        .with_context(|| format!("calibrating {}", a.dir.display()))?;
+    if let Some(out) = &a.out {
+        kinematic::write_params(out, shape, method, Some(a.yaw.name()), &c)?;
+    }
+    if a.json {
+        let mut v = kinematic::calibration_json(shape, method, &c);
+        v["yaw_source"] = a.yaw.name().into();
+        println!("{}", serde_json::to_string_pretty(&v)?);
+    } else {
+        kinematic::print_table(&c);
+        if let Some(out) = &a.out {
+            println!("wrote {}", out.display());
+        }
+    }
+    Ok(())
 }

@@ -4,10 +4,60 @@
 use std::path::Path;
 
 use anyhow::{Context, Result};
+use deadreckon_core::kinematics::diff_drive::{DiffDriveDrive, YawSource};
 use deadreckon_core::kinematics::tricycle::TricycleDrive;
 use deadreckon_core::kinematics::{KinematicCalibration, KinematicModel, KinematicOutages, Shape};
 use deadreckon_io::kinematic_toml::{is_kinematic_params, KinematicParamsFile};
 use serde_json::json;
+
+/// `--shape`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum ShapeArg {
+    /// Four wheels, front-steered (the paper's car).
+    Car,
+    /// Left/right wheels or an odometry twist.
+    DiffDrive,
+}
+
+/// `--yaw` of a differential drive.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum YawArg {
+    /// The gyro.
+    Gyro,
+    /// The odometry's wheel-speed difference.
+    Odometry,
+}
+
+impl YawArg {
+    /// The name written into params.toml.
+    pub fn name(self) -> &'static str {
+        match self {
+            YawArg::Gyro => "gyro",
+            YawArg::Odometry => "odometry",
+        }
+    }
+}
+
+/// A drive as a differential drive with the chosen yaw source, cut to `[from, until)`.
+pub fn diff_drive(
+    drive: &deadreckon_core::Drive,
+    yaw: YawArg,
+    from: Option<f64>,
+    until: Option<f64>,
+) -> Result<DiffDriveDrive> {
+    let source = match yaw {
+        YawArg::Gyro => YawSource::Gyro,
+        YawArg::Odometry => YawSource::Odometry,
+    };
+    let d = DiffDriveDrive::from_drive(drive, source, from, until)?;
+    anyhow::ensure!(
+        d.samples.len() >= 2 && d.fixes.len() >= 3,
+        "{} odometry samples and {} GNSS fixes in the range: a differential drive needs odometry and GNSS",
+        d.samples.len(),
+        d.fixes.len()
+    );
+    Ok(d)
+}
 
 /// Whether `path` is a recording read through a kinematic shape (a
 /// tricycle `dataset.txt`).
@@ -56,6 +106,17 @@ pub fn load_params<M: KinematicModel>(
     if spec == "nominal" {
         return Ok((model.nominal(), "nominal".into()));
     }
+    load_params_file(spec, shape, model.names(), None)
+}
+
+/// A kinematic params.toml for `shape` with these parameter names (and, for
+/// a differential drive, this yaw source).
+pub fn load_params_file(
+    spec: &str,
+    shape: Shape,
+    names: &[&str],
+    yaw_source: Option<&str>,
+) -> Result<(Vec<f64>, String)> {
     let path = Path::new(spec);
     if !is_kinematic_params(path) {
         anyhow::bail!(
@@ -65,7 +126,13 @@ pub fn load_params<M: KinematicModel>(
     }
     let f = deadreckon_io::read_kinematic_params(path)
         .with_context(|| format!("reading parameters {spec}"))?;
-    f.check(path, shape, model.names())?;
+    f.check(path, shape, names)?;
+    if let (Some(want), Some(have)) = (yaw_source, f.yaw_source.as_deref()) {
+        anyhow::ensure!(
+            want == have,
+            "{spec}: calibrated with --yaw {have}, evaluated with --yaw {want}"
+        );
+    }
     let n_not = f.param.iter().filter(|p| !p.estimated).count();
     let source = if n_not == 0 {
         spec.to_string()
@@ -155,9 +222,11 @@ pub fn write_params(
     path: &Path,
     shape: Shape,
     method: &str,
+    yaw_source: Option<&str>,
     c: &KinematicCalibration,
 ) -> Result<()> {
-    let f = KinematicParamsFile::from_calibration(shape, method, c);
+    let mut f = KinematicParamsFile::from_calibration(shape, method, c);
+    f.yaw_source = yaw_source.map(str::to_string);
     deadreckon_io::write_kinematic_params(path, &f)
         .with_context(|| format!("writing {}", path.display()))
 }

@@ -44,6 +44,9 @@ pub struct KinematicParamsFile {
     pub windows_used: usize,
     /// Speed threshold applied, m/s.
     pub min_speed_mps: f64,
+    /// The yaw rate a differential drive integrates (`gyro`, `odometry`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub yaw_source: Option<String>,
     /// The parameters, in the shape's order.
     pub param: Vec<ParamEstimate>,
     /// Correlation of the estimated parameters.
@@ -70,6 +73,7 @@ impl KinematicParamsFile {
             converged: c.converged,
             windows_used: c.windows_used,
             min_speed_mps: c.min_speed_mps,
+            yaw_source: None,
             param: c.params.clone(),
             correlation: (!c.correlated.is_empty()).then(|| Correlation {
                 names: c.correlated.clone(),
@@ -169,6 +173,7 @@ mod tests {
             converged: false,
             windows_used: 0,
             min_speed_mps: 2.0,
+            yaw_source: None,
             param: vec![
                 ParamEstimate {
                     name: "a_m".into(),

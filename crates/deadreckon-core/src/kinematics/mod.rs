@@ -29,6 +29,7 @@
 //! `measured = base ∘ m`.
 
 pub mod calibrate;
+pub mod diff_drive;
 pub mod evaluate;
 pub mod steering;
 pub mod tricycle;
