@@ -3,8 +3,9 @@
 //! Reads and writes the drive directory format of deadreckon (specified in
 //! `docs/drive-format.md`): a directory of CSV files with a header row, one per
 //! sensor stream, plus `vehicle.toml`; and the files around it: calibrated
-//! parameters (`params.toml`, `truth_params.toml`) and estimated tracks (one CSV,
-//! or GeoJSON for maps). Everything it reads is checked, and every error names
+//! parameters (`params.toml`, `truth_params.toml`; for the kinematic shapes,
+//! tricycle and differential drive, the [`kinematic_toml`] form with a status
+//! and reason per parameter) and estimated tracks (one CSV, or GeoJSON for maps). Everything it reads is checked, and every error names
 //! the file, the 1-based line (the header is line 1) and the column.
 //!
 //! ## Conventions
