@@ -585,3 +585,52 @@ fn tedris_train_variant_paper_and_extended() {
         "{c}"
     );
 }
+
+/// Regression: `calibrate --method truth` wrote the nominal values with
+/// `converged: true` when no sample was above the speed threshold. Now the
+/// parameters without samples are listed as not estimated, with why, and the
+/// steering ratio and offset are calibrated beside the six (or not, and why).
+#[test]
+fn car_truth_calibration_with_zero_samples_is_not_converged() {
+    let tmp = tempfile::tempdir().unwrap();
+    let cal = tmp.path().join("cal");
+    simulate(&cal, "calibration", 11);
+    let out = tmp.path().join("p.toml");
+    let v = json(&run_ok(&[
+        "calibrate",
+        cal.to_str().unwrap(),
+        "--method",
+        "truth",
+        "--min-speed",
+        "100",
+        "--json",
+        "--out",
+        out.to_str().unwrap(),
+    ]));
+    assert_eq!(v["converged"], false, "{v}");
+    let not = v["not_estimated"].as_object().unwrap();
+    assert_eq!(not.len(), 5, "{v}");
+    assert!(
+        not["speed_scale"].as_str().unwrap().contains("0 samples"),
+        "{v}"
+    );
+    assert_eq!(v["steering"]["ratio"]["estimated"], false, "{v}");
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert!(
+        text.contains("converged = false") && text.contains("[not_estimated]"),
+        "{text}"
+    );
+    // At the default threshold everything is estimated, steering included.
+    let v = json(&run_ok(&[
+        "calibrate",
+        cal.to_str().unwrap(),
+        "--method",
+        "truth",
+        "--json",
+    ]));
+    assert_eq!(v["converged"], true, "{v}");
+    assert!(v["not_estimated"].as_object().unwrap().is_empty(), "{v}");
+    let ratio = v["steering"]["ratio"]["value"].as_f64().unwrap();
+    // The simulator's true ratio is the nominal 15.9 here.
+    assert!((ratio / 15.9 - 1.0).abs() < 0.005, "{v}");
+}

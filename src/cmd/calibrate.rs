@@ -1,4 +1,6 @@
-//! `deadreckon calibrate`: RTS, ZUPT or truth calibration of the six parameters.
+//! `deadreckon calibrate`: RTS, ZUPT or truth calibration of the six
+//! parameters of the four-wheel car; for a tricycle log, the kinematic
+//! calibration of its seven parameters against the tracker.
 
 use std::path::PathBuf;
 
@@ -6,8 +8,14 @@ use anyhow::{Context, Result};
 use clap::Args;
 use deadreckon_core::calibrate::{self, CalibrationOptions, Iteration, Method, PassState};
 use deadreckon_core::ekf::FilterOptions;
+use deadreckon_core::kinematics::steering::{calibrate_steering, SteeringCalibration};
+use deadreckon_core::reference::Reference;
 
-use super::common;
+use deadreckon_core::kinematics::diff_drive::{calibrate_diff_drive, DiffDriveOptions};
+use deadreckon_core::kinematics::{self, KinematicOptions, Shape};
+
+use super::kinematic::{ShapeArg, YawArg};
+use super::{common, kinematic};
 
 /// What `calibrate --out` writes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -23,11 +31,17 @@ pub enum OutFormat {
 /// Arguments of `calibrate`.
 #[derive(Args, Debug)]
 pub struct CalibrateArgs {
-    /// The drive directory.
+    /// The drive directory or recording (a tricycle `dataset.txt` is calibrated through its own kinematics).
     pub dir: PathBuf,
-    /// rts (smoothed states, needs GNSS), zupt (standstill gyro bias), truth (needs truth.csv).
-    #[arg(long, default_value = "rts")]
-    pub method: String,
+    /// rts (smoothed states, needs GNSS), zupt (standstill gyro bias), truth (needs truth.csv); a tricycle: truth (its tracker); a differential drive: gnss (default: rts, truth, gnss by shape).
+    #[arg(long)]
+    pub method: Option<String>,
+    /// The vehicle shape: car (four wheels, the default) or diff-drive (odometry twist, calibrated against GNSS). A tricycle log is recognised by itself.
+    #[arg(long, value_enum, default_value_t = ShapeArg::Car)]
+    pub shape: ShapeArg,
+    /// Differential drive: the yaw rate integrated, gyro or odometry.
+    #[arg(long, value_enum, default_value_t = YawArg::Gyro)]
+    pub yaw: YawArg,
     /// What each smoothing pass carries: augmented (car state + the six parameters) or paper (5-state, parameters fixed).
     #[arg(long, default_value = "augmented")]
     pub state: String,
@@ -40,9 +54,18 @@ pub struct CalibrateArgs {
     /// Filter timing: wheel (the paper's, one epoch per wheel row) or each (every reading at its time).
     #[arg(long, default_value = "wheel")]
     pub timing: String,
-    /// Speed below which epochs are dropped for speed-dependent parameters, m/s.
-    #[arg(long, default_value_t = 2.0)]
-    pub min_speed: f64,
+    /// Speed below which epochs (car) or windows (tricycle) are dropped for speed-dependent parameters, m/s (default: 2 for a car, 0.05 for a tricycle).
+    #[arg(long)]
+    pub min_speed: Option<f64>,
+    /// Use only data from this time on, s (drive clock).
+    #[arg(long = "from")]
+    pub from_s: Option<f64>,
+    /// Use only data before this time, s (drive clock).
+    #[arg(long = "until")]
+    pub until_s: Option<f64>,
+    /// Tricycle and differential drive: length of the windows of the fit, s (default 2 for a tricycle, 60 for a differential drive).
+    #[arg(long)]
+    pub window: Option<f64>,
     /// Write the parameters here: a params.toml, or with --format autoware or
     /// eagleye a directory (created if missing).
     #[arg(long)]
@@ -59,7 +82,15 @@ pub struct CalibrateArgs {
 
 /// Runs `calibrate`.
 pub fn run(a: CalibrateArgs) -> Result<()> {
-    let method: Method = a.method.parse()?;
+    kinematic::check_range(a.from_s, a.until_s)?;
+    if kinematic::is_tricycle_log(&a.dir) {
+        return run_tricycle(&a);
+    }
+    if a.shape == ShapeArg::DiffDrive {
+        return run_diff_drive(&a);
+    }
+    let method_name = a.method.clone().unwrap_or_else(|| "rts".into());
+    let method: Method = method_name.parse()?;
     // Only the truth calibration reads truth.csv.
     let read = deadreckon_io::ReadOptions::default();
     let read = if method == Method::Truth {
@@ -68,6 +99,11 @@ pub fn run(a: CalibrateArgs) -> Result<()> {
         read.without_truth()
     };
     let drive = common::load_drive_with(&a.dir, &read)?;
+    let drive = if a.from_s.is_some() || a.until_s.is_some() {
+        drive.time_range(a.from_s, a.until_s)
+    } else {
+        drive
+    };
     let iteration = match a.iteration.as_str() {
         "anderson" => Iteration::Anderson,
         "plain" => Iteration::Plain,
@@ -83,7 +119,9 @@ pub fn run(a: CalibrateArgs) -> Result<()> {
         state,
         iteration,
         max_iterations: a.max_iterations,
-        min_speed_mps: a.min_speed,
+        min_speed_mps: a
+            .min_speed
+            .unwrap_or(Shape::FourWheel.default_min_speed_mps()),
         filter: FilterOptions {
             timing: common::parse_timing(&a.timing)?,
             ..Default::default()
@@ -92,6 +130,30 @@ pub fn run(a: CalibrateArgs) -> Result<()> {
     };
     let c = calibrate::calibrate(&drive, &opts)
         .with_context(|| format!("calibrating {}", a.dir.display()))?;
+    // Parameters no sample above the threshold informed keep their nominal
+    // value: say so instead of reporting them as calibrated.
+    let not_estimated: Vec<(&str, String)> = deadreckon_core::Params::NAMES
+        .iter()
+        .zip(c.samples)
+        .filter(|(_, n)| *n == 0)
+        .map(|(name, _)| {
+            (
+                *name,
+                format!(
+                    "0 samples above the speed threshold {} m/s: nominal kept",
+                    opts.min_speed_mps
+                ),
+            )
+        })
+        .collect();
+    // With the truth, the steering ratio and offset too.
+    let steering = match (method, Reference::from_truth(&drive.truth)) {
+        (Method::Truth, Some(r)) if !drive.steering.is_empty() => Some(
+            calibrate_steering(&drive, &r, opts.min_speed_mps)
+                .context("calibrating the steering")?,
+        ),
+        _ => None,
+    };
     let mut written = Vec::new();
     if let Some(out) = &a.out {
         let export = || deadreckon_io::stack_params::StackExport {
@@ -101,7 +163,7 @@ pub fn run(a: CalibrateArgs) -> Result<()> {
             provenance: format!(
                 "Calibrated on {} with --method {} ({} passes, {}).",
                 a.dir.display(),
-                a.method,
+                method_name,
                 c.iterations,
                 if c.converged {
                     "converged"
@@ -114,9 +176,19 @@ pub fn run(a: CalibrateArgs) -> Result<()> {
         match a.format {
             OutFormat::Params => {
                 let mut extra = toml::Table::new();
-                extra.insert("method".into(), a.method.clone().into());
+                extra.insert("method".into(), method_name.clone().into());
                 extra.insert("iterations".into(), (c.iterations as i64).into());
                 extra.insert("converged".into(), c.converged.into());
+                if !not_estimated.is_empty() {
+                    let t: toml::Table = not_estimated
+                        .iter()
+                        .map(|(k, why)| (k.to_string(), why.clone().into()))
+                        .collect();
+                    extra.insert("not_estimated".into(), t.into());
+                }
+                if let Some(st) = &steering {
+                    extra.insert("steering".into(), steering_toml(st).into());
+                }
                 deadreckon_io::write_params(out, &c.estimate, Some(&extra))
                     .with_context(context)?;
                 written.push(out.clone());
@@ -136,13 +208,33 @@ pub fn run(a: CalibrateArgs) -> Result<()> {
         );
     }
     if a.json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&common::calibration_json(&a.method, &c))?
-        );
+        let mut v = common::calibration_json(&method_name, &c);
+        v["not_estimated"] = not_estimated
+            .iter()
+            .map(|(k, why)| (k.to_string(), serde_json::Value::from(why.clone())))
+            .collect::<serde_json::Map<_, _>>()
+            .into();
+        if let Some(st) = &steering {
+            v["steering"] = serde_json::json!({
+                "ratio": st.ratio, "offset_rad": st.offset, "samples": st.samples, "rms_rad": st.rms_rad,
+            });
+        }
+        println!("{}", serde_json::to_string_pretty(&v)?);
     } else {
         println!("{}", common::params_header());
-        println!("{}", common::params_row(&a.method, &c.estimate));
+        println!("{}", common::params_row(&method_name, &c.estimate));
+        for (k, why) in &not_estimated {
+            println!("{k}: NOT ESTIMATED ({why})");
+        }
+        if let Some(st) = &steering {
+            for p in [&st.ratio, &st.offset] {
+                match (&p.reason, p.std) {
+                    (None, Some(s)) => println!("{}: {:.5} ± {s:.5}", p.name, p.value),
+                    (Some(r), _) => println!("{}: NOT ESTIMATED ({r}), {} kept", p.name, p.value),
+                    (None, None) => println!("{}: {:.5}", p.name, p.value),
+                }
+            }
+        }
         if method == Method::Rts {
             println!(
                 "{} smoothing passes ({} state, {} iteration), {}",
@@ -161,6 +253,92 @@ pub fn run(a: CalibrateArgs) -> Result<()> {
         }
         for w in &written {
             println!("wrote {}", w.display());
+        }
+    }
+    Ok(())
+}
+
+/// The tricycle: the seven kinematic parameters against the tracker.
+fn run_tricycle(a: &CalibrateArgs) -> Result<()> {
+    let method = a.method.as_deref().unwrap_or("truth");
+    anyhow::ensure!(
+        method == "truth",
+        "a tricycle log has no GNSS and no gyro: it is calibrated against its tracker with --method truth (got `{method}`)"
+    );
+    let drive = kinematic::load_tricycle(&a.dir, a.from_s, a.until_s)?;
+    let shape = Shape::Tricycle;
+    let opts = KinematicOptions {
+        window_s: a.window.unwrap_or(2.0),
+        min_speed_mps: a.min_speed.unwrap_or(shape.default_min_speed_mps()),
+        ..Default::default()
+    };
+    let c = kinematics::calibrate(&drive, &opts)
+        .with_context(|| format!("calibrating {}", a.dir.display()))?;
+    if let Some(out) = &a.out {
+        kinematic::write_params(out, shape, method, None, &c)?;
+    }
+    if a.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&kinematic::calibration_json(shape, method, &c))?
+        );
+    } else {
+        kinematic::print_table(&c);
+        if let Some(out) = &a.out {
+            println!("wrote {}", out.display());
+        }
+    }
+    Ok(())
+}
+
+/// The steering calibration as a params.toml table: value, std (when
+/// estimated) and the reason when not.
+fn steering_toml(st: &SteeringCalibration) -> toml::Table {
+    let mut t = toml::Table::new();
+    for p in [&st.ratio, &st.offset] {
+        let mut e = toml::Table::new();
+        e.insert("value".into(), p.value.into());
+        e.insert("estimated".into(), p.estimated.into());
+        if let Some(s) = p.std {
+            e.insert("std".into(), s.into());
+        }
+        if let Some(r) = &p.reason {
+            e.insert("reason".into(), r.clone().into());
+        }
+        t.insert(p.name.clone(), e.into());
+    }
+    t.insert("samples".into(), (st.samples as i64).into());
+    t
+}
+
+/// The differential drive: five parameters against the GNSS fixes.
+fn run_diff_drive(a: &CalibrateArgs) -> Result<()> {
+    let method = a.method.as_deref().unwrap_or("gnss");
+    anyhow::ensure!(
+        method == "gnss",
+        "a differential drive is calibrated against its GNSS fixes with --method gnss (got `{method}`)"
+    );
+    let drive = common::load_drive(&a.dir)?;
+    let dd = kinematic::diff_drive(&drive, a.yaw, a.from_s, a.until_s)?;
+    let shape = Shape::DiffDrive;
+    let opts = DiffDriveOptions {
+        window_s: a.window.unwrap_or(DiffDriveOptions::default().window_s),
+        min_speed_mps: a.min_speed.unwrap_or(shape.default_min_speed_mps()),
+        ..Default::default()
+    };
+    let c = calibrate_diff_drive(&dd, &opts)
+        .with_context(|| format!("calibrating {}", a.dir.display()))?;
+    if let Some(out) = &a.out {
+        kinematic::write_params(out, shape, method, Some(a.yaw.name()), &c)?;
+    }
+    if a.json {
+        let mut v = kinematic::calibration_json(shape, method, &c);
+        v["yaw_source"] = a.yaw.name().into();
+        println!("{}", serde_json::to_string_pretty(&v)?);
+    } else {
+        kinematic::print_table(&c);
+        if let Some(out) = &a.out {
+            println!("wrote {}", out.display());
         }
     }
     Ok(())

@@ -6,6 +6,7 @@ pub mod demo;
 pub mod evaluate;
 pub mod events;
 pub mod import;
+pub mod kinematic;
 pub mod progress;
 pub mod report;
 pub mod run;

@@ -7,10 +7,12 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use clap::Args;
 use deadreckon_core::ekf::FilterOptions;
+use deadreckon_core::kinematics::tricycle::TricycleParams;
+use deadreckon_core::kinematics::Shape;
 use deadreckon_core::{evo, track, Track};
 use deadreckon_io::TrackFormat;
 
-use super::common;
+use super::{common, kinematic};
 
 /// Arguments of `run`.
 #[derive(Args, Debug)]
@@ -121,6 +123,28 @@ pub fn write_tracks(
 /// Runs `run`.
 pub fn run(a: RunArgs) -> Result<()> {
     deadreckon_io::check_not_an_input(&a.out, &a.dir)?;
+    if kinematic::is_tricycle_log(&a.dir) {
+        // The tricycle is dead-reckoned through its own kinematics (the car
+        // filter's wheel and steering observations oscillate at its steering
+        // angles near 1.1 rad), from the first tracker pose.
+        anyhow::ensure!(
+            a.init_pose.is_none(),
+            "a tricycle log starts from its first tracker pose: --init-pose is not used"
+        );
+        let drive = kinematic::load_tricycle(&a.dir, None, None)?;
+        let (p, _) = kinematic::load_params(&a.params, Shape::Tricycle, &drive)?;
+        let params = TricycleParams::from_slice(&p)?;
+        let all = drive.tracks(&params)?;
+        let format = TrackFormat::from_path(&a.out)?;
+        let t = select(&all, &a, format)?;
+        write_tracks(&a.out, format, &t, a.mcap)
+            .with_context(|| format!("writing {}", a.out.display()))?;
+        for tr in &t {
+            println!("{:<14} {:>7} poses", tr.name, tr.points.len());
+        }
+        println!("wrote {}", a.out.display());
+        return Ok(());
+    }
     let drive = common::load_drive(&a.dir)?;
     let params = common::load_params(&a.params, &drive)?;
     let init_pose = match &a.init_pose {

@@ -139,7 +139,8 @@ pub struct Calibration {
     pub iterations: usize,
     /// The least-squares result of every pass, in order (the last is the estimate).
     pub history: Vec<Params>,
-    /// True when the passes settled within the tolerance.
+    /// True when the passes settled within the tolerance (truth: when every
+    /// parameter had samples above the speed threshold).
     pub converged: bool,
     /// Samples used per parameter (in [`Params::to_array`] order).
     pub samples: [usize; 6],
@@ -172,7 +173,9 @@ pub fn calibrate(drive: &Drive, opts: &CalibrationOptions) -> Result<Calibration
                 estimate: est,
                 iterations: 1,
                 history: vec![est.params],
-                converged: true,
+                // A parameter fitted on no sample keeps its nominal value: not
+                // a converged calibration.
+                converged: samples.iter().all(|&n| n > 0),
                 samples,
                 filter_stats: None,
             })

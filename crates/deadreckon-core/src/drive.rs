@@ -150,6 +150,26 @@ pub struct Drive {
 }
 
 impl Drive {
+    /// The part of the drive with `from_s ≤ t < until_s` (drive clock;
+    /// `None`: open), every stream cut alike (wheel ticks are per-epoch
+    /// increments, so the cut is exact).
+    pub fn time_range(&self, from_s: Option<f64>, until_s: Option<f64>) -> Drive {
+        let lo = from_s.unwrap_or(f64::NEG_INFINITY);
+        let hi = until_s.unwrap_or(f64::INFINITY);
+        let keep = |t: f64| t >= lo && t < hi;
+        let mut d = self.clone();
+        match &mut d.wheels {
+            Wheels::Ticks(v) => v.retain(|w| keep(w.t_s)),
+            Wheels::Speeds(v) => v.retain(|w| keep(w.t_s)),
+        }
+        d.yaw_rate.retain(|s| keep(s.t_s));
+        d.speed.retain(|s| keep(s.t_s));
+        d.steering.retain(|s| keep(s.t_s));
+        d.gnss.retain(|g| keep(g.t_s));
+        d.truth.retain(|p| keep(p.t_s));
+        d
+    }
+
     /// An empty drive for `vehicle` with wheel ticks, to be filled by a reader or simulator.
     pub fn empty(vehicle: Vehicle) -> Self {
         Drive {

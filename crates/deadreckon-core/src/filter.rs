@@ -606,6 +606,16 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
 
     /// Eq. (7): one steering-wheel reading, rad, with the prior speed.
     pub fn update_steering(&mut self, steering_wheel_rad: f64) -> Result<Update, Error> {
+        let wheel_angle = steering_wheel_rad / self.sensors.steering_ratio;
+        if wheel_angle.abs() > crate::observation::STEERING_CONSTRAINT_ABOVE_RAD {
+            // Large wheel angles: the constraint form, stable up to ±90°.
+            let (h, row, r) = self.sensors.steering_constraint(
+                &self.car_state(),
+                steering_wheel_rad,
+                self.noise.steering,
+            );
+            return self.scalar(SensorKind::Steering, 0.0, (h, row), r, None);
+        }
         let (z, r) =
             self.sensors
                 .steering_measurement(steering_wheel_rad, self.x[V], self.noise.steering);

@@ -5,7 +5,9 @@
 //! four-wheel car model of Welte, Xu and Bonnifait (ICRA 2019), its extended
 //! Kalman filter and Rauch–Tung–Striebel smoother, the least-squares calibration
 //! of gyro bias, speed scale and wheel circumferences, dead reckoning, and the
-//! papers' evaluation metrics.
+//! papers' evaluation metrics. Other vehicle shapes (a tricycle with a
+//! steered driven wheel, a differential drive) and their kinematic
+//! calibration against a reference live in [`kinematics`].
 //!
 //! ## Conventions
 //!
@@ -28,6 +30,7 @@ pub mod filter;
 pub mod geo;
 pub mod init;
 pub mod kalman;
+pub mod kinematics;
 pub mod metrics;
 pub mod model;
 pub mod observation;

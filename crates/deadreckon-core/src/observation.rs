@@ -40,6 +40,12 @@ pub struct Sensors {
     pub inv_circumference: [f64; 4],
 }
 
+/// Wheel angle above which the filter takes the steering as the constraint
+/// [`Sensors::steering_constraint`] instead of eq. (7)'s pseudo-measurement,
+/// rad (45°: where eq. 7's loop gain tan²δ reaches 1; a car's wheels stay
+/// well below, so its results are those of the paper's form).
+pub const STEERING_CONSTRAINT_ABOVE_RAD: f64 = std::f64::consts::FRAC_PI_4;
+
 impl Sensors {
     /// Builds the models for a vehicle and a parameter set.
     pub fn new(vehicle: &Vehicle, params: &Params) -> Self {
@@ -148,6 +154,34 @@ impl Sensors {
         (z, r)
     }
 
+    /// The steering as a constraint, for large wheel angles: the rear-axle
+    /// velocity and the turn agree with the wheel angle `δ = s / r_s`,
+    /// `h = l_RF·ψ̇·cos δ − v·sin δ = 0`, bounded at every angle (at ±90° it
+    /// says that the rear axle centre stands still). Eq. (7)'s
+    /// pseudo-measurement `v_{k-1}·tan δ` feeds the prior speed back with a
+    /// loop gain of about tan²δ through the front wheel's observation, which
+    /// makes speed and yaw rate alternate in sign and grow beyond 45° (the
+    /// tricycle log steers to 1.1 rad); the filter uses this form there
+    /// ([`STEERING_CONSTRAINT_ABOVE_RAD`]). Returns the model, its row and
+    /// the variance for a wheel-angle error of `beta` rad, scaled by the
+    /// front wheel's rolling speed `l_RF·ψ̇·sin δ + v·cos δ` of the prior
+    /// (floored at 0.1 m/s; at small angles this is eq. 7's `(v·β)²`).
+    pub fn steering_constraint(
+        &self,
+        x: &State,
+        steering_wheel_rad: f64,
+        beta: f64,
+    ) -> (f64, Row, f64) {
+        let (sd, cd) = (steering_wheel_rad / self.steering_ratio).sin_cos();
+        let l = self.wheelbase_m;
+        let mut h = Row::zeros();
+        h[YAW_RATE] = l * cd;
+        h[V] = -sd;
+        let rolling = l * x[YAW_RATE] * sd + x[V] * cd;
+        let r = (rolling.abs().max(0.1) * beta).powi(2);
+        (l * x[YAW_RATE] * cd - x[V] * sd, h, r)
+    }
+
     /// Eq. (10): the GNSS antenna position `[x + l·cos ψ, y + l·sin ψ]` and its Jacobian.
     pub fn gnss(&self, x: &State) -> (nalgebra::Vector2<f64>, nalgebra::SMatrix<f64, 2, 5>) {
         let (s, c) = x[YAW].sin_cos();
@@ -210,6 +244,20 @@ mod tests {
             fd_check(|x| s.gyro(x), &x);
             fd_check(|x| s.can_speed(x), &x);
             fd_check(|x| s.steering(x), &x);
+            for sw in [
+                0.3,
+                8.0,
+                -20.0,
+                s.steering_ratio * std::f64::consts::FRAC_PI_2,
+            ] {
+                fd_check(
+                    |x| {
+                        let (h, row, _) = s.steering_constraint(x, sw, 0.02);
+                        (h, row)
+                    },
+                    &x,
+                );
+            }
             fd_check(|x| s.yaw(x), &x);
             let (_, j) = s.gnss(&x);
             for c in 0..5 {

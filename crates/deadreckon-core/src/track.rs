@@ -34,22 +34,32 @@ pub struct TrackPoint {
     pub speed_mps: f64,
     /// Yaw rate, rad/s.
     pub yaw_rate_rps: f64,
-    /// Covariance of (east, north, yaw): [[ee, en, ey], [ne, nn, ny], [ye, yn, yy]], row-major.
+    /// Covariance of (east, north, yaw): [[ee, en, ey], [ne, nn, ny], [ye, yn, yy]], row-major
+    /// (NaN where unknown: the kinematic dead reckoning of a tricycle carries none).
     pub cov_pose: [f64; 9],
+}
+
+/// The square root of a variance, clamped at zero; unknown (NaN) stays unknown.
+fn std_of(var: f64) -> f64 {
+    if var.is_nan() {
+        var
+    } else {
+        var.max(0.0).sqrt()
+    }
 }
 
 impl TrackPoint {
     /// Standard deviation of the east coordinate, m.
     pub fn std_east_m(&self) -> f64 {
-        self.cov_pose[0].max(0.0).sqrt()
+        std_of(self.cov_pose[0])
     }
     /// Standard deviation of the north coordinate, m.
     pub fn std_north_m(&self) -> f64 {
-        self.cov_pose[4].max(0.0).sqrt()
+        std_of(self.cov_pose[4])
     }
     /// Standard deviation of the yaw, rad.
     pub fn std_yaw_rad(&self) -> f64 {
-        self.cov_pose[8].max(0.0).sqrt()
+        std_of(self.cov_pose[8])
     }
 }
 

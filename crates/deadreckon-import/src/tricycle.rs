@@ -37,6 +37,10 @@
 use std::path::Path;
 
 use deadreckon_core::drive::{Scalar, TruthPose, WheelTicks, Wheels};
+use deadreckon_core::kinematics::tricycle::{
+    TricycleDrive, TricycleGeometry, TricycleParams, TricycleSample,
+};
+use deadreckon_core::kinematics::Pose2;
 use deadreckon_core::vehicle::Noise;
 use deadreckon_core::{Drive, Vehicle};
 
@@ -575,6 +579,109 @@ pub fn tricycle_drive(
         source,
     })?;
     Ok(Import { drive, report })
+}
+
+/// Reads the log at `path` as a tricycle drive for the kinematic model
+/// ([`deadreckon_core::kinematics::tricycle`]): cumulative signed traction
+/// ticks (unwrapped), the steering encoder read as signed counts, and the
+/// tracker pose as the reference of the measured point, as recorded (not
+/// moved to the base: the calibration estimates the mounting). The nominal
+/// parameters are the header's.
+pub fn read_tricycle_kinematic(
+    path: &Path,
+    o: &TricycleOptions,
+) -> Result<TricycleDrive, ImportError> {
+    let log = read_tricycle_log(path)?;
+    tricycle_kinematic(&log, path, o)
+}
+
+/// [`read_tricycle_kinematic`] on a parsed log; `path` names it in errors.
+/// Implausible traction steps and steering readings out of range are errors
+/// (naming the line); time must strictly increase.
+pub fn tricycle_kinematic(
+    log: &TricycleLog,
+    path: &Path,
+    o: &TricycleOptions,
+) -> Result<TricycleDrive, ImportError> {
+    let h = &log.header;
+    let inv = |m: String| ImportError::Invalid {
+        path: path.to_path_buf(),
+        source: deadreckon_core::Error::InvalidDrive(m),
+    };
+    if h.kinematic_model != "traction_drive_wheel" {
+        return Err(inv(format!(
+            "kinematic_model `{}` is not supported (traction_drive_wheel)",
+            h.kinematic_model
+        )));
+    }
+    if !(o.max_speed_mps.is_finite() && o.max_speed_mps > 0.0) {
+        return Err(inv("max_speed_mps must be positive".into()));
+    }
+    let [qx, qy, qz, qw] = h.sensor_rotation_xyzw;
+    let sensor_yaw = (2.0 * (qw * qz + qx * qy)).atan2(1.0 - 2.0 * (qy * qy + qz * qz));
+    let nominal = TricycleParams {
+        ktraction_m: h.ktraction_m,
+        ksteer: h.ksteer,
+        steer_offset_rad: h.steer_offset_rad,
+        axle_length_m: h.axis_length_m,
+        mount: Pose2::new(
+            h.sensor_translation_m[0],
+            h.sensor_translation_m[1],
+            sensor_yaw,
+        ),
+    };
+    let m_per_tick = h.ktraction_m.abs() / f64::from(h.traction_encoder_max);
+    let steer_max = i64::from(h.steering_encoder_max);
+    let mut samples: Vec<TricycleSample> = Vec::with_capacity(log.records.len());
+    let mut prev: Option<(f64, u32)> = None;
+    let mut ticks = 0i64;
+    for r in &log.records {
+        if let Some((pt, pc)) = prev {
+            if r.t_s <= pt {
+                return Err(inv(format!(
+                    "line {}: time {} does not increase (previous {pt})",
+                    r.line, r.t_s
+                )));
+            }
+            let d = tick_delta(pc, r.traction_ticks);
+            let dist = d.unsigned_abs() as f64 * m_per_tick;
+            if dist > o.max_speed_mps * (r.t_s - pt) {
+                return Err(inv(format!(
+                    "line {}: traction counter {pc} -> {} is {d} ticks ({dist:.3} m in {:.3} s, more than {} m/s)",
+                    r.line, r.traction_ticks, r.t_s - pt, o.max_speed_mps
+                )));
+            }
+            ticks += d;
+        }
+        prev = Some((r.t_s, r.traction_ticks));
+        let e = i64::from(r.steering_ticks);
+        if e >= steer_max {
+            return Err(inv(format!(
+                "line {}: steering encoder {e} is outside 0..{steer_max}",
+                r.line
+            )));
+        }
+        let [x, y, th] = r.tracker_pose;
+        samples.push(TricycleSample {
+            t_s: r.t_s,
+            ticks,
+            steer_counts: if 2 * e >= steer_max { e - steer_max } else { e },
+            reference: Some(Pose2::new(x, y, th)),
+        });
+    }
+    let drive = TricycleDrive {
+        geometry: TricycleGeometry {
+            ticks_per_rev: h.traction_encoder_max,
+            steer_counts_per_rev: h.steering_encoder_max,
+        },
+        nominal,
+        samples,
+    };
+    drive.validate().map_err(|source| ImportError::Invalid {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    Ok(drive)
 }
 
 #[cfg(test)]

@@ -3,9 +3,12 @@
 //! Reads and writes the drive directory format of deadreckon (specified in
 //! `docs/drive-format.md`): a directory of CSV files with a header row, one per
 //! sensor stream, plus `vehicle.toml`; and the files around it: calibrated
-//! parameters (`params.toml`, `truth_params.toml`, and the files Autoware and
-//! Eagleye read, [`stack_params`]) and estimated tracks (one CSV, GeoJSON for
-//! maps, one track as TUM or KITTI for trajectory tools such as `evo`). Everything it reads is checked, and every error names
+//! parameters (`params.toml`, `truth_params.toml`; for the kinematic shapes,
+//! tricycle and differential drive, the [`kinematic_toml`] form with a status
+//! and reason per parameter; the files Autoware and Eagleye read,
+//! [`stack_params`]) and estimated tracks (one CSV, GeoJSON for maps, one
+//! track as TUM or KITTI for trajectory tools such as `evo`). Everything it
+//! reads is checked, and every error names
 //! the file, the 1-based line (the header is line 1) and the column.
 //!
 //! ## Conventions
@@ -41,6 +44,8 @@ mod toml_files;
 mod track_out;
 mod track_text;
 mod whole;
+
+pub mod kinematic_toml;
 mod write;
 
 pub mod stack_params;
@@ -50,6 +55,7 @@ pub use atomic::atomic_write;
 /// Latitude/longitude ↔ local east-north (re-exported from `deadreckon-core`).
 pub use deadreckon_core::geo;
 pub use error::IoError;
+pub use kinematic_toml::{read_kinematic_params, write_kinematic_params, KinematicParamsFile};
 pub use read::{read_drive, read_drive_with, ReadOptions, WheelFile};
 pub use toml_files::{
     read_params, read_params_with_extra, read_truth_params, read_vehicle, write_params,

@@ -23,6 +23,10 @@
 //! | steering wheel | r_s · atan(l_RF · κ + β), β white: the noise of eq. 7 on tan(δ/r_s) |
 //! | GNSS | antenna position (lever arm forward of M) + white noise; course and speed from the antenna velocity + white noise |
 //!
+//! Other vehicle shapes: [`tricycle`] simulates a steered, driven front
+//! wheel with steering and traction encoders and an external tracker, through
+//! full-lock turns and reversals.
+//!
 //! Conventions are those of `deadreckon-core`: metres east and north, yaw
 //! counter-clockwise from east, yaw rate counter-clockwise positive, course in
 //! degrees clockwise from north. The route starts at the origin.
@@ -42,6 +46,7 @@ pub mod profile;
 pub mod route;
 pub mod scenario;
 pub mod sensors;
+pub mod tricycle;
 mod truth;
 
 use deadreckon_core::{Drive, Params};

@@ -365,6 +365,22 @@ impl Scenario {
                 ));
             }
         }
+        if let Some(g) = &self.sensors.steering {
+            if let Some(r) = g.true_ratio {
+                if !(r.is_finite() && r > 0.0) {
+                    return Err(invalid(
+                        "sensors.steering.true_ratio",
+                        format!("must be a positive number, got {r}"),
+                    ));
+                }
+            }
+            if !g.wheel_offset_rad.is_finite() {
+                return Err(invalid(
+                    "sensors.steering.wheel_offset_rad",
+                    "must be finite".into(),
+                ));
+            }
+        }
         if let Some(g) = &self.sensors.gnss {
             if g.std_m.is_nan() || g.std_m <= 0.0 {
                 return Err(invalid(

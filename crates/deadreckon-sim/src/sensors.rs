@@ -78,7 +78,7 @@ pub struct ScalarSpec {
 
 /// The steering-wheel stream (`[sensors.steering]`).
 ///
-/// The reading is δ = r_s · atan(l_RF·κ + β) with β white of std `noise_std`:
+/// The reading is δ = r_s · atan(l_RF·κ + β) + offset with β white of std `noise_std`:
 /// exactly the noise model of eq. 7 of the paper, where β is the error on
 /// tan(δ/r_s). For small angles this is a steering-wheel noise of about
 /// `noise_std · r_s` rad.
@@ -92,6 +92,14 @@ pub struct SteeringSpec {
     pub offset_s: f64,
     /// Standard deviation of the error on tan(δ/r_s), unitless (table II: 0.02).
     pub noise_std: f64,
+    /// The true steering ratio r_s (default: the vehicle's nominal one), for
+    /// drives on which the ratio is to be calibrated.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub true_ratio: Option<f64>,
+    /// Steering-wheel angle read when the wheels point straight ahead, rad
+    /// (default 0): the reading is r_s · atan(l_RF·κ + β) + this.
+    #[serde(default)]
+    pub wheel_offset_rad: f64,
 }
 
 /// The GNSS receiver (`[sensors.gnss]`).
@@ -407,7 +415,11 @@ impl Suite {
             nominal_circ: vehicle.wheel_circumference_m,
             ticks_per_rev: f64::from(vehicle.ticks_per_rev),
             params: *params,
-            steering_ratio: vehicle.steering_ratio,
+            steering_ratio: spec
+                .steering
+                .as_ref()
+                .and_then(|g| g.true_ratio)
+                .unwrap_or(vehicle.steering_ratio),
             wheelbase: vehicle.wheelbase_m,
             lever_arm: vehicle.gnss_lever_arm_m,
             clocks,
@@ -453,11 +465,15 @@ impl Suite {
                 self.speed.push(Scalar { t_s, value });
             }
             STEERING => {
-                let std = self.spec.steering.as_ref().map_or(0.0, |g| g.noise_std);
+                let (std, offset) = self
+                    .spec
+                    .steering
+                    .as_ref()
+                    .map_or((0.0, 0.0), |g| (g.noise_std, g.wheel_offset_rad));
                 let tan = self.wheelbase * st.kappa + self.noise[STEERING].gauss(std);
                 self.steering.push(Scalar {
                     t_s,
-                    value: self.steering_ratio * tan.atan(),
+                    value: self.steering_ratio * tan.atan() + offset,
                 });
             }
             GNSS => self.emit_gnss(st),

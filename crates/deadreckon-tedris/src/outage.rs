@@ -11,7 +11,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use deadreckon_core::drive::{Drive, Wheels};
+use deadreckon_core::drive::Drive;
 use deadreckon_core::{Track, TrackPoint};
 
 use crate::config::TedrisConfig;
@@ -123,20 +123,7 @@ fn feed(machine: &mut Tedris, events: &[Event]) -> Vec<Estimate> {
 /// The part of a drive with `from_s ≤ t < until_s` (drive clock; `None`: open),
 /// every stream cut alike (wheel ticks are per-epoch increments, so the cut is exact).
 pub fn time_range(drive: &Drive, from_s: Option<f64>, until_s: Option<f64>) -> Drive {
-    let lo = from_s.unwrap_or(f64::NEG_INFINITY);
-    let hi = until_s.unwrap_or(f64::INFINITY);
-    let keep = |t: f64| t >= lo && t < hi;
-    let mut d = drive.clone();
-    match &mut d.wheels {
-        Wheels::Ticks(v) => v.retain(|w| keep(w.t_s)),
-        Wheels::Speeds(v) => v.retain(|w| keep(w.t_s)),
-    }
-    d.yaw_rate.retain(|s| keep(s.t_s));
-    d.speed.retain(|s| keep(s.t_s));
-    d.steering.retain(|s| keep(s.t_s));
-    d.gnss.retain(|g| keep(g.t_s));
-    d.truth.retain(|p| keep(p.t_s));
-    d
+    drive.time_range(from_s, until_s)
 }
 
 /// Trains a model over a whole drive (GNSS or gyro good throughout).
