@@ -54,7 +54,7 @@ fn drives_of(path: &Path) -> Result<Vec<PathBuf>, FleetError> {
     if found.is_empty() {
         return Err(FleetError::NoDrives {
             path: path.to_path_buf(),
-            note: "not a drive (no vehicle.toml) and no drive directories inside".into(),
+            note: "not a drive (no vehicle.toml) and no drive directories or .bag/.mcap recordings inside (name other recordings, e.g. a tricycle .txt, directly)".into(),
         });
     }
     Ok(found)

@@ -301,6 +301,8 @@ pub fn history_table(histories: &[VehicleHistory]) -> String {
                     "not estimated"
                 } else if c.consistent {
                     "consistent"
+                } else if p.changes.is_empty() {
+                    "INCONSISTENT"
                 } else {
                     "MOVED"
                 },
@@ -327,4 +329,75 @@ pub fn summary_line(results: &[DriveResult], wall_s: f64, threads: usize) -> Str
         threads,
         results.len() as f64 / wall_s.max(1e-9)
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::history::{vehicle_history, HistoryDrive, HistoryOptions};
+
+    fn drives(values: &[f64]) -> Vec<HistoryDrive> {
+        values
+            .iter()
+            .enumerate()
+            .map(|(j, v)| HistoryDrive {
+                path: format!("d{j}").into(),
+                recorded_at: Some(format!("2026-01-0{}", j + 1)),
+                value: [*v; 6],
+                std: [0.01; 6],
+                estimated: [true, true, false, false, false, false],
+            })
+            .collect()
+    }
+
+    #[test]
+    fn verdicts_and_history_rows() {
+        let o = HistoryOptions {
+            alpha: 1e-3,
+            tolerance: [0.0; 6],
+        };
+        // A step: MOVED with the change; alternating values: INCONSISTENT
+        // without a single change.
+        let step = vehicle_history(
+            "a",
+            DriveOrder::RecordedAt,
+            drives(&[1.0, 1.0, 1.0, 1.2, 1.2, 1.2]),
+            0,
+            &o,
+        );
+        let zigzag = vehicle_history(
+            "b",
+            DriveOrder::Path,
+            drives(&[1.0, 1.06, 1.0, 1.06, 1.0, 1.06]),
+            1,
+            &o,
+        );
+        let table = history_table(&[step.clone(), zigzag.clone()]);
+        assert!(
+            table.contains("MOVED      from drive 4 (d3, 2026-01-04): +0.200000 ± 0.008165"),
+            "{table}"
+        );
+        assert!(table.contains("INCONSISTENT -"), "{table}");
+        assert!(
+            table.contains("circumference_fl_m") && table.contains("not estimated"),
+            "{table}"
+        );
+        assert!(
+            table.contains("vehicle b: 6 drives (ordered by path), 1 failed"),
+            "{table}"
+        );
+        let rows = history_rows(&[step, zigzag]);
+        // 7 rows per vehicle, plus one per change (two parameters moved in `a`).
+        assert_eq!(rows.len(), 7 + 2 + 7);
+        assert!(rows.iter().all(|r| r.len() == history_header().len()));
+        let change = &rows[7];
+        assert_eq!(
+            &change[..2],
+            &["a".to_string(), "gyro_bias_rps".to_string()]
+        );
+        assert_eq!(
+            &change[9..12],
+            &["4".to_string(), "d3".to_string(), "2026-01-04".to_string()]
+        );
+    }
 }
