@@ -48,6 +48,8 @@ enum Command {
     Stream(cmd::stream::StreamArgs),
     /// Convert a log (comma2k19, ROS bag, MCAP, CAN + DBC, tricycle) into a drive directory.
     Import(cmd::import::ImportArgs),
+    /// Calibrate many drives in parallel, one CSV row each, and each vehicle's calibration history.
+    Batch(cmd::batch::BatchArgs),
 }
 
 fn main() {
@@ -90,5 +92,6 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Report(a) => cmd::report::run(a, cli.quiet),
         Command::Tedris(c) => cmd::tedris::run(c),
         Command::Import(a) => cmd::import::run(a),
+        Command::Batch(a) => cmd::batch::run(a, cli.quiet),
     }
 }

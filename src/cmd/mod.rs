@@ -1,4 +1,5 @@
 //! One module per subcommand.
+pub mod batch;
 pub mod calibrate;
 pub mod common;
 pub mod compare;

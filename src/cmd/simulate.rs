@@ -43,12 +43,24 @@ pub struct SimulateArgs {
     /// that tracks can be written as GeoJSON.
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     pub origin: Option<Vec<f64>>,
+    /// The vehicle id written to vehicle.toml (drives with one id form a calibration history).
+    #[arg(long)]
+    pub vehicle_id: Option<String>,
+    /// The recording time written to vehicle.toml, UTC: YYYY-MM-DD or YYYY-MM-DDTHH:MM:SS[Z].
+    #[arg(long)]
+    pub recorded_at: Option<String>,
 }
 
 /// Applies the command-line overrides to a scenario.
 fn with_overrides(mut sc: Scenario, a: &SimulateArgs) -> Result<Scenario> {
     if let Some(v) = &a.vehicle {
         sc = sc.with_vehicle(deadreckon_io::read_vehicle(v)?);
+    }
+    if a.vehicle_id.is_some() {
+        sc.vehicle.vehicle_id = a.vehicle_id.clone();
+    }
+    if a.recorded_at.is_some() {
+        sc.vehicle.recorded_at = a.recorded_at.clone();
     }
     let mut e = sc.true_params();
     if let Some(b) = a.gyro_bias {

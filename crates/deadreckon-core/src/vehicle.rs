@@ -140,6 +140,15 @@ pub struct Vehicle {
     /// Noise overrides (defaults: the paper's tables I and II).
     #[serde(default)]
     pub noise: Noise,
+    /// Which physical vehicle recorded the drive (a fleet id, e.g. a plate or
+    /// VIN); drives with the same id form a calibration history.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vehicle_id: Option<String>,
+    /// When the drive was recorded, UTC: `YYYY-MM-DD` or
+    /// `YYYY-MM-DDTHH:MM:SS[.fff][Z]` (orders a vehicle's drives; see
+    /// [`recorded_at_key`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub recorded_at: Option<String>,
 }
 
 impl Vehicle {
@@ -157,6 +166,8 @@ impl Vehicle {
             wheels_present: [true; 4],
             origin: None,
             noise: Noise::default(),
+            vehicle_id: None,
+            recorded_at: None,
         }
     }
 
@@ -194,6 +205,16 @@ impl Vehicle {
             return Err(Error::InvalidVehicle(
                 "gnss_lever_arm_m must be finite".into(),
             ));
+        }
+        if let Some(id) = &self.vehicle_id {
+            if id.trim().is_empty() || id.chars().any(char::is_control) {
+                return Err(Error::InvalidVehicle(format!(
+                    "vehicle_id must be a non-empty name without control characters, got {id:?}"
+                )));
+            }
+        }
+        if let Some(t) = &self.recorded_at {
+            recorded_at_key(t).map_err(Error::InvalidVehicle)?;
         }
         if !self.wheels_present.iter().any(|p| *p) {
             return Err(Error::InvalidVehicle(
@@ -252,6 +273,64 @@ impl Vehicle {
         }
         Ok(())
     }
+}
+
+/// The sort key of a `recorded_at` value (`YYYY-MM-DD` or
+/// `YYYY-MM-DDTHH:MM:SS[.fff][Z]`, UTC): the date-time with a missing time
+/// taken as midnight and the `Z` dropped, so that keys compare as strings in
+/// time order. Anything else (another separator, an offset other than `Z`, a
+/// month 13) is an error saying what was expected.
+pub fn recorded_at_key(t: &str) -> Result<String, String> {
+    let bad = || {
+        format!(
+            "recorded_at must be a UTC date or date-time, YYYY-MM-DD or YYYY-MM-DDTHH:MM:SS[.fff][Z], got {t:?}"
+        )
+    };
+    let body = t.strip_suffix('Z').unwrap_or(t);
+    let (date, time) = match body.split_once('T') {
+        Some((d, tm)) => (d, Some(tm)),
+        None if t.ends_with('Z') => return Err(bad()),
+        None => (body, None),
+    };
+    let num = |s: &str, lo: u32, hi: u32| -> Option<()> {
+        (s.bytes().all(|b| b.is_ascii_digit()) && !s.is_empty())
+            .then(|| s.parse::<u32>().ok())
+            .flatten()
+            .filter(|v| (lo..=hi).contains(v))
+            .map(|_| ())
+    };
+    let d: Vec<&str> = date.split('-').collect();
+    let date_ok = d.len() == 3
+        && d[0].len() == 4
+        && d[1].len() == 2
+        && d[2].len() == 2
+        && num(d[0], 0, 9999).is_some()
+        && num(d[1], 1, 12).is_some()
+        && num(d[2], 1, 31).is_some();
+    if !date_ok {
+        return Err(bad());
+    }
+    let time = match time {
+        None => "00:00:00".to_string(),
+        Some(tm) => {
+            let (hms, frac) = match tm.split_once('.') {
+                Some((a, f)) => (a, Some(f)),
+                None => (tm, None),
+            };
+            let h: Vec<&str> = hms.split(':').collect();
+            let ok = h.len() == 3
+                && h.iter().all(|x| x.len() == 2)
+                && num(h[0], 0, 23).is_some()
+                && num(h[1], 0, 59).is_some()
+                && num(h[2], 0, 60).is_some()
+                && frac.is_none_or(|f| !f.is_empty() && f.bytes().all(|b| b.is_ascii_digit()));
+            if !ok {
+                return Err(bad());
+            }
+            tm.to_string()
+        }
+    };
+    Ok(format!("{date}T{time}"))
 }
 
 /// The six calibrated parameters p of eq. (9), stored as circumferences (the
@@ -356,4 +435,44 @@ pub struct ParamsWithStd {
     pub params: Params,
     /// One standard error for each estimate (same keys).
     pub std: Params,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn recorded_at_keys_sort_in_time_order() {
+        let k = |t: &str| recorded_at_key(t).unwrap();
+        assert_eq!(k("2026-03-01"), "2026-03-01T00:00:00");
+        assert_eq!(k("2026-03-01T08:05:09Z"), "2026-03-01T08:05:09");
+        assert!(k("2026-03-01") < k("2026-03-01T00:00:01"));
+        assert!(k("2026-03-01T09:59:59.5") < k("2026-03-01T10:00:00"));
+        assert!(k("2026-02-28T23:00:00Z") < k("2026-03-01"));
+    }
+
+    #[test]
+    fn bad_recorded_at_and_vehicle_id_are_refused() {
+        for t in [
+            "2026-3-01",
+            "2026-13-01",
+            "01.03.2026",
+            "2026-03-01Z",
+            "2026-03-01T8:00:00",
+            "2026-03-01T08:00:00+01:00",
+            "2026-03-01T08:00:00.",
+            "",
+        ] {
+            let e = recorded_at_key(t).unwrap_err();
+            assert!(e.contains("YYYY-MM-DD"), "{t}: {e}");
+        }
+        let mut v = Vehicle::paper_car();
+        v.recorded_at = Some("yesterday".into());
+        assert!(v.validate().is_err());
+        v.recorded_at = None;
+        v.vehicle_id = Some("  ".into());
+        assert!(v.validate().is_err());
+        v.vehicle_id = Some("car-7".into());
+        v.validate().unwrap();
+    }
 }

@@ -36,6 +36,8 @@ pub fn toyota_rav4() -> Vehicle {
         wheels_present: [true; 4],
         origin: None,
         noise: Noise::default(),
+        vehicle_id: None,
+        recorded_at: None,
     }
 }
 

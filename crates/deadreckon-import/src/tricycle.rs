@@ -415,6 +415,8 @@ pub fn vehicle_from_header(h: &TricycleHeader) -> Vehicle {
         wheels_present: [true, false, false, false],
         origin: None,
         noise: Noise::default(),
+        vehicle_id: None,
+        recorded_at: None,
     }
 }
 

@@ -242,6 +242,8 @@ pub fn differential_vehicle(track_m: f64, wheel_radius_m: f64) -> Vehicle {
         wheels_present: [true; 4],
         origin: None,
         noise: Noise::default(),
+        vehicle_id: None,
+        recorded_at: None,
     }
 }
 

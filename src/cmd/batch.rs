@@ -1,0 +1,185 @@
+//! `deadreckon batch`: calibrate (and evaluate) many drives in parallel, one
+//! CSV row per drive, and each vehicle's calibration history. The work is
+//! `deadreckon_fleet`'s; this parses, reports progress and prints.
+
+use std::io::{IsTerminal, Write};
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use clap::Args;
+use deadreckon_core::calibrate::{CalibrationOptions, Method};
+use deadreckon_core::ekf::FilterOptions;
+use deadreckon_core::Params;
+use deadreckon_fleet::batch::{BatchOptions, OutageOptions};
+use deadreckon_fleet::history::HistoryOptions;
+use deadreckon_fleet::{batch, history, inputs, output};
+use indicatif::{ProgressBar, ProgressStyle};
+
+use super::common;
+
+/// Arguments of `batch`.
+#[derive(Args, Debug)]
+pub struct BatchArgs {
+    /// Drives: drive directories, directories of drive directories, recordings, or glob patterns.
+    #[arg(required = true)]
+    pub inputs: Vec<String>,
+    /// The results CSV, one row per drive (written atomically; must not be an input).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// The calibration history CSV, one row per vehicle and parameter and one per change.
+    #[arg(long)]
+    pub history: Option<PathBuf>,
+    /// Worker threads (0: one per core).
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+    /// rts, zupt or truth (needs truth.csv).
+    #[arg(long, default_value = "rts")]
+    pub method: String,
+    /// Maximum smoothing passes per drive.
+    #[arg(long, default_value_t = 60)]
+    pub max_iterations: usize,
+    /// Filter timing: wheel or each.
+    #[arg(long, default_value = "wheel")]
+    pub timing: String,
+    /// Speed below which epochs are dropped for speed-dependent parameters, m/s.
+    #[arg(long, default_value_t = 2.0)]
+    pub min_speed: f64,
+    /// Also evaluate each drive, with its own parameters, through sliding GNSS outages of this length, s.
+    #[arg(long)]
+    pub outage: Option<f64>,
+    /// Step between outage windows, s (default: half the outage length).
+    #[arg(long)]
+    pub step: Option<f64>,
+    /// GNSS-aided time before the first outage window, s.
+    #[arg(long, default_value_t = 5.0)]
+    pub warmup: f64,
+    /// Significance level of the history's χ² and change-point tests.
+    #[arg(long, default_value_t = 1e-3)]
+    pub alpha: f64,
+    /// Drive-to-drive tolerance of a parameter, NAME=VALUE in its unit (repeatable; defaults in docs/fleet.md).
+    #[arg(long, value_delimiter = ',')]
+    pub tolerance: Vec<String>,
+}
+
+fn history_options(a: &BatchArgs) -> Result<HistoryOptions> {
+    let mut o = HistoryOptions {
+        alpha: a.alpha,
+        ..Default::default()
+    };
+    for t in &a.tolerance {
+        let (name, value) = t
+            .split_once('=')
+            .with_context(|| format!("--tolerance `{t}`: expected NAME=VALUE"))?;
+        let i = Params::NAMES
+            .iter()
+            .position(|n| *n == name.trim())
+            .with_context(|| {
+                format!(
+                    "--tolerance `{t}`: unknown parameter `{name}` (known: {})",
+                    Params::NAMES.join(", ")
+                )
+            })?;
+        o.tolerance[i] = value
+            .trim()
+            .parse()
+            .with_context(|| format!("--tolerance `{t}`: `{value}` is not a number"))?;
+    }
+    o.validate()?;
+    Ok(o)
+}
+
+fn bar(total: usize, quiet: bool) -> Option<ProgressBar> {
+    if quiet || !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let b = ProgressBar::new(total as u64);
+    if let Ok(style) = ProgressStyle::with_template(
+        "{bar:30} {pos}/{len} drives [{elapsed_precise}, eta {eta}] {wide_msg}",
+    ) {
+        b.set_style(style);
+    }
+    Some(b)
+}
+
+/// Runs `batch`.
+pub fn run(a: BatchArgs, quiet: bool) -> Result<()> {
+    let method: Method = a.method.parse()?;
+    let hist_opts = history_options(&a)?;
+    let options = BatchOptions {
+        calibration: CalibrationOptions {
+            method,
+            max_iterations: a.max_iterations,
+            min_speed_mps: a.min_speed,
+            filter: FilterOptions {
+                timing: common::parse_timing(&a.timing)?,
+                ..Default::default()
+            },
+            ..Default::default()
+        },
+        outage: a.outage.map(|len| OutageOptions {
+            length_s: len,
+            step_s: a.step.unwrap_or(len / 2.0),
+            warmup_s: a.warmup,
+        }),
+        threads: a.threads,
+    };
+    batch::validate(&options)?;
+    let drives = inputs::expand(&a.inputs)?;
+    inputs::check_output(&a.out, &drives, "--out")?;
+    if let Some(h) = &a.history {
+        inputs::check_output(h, &drives, "--history")?;
+        inputs::check_distinct(&a.out, h)?;
+    }
+    // Truth is read only where it is used.
+    let read = deadreckon_io::ReadOptions::default();
+    let read = if method == Method::Truth || options.outage.is_some() {
+        read
+    } else {
+        read.without_truth()
+    };
+    let load =
+        |p: &std::path::Path| common::load_drive_with(p, &read).map_err(|e| format!("{e:#}"));
+    let progress = bar(drives.len(), quiet);
+    let start = Instant::now();
+    let results = batch::run(&drives, &load, &options, &|r: &batch::DriveResult| {
+        if let Some(b) = &progress {
+            b.inc(1);
+            b.set_message(r.path.display().to_string());
+        }
+    })?;
+    let wall_s = start.elapsed().as_secs_f64();
+    if let Some(b) = &progress {
+        b.finish_and_clear();
+    }
+    output::write_results(&a.out, &results)?;
+    let histories = history::histories(&results, &hist_opts)?;
+    if let Some(h) = &a.history {
+        output::write_history(h, &histories)?;
+    }
+    let threads = if a.threads == 0 {
+        std::thread::available_parallelism().map_or(1, |n| n.get())
+    } else {
+        a.threads
+    };
+    // Failures on standard error; a closed standard error is no reason to stop.
+    let mut err = std::io::stderr().lock();
+    for r in &results {
+        if let Err(e) = &r.outcome {
+            let _ = writeln!(err, "failed: {}: {e}", r.path.display());
+        }
+    }
+    drop(err);
+    let mut text = output::summary_line(&results, wall_s, threads);
+    text.push_str(&format!("\nwrote {}", a.out.display()));
+    if let Some(h) = &a.history {
+        text.push_str(&format!("\nwrote {}", h.display()));
+    }
+    text.push('\n');
+    if histories.is_empty() {
+        text.push_str("no drive has a vehicle_id in its vehicle.toml: no calibration history\n");
+    } else {
+        text.push_str(&output::history_table(&histories));
+    }
+    common::quiet_on_broken_pipe(std::io::stdout().lock().write_all(text.as_bytes()))
+}
