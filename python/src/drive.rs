@@ -342,11 +342,15 @@ impl Drive {
             Wheels::Ticks(_) => "wheel ticks",
             Wheels::Speeds(_) => "wheel speeds",
         };
+        let n = d.wheels.len();
+        if n == 0 {
+            return format!("<deadreckon.Drive: no {kind}>");
+        }
         format!(
             "<deadreckon.Drive: {} rows of {kind} from {:.3} s to {:.3} s, {} gyro, {} speed, {} steering, {} GNSS, {} truth>",
-            d.wheels.len(),
+            n,
             d.wheels.t_s(0),
-            d.wheels.t_s(d.wheels.len().saturating_sub(1)),
+            d.wheels.t_s(n - 1),
             d.yaw_rate.len(),
             d.speed.len(),
             d.steering.len(),
