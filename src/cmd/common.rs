@@ -3,14 +3,14 @@
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use deadreckon_core::calibrate::Calibration;
 use deadreckon_core::ekf::Timing;
 use deadreckon_core::{Drive, Params, ParamsWithStd};
 
 /// Reads a drive from a drive directory or, directly, from a recording that a
 /// reader understands: a comma2k19 segment directory, a ROS1 `.bag`, a ROS2
-/// `.mcap` (with the built-in mapping) or a rosbag2 directory holding one, or a
-/// tricycle `dataset.txt`.
+/// `.mcap` (with the `--mapping` file or the built-in mapping) or a rosbag2
+/// directory holding one, or a tricycle `dataset.txt`
+/// ([`deadreckon_api::read_drive`]).
 pub fn load_drive(path: &Path) -> Result<Drive> {
     load_drive_with(path, &deadreckon_io::ReadOptions::default())
 }
@@ -50,28 +50,8 @@ pub fn plausible(path: &Path, drive: &Drive) -> Result<()> {
 }
 
 fn read_drive_any(path: &Path, options: &deadreckon_io::ReadOptions) -> Result<Drive> {
-    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
-    if path.is_dir() && !path.join("vehicle.toml").exists() && path.join("processed_log").is_dir() {
-        return deadreckon_import::read_comma2k19(path, None)
-            .with_context(|| format!("reading comma2k19 segment {}", path.display()));
-    }
-    if path.is_dir() && path.join("metadata.yaml").is_file() {
-        return super::load_ros(path);
-    }
-    if path.is_file() {
-        match ext {
-            "bag" | "mcap" => return super::load_ros(path),
-            "txt" => {
-                let o = deadreckon_import::tricycle::TricycleOptions::default();
-                return Ok(deadreckon_import::tricycle::read_tricycle(path, &o)
-                    .with_context(|| format!("reading tricycle log {}", path.display()))?
-                    .drive);
-            }
-            _ => anyhow::bail!("{}: not a drive directory and not a recording this tool reads (.bag, .mcap, comma2k19 segment, tricycle .txt)", path.display()),
-        }
-    }
-    deadreckon_io::read_drive_with(path, options)
-        .with_context(|| format!("reading drive {}", path.display()))
+    let mapping = super::ROS_MAPPING.get().map(|m| m.as_path());
+    Ok(deadreckon_api::read_drive_with(path, options, mapping)?)
 }
 
 /// `--params nominal` or a `params.toml` path.
@@ -103,11 +83,7 @@ pub fn quiet_on_broken_pipe(r: std::io::Result<()>) -> Result<()> {
 
 /// Parses `--timing`.
 pub fn parse_timing(s: &str) -> Result<Timing> {
-    match s {
-        "wheel" => Ok(Timing::WheelEpochs),
-        "each" => Ok(Timing::EachMeasurement),
-        _ => anyhow::bail!("unknown timing `{s}` (wheel, each)"),
-    }
+    Ok(deadreckon_api::options::parse_timing(s)?)
 }
 
 /// The header of a table-III-like parameter table.
@@ -141,53 +117,7 @@ pub fn params_row(name: &str, p: &ParamsWithStd) -> String {
     )
 }
 
-/// The `calibrate --json` object: the six parameters, `std`, `iterations`, and more.
-pub fn calibration_json(method: &str, c: &Calibration) -> serde_json::Value {
-    let mut m = serde_json::Map::new();
-    let a = c.estimate.params.to_array();
-    let s = c.estimate.std.to_array();
-    let mut std = serde_json::Map::new();
-    for (i, name) in Params::NAMES.iter().enumerate() {
-        m.insert((*name).into(), a[i].into());
-        std.insert((*name).into(), s[i].into());
-    }
-    m.insert("std".into(), std.into());
-    m.insert("iterations".into(), c.iterations.into());
-    m.insert("converged".into(), c.converged.into());
-    m.insert("method".into(), method.into());
-    m.insert("samples".into(), serde_json::json!(c.samples));
-    m.insert(
-        "history".into(),
-        c.history
-            .iter()
-            .map(|p| serde_json::json!(p.to_array()))
-            .collect::<Vec<_>>()
-            .into(),
-    );
-    if let Some(st) = &c.filter_stats {
-        m.insert(
-            "gnss".into(),
-            serde_json::json!({"used": st.gnss_updates, "rejected": st.gnss_rejected, "recoveries": st.gnss_recoveries, "hidden": st.gnss_hidden}),
-        );
-        m.insert("wheel_gaps".into(), st.wheel_gaps.into());
-        m.insert("gates".into(), gates_json(&st.gates));
-    }
-    serde_json::Value::Object(m)
-}
-
-/// The per-sensor χ² gate counters as JSON: `{sensor: {accepted, rejected, recovered}}`.
-pub fn gates_json(g: &deadreckon_core::filter::GateCounts) -> serde_json::Value {
-    g.rows()
-        .into_iter()
-        .map(|(name, a, r, rec)| {
-            (
-                name.to_string(),
-                serde_json::json!({"accepted": a, "rejected": r, "recovered": rec}),
-            )
-        })
-        .collect::<serde_json::Map<_, _>>()
-        .into()
-}
+pub use deadreckon_api::json::{calibration_json, gates_json};
 
 /// A one-line account of what the filter used and gated.
 pub fn stats_line(st: &deadreckon_core::ekf::FilterStats) -> String {

@@ -11,7 +11,6 @@ use deadreckon_core::ekf::FilterOptions;
 use deadreckon_core::metrics::{self, Summary};
 use deadreckon_core::outage;
 use deadreckon_core::{evo, track};
-use serde_json::json;
 
 use deadreckon_core::kinematics::diff_drive::{self, evaluate_diff_drive, DiffDriveDrive};
 use deadreckon_core::kinematics::{self, KinematicOptions, Shape};
@@ -85,10 +84,6 @@ pub struct EvaluateArgs {
     pub until_s: Option<f64>,
 }
 
-fn summary_json(s: &Summary) -> serde_json::Value {
-    json!({"mean": s.mean, "median": s.median, "p95": s.p95, "min": s.min, "max": s.max, "std": s.std, "n": s.n})
-}
-
 /// Runs `evaluate`.
 pub fn run(a: EvaluateArgs) -> Result<()> {
     kinematic::check_range(a.from_s, a.until_s)?;
@@ -128,17 +123,7 @@ pub fn run(a: EvaluateArgs) -> Result<()> {
         )?;
         let (fe, dr, d1) = (ev.final_error(), ev.drift_pct(), ev.distance_to_1m());
         if a.json {
-            let v = json!({
-                "outage_s": len,
-                "windows": ev.windows.len(),
-                "reference": ev.reference.name(),
-                "params": source,
-                "final_error_m": summary_json(&fe),
-                "drift_pct": summary_json(&dr),
-                "distance_to_1m_m": summary_json(&d1),
-                "windows_reaching_1m": ev.windows.iter().filter(|w| w.reached_1m).count(),
-                "gates": common::gates_json(&ev.gates),
-            });
+            let v = deadreckon_api::json::outage_json(len, &source, &ev);
             println!("{}", serde_json::to_string_pretty(&v)?);
         } else {
             println!(
@@ -173,8 +158,7 @@ pub fn run(a: EvaluateArgs) -> Result<()> {
             let r = metrics::drift(&drive, &params, a.segment_m, timing)?;
             let s = Summary::of(&r.errors_pct());
             if a.json {
-                let v = json!({"metric": "drift", "mean_pct": s.mean, "std_pct": s.std, "n": s.n,
-                    "median_pct": s.median, "p95_pct": s.p95, "max_pct": s.max, "segment_m": a.segment_m, "errors_m": r.errors_m, "gates": common::gates_json(&r.gates)});
+                let v = deadreckon_api::json::drift_json(&r, a.segment_m);
                 println!("{}", serde_json::to_string_pretty(&v)?);
             } else {
                 println!("drift per {} m over {} segments: mean {:.3}%, std {:.3}%, median {:.3}%, max {:.3}%", a.segment_m, s.n, s.mean, s.std, s.median, s.max);
@@ -185,8 +169,7 @@ pub fn run(a: EvaluateArgs) -> Result<()> {
             let r = metrics::reset_on_error(&drive, &params, a.threshold_m, timing)?;
             let s = Summary::of(&r.distances_m);
             if a.json {
-                let v = json!({"metric": "reset-1m", "mean_m": s.mean, "median_m": s.median, "min_m": s.min, "max_m": s.max, "n": s.n,
-                    "threshold_m": a.threshold_m, "distances_m": r.distances_m, "gates": common::gates_json(&r.gates)});
+                let v = deadreckon_api::json::reset_json(&r, a.threshold_m);
                 println!("{}", serde_json::to_string_pretty(&v)?);
             } else {
                 println!(
@@ -225,22 +208,15 @@ pub fn run(a: EvaluateArgs) -> Result<()> {
             }
             .with_context(|| format!("{} of `{}` against `{}`", a.metric, a.track, a.reference))?;
             if a.json {
-                let mut v = json!({
-                    "metric": a.metric,
-                    "track": a.track,
-                    "reference": a.reference,
-                    "matched": r.matched,
-                    "n": r.errors_m.len(),
-                    "stats_m": r.stats,
-                    "errors_m": r.errors_m,
-                    "t_s": r.t_s,
-                    "evo_version": evo::EVO_VERSION,
-                    "max_diff_s": a.max_diff_s,
-                });
-                if a.metric == "rpe" {
-                    v["delta_m"] = json!(a.delta_m);
-                    v["pairs_from"] = json!(a.pairs_from);
-                }
+                let q = deadreckon_api::json::EvoQuery {
+                    metric: &a.metric,
+                    track: &a.track,
+                    reference: &a.reference,
+                    max_diff_s: a.max_diff_s,
+                    delta_m: a.delta_m,
+                    pairs_from: &a.pairs_from,
+                };
+                let v = deadreckon_api::json::evo_json(&q, &r);
                 println!("{}", serde_json::to_string_pretty(&v)?);
             } else {
                 let what = if a.metric == "rpe" {

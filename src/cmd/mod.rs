@@ -22,30 +22,11 @@ pub static ROS_MAPPING: std::sync::OnceLock<std::path::PathBuf> = std::sync::Onc
 pub static SKIP_CHECKS: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
 
 /// Reads a ROS1 bag or ROS2 MCAP recording with the `--mapping` file, or the
-/// built-in mapping (Husky, or Jackal when the file name says so).
-pub fn load_ros(path: &std::path::Path) -> anyhow::Result<deadreckon_core::Drive> {
-    Ok(load_ros_with_report(path)?.0)
-}
-
-/// [`load_ros`] with the reader's report of what was used, dropped and counted.
+/// built-in mapping (Husky, or Jackal when the file name says so), with the
+/// reader's report of what was used, dropped and counted.
 pub fn load_ros_with_report(
     path: &std::path::Path,
 ) -> anyhow::Result<(deadreckon_core::Drive, deadreckon_ros::ImportReport)> {
-    use anyhow::Context;
-    let mapping = match ROS_MAPPING.get() {
-        Some(m) => {
-            let text = std::fs::read_to_string(m)
-                .with_context(|| format!("reading mapping {}", m.display()))?;
-            deadreckon_ros::Mapping::from_toml_str(&text)
-                .with_context(|| format!("mapping {}", m.display()))?
-        }
-        None if path
-            .file_name()
-            .is_some_and(|n| n.to_string_lossy().contains("jackal")) =>
-        {
-            deadreckon_ros::Mapping::jackal()
-        }
-        None => deadreckon_ros::Mapping::husky(),
-    };
-    deadreckon_ros::read_log(path, &mapping).with_context(|| format!("reading {}", path.display()))
+    let mapping = ROS_MAPPING.get().map(|m| m.as_path());
+    Ok(deadreckon_api::read_ros(path, mapping)?)
 }

@@ -209,7 +209,12 @@ pub fn run(c: TedrisCommand) -> Result<()> {
             let text = serde_json::to_string_pretty(&m)?;
             std::fs::write(&out, text).with_context(|| format!("writing {}", out.display()))?;
             if json {
-                println!("{}", serde_json::to_string_pretty(&train_json(&m, source))?);
+                println!(
+                    "{}",
+                    serde_json::to_string_pretty(&deadreckon_api::json::tedris_train_json(
+                        &m, source
+                    ))?
+                );
             } else {
                 print_train(&m, source);
                 println!("model written to {}", out.display());
@@ -298,34 +303,6 @@ pub fn run(c: TedrisCommand) -> Result<()> {
             Ok(())
         }
     }
-}
-
-fn train_json(m: &TedrisModel, source: ReferenceSource) -> serde_json::Value {
-    let s = m.straight();
-    serde_json::json!({
-        "source": source,
-        "chosen": m.chosen.name(),
-        "lag_samples": m.lag_samples,
-        "tau_samples": m.config.tau_samples,
-        "sample_period_s": m.sample_period_s,
-        "mu_m": s.mu_m,
-        "w_low_m": s.w_low_m,
-        "w_high_m": s.w_high_m,
-        "epsilon_m": s.epsilon_m,
-        "dcf0_rad": m.dcf0_rad,
-        // Not a parameter of the per-metre form (no heading per sample).
-        "dcf_rad": (!m.per_metre_straight).then_some(m.dcf_rad),
-        // Estimated by the joint calibration only (the extended variant):
-        // otherwise not estimated, not a nominal value.
-        "dcf_distance_rad_per_m": m.config.joint_calibration().then_some(m.dcf_distance_rad_per_m),
-        "gyro_bias": m.gyro_bias,
-        "turn_gain": m.config.turn_gain().then_some(m.turn_gain),
-        "per_metre_straight": m.per_metre_straight,
-        "course_convention": m.course_convention,
-        "complete": m.complete,
-        "fill": m.repositories.fill(m.config.required_bins),
-        "fits": m.fits,
-    })
 }
 
 fn print_train(m: &TedrisModel, source: ReferenceSource) {

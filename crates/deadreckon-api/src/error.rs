@@ -1,0 +1,107 @@
+//! The crate's error type.
+
+use std::path::PathBuf;
+
+/// What went wrong, and where. The `Display` of each variant is the context
+/// (which file, doing what); the cause is its `source`.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// A drive directory could not be read.
+    #[error("reading drive {}", path.display())]
+    Drive {
+        /// The directory.
+        path: PathBuf,
+        /// The reader's error (file, line, column).
+        #[source]
+        source: deadreckon_io::IoError,
+    },
+    /// A comma2k19 segment could not be read.
+    #[error("reading comma2k19 segment {}", path.display())]
+    Comma2k19 {
+        /// The segment directory.
+        path: PathBuf,
+        /// The reader's error.
+        #[source]
+        source: deadreckon_import::ImportError,
+    },
+    /// A tricycle log could not be read.
+    #[error("reading tricycle log {}", path.display())]
+    Tricycle {
+        /// The log file.
+        path: PathBuf,
+        /// The reader's error.
+        #[source]
+        source: deadreckon_import::ImportError,
+    },
+    /// A topic mapping file could not be read.
+    #[error("reading mapping {}", path.display())]
+    MappingFile {
+        /// The mapping file.
+        path: PathBuf,
+        /// The I/O error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// A topic mapping file is not a valid mapping.
+    #[error("mapping {}", path.display())]
+    Mapping {
+        /// The mapping file.
+        path: PathBuf,
+        /// The parser's error.
+        #[source]
+        source: deadreckon_ros::RosError,
+    },
+    /// A ROS bag or MCAP file could not be read.
+    #[error("reading {}", path.display())]
+    Ros {
+        /// The recording.
+        path: PathBuf,
+        /// The reader's error.
+        #[source]
+        source: deadreckon_ros::RosError,
+    },
+    /// The path is none of the sources the tool reads.
+    #[error("{}: not a drive directory and not a recording this tool reads (.bag, .mcap, comma2k19 segment, tricycle .txt)", path.display())]
+    Unrecognised {
+        /// The path.
+        path: PathBuf,
+    },
+    /// An option word is not one of those allowed.
+    #[error("unknown {what} `{value}` ({allowed})")]
+    UnknownOption {
+        /// The option (`timing`, `pass state`, ...).
+        what: &'static str,
+        /// The word given.
+        value: String,
+        /// The words allowed, comma-separated.
+        allowed: &'static str,
+    },
+}
+
+/// An error and its sources as one line, `outer: inner: ...`: the form
+/// `anyhow` prints with `{:#}` (the command line's `error:` lines).
+pub fn chain_text(e: &(dyn std::error::Error + 'static)) -> String {
+    let mut text = e.to_string();
+    let mut cur = e.source();
+    while let Some(s) = cur {
+        text.push_str(": ");
+        text.push_str(&s.to_string());
+        cur = s.source();
+    }
+    text
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn chain_text_joins_the_sources_like_anyhow() {
+        let e = Error::MappingFile {
+            path: "m.toml".into(),
+            source: std::io::Error::new(std::io::ErrorKind::NotFound, "gone"),
+        };
+        assert_eq!(chain_text(&e), "reading mapping m.toml: gone");
+    }
+}

@@ -1,0 +1,163 @@
+//! The objects the commands print with `--json`, built from library results.
+//! The command line prints them; the Python bindings return them as dicts.
+
+use deadreckon_core::calibrate::Calibration;
+use deadreckon_core::evo::{self, TrajectoryError};
+use deadreckon_core::filter::GateCounts;
+use deadreckon_core::metrics::{DriftResult, ResetResult, Summary};
+use deadreckon_core::outage::OutageEvaluation;
+use deadreckon_core::Params;
+use deadreckon_tedris::{ReferenceSource, TedrisModel};
+use serde_json::{json, Value};
+
+/// The `calibrate --json` object: the six parameters, `std`, `iterations`,
+/// `converged`, `method` (the word given), `samples`, `history` and, when the
+/// filter ran, `gnss`, `wheel_gaps` and `gates`.
+pub fn calibration_json(method: &str, c: &Calibration) -> Value {
+    let mut m = serde_json::Map::new();
+    let a = c.estimate.params.to_array();
+    let s = c.estimate.std.to_array();
+    let mut std = serde_json::Map::new();
+    for (i, name) in Params::NAMES.iter().enumerate() {
+        m.insert((*name).into(), a[i].into());
+        std.insert((*name).into(), s[i].into());
+    }
+    m.insert("std".into(), std.into());
+    m.insert("iterations".into(), c.iterations.into());
+    m.insert("converged".into(), c.converged.into());
+    m.insert("method".into(), method.into());
+    m.insert("samples".into(), json!(c.samples));
+    m.insert(
+        "history".into(),
+        c.history
+            .iter()
+            .map(|p| json!(p.to_array()))
+            .collect::<Vec<_>>()
+            .into(),
+    );
+    if let Some(st) = &c.filter_stats {
+        m.insert(
+            "gnss".into(),
+            json!({"used": st.gnss_updates, "rejected": st.gnss_rejected, "recoveries": st.gnss_recoveries, "hidden": st.gnss_hidden}),
+        );
+        m.insert("wheel_gaps".into(), st.wheel_gaps.into());
+        m.insert("gates".into(), gates_json(&st.gates));
+    }
+    Value::Object(m)
+}
+
+/// The per-sensor χ² gate counters: `{sensor: {accepted, rejected, recovered}}`.
+pub fn gates_json(g: &GateCounts) -> Value {
+    g.rows()
+        .into_iter()
+        .map(|(name, a, r, rec)| {
+            (
+                name.to_string(),
+                json!({"accepted": a, "rejected": r, "recovered": rec}),
+            )
+        })
+        .collect::<serde_json::Map<_, _>>()
+        .into()
+}
+
+/// A summary of values: mean, median, p95, min, max, std, n.
+pub fn summary_json(s: &Summary) -> Value {
+    json!({"mean": s.mean, "median": s.median, "p95": s.p95, "min": s.min, "max": s.max, "std": s.std, "n": s.n})
+}
+
+/// `evaluate --outage LEN --json`: sliding outages of `outage_s` with the
+/// parameters from `params` (their source, as printed).
+pub fn outage_json(outage_s: f64, params: &str, ev: &OutageEvaluation) -> Value {
+    json!({
+        "outage_s": outage_s,
+        "windows": ev.windows.len(),
+        "reference": ev.reference.name(),
+        "params": params,
+        "final_error_m": summary_json(&ev.final_error()),
+        "drift_pct": summary_json(&ev.drift_pct()),
+        "distance_to_1m_m": summary_json(&ev.distance_to_1m()),
+        "windows_reaching_1m": ev.windows.iter().filter(|w| w.reached_1m).count(),
+        "gates": gates_json(&ev.gates),
+    })
+}
+
+/// `evaluate --metric drift --json`, segments of `segment_m`.
+pub fn drift_json(r: &DriftResult, segment_m: f64) -> Value {
+    let s = Summary::of(&r.errors_pct());
+    json!({"metric": "drift", "mean_pct": s.mean, "std_pct": s.std, "n": s.n,
+        "median_pct": s.median, "p95_pct": s.p95, "max_pct": s.max, "segment_m": segment_m, "errors_m": r.errors_m, "gates": gates_json(&r.gates)})
+}
+
+/// `evaluate --metric reset-1m --json`, resets at `threshold_m`.
+pub fn reset_json(r: &ResetResult, threshold_m: f64) -> Value {
+    let s = Summary::of(&r.distances_m);
+    json!({"metric": "reset-1m", "mean_m": s.mean, "median_m": s.median, "min_m": s.min, "max_m": s.max, "n": s.n,
+        "threshold_m": threshold_m, "distances_m": r.distances_m, "gates": gates_json(&r.gates)})
+}
+
+/// What an `evaluate --metric rpe|ape` asked for, to print beside the result.
+#[derive(Debug, Clone, Copy)]
+pub struct EvoQuery<'a> {
+    /// `rpe` or `ape`.
+    pub metric: &'a str,
+    /// The estimated track's name.
+    pub track: &'a str,
+    /// The reference track's name.
+    pub reference: &'a str,
+    /// Largest time difference of associated poses, s.
+    pub max_diff_s: f64,
+    /// RPE: path length between the poses of a pair, m.
+    pub delta_m: f64,
+    /// RPE: `estimate` or `reference`.
+    pub pairs_from: &'a str,
+}
+
+/// `evaluate --metric rpe|ape --json`.
+pub fn evo_json(q: &EvoQuery<'_>, r: &TrajectoryError) -> Value {
+    let mut v = json!({
+        "metric": q.metric,
+        "track": q.track,
+        "reference": q.reference,
+        "matched": r.matched,
+        "n": r.errors_m.len(),
+        "stats_m": r.stats,
+        "errors_m": r.errors_m,
+        "t_s": r.t_s,
+        "evo_version": evo::EVO_VERSION,
+        "max_diff_s": q.max_diff_s,
+    });
+    if q.metric == "rpe" {
+        v["delta_m"] = json!(q.delta_m);
+        v["pairs_from"] = json!(q.pairs_from);
+    }
+    v
+}
+
+/// `tedris train --json`: the trained model's summary.
+pub fn tedris_train_json(m: &TedrisModel, source: ReferenceSource) -> Value {
+    let s = m.straight();
+    json!({
+        "source": source,
+        "chosen": m.chosen.name(),
+        "lag_samples": m.lag_samples,
+        "tau_samples": m.config.tau_samples,
+        "sample_period_s": m.sample_period_s,
+        "mu_m": s.mu_m,
+        "w_low_m": s.w_low_m,
+        "w_high_m": s.w_high_m,
+        "epsilon_m": s.epsilon_m,
+        "dcf0_rad": m.dcf0_rad,
+        // Not a parameter of the per-metre form (no heading per sample).
+        "dcf_rad": (!m.per_metre_straight).then_some(m.dcf_rad),
+        // Estimated by the joint calibration only (the extended variant):
+        // otherwise not estimated, not a nominal value.
+        "dcf_distance_rad_per_m": m.config.joint_calibration().then_some(m.dcf_distance_rad_per_m),
+        "gyro_bias": m.gyro_bias,
+        "turn_gain": m.config.turn_gain().then_some(m.turn_gain),
+        "per_metre_straight": m.per_metre_straight,
+        "course_convention": m.course_convention,
+        "complete": m.complete,
+        "fill": m.repositories.fill(m.config.required_bins),
+        "fits": m.fits,
+    })
+}

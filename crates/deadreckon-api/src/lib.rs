@@ -1,0 +1,28 @@
+//! # deadreckon-api
+//!
+//! The operations the `deadreckon` command line and the Python bindings
+//! (`python/`) share, so both read the same sources and print the same
+//! numbers under the same keys:
+//!
+//! - [`source`]: a drive from any source the tool reads: a drive directory
+//!   (`deadreckon-io`), a comma2k19 segment, a ROS1 bag or ROS2 MCAP (with a
+//!   topic mapping) or a tricycle log, chosen by what the path holds; errors
+//!   name the file and, through their sources, the line and column.
+//! - [`json`]: the objects `calibrate --json`, `evaluate --json` and
+//!   `tedris train --json` print, built from the library results.
+//! - [`options`]: the option words of the commands (`--timing wheel|each`,
+//!   `--state`, `--iteration`) parsed into the library's enums.
+//!
+//! The one error type is [`Error`]; its `Display` is the context the command
+//! line adds ("reading drive DIR") and its `source` chain carries the reader's
+//! file/line message, so `{:#}` of an `anyhow` error and the Python
+//! exception's text read the same.
+#![deny(missing_docs)]
+
+pub mod json;
+pub mod options;
+pub mod source;
+
+mod error;
+pub use error::{chain_text, Error};
+pub use source::{read_drive, read_drive_with, read_ros};

@@ -1,0 +1,57 @@
+//! The commands' option words parsed into the library's enums.
+
+use deadreckon_core::calibrate::{Iteration, PassState};
+use deadreckon_core::ekf::Timing;
+
+use crate::Error;
+
+/// `--timing`: `wheel` (the paper's, one epoch per wheel row) or `each`.
+pub fn parse_timing(s: &str) -> Result<Timing, Error> {
+    match s {
+        "wheel" => Ok(Timing::WheelEpochs),
+        "each" => Ok(Timing::EachMeasurement),
+        _ => Err(unknown("timing", s, "wheel, each")),
+    }
+}
+
+/// `calibrate --iteration`: `anderson` or `plain`.
+pub fn parse_iteration(s: &str) -> Result<Iteration, Error> {
+    match s {
+        "anderson" => Ok(Iteration::Anderson),
+        "plain" => Ok(Iteration::Plain),
+        _ => Err(unknown("iteration", s, "anderson, plain")),
+    }
+}
+
+/// `calibrate --state`: `augmented` or `paper`.
+pub fn parse_pass_state(s: &str) -> Result<PassState, Error> {
+    match s {
+        "augmented" => Ok(PassState::Augmented),
+        "paper" => Ok(PassState::Paper),
+        _ => Err(unknown("pass state", s, "augmented, paper")),
+    }
+}
+
+fn unknown(what: &'static str, value: &str, allowed: &'static str) -> Error {
+    Error::UnknownOption {
+        what,
+        value: value.to_string(),
+        allowed,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn words_parse_and_unknown_words_say_what_is_allowed() {
+        assert_eq!(parse_timing("each").unwrap(), Timing::EachMeasurement);
+        assert_eq!(parse_iteration("plain").unwrap(), Iteration::Plain);
+        assert_eq!(parse_pass_state("paper").unwrap(), PassState::Paper);
+        assert_eq!(
+            parse_timing("every").unwrap_err().to_string(),
+            "unknown timing `every` (wheel, each)"
+        );
+    }
+}

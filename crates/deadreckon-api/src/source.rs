@@ -1,0 +1,114 @@
+//! A drive from any source the tool reads, chosen by what the path holds.
+
+use std::path::Path;
+
+use deadreckon_core::Drive;
+
+use crate::Error;
+
+/// Reads a drive from a drive directory or, directly, from a recording that a
+/// reader understands: a comma2k19 segment directory, a ROS1 `.bag`, a ROS2
+/// `.mcap` (with `mapping`, a topic-mapping TOML file, or the built-in Husky
+/// or Jackal mapping) or a tricycle `dataset.txt`.
+pub fn read_drive(path: &Path, mapping: Option<&Path>) -> Result<Drive, Error> {
+    read_drive_with(path, &deadreckon_io::ReadOptions::default(), mapping)
+}
+
+/// [`read_drive`] with reading options for drive directories (recordings are
+/// read whole).
+pub fn read_drive_with(
+    path: &Path,
+    options: &deadreckon_io::ReadOptions,
+    mapping: Option<&Path>,
+) -> Result<Drive, Error> {
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+    if path.is_dir() && !path.join("vehicle.toml").exists() && path.join("processed_log").is_dir() {
+        return deadreckon_import::read_comma2k19(path, None).map_err(|source| Error::Comma2k19 {
+            path: path.to_path_buf(),
+            source,
+        });
+    }
+    // A rosbag2 directory: read through its one .mcap file.
+    if path.is_dir() && path.join("metadata.yaml").is_file() {
+        return Ok(read_ros(path, mapping)?.0);
+    }
+    if path.is_file() {
+        return match ext {
+            "bag" | "mcap" => Ok(read_ros(path, mapping)?.0),
+            "txt" => {
+                let o = deadreckon_import::tricycle::TricycleOptions::default();
+                Ok(deadreckon_import::tricycle::read_tricycle(path, &o)
+                    .map_err(|source| Error::Tricycle {
+                        path: path.to_path_buf(),
+                        source,
+                    })?
+                    .drive)
+            }
+            _ => Err(Error::Unrecognised {
+                path: path.to_path_buf(),
+            }),
+        };
+    }
+    deadreckon_io::read_drive_with(path, options).map_err(|source| Error::Drive {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// Reads a ROS1 bag or ROS2 MCAP recording with the `mapping` file, or the
+/// built-in mapping (Jackal when the file name says so, else Husky), with the
+/// reader's report of what was used, dropped and counted.
+pub fn read_ros(
+    path: &Path,
+    mapping: Option<&Path>,
+) -> Result<(Drive, deadreckon_ros::ImportReport), Error> {
+    let mapping = match mapping {
+        Some(m) => {
+            let text = std::fs::read_to_string(m).map_err(|source| Error::MappingFile {
+                path: m.to_path_buf(),
+                source,
+            })?;
+            deadreckon_ros::Mapping::from_toml_str(&text).map_err(|source| Error::Mapping {
+                path: m.to_path_buf(),
+                source,
+            })?
+        }
+        None if path
+            .file_name()
+            .is_some_and(|n| n.to_string_lossy().contains("jackal")) =>
+        {
+            deadreckon_ros::Mapping::jackal()
+        }
+        None => deadreckon_ros::Mapping::husky(),
+    };
+    deadreckon_ros::read_log(path, &mapping).map_err(|source| Error::Ros {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_unknown_file_is_refused_naming_it() {
+        let dir = tempfile::tempdir().unwrap();
+        let f = dir.path().join("x.csv");
+        std::fs::write(&f, "t_s\n").unwrap();
+        let e = read_drive(&f, None).unwrap_err();
+        assert!(matches!(e, Error::Unrecognised { .. }));
+        assert!(e
+            .to_string()
+            .starts_with(&format!("{}: not a drive", f.display())));
+    }
+
+    #[test]
+    fn a_missing_vehicle_toml_names_the_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let e = read_drive(dir.path(), None).unwrap_err();
+        let text = crate::chain_text(&e);
+        assert!(text.starts_with("reading drive "), "{text}");
+        assert!(text.contains("vehicle.toml"), "{text}");
+    }
+}

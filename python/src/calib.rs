@@ -1,0 +1,288 @@
+//! `calibrate`, `run` and `evaluate`: the commands' computations and their
+//! `--json` objects (built by `deadreckon_api::json`, as the CLI prints them).
+
+use std::path::PathBuf;
+
+use deadreckon_api::json;
+use deadreckon_api::options::{parse_iteration, parse_pass_state, parse_timing};
+use deadreckon_core::calibrate::{self as core_calibrate, CalibrationOptions, Method};
+use deadreckon_core::ekf::FilterOptions;
+use deadreckon_core::metrics;
+use deadreckon_core::{evo, outage, track, Params};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::columns::ColumnsOut;
+use crate::drive::drive_arg;
+use crate::pyjson::to_py;
+use crate::{to_py_err, with_context, DeadreckonError};
+
+fn err(e: impl std::fmt::Display) -> PyErr {
+    DeadreckonError::new_err(e.to_string())
+}
+
+/// `calibrate --json` as a dict; the options are the command's.
+#[pyfunction]
+#[pyo3(signature = (source, method="rts", state="augmented", iteration="anderson", max_iterations=60, timing="wheel", min_speed=2.0, mapping=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn calibrate(
+    py: Python<'_>,
+    source: &Bound<'_, PyAny>,
+    method: &str,
+    state: &str,
+    iteration: &str,
+    max_iterations: usize,
+    timing: &str,
+    min_speed: f64,
+    mapping: Option<PathBuf>,
+) -> PyResult<Py<PyAny>> {
+    let m: Method = method.parse().map_err(to_py_err)?;
+    let opts = CalibrationOptions {
+        method: m,
+        state: parse_pass_state(state).map_err(to_py_err)?,
+        iteration: parse_iteration(iteration).map_err(to_py_err)?,
+        max_iterations,
+        min_speed_mps: min_speed,
+        filter: FilterOptions {
+            timing: parse_timing(timing).map_err(to_py_err)?,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    // Only the truth calibration reads truth.csv (as `calibrate` does).
+    let read = deadreckon_io::ReadOptions::default();
+    let read = if m == Method::Truth {
+        read
+    } else {
+        read.without_truth()
+    };
+    let what = source
+        .extract::<PathBuf>()
+        .map(|p| p.display().to_string())
+        .unwrap_or_else(|_| "the drive".into());
+    let drive = drive_arg(py, source, &read, mapping)?;
+    let c = py
+        .detach(|| core_calibrate::calibrate(&drive, &opts))
+        .map_err(with_context(format!("calibrating {what}")))?;
+    to_py(py, &json::calibration_json(method, &c))
+}
+
+/// `nominal`, a params.toml path, or a dict with the six parameters (extra
+/// keys, such as those of `calibrate`'s dict, are ignored); with its label.
+pub fn params_arg(
+    p: &Bound<'_, PyAny>,
+    vehicle: &deadreckon_core::Vehicle,
+) -> PyResult<(Params, String)> {
+    if let Ok(d) = p.cast::<PyDict>() {
+        let mut a = [0.0; 6];
+        for (i, name) in Params::NAMES.iter().enumerate() {
+            a[i] = d
+                .get_item(name)?
+                .ok_or_else(|| err(format!("params: missing `{name}`")))?
+                .extract()?;
+        }
+        let params = Params::from_array(a);
+        params
+            .validate()
+            .map_err(|e| err(format!("params: {}", deadreckon_api::chain_text(&e))))?;
+        return Ok((params, "given".into()));
+    }
+    let spec: PathBuf = p.extract()?;
+    let label = spec.display().to_string();
+    if label == "nominal" {
+        return Ok((Params::nominal(vehicle), label));
+    }
+    let read = deadreckon_io::read_params(&spec).map_err(|e| {
+        err(format!(
+            "reading parameters {label}: {}",
+            deadreckon_api::chain_text(&e)
+        ))
+    })?;
+    read.params.validate().map_err(|e| {
+        err(format!(
+            "parameters in {label}: {}",
+            deadreckon_api::chain_text(&e)
+        ))
+    })?;
+    Ok((read.params, label))
+}
+
+/// Every track of a drive (dead-reckoned, filtered, smoothed, and truth),
+/// as `{name: {column: array}}` with the track CSV's columns.
+#[pyfunction]
+#[pyo3(signature = (source, params=None, timing="wheel", init_pose=None, mapping=None))]
+pub fn run_tracks<'py>(
+    py: Python<'py>,
+    source: &Bound<'py, PyAny>,
+    params: Option<&Bound<'py, PyAny>>,
+    timing: &str,
+    init_pose: Option<(f64, f64, f64)>,
+    mapping: Option<PathBuf>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let drive = drive_arg(py, source, &Default::default(), mapping)?;
+    let params = match params {
+        Some(p) => params_arg(p, &drive.vehicle)?.0,
+        None => Params::nominal(&drive.vehicle),
+    };
+    if let Some((e, n, y)) = init_pose {
+        if !(e.is_finite() && n.is_finite() && y.is_finite()) {
+            return Err(err(
+                "init_pose needs three finite numbers (east_m, north_m, yaw_rad)",
+            ));
+        }
+    }
+    let opts = FilterOptions {
+        timing: parse_timing(timing).map_err(to_py_err)?,
+        ..Default::default()
+    };
+    let tracks = py
+        .detach(|| -> Result<Vec<track::Track>, deadreckon_core::Error> {
+            let mut t = track::drive_tracks(&drive, &params, &opts, init_pose)?;
+            t.extend(track::Track::from_truth(&drive));
+            Ok(t)
+        })
+        .map_err(to_py_err)?;
+    let out = PyDict::new(py);
+    for t in &tracks {
+        out.set_item(&t.name, track_columns(py, t)?)?;
+    }
+    Ok(out)
+}
+
+/// One track's columns (those of the track CSV but `track`).
+pub fn track_columns<'py>(py: Python<'py>, t: &track::Track) -> PyResult<Bound<'py, PyDict>> {
+    let p = &t.points;
+    let mut c = ColumnsOut::new(py);
+    c.add("t_s", p, |r| r.t_s)?
+        .add("east_m", p, |r| r.east_m)?
+        .add("north_m", p, |r| r.north_m)?
+        .add("yaw_rad", p, |r| r.yaw_rad)?
+        .add("speed_mps", p, |r| r.speed_mps)?
+        .add("yaw_rate_rps", p, |r| r.yaw_rate_rps)?
+        .add("std_east_m", p, |r| r.std_east_m())?
+        .add("std_north_m", p, |r| r.std_north_m())?
+        .add("std_yaw_rad", p, |r| r.std_yaw_rad())?
+        .add("cov_en_m2", p, |r| r.cov_pose[1])?;
+    Ok(c.finish())
+}
+
+/// `evaluate --json` as a dict; the options are the command's.
+#[pyfunction]
+#[pyo3(signature = (source, params=None, metric="drift", outage=None, step=None, warmup=5.0, segment_m=100.0, threshold_m=1.0, track="dead-reckoned", reference="truth", delta_m=100.0, pairs_from="estimate", max_diff_s=evo::DEFAULT_MAX_DIFF_S, timing="wheel", mapping=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn evaluate(
+    py: Python<'_>,
+    source: &Bound<'_, PyAny>,
+    params: Option<&Bound<'_, PyAny>>,
+    metric: &str,
+    outage: Option<f64>,
+    step: Option<f64>,
+    warmup: f64,
+    segment_m: f64,
+    threshold_m: f64,
+    track: &str,
+    reference: &str,
+    delta_m: f64,
+    pairs_from: &str,
+    max_diff_s: f64,
+    timing: &str,
+    mapping: Option<PathBuf>,
+) -> PyResult<Py<PyAny>> {
+    let drive = drive_arg(py, source, &Default::default(), mapping)?;
+    let timing = parse_timing(timing).map_err(to_py_err)?;
+    if let Some(len) = outage {
+        let given = params.map(|p| params_arg(p, &drive.vehicle)).transpose()?;
+        let base = FilterOptions {
+            timing,
+            ..Default::default()
+        };
+        let v = py.detach(|| -> PyResult<serde_json::Value> {
+            let (params, label) = match given {
+                Some(g) => g,
+                None => {
+                    let c = core_calibrate::calibrate(&drive, &CalibrationOptions::default())
+                        .map_err(with_context("RTS calibration with GNSS"))?;
+                    (c.estimate.params, format!("rts ({} passes)", c.iterations))
+                }
+            };
+            let ev = outage::evaluate(
+                &drive,
+                &params,
+                len,
+                step.unwrap_or(len / 2.0),
+                warmup,
+                &base,
+            )
+            .map_err(to_py_err)?;
+            Ok(json::outage_json(len, &label, &ev))
+        })?;
+        return to_py(py, &v);
+    }
+    let params = match params {
+        Some(p) => params_arg(p, &drive.vehicle)?.0,
+        None => Params::nominal(&drive.vehicle),
+    };
+    let v = py.detach(|| -> PyResult<serde_json::Value> {
+        match metric {
+            "drift" => {
+                let r = metrics::drift(&drive, &params, segment_m, timing).map_err(to_py_err)?;
+                Ok(json::drift_json(&r, segment_m))
+            }
+            "reset-1m" => {
+                let r = metrics::reset_on_error(&drive, &params, threshold_m, timing)
+                    .map_err(to_py_err)?;
+                Ok(json::reset_json(&r, threshold_m))
+            }
+            "rpe" | "ape" => {
+                let opts = FilterOptions {
+                    timing,
+                    ..Default::default()
+                };
+                let mut all =
+                    track::drive_tracks(&drive, &params, &opts, None).map_err(to_py_err)?;
+                all.extend(track::Track::from_truth(&drive));
+                let reference_t =
+                    &evo::as_written(track::find(&all, reference).map_err(to_py_err)?);
+                let estimate = &evo::as_written(track::find(&all, track).map_err(to_py_err)?);
+                let pairs = match pairs_from {
+                    "estimate" => evo::PairsFrom::Estimate,
+                    "reference" => evo::PairsFrom::Reference,
+                    s => {
+                        return Err(err(format!(
+                            "unknown pairs_from `{s}` (estimate, reference)"
+                        )))
+                    }
+                };
+                let r = if metric == "rpe" {
+                    evo::rpe(
+                        reference_t,
+                        estimate,
+                        &evo::RpeOptions {
+                            delta_m,
+                            max_diff_s,
+                            pairs_from: pairs,
+                        },
+                    )
+                } else {
+                    evo::ape(reference_t, estimate, max_diff_s)
+                }
+                .map_err(with_context(format!(
+                    "{metric} of `{track}` against `{reference}`"
+                )))?;
+                let q = json::EvoQuery {
+                    metric,
+                    track,
+                    reference,
+                    max_diff_s,
+                    delta_m,
+                    pairs_from,
+                };
+                Ok(json::evo_json(&q, &r))
+            }
+            m => Err(err(format!(
+                "unknown metric `{m}` (drift, reset-1m, rpe, ape)"
+            ))),
+        }
+    })?;
+    to_py(py, &v)
+}

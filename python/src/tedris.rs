@@ -1,0 +1,152 @@
+//! TedriS: train a model on a drive, run a drive through GNSS outages.
+
+use std::path::PathBuf;
+
+use deadreckon_tedris::{
+    run_outages_with, time_range, train, ModelChoice, ModelKind, Outage, ReferenceSource,
+    RunOptions, TedrisConfig, TedrisModel, Variant,
+};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::calib::track_columns;
+use crate::drive::drive_arg;
+use crate::pyjson::to_py;
+use crate::{to_py_err, DeadreckonError};
+
+fn reference_source(s: &str) -> PyResult<Option<ReferenceSource>> {
+    Ok(match s {
+        "auto" => None,
+        "course" => Some(ReferenceSource::GnssCourse),
+        "track" => Some(ReferenceSource::GnssTrack),
+        "gyro" => Some(ReferenceSource::Gyro),
+        _ => {
+            return Err(DeadreckonError::new_err(format!(
+                "unknown reference `{s}` (auto, course, track, gyro)"
+            )))
+        }
+    })
+}
+
+/// `tedris train`: the model as JSON text (what `--out` writes) and the
+/// summary `tedris train --json` prints.
+#[pyfunction]
+#[pyo3(signature = (source, reference="auto", variant=None, model="auto", config_json=None, from_s=None, until_s=None, mapping=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn tedris_train(
+    py: Python<'_>,
+    source: &Bound<'_, PyAny>,
+    reference: &str,
+    variant: Option<&str>,
+    model: &str,
+    config_json: Option<&str>,
+    from_s: Option<f64>,
+    until_s: Option<f64>,
+    mapping: Option<PathBuf>,
+) -> PyResult<(String, Py<PyAny>)> {
+    if let (Some(a), Some(b)) = (from_s, until_s) {
+        if a.partial_cmp(&b) != Some(std::cmp::Ordering::Less) {
+            return Err(DeadreckonError::new_err(format!(
+                "from_s {a} must be before until_s {b}"
+            )));
+        }
+    }
+    let drive = drive_arg(py, source, &Default::default(), mapping)?;
+    let drive = if from_s.is_some() || until_s.is_some() {
+        std::sync::Arc::new(time_range(&drive, from_s, until_s))
+    } else {
+        drive
+    };
+    let source = match reference_source(reference)? {
+        Some(s) => Some(s),
+        None => ReferenceSource::auto(&drive).ok(),
+    };
+    let variant = match variant {
+        None => None,
+        Some("paper") => Some(Variant::Paper),
+        Some("extended") => Some(Variant::Extended),
+        Some(v) => {
+            return Err(DeadreckonError::new_err(format!(
+                "unknown variant `{v}` (paper, extended)"
+            )))
+        }
+    };
+    let mut cfg = match config_json {
+        Some(text) => serde_json::from_str::<TedrisConfig>(text)
+            .map_err(|e| DeadreckonError::new_err(format!("TedriS configuration: {e}")))?,
+        None if variant == Some(Variant::Paper) => TedrisConfig::paper(),
+        None if source == Some(ReferenceSource::Gyro) => TedrisConfig::robot(),
+        None => TedrisConfig::default(),
+    };
+    if let Some(v) = variant {
+        cfg.variant = v;
+    }
+    cfg.model = match model {
+        "auto" => cfg.model,
+        "paper" => ModelChoice::Fixed(ModelKind::Paper),
+        "distance" => ModelChoice::Fixed(ModelKind::Distance),
+        "arx" => ModelChoice::Fixed(ModelKind::Arx),
+        "baseline" => ModelChoice::Fixed(ModelKind::Baseline),
+        m => {
+            return Err(DeadreckonError::new_err(format!(
+                "unknown model `{m}` (auto, paper, distance, arx, baseline)"
+            )))
+        }
+    };
+    cfg.validate().map_err(to_py_err)?;
+    let (m, source) = py
+        .detach(|| train(&drive, cfg, source))
+        .map_err(to_py_err)?;
+    let text = serde_json::to_string_pretty(&m).map_err(to_py_err)?;
+    let summary = deadreckon_api::json::tedris_train_json(&m, source);
+    Ok((text, to_py(py, &summary)?))
+}
+
+/// `tedris run --json` as a dict, plus `track`: the predicted track's columns.
+#[pyfunction]
+#[pyo3(signature = (source, model_json, outages, reference="auto", threshold_m=1.0, mapping=None))]
+pub fn tedris_run<'py>(
+    py: Python<'py>,
+    source: &Bound<'py, PyAny>,
+    model_json: &str,
+    outages: Vec<(f64, f64)>,
+    reference: &str,
+    threshold_m: f64,
+    mapping: Option<PathBuf>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let m: TedrisModel = serde_json::from_str(model_json)
+        .map_err(|e| DeadreckonError::new_err(format!("parsing the model: {e}")))?;
+    m.validate().map_err(to_py_err)?;
+    let outages: Vec<Outage> = outages
+        .iter()
+        .map(|(a, b)| format!("{a}:{b}").parse())
+        .collect::<Result<_, _>>()
+        .map_err(to_py_err)?;
+    if outages.is_empty() {
+        return Err(DeadreckonError::new_err(
+            "at least one outage window is needed",
+        ));
+    }
+    if !(threshold_m.is_finite() && threshold_m > 0.0) {
+        return Err(DeadreckonError::new_err(
+            "threshold_m must be a positive number",
+        ));
+    }
+    let drive = drive_arg(py, source, &Default::default(), mapping)?;
+    let opts = RunOptions {
+        source: reference_source(reference)?,
+        threshold_m: Some(threshold_m),
+    };
+    let r = py
+        .detach(|| run_outages_with(&drive, &m, &outages, &opts))
+        .map_err(to_py_err)?;
+    let v = serde_json::json!({
+        "outages": r.outages,
+        "reference": r.reference,
+        "source": r.source,
+        "model": m.chosen.name(),
+    });
+    let out: Bound<'py, PyDict> = to_py(py, &v)?.into_bound(py).cast_into()?;
+    out.set_item("track", track_columns(py, &r.track)?)?;
+    Ok(out)
+}

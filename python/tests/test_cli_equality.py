@@ -1,0 +1,109 @@
+"""The Python results are the command line's, exactly: same keys, same numbers."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import deadreckon
+from conftest import COMMA2K19
+
+
+def test_calibrate_comma2k19_equals_cli_json(cli_json):
+    # The issue's "done" line: deadreckon.calibrate("../shared/data/comma2k19-rav4")
+    # returns the CLI's numbers exactly.
+    ours = deadreckon.calibrate(str(COMMA2K19))
+    theirs = cli_json("calibrate", COMMA2K19, "--json")
+    assert ours == theirs
+    assert ours["converged"] is True
+    assert set(ours) >= {"gyro_bias_rps", "speed_scale", "std", "iterations", "gates"}
+
+
+def test_calibrate_with_a_drive_object_equals_the_path(sim_drive):
+    by_path = deadreckon.calibrate(sim_drive)
+    by_drive = deadreckon.calibrate(deadreckon.read_drive(sim_drive))
+    assert by_path == by_drive
+
+
+@pytest.mark.parametrize(
+    "method,extra",
+    [
+        ("rts", ["--state", "paper", "--iteration", "plain", "--max-iterations", "3"]),
+        ("rts", ["--timing", "each", "--min-speed", "3"]),
+        ("zupt", []),
+        ("truth", []),
+    ],
+)
+def test_calibrate_options_equal_cli(sim_drive, cli_json, method, extra):
+    opts = {}
+    it = iter(extra)
+    for flag in it:
+        key = flag[2:].replace("-", "_")
+        value = next(it)
+        opts[key] = float(value) if key == "min_speed" else int(value) if key == "max_iterations" else value
+    ours = deadreckon.calibrate(sim_drive, method, **opts)
+    theirs = cli_json("calibrate", sim_drive, "--method", method, "--json", *extra)
+    assert ours == theirs
+
+
+@pytest.mark.parametrize(
+    "args,kwargs",
+    [
+        (["--metric", "drift"], dict(metric="drift")),
+        (["--metric", "reset-1m", "--threshold-m", "2"], dict(metric="reset-1m", threshold_m=2.0)),
+        (["--metric", "rpe", "--delta-m", "50"], dict(metric="rpe", delta_m=50.0)),
+        (["--metric", "ape", "--track", "filtered"], dict(metric="ape", track="filtered")),
+        (["--outage", "30", "--step", "40"], dict(outage=30.0, step=40.0)),
+    ],
+)
+def test_evaluate_equals_cli_json(sim_drive, cli_json, args, kwargs):
+    ours = deadreckon.evaluate(sim_drive, **kwargs)
+    theirs = cli_json("evaluate", sim_drive, "--json", *args)
+    assert ours == theirs
+
+
+def test_evaluate_with_calibrated_params_equals_cli(sim_drive, cli, cli_json, tmp_path):
+    params = tmp_path / "params.toml"
+    cli("calibrate", sim_drive, "--out", params)
+    theirs = cli_json("evaluate", sim_drive, "--params", params, "--json")
+    assert deadreckon.evaluate(sim_drive, params=params) == theirs
+    # The dict calibrate returns works as parameters too (the same six numbers
+    # as params.toml, which writes them exactly).
+    cal = deadreckon.calibrate(sim_drive)
+    assert deadreckon.evaluate(sim_drive, params=cal) == theirs
+
+
+def test_run_tracks_equal_the_cli_csv(sim_drive, cli, tmp_path):
+    out = tmp_path / "track.csv"
+    cli("run", sim_drive, "--out", out, "--track", "dead-reckoned", "--track", "filtered",
+        "--track", "smoothed", "--track", "truth")
+    csv = pd.read_csv(out)
+    ours = deadreckon.run(sim_drive)
+    assert list(ours) == ["dead-reckoned", "filtered", "smoothed", "truth"]
+    for name, df in ours.items():
+        theirs = csv[csv["track"] == name].drop(columns="track").reset_index(drop=True)
+        assert list(df.columns) == list(theirs.columns)
+        assert len(df) == len(theirs) > 100
+        for c in df.columns:
+            assert np.array_equal(df[c].to_numpy(), theirs[c].to_numpy()), (name, c)
+
+
+def test_tedris_train_and_run_equal_cli(sim_drive, cli, cli_json, tmp_path):
+    model_path = tmp_path / "model.json"
+    theirs = cli_json("tedris", "train", sim_drive, "--out", model_path, "--json")
+    model = deadreckon.tedris_train(sim_drive)
+    assert model.summary == theirs
+    with open(model_path, encoding="utf-8") as f:
+        assert model.json == f.read()
+    ran = deadreckon.tedris_run(sim_drive, model, [(100.0, 140.0), (180.0, 200.0)])
+    track = ran.pop("track")
+    theirs = cli_json("tedris", "run", sim_drive, "--model", model_path,
+                      "--outage", "100:140", "--outage", "180:200", "--json")
+    theirs.pop("track")
+    assert ran == theirs
+    assert len(ran["outages"]) == 2
+    assert all(math.isfinite(o["final_error_m"]) for o in ran["outages"])
+    assert {"t_s", "east_m", "north_m", "yaw_rad"} <= set(track.columns)
