@@ -220,6 +220,8 @@ fn car_filter_on_simulated_tricycle(seed: u64) {
         steering_ratio: 1.0 / t.ksteer,
         wheels_present: [true, false, false, false],
         origin: None,
+        vehicle_id: None,
+        recorded_at: None,
         noise: Noise::default(),
     };
     let mut drive = Drive::empty(vehicle.clone());
