@@ -4,7 +4,8 @@ The Rust crates of https://github.com/ (this repository) from Python: read a
 drive from any source the ``deadreckon`` command line reads, or build one from
 pandas DataFrames; calibrate the six parameters (gyro bias, speed scale, four
 wheel circumferences); run the filter, smoother and dead reckoning; evaluate;
-TedriS; and the four-wheel filter one step at a time. Arrays cross as numpy
+TedriS; the four-wheel filter one step at a time (:class:`Filter`) and the
+online filter of ``deadreckon stream`` on JSON-line events (:class:`Online`). Arrays cross as numpy
 arrays. The dicts returned by :func:`calibrate` and :func:`evaluate` have
 exactly the keys and numbers of ``deadreckon calibrate --json`` and
 ``deadreckon evaluate --json`` (the same Rust code builds them).
@@ -29,12 +30,13 @@ import numpy as np
 import pandas as pd
 
 from . import _native
-from ._native import DeadreckonError, Filter, Update
+from ._native import DeadreckonError, Filter, Online, Update
 
 __all__ = [
     "DeadreckonError",
     "Drive",
     "Filter",
+    "Online",
     "TedrisModel",
     "Update",
     "calibrate",
