@@ -94,7 +94,11 @@ class Drive:
         or ``lat_deg, lon_deg``, ``std_m``, optional ``course_deg``,
         ``speed_mps``), ``truth`` (``t_s``, positions, ``yaw_rad``, optional
         ``speed_mps``). Extra columns are ignored; NaN in an optional column
-        means absent. The drive is validated as the readers validate it.
+        means absent. The drive is checked as every drive is
+        (``Drive::validate``: at least two wheel rows, strictly increasing
+        times, finite values, ``std_m`` > 0, integer tick counts); the CSV
+        readers' plausibility ranges of each unit (such as |speed| <= 100 m/s)
+        are not applied.
         """
         frames = dict(
             wheel_ticks=wheel_ticks,
