@@ -4,7 +4,8 @@ The Rust crates of https://github.com/ (this repository) from Python: read a
 drive from any source the ``deadreckon`` command line reads, or build one from
 pandas DataFrames; calibrate the six parameters (gyro bias, speed scale, four
 wheel circumferences); run the filter, smoother and dead reckoning; evaluate;
-TedriS; and the four-wheel filter one step at a time. Arrays cross as numpy
+TedriS; the four-wheel filter one step at a time (:class:`Filter`) and the
+online filter of ``deadreckon stream`` on JSON-line events (:class:`Online`). Arrays cross as numpy
 arrays. The dicts returned by :func:`calibrate` and :func:`evaluate` have
 exactly the keys and numbers of ``deadreckon calibrate --json`` and
 ``deadreckon evaluate --json`` (the same Rust code builds them).
@@ -29,12 +30,13 @@ import numpy as np
 import pandas as pd
 
 from . import _native
-from ._native import DeadreckonError, Filter, Update
+from ._native import DeadreckonError, Filter, Online, Update
 
 __all__ = [
     "DeadreckonError",
     "Drive",
     "Filter",
+    "Online",
     "TedrisModel",
     "Update",
     "calibrate",
@@ -92,7 +94,11 @@ class Drive:
         or ``lat_deg, lon_deg``, ``std_m``, optional ``course_deg``,
         ``speed_mps``), ``truth`` (``t_s``, positions, ``yaw_rad``, optional
         ``speed_mps``). Extra columns are ignored; NaN in an optional column
-        means absent. The drive is validated as the readers validate it.
+        means absent. The drive is checked as every drive is
+        (``Drive::validate``: at least two wheel rows, strictly increasing
+        times, finite values, ``std_m`` > 0, integer tick counts); the CSV
+        readers' plausibility ranges of each unit (such as |speed| <= 100 m/s)
+        are not applied.
         """
         frames = dict(
             wheel_ticks=wheel_ticks,

@@ -95,7 +95,8 @@ impl Drive {
     /// Builds a drive from columns: `streams` maps a drive-format file stem
     /// (`wheel_ticks`, `wheel_speeds`, `yaw_rate`, `speed`, `steering`,
     /// `gnss`, `truth`) to a dict of column name → float64 array (NaN: an
-    /// absent optional value). The result passes the readers' validation.
+    /// absent optional value). The result passes `Drive::validate`; the CSV
+    /// readers' unit range checks are not applied.
     #[staticmethod]
     #[pyo3(signature = (streams, vehicle_json=None, vehicle_path=None))]
     fn _from_columns(

@@ -94,7 +94,7 @@ fn native_drive<'py>(obj: &Bound<'py, PyAny>) -> Option<Bound<'py, Drive>> {
         .and_then(|n| n.cast_into::<Drive>().ok())
 }
 
-fn vehicle_of(vehicle: &Bound<'_, PyAny>) -> PyResult<Vehicle> {
+pub fn vehicle_of(vehicle: &Bound<'_, PyAny>) -> PyResult<Vehicle> {
     if let Some(d) = native_drive(vehicle) {
         return Ok(d.get().inner.vehicle.clone());
     }

@@ -18,6 +18,7 @@ mod calib;
 mod columns;
 mod drive;
 mod filter;
+mod online;
 mod pyjson;
 mod tedris;
 
@@ -47,6 +48,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<drive::Drive>()?;
     m.add_class::<filter::Filter>()?;
     m.add_class::<filter::Update>()?;
+    m.add_class::<online::Online>()?;
     m.add_function(wrap_pyfunction!(drive::read_drive, m)?)?;
     m.add_function(wrap_pyfunction!(calib::calibrate, m)?)?;
     m.add_function(wrap_pyfunction!(calib::run_tracks, m)?)?;

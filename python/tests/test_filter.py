@@ -1,12 +1,16 @@
 """The step API: one update per sensor, each returning innovation, NIS and
-whether the χ² gate accepted it."""
+whether the χ² gate accepted it; the online filter of `deadreckon stream`."""
 
 from __future__ import annotations
+
+import json
+import subprocess
 
 import numpy as np
 import pytest
 
 import deadreckon
+from conftest import _find_cli
 
 
 def test_gyro_innovation_is_reading_minus_predicted_yaw_rate(sim_drive):
@@ -76,3 +80,37 @@ def test_a_filter_from_vehicle_and_state(sim_drive):
         deadreckon.Filter(v, 0.0, np.zeros(4), np.eye(5))
     with pytest.raises(deadreckon.DeadreckonError):
         deadreckon.Filter({**v, "wheelbase_m": -1.0}, 0.0, x0, np.eye(5))
+
+
+def test_online_on_event_lines_equals_stream(sim_drive, cli):
+    events = cli("events", sim_drive).stdout.splitlines()
+    stream = subprocess.run(
+        [str(_find_cli()), "--quiet", "stream", "--vehicle", str(sim_drive / "vehicle.toml")],
+        input="\n".join(events) + "\n", capture_output=True, text=True, check=True,
+    ).stdout.splitlines()
+    theirs = [json.loads(l) for l in stream]
+    o = deadreckon.Online(deadreckon.read_drive(sim_drive))
+    # In two parts, with a stop and resume through the state in between.
+    half = len(events) // 2
+    a = o.push_lines(events[:half])
+    o = deadreckon.Online.from_json(o.to_json())
+    b = o.push_lines(events[half:])
+    c = o.finish()
+    ours = {k: np.concatenate([a[k], b[k], c[k]]) for k in a}
+    assert len(ours["t_s"]) == len(theirs) > 1000
+    for k in ("t_s", "east_m", "north_m", "yaw_rad", "speed_mps", "yaw_rate_rps"):
+        assert np.array_equal(ours[k], np.array([p[k] for p in theirs])), k
+    assert o.is_started and o.learned() is None
+    with pytest.raises(deadreckon.DeadreckonError, match="line 1"):
+        deadreckon.Online(deadreckon.read_drive(sim_drive)).push_lines(["{not json"])
+
+
+def test_online_learning_reports_parameters_with_std(sim_drive, cli):
+    events = cli("events", sim_drive).stdout.splitlines()
+    o = deadreckon.Online(deadreckon.read_drive(sim_drive), learn=True)
+    o.push_lines(events)
+    o.finish()
+    l = o.learned()
+    assert set(l) >= {"speed_scale", "std", "valid", "calibrated_pct"}
+    assert 0 < l["std"]["speed_scale"] < 0.01
+    assert 0.0 <= l["calibrated_pct"] <= 100.0
