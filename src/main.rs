@@ -55,9 +55,22 @@ enum Command {
 fn main() {
     let cli = Cli::parse();
     if let Err(e) = run(cli) {
+        // A closed standard output (`| head`) ends the command quietly.
+        if closed_pipe(&e) {
+            return;
+        }
         eprintln!("error: {}", message(&e));
         std::process::exit(1);
     }
+}
+
+/// Whether `e` comes from writing to a closed pipe.
+fn closed_pipe(e: &anyhow::Error) -> bool {
+    e.chain().any(|c| {
+        c.is::<cmd::BrokenPipe>()
+            || c.downcast_ref::<std::io::Error>()
+                .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+    })
 }
 
 /// The error and its causes joined by ": ", leaving out a cause whose text the

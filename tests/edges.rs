@@ -207,3 +207,37 @@ fn a_flipped_gyro_sign_calibrated_to_a_confident_wrong_answer() {
         String::from_utf8_lossy(&st.stderr)
     );
 }
+
+#[test]
+fn calibrate_json_into_a_full_device_or_a_closed_pipe_panicked() {
+    let tmp = vehicle_dir();
+    let d = tmp.path().join("d");
+    // A full device: an error naming it, no panic.
+    let full = std::fs::OpenOptions::new()
+        .write(true)
+        .open("/dev/full")
+        .unwrap();
+    let out = bin()
+        .args(["calibrate", "--json"])
+        .arg(&d)
+        .stdout(full)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("No space left on device"), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    // A pipe closed before the command writes: it ends quietly.
+    let mut child = bin()
+        .args(["calibrate", "--json"])
+        .arg(&d)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+}

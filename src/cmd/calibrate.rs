@@ -219,24 +219,24 @@ pub fn run(a: CalibrateArgs) -> Result<()> {
                 "ratio": st.ratio, "offset_rad": st.offset, "samples": st.samples, "rms_rad": st.rms_rad,
             });
         }
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        outln!("{}", serde_json::to_string_pretty(&v)?);
     } else {
-        println!("{}", common::params_header());
-        println!("{}", common::params_row(&method_name, &c.estimate));
+        outln!("{}", common::params_header());
+        outln!("{}", common::params_row(&method_name, &c.estimate));
         for (k, why) in &not_estimated {
-            println!("{k}: NOT ESTIMATED ({why})");
+            outln!("{k}: NOT ESTIMATED ({why})");
         }
         if let Some(st) = &steering {
             for p in [&st.ratio, &st.offset] {
                 match (&p.reason, p.std) {
-                    (None, Some(s)) => println!("{}: {:.5} ± {s:.5}", p.name, p.value),
-                    (Some(r), _) => println!("{}: NOT ESTIMATED ({r}), {} kept", p.name, p.value),
-                    (None, None) => println!("{}: {:.5}", p.name, p.value),
+                    (None, Some(s)) => outln!("{}: {:.5} ± {s:.5}", p.name, p.value),
+                    (Some(r), _) => outln!("{}: NOT ESTIMATED ({r}), {} kept", p.name, p.value),
+                    (None, None) => outln!("{}: {:.5}", p.name, p.value),
                 }
             }
         }
         if method == Method::Rts {
-            println!(
+            outln!(
                 "{} smoothing passes ({} state, {} iteration), {}",
                 c.iterations,
                 a.state,
@@ -249,10 +249,10 @@ pub fn run(a: CalibrateArgs) -> Result<()> {
             );
         }
         if let Some(st) = &c.filter_stats {
-            println!("{}", common::stats_line(st));
+            outln!("{}", common::stats_line(st));
         }
         for w in &written {
-            println!("wrote {}", w.display());
+            outln!("wrote {}", w.display());
         }
     }
     Ok(())
@@ -278,14 +278,14 @@ fn run_tricycle(a: &CalibrateArgs) -> Result<()> {
         kinematic::write_params(out, shape, method, None, &c)?;
     }
     if a.json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&kinematic::calibration_json(shape, method, &c))?
         );
     } else {
-        kinematic::print_table(&c);
+        kinematic::print_table(&c)?;
         if let Some(out) = &a.out {
-            println!("wrote {}", out.display());
+            outln!("wrote {}", out.display());
         }
     }
     Ok(())
@@ -334,11 +334,11 @@ fn run_diff_drive(a: &CalibrateArgs) -> Result<()> {
     if a.json {
         let mut v = kinematic::calibration_json(shape, method, &c);
         v["yaw_source"] = a.yaw.name().into();
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        outln!("{}", serde_json::to_string_pretty(&v)?);
     } else {
-        kinematic::print_table(&c);
+        kinematic::print_table(&c)?;
         if let Some(out) = &a.out {
-            println!("wrote {}", out.display());
+            outln!("wrote {}", out.display());
         }
     }
     Ok(())

@@ -174,18 +174,25 @@ pub fn to_json(c: &Comparison) -> serde_json::Value {
 }
 
 /// Prints the comparison table; `t0` is subtracted from the outage times.
-pub fn print(c: &Comparison, t0: f64) {
-    println!(
+pub fn print(c: &Comparison, t0: f64) -> anyhow::Result<()> {
+    outln!(
         "four-wheel EKF: {}; errors against the {}",
-        c.params_source, c.four_wheel_reference
+        c.params_source,
+        c.four_wheel_reference
     );
-    println!(
+    outln!(
         "TedriS: {}; errors against the {}",
-        c.model_source, c.tedris_reference
+        c.model_source,
+        c.tedris_reference
     );
-    println!(
+    outln!(
         "{:<20} {:<12} {:>10} {:>10} {:>10} {:>16}",
-        "outage (s)", "method", "mean (m)", "max (m)", "final (m)", "time to 1 m (s)"
+        "outage (s)",
+        "method",
+        "mean (m)",
+        "max (m)",
+        "final (m)",
+        "time to 1 m (s)"
     );
     let fmt = |r: &Option<Row>| match r {
         Some(r) => format!(
@@ -201,9 +208,10 @@ pub fn print(c: &Comparison, t0: f64) {
     };
     for (o, f, t) in &c.rows {
         let w = format!("{:.1}:{:.1}", o.start_s - t0, o.end_s - t0);
-        println!("{:<20} {:<12} {}", w, "four-wheel", fmt(f));
-        println!("{:<20} {:<12} {}", "", "TedriS", fmt(t));
+        outln!("{:<20} {:<12} {}", w, "four-wheel", fmt(f));
+        outln!("{:<20} {:<12} {}", "", "TedriS", fmt(t));
     }
+    Ok(())
 }
 
 /// Runs `compare`.
@@ -232,9 +240,9 @@ pub fn run(a: CompareArgs) -> Result<()> {
     };
     let c = compare(&drive, &outages, params, model)?;
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&to_json(&c))?);
+        outln!("{}", serde_json::to_string_pretty(&to_json(&c))?);
     } else {
-        print(&c, 0.0);
+        print(&c, 0.0)?;
     }
     Ok(())
 }

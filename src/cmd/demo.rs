@@ -168,10 +168,10 @@ pub fn run(a: DemoArgs, quiet: bool) -> Result<()> {
             "plain_iterations": plain.iterations,
             "tedris_comparison": super::compare::to_json(&tedris.0),
         });
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        outln!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
     }
-    println!(
+    outln!(
         "calibration drive: {:.2} km, {:.0} s, mean {:.1} km/h; evaluation drive: {:.2} km, {:.0} s",
         sim_cal.stats.distance_m / 1000.0,
         sim_cal.stats.duration_s,
@@ -179,10 +179,10 @@ pub fn run(a: DemoArgs, quiet: bool) -> Result<()> {
         sim_eval.stats.distance_m / 1000.0,
         sim_eval.stats.duration_s
     );
-    println!();
-    println!("Table III: parameter calibration");
-    println!("{}", common::params_header());
-    println!(
+    outln!();
+    outln!("Table III: parameter calibration");
+    outln!("{}", common::params_header());
+    outln!(
         "{}",
         common::params_row(
             "GT",
@@ -193,7 +193,7 @@ pub fn run(a: DemoArgs, quiet: bool) -> Result<()> {
         )
     );
     for r in &results {
-        println!("{}", common::params_row(r.name, &r.params));
+        outln!("{}", common::params_row(r.name, &r.params));
     }
     if let Some(rts) = results
         .iter()
@@ -202,7 +202,7 @@ pub fn run(a: DemoArgs, quiet: bool) -> Result<()> {
     {
         let e = rts.estimate.params.to_array();
         let t = truth.to_array();
-        println!(
+        outln!(
             "RTS errors: gyro bias {:.2}%, speed scale {:.3}%, circumferences {:.3}% {:.3}% {:.3}% {:.3}%",
             100.0 * ((e[0] - t[0]) / t[0]).abs(),
             100.0 * ((e[1] - t[1]) / t[1]).abs(),
@@ -217,7 +217,7 @@ pub fn run(a: DemoArgs, quiet: bool) -> Result<()> {
                 .fold(0.0, f64::max)
                 * 100.0
         };
-        println!(
+        outln!(
             "RTS smoothing passes: {} (augmented state); the paper's 5-state plain iteration: worst circumference error {:.3}% after 1 pass, {:.3}% after 3, {:.3}% after {}{}",
             rts.iterations,
             worst(&plain.history[0]),
@@ -227,34 +227,41 @@ pub fn run(a: DemoArgs, quiet: bool) -> Result<()> {
             if plain.converged { " (converged)" } else { " (not converged)" }
         );
     }
-    println!();
-    println!(
+    outln!();
+    outln!(
         "Table IV: dead-reckoning drift on the evaluation drive (reset to the truth every 100 m)"
     );
-    println!(
+    outln!(
         "{:<8} {:>12} {:>12} {:>6}   {:>24}",
-        "method", "mean error", "std", "n", "distance before 1 m error"
+        "method",
+        "mean error",
+        "std",
+        "n",
+        "distance before 1 m error"
     );
     for r in &results {
         let d = Summary::of(&r.drift.errors_pct());
         let s = Summary::of(&r.reset.distances_m);
-        println!(
+        outln!(
             "{:<8} {:>11.3}% {:>11.3}% {:>6}   mean {:>6.1} m, median {:>6.1} m",
-            r.name, d.mean, d.std, d.n, s.mean, s.median
+            r.name,
+            d.mean,
+            d.std,
+            d.n,
+            s.mean,
+            s.median
         );
     }
-    println!();
-    println!(
+    outln!();
+    outln!(
         "drives and parameters in {}, report in {}",
         a.out.display(),
         report_path.display()
     );
-    println!();
-    println!(
-        "TedriS and the four-wheel EKF through 80 s GNSS outages on the simulated campus drive"
-    );
-    super::compare::print(&tedris.0, tedris.1);
-    println!("report in {}", tedris.2.display());
+    outln!();
+    outln!("TedriS and the four-wheel EKF through 80 s GNSS outages on the simulated campus drive");
+    super::compare::print(&tedris.0, tedris.1)?;
+    outln!("report in {}", tedris.2.display());
     Ok(())
 }
 

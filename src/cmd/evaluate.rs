@@ -124,28 +124,36 @@ pub fn run(a: EvaluateArgs) -> Result<()> {
         let (fe, dr, d1) = (ev.final_error(), ev.drift_pct(), ev.distance_to_1m());
         if a.json {
             let v = deadreckon_api::json::outage_json(len, &source, &ev);
-            println!("{}", serde_json::to_string_pretty(&v)?);
+            outln!("{}", serde_json::to_string_pretty(&v)?);
         } else {
-            println!(
+            outln!(
                 "{} outage windows of {len} s against the {} (parameters: {source})",
                 ev.windows.len(),
                 ev.reference.name()
             );
-            println!(
+            outln!(
                 "{:<28} {:>9} {:>9} {:>9} {:>9}",
-                "", "mean", "median", "p95", "max"
+                "",
+                "mean",
+                "median",
+                "p95",
+                "max"
             );
             for (name, s) in [
                 ("final error (m)", fe),
                 ("drift per 100 m (%)", dr),
                 ("distance before 1 m (m)", d1),
             ] {
-                println!(
+                outln!(
                     "{:<28} {:>9.3} {:>9.3} {:>9.3} {:>9.3}",
-                    name, s.mean, s.median, s.p95, s.max
+                    name,
+                    s.mean,
+                    s.median,
+                    s.p95,
+                    s.max
                 );
             }
-            println!(
+            outln!(
                 "rejected by the χ² gates: {}",
                 common::gated_text(&ev.gates)
             );
@@ -159,10 +167,10 @@ pub fn run(a: EvaluateArgs) -> Result<()> {
             let s = Summary::of(&r.errors_pct());
             if a.json {
                 let v = deadreckon_api::json::drift_json(&r, a.segment_m);
-                println!("{}", serde_json::to_string_pretty(&v)?);
+                outln!("{}", serde_json::to_string_pretty(&v)?);
             } else {
-                println!("drift per {} m over {} segments: mean {:.3}%, std {:.3}%, median {:.3}%, max {:.3}%", a.segment_m, s.n, s.mean, s.std, s.median, s.max);
-                println!("rejected by the χ² gates: {}", common::gated_text(&r.gates));
+                outln!("drift per {} m over {} segments: mean {:.3}%, std {:.3}%, median {:.3}%, max {:.3}%", a.segment_m, s.n, s.mean, s.std, s.median, s.max);
+                outln!("rejected by the χ² gates: {}", common::gated_text(&r.gates));
             }
         }
         "reset-1m" => {
@@ -170,13 +178,13 @@ pub fn run(a: EvaluateArgs) -> Result<()> {
             let s = Summary::of(&r.distances_m);
             if a.json {
                 let v = deadreckon_api::json::reset_json(&r, a.threshold_m);
-                println!("{}", serde_json::to_string_pretty(&v)?);
+                outln!("{}", serde_json::to_string_pretty(&v)?);
             } else {
-                println!(
+                outln!(
                     "distance before {} m of error over {} resets: mean {:.1} m, median {:.1} m, min {:.1} m, max {:.1} m",
                     a.threshold_m, s.n, s.mean, s.median, s.min, s.max
                 );
-                println!("rejected by the χ² gates: {}", common::gated_text(&r.gates));
+                outln!("rejected by the χ² gates: {}", common::gated_text(&r.gates));
             }
         }
         "rpe" | "ape" => {
@@ -217,7 +225,7 @@ pub fn run(a: EvaluateArgs) -> Result<()> {
                     pairs_from: &a.pairs_from,
                 };
                 let v = deadreckon_api::json::evo_json(&q, &r);
-                println!("{}", serde_json::to_string_pretty(&v)?);
+                outln!("{}", serde_json::to_string_pretty(&v)?);
             } else {
                 let what = if a.metric == "rpe" {
                     format!(
@@ -228,7 +236,7 @@ pub fn run(a: EvaluateArgs) -> Result<()> {
                     "APE (translation, no alignment)".to_string()
                 };
                 let s = r.stats;
-                println!(
+                outln!(
                     "{what} of `{}` against `{}`: {} errors over {} associated poses (as evo {})",
                     a.track,
                     a.reference,
@@ -236,7 +244,7 @@ pub fn run(a: EvaluateArgs) -> Result<()> {
                     r.matched,
                     evo::EVO_VERSION
                 );
-                println!(
+                outln!(
                     "rmse {:.4} m, mean {:.4} m, median {:.4} m, std {:.4} m, min {:.4} m, max {:.4} m",
                     s.rmse, s.mean, s.median, s.std, s.min, s.max
                 );
@@ -273,23 +281,31 @@ fn run_tricycle(a: &EvaluateArgs) -> Result<()> {
     };
     let ev = kinematics::evaluate(&drive, &params, len, a.step.unwrap_or(len / 2.0))?;
     if a.json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&kinematic::outages_json(shape, &ev, &source))?
         );
     } else {
         let s = ev.final_error();
-        println!(
+        outln!(
             "{} outage windows of {len} s from the reference pose (parameters: {source})",
             ev.windows.len()
         );
-        println!(
+        outln!(
             "{:<28} {:>9} {:>9} {:>9} {:>9}",
-            "", "mean", "median", "p95", "max"
+            "",
+            "mean",
+            "median",
+            "p95",
+            "max"
         );
-        println!(
+        outln!(
             "{:<28} {:>9.3} {:>9.3} {:>9.3} {:>9.3}",
-            "final error (m)", s.mean, s.median, s.p95, s.max
+            "final error (m)",
+            s.mean,
+            s.median,
+            s.p95,
+            s.max
         );
     }
     Ok(())
@@ -328,21 +344,29 @@ fn run_diff_drive(a: &EvaluateArgs) -> Result<()> {
         let mut v = kinematic::outages_json(Shape::DiffDrive, &ev, &source);
         v["reference"] = "gnss (hidden fixes; start aligned to the preceding fixes)".into();
         v["align_s"] = a.align.into();
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        outln!("{}", serde_json::to_string_pretty(&v)?);
     } else {
         let s = ev.final_error();
-        println!(
+        outln!(
             "{} outage windows of {len} s, each started from {} s of dead reckoning aligned to the fixes (parameters: {source})",
             ev.windows.len(),
             a.align
         );
-        println!(
+        outln!(
             "{:<28} {:>9} {:>9} {:>9} {:>9}",
-            "", "mean", "median", "p95", "max"
+            "",
+            "mean",
+            "median",
+            "p95",
+            "max"
         );
-        println!(
+        outln!(
             "{:<28} {:>9.3} {:>9.3} {:>9.3} {:>9.3}",
-            "final error (m)", s.mean, s.median, s.p95, s.max
+            "final error (m)",
+            s.mean,
+            s.median,
+            s.p95,
+            s.max
         );
     }
     Ok(())

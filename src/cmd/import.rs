@@ -167,14 +167,14 @@ pub fn run(a: ImportArgs) -> Result<()> {
     };
     write_new_or_update(&a.out, &drive)?;
     print!("{report}");
-    print_counts(&drive);
-    println!("wrote {}", a.out.display());
+    print_counts(&drive)?;
+    outln!("wrote {}", a.out.display());
     Ok(())
 }
 
-fn print_counts(d: &Drive) {
+fn print_counts(d: &Drive) -> anyhow::Result<()> {
     let span = d.time_span().map_or(0.0, |(a, b)| b - a);
-    println!(
+    outln!(
         "drive: {:.3} s, wheels {}, yaw_rate {}, speed {}, steering {}, gnss {}, truth {}",
         span,
         d.wheels.len(),
@@ -184,6 +184,7 @@ fn print_counts(d: &Drive) {
         d.gnss.len(),
         d.truth.len()
     );
+    Ok(())
 }
 
 /// Writes `drive` into `out` whole (written beside it under a temporary name,

@@ -144,32 +144,32 @@ pub fn load_params_file(
 
 /// The calibration as a table: value, standard error, status; then the
 /// correlation of the estimated parameters.
-pub fn print_table(c: &KinematicCalibration) {
-    println!("{:<18} {:>12} {:>12}  status", "parameter", "value", "std");
+pub fn print_table(c: &KinematicCalibration) -> anyhow::Result<()> {
+    outln!("{:<18} {:>12} {:>12}  status", "parameter", "value", "std");
     for p in &c.params {
         let std = p.std.map_or("-".to_string(), |s| format!("{s:.6}"));
         let status = match &p.reason {
             None => "estimated".to_string(),
             Some(r) => format!("NOT ESTIMATED (nominal kept): {r}"),
         };
-        println!("{:<18} {:>12.6} {:>12}  {status}", p.name, p.value, std);
+        outln!("{:<18} {:>12.6} {:>12}  {status}", p.name, p.value, std);
     }
     if !c.correlated.is_empty() {
-        println!("correlation:");
+        outln!("correlation:");
         print!("{:<18}", "");
         for n in &c.correlated {
             print!(" {:>8}", abbreviate(n));
         }
-        println!();
+        outln!();
         for (n, row) in c.correlated.iter().zip(&c.correlation) {
             print!("{n:<18}");
             for v in row {
                 print!(" {v:>8.3}");
             }
-            println!();
+            outln!();
         }
     }
-    println!(
+    outln!(
         "{} of {} windows above {} m/s, RMS at the window ends {:.3} m / {:.4} rad; {} ({})",
         c.windows_used,
         c.windows_total,
@@ -183,6 +183,7 @@ pub fn print_table(c: &KinematicCalibration) {
         },
         c.termination
     );
+    Ok(())
 }
 
 fn abbreviate(name: &str) -> String {

@@ -1,4 +1,39 @@
 //! One module per subcommand.
+
+/// `println!` that fails instead of panicking: a write error (a full disk)
+/// becomes the command's error, and a closed pipe (`| head`) ends the command
+/// quietly ([`BrokenPipe`] is recognised by `main`). Use inside functions
+/// returning `anyhow::Result`.
+macro_rules! outln {
+    () => {
+        $crate::cmd::write_line(format_args!(""))?
+    };
+    ($($arg:tt)*) => {
+        $crate::cmd::write_line(format_args!($($arg)*))?
+    };
+}
+
+/// A closed standard output: not an error to report.
+#[derive(Debug)]
+pub struct BrokenPipe;
+
+impl std::fmt::Display for BrokenPipe {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("standard output was closed")
+    }
+}
+
+impl std::error::Error for BrokenPipe {}
+
+/// Writes one line to standard output (see `outln!`).
+pub fn write_line(args: std::fmt::Arguments<'_>) -> anyhow::Result<()> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    match writeln!(out, "{args}") {
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Err(BrokenPipe.into()),
+        r => Ok(anyhow::Context::context(r, "writing to standard output")?),
+    }
+}
 pub mod batch;
 pub mod calibrate;
 pub mod common;

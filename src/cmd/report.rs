@@ -393,7 +393,7 @@ pub fn run(a: ReportArgs, quiet: bool) -> Result<()> {
     deadreckon_report::write_report(&a.out, &input)
         .with_context(|| format!("writing {}", a.out.display()))?;
     steps.finish();
-    println!("wrote {}", a.out.display());
+    outln!("wrote {}", a.out.display());
     Ok(())
 }
 

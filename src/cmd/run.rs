@@ -140,9 +140,9 @@ pub fn run(a: RunArgs) -> Result<()> {
         write_tracks(&a.out, format, &t, a.mcap)
             .with_context(|| format!("writing {}", a.out.display()))?;
         for tr in &t {
-            println!("{:<14} {:>7} poses", tr.name, tr.points.len());
+            outln!("{:<14} {:>7} poses", tr.name, tr.points.len());
         }
-        println!("wrote {}", a.out.display());
+        outln!("wrote {}", a.out.display());
         return Ok(());
     }
     let drive = common::load_drive(&a.dir)?;
@@ -172,11 +172,11 @@ pub fn run(a: RunArgs) -> Result<()> {
     write_tracks(&a.out, format, &t, a.mcap)
         .with_context(|| format!("writing {}", a.out.display()))?;
     for tr in &t {
-        println!("{:<14} {:>7} poses", tr.name, tr.points.len());
+        outln!("{:<14} {:>7} poses", tr.name, tr.points.len());
     }
-    println!("wrote {}", a.out.display());
+    outln!("wrote {}", a.out.display());
     if format == TrackFormat::Kitti {
-        println!(
+        outln!(
             "wrote {} (the poses' timestamps)",
             deadreckon_io::kitti_times_path(&a.out).display()
         );

@@ -137,7 +137,7 @@ pub fn run(a: SimulateArgs) -> Result<()> {
     let sc = with_overrides(scenario(&a.scenario)?, &a)?;
     let out = write_scenario(sc, &a.scenario, a.seed, &a.out)?;
     let s = &out.stats;
-    println!(
+    outln!(
         "simulated {} (seed {}): {:.2} km in {:.0} s, mean {:.1} km/h, max {:.1} km/h, {} stops -> {}",
         a.scenario,
         a.seed,

@@ -209,15 +209,15 @@ pub fn run(c: TedrisCommand) -> Result<()> {
             let text = serde_json::to_string_pretty(&m)?;
             std::fs::write(&out, text).with_context(|| format!("writing {}", out.display()))?;
             if json {
-                println!(
+                outln!(
                     "{}",
                     serde_json::to_string_pretty(&deadreckon_api::json::tedris_train_json(
                         &m, source
                     ))?
                 );
             } else {
-                print_train(&m, source);
-                println!("model written to {}", out.display());
+                print_train(&m, source)?;
+                outln!("model written to {}", out.display());
             }
             Ok(())
         }
@@ -260,15 +260,16 @@ pub fn run(c: TedrisCommand) -> Result<()> {
                     "model": m.chosen.name(),
                     "track": out.as_ref().map(|p| p.display().to_string()),
                 });
-                println!("{}", serde_json::to_string_pretty(&v)?);
+                outln!("{}", serde_json::to_string_pretty(&v)?);
             } else {
-                println!(
+                outln!(
                     "reference heading: {:?}; errors against {}",
-                    r.source, r.reference
+                    r.source,
+                    r.reference
                 );
                 // The threshold column only when it is not the 1 m one.
                 let extra = (threshold_m != 1.0).then(|| format!("to_{threshold_m}m_s"));
-                println!(
+                outln!(
                     "{:>9} {:>9} {:>10} {:>9} {:>10} {:>12}{}",
                     "start_s",
                     "end_s",
@@ -282,7 +283,7 @@ pub fn run(c: TedrisCommand) -> Result<()> {
                 );
                 let opt = |v: Option<f64>| v.map_or("never".to_string(), |x| format!("{x:.1}"));
                 for o in &r.outages {
-                    println!(
+                    outln!(
                         "{:>9.1} {:>9.1} {:>10.2} {:>9.2} {:>10.2} {:>12}{}",
                         o.start_s,
                         o.end_s,
@@ -297,7 +298,7 @@ pub fn run(c: TedrisCommand) -> Result<()> {
                     );
                 }
                 if let Some(p) = &out {
-                    println!("track written to {}", p.display());
+                    outln!("track written to {}", p.display());
                 }
             }
             Ok(())
@@ -305,10 +306,10 @@ pub fn run(c: TedrisCommand) -> Result<()> {
     }
 }
 
-fn print_train(m: &TedrisModel, source: ReferenceSource) {
+fn print_train(m: &TedrisModel, source: ReferenceSource) -> anyhow::Result<()> {
     let s = m.straight();
-    println!("reference heading: {source:?}");
-    println!(
+    outln!("reference heading: {source:?}");
+    outln!(
         "tau = {} samples, sample period {:.4} s, lag h = {} samples (peak corr {:.3})",
         m.config.tau_samples,
         m.sample_period_s,
@@ -320,7 +321,7 @@ fn print_train(m: &TedrisModel, source: ReferenceSource) {
             .fold(f64::NEG_INFINITY, f64::max)
     );
     let eps = s.epsilon_m.map_or("inf".to_string(), |e| format!("{e:.6}"));
-    println!(
+    outln!(
         "straight line ({} blocks{}): mu = {:.6} m, W_L = {:.6} m, W_H = {:.6} m, epsilon = {} m (per wheel sample)",
         s.blocks,
         if s.fallback { ", quietest blocks" } else { "" },
@@ -331,29 +332,33 @@ fn print_train(m: &TedrisModel, source: ReferenceSource) {
     );
     if m.per_metre_straight {
         // Heading per metre as the rear radius mismatch it is.
-        println!(
+        outln!(
             "straight-line heading {:.3e} rad/m (per metre only: none at rest), turn gain = {:.4}",
-            m.dcf_distance_rad_per_m, m.turn_gain
+            m.dcf_distance_rad_per_m,
+            m.turn_gain
         );
     } else if m.config.joint_calibration() {
-        println!(
+        outln!(
             "DCF0 = {:.3e} rad/sample, DCF = {:.3e} rad/sample + {:.3e} rad/m, turn gain = {:.4}",
-            m.dcf0_rad, m.dcf_rad, m.dcf_distance_rad_per_m, m.turn_gain
+            m.dcf0_rad,
+            m.dcf_rad,
+            m.dcf_distance_rad_per_m,
+            m.turn_gain
         );
     } else {
         // The paper's method: eq. (6) only; no distance term, no turn gain.
-        println!(
+        outln!(
             "DCF0 = {:.3e} rad/sample, DCF = {:.3e} rad/sample (eq. 6; heading per metre and turn gain not estimated)",
             m.dcf0_rad, m.dcf_rad
         );
     }
     match &m.course_convention {
-        Some(c) => println!(
+        Some(c) => outln!(
             "course convention found on the data: {:?} (residual as body yaw / as antenna course = {:.3})",
             c.convention, c.rss_ratio
         ),
         None if source == ReferenceSource::GnssCourse => {
-            println!("course convention: not decided on the data (taken as the antenna's velocity)")
+            outln!("course convention: not decided on the data (taken as the antenna's velocity)")
         }
         None => {}
     }
@@ -363,8 +368,8 @@ fn print_train(m: &TedrisModel, source: ReferenceSource) {
         } else {
             ""
         };
-        println!();
-        println!(
+        outln!();
+        outln!(
             "model {} (n = {}, R² = {:.4}, sigma = {:.3e}, AIC = {:.1}, BIC = {:.1}){mark}",
             f.kind.name(),
             f.global.n,
@@ -373,8 +378,8 @@ fn print_train(m: &TedrisModel, source: ReferenceSource) {
             f.global.aic,
             f.global.bic
         );
-        print_table(&f.global.coefficients);
-        println!(
+        print_table(&f.global.coefficients)?;
+        outln!(
             "  Box-Pierce Q = {:.2} (L = {}, p = {:.4}); Ljung-Box Q* = {:.2} (p = {:.4})",
             f.box_pierce.statistic,
             f.box_pierce.lags,
@@ -384,23 +389,23 @@ fn print_train(m: &TedrisModel, source: ReferenceSource) {
         );
         match (&f.correction, &f.corrected) {
             (Some(c), Some(t)) => {
-                println!(
+                outln!(
                     "  residuals not white: {} correction (innovations Ljung-Box p = {:.4}); joint refit:",
                     c.correction.label(),
                     c.ljung_box.p_value
                 );
-                print_table(&t.coefficients);
+                print_table(&t.coefficients)?;
             }
             (Some(c), None) => {
-                println!("  residuals not white: {} correction", c.correction.label())
+                outln!("  residuals not white: {} correction", c.correction.label())
             }
-            _ => println!("  residuals white: no correction"),
+            _ => outln!("  residuals white: no correction"),
         }
     }
-    println!();
-    println!("repositories (omega interval per wheel sample, m):");
+    outln!();
+    outln!("repositories (omega interval per wheel sample, m):");
     for r in m.repositories.fill(m.config.required_bins) {
-        println!(
+        outln!(
             "  R{:<4} [{:>10.5}, {:>10.5}]  {:>6} tuples{}",
             r.index,
             r.low_m,
@@ -413,18 +418,28 @@ fn print_train(m: &TedrisModel, source: ReferenceSource) {
             }
         );
     }
-    println!("training complete: {}", m.complete);
+    outln!("training complete: {}", m.complete);
+    Ok(())
 }
 
-fn print_table(c: &[deadreckon_tedris::stats::Coefficient]) {
-    println!(
+fn print_table(c: &[deadreckon_tedris::stats::Coefficient]) -> anyhow::Result<()> {
+    outln!(
         "  {:<12} {:>14} {:>14} {:>10} {:>10}",
-        "", "Estimate", "Std. Error", "t value", "p value"
+        "",
+        "Estimate",
+        "Std. Error",
+        "t value",
+        "p value"
     );
     for r in c {
-        println!(
+        outln!(
             "  {:<12} {:>14.6e} {:>14.6e} {:>10.2} {:>10.4}",
-            r.name, r.estimate, r.std_error, r.t_value, r.p_value
+            r.name,
+            r.estimate,
+            r.std_error,
+            r.t_value,
+            r.p_value
         );
     }
+    Ok(())
 }
