@@ -133,6 +133,16 @@ pub fn check_output(out: &Path, drives: &[PathBuf], what: &str) -> Result<(), Fl
             out.display()
         )));
     }
+    // Found before the drives are run, not after.
+    if let Some(parent) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
+        if !parent.is_dir() {
+            return Err(FleetError::Options(format!(
+                "{what} {}: directory {} does not exist",
+                out.display(),
+                parent.display()
+            )));
+        }
+    }
     let o = resolved(out);
     for d in drives {
         let d_res = resolved(d);
@@ -215,6 +225,13 @@ mod tests {
         let other = a.join("..").join("r.bag");
         assert!(check_output(&other, &drives, "--out").is_err());
         assert!(check_output(&a, &drives, "--out").is_err());
+        let e = check_output(&t.path().join("no/r.csv"), &drives, "--history")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("--history") && e.contains("does not exist"),
+            "{e}"
+        );
         assert!(check_distinct(&t.path().join("x.csv"), &t.path().join("./x.csv")).is_err());
     }
 }
