@@ -64,7 +64,13 @@ pub fn calibrate(
     let c = py
         .detach(|| core_calibrate::calibrate(&drive, &opts))
         .map_err(with_context(format!("calibrating {what}")))?;
-    to_py(py, &json::calibration_json(method, &c))
+    let steering = py
+        .detach(|| json::car_steering(&drive, m, opts.min_speed_mps))
+        .map_err(with_context("calibrating the steering".to_string()))?;
+    to_py(
+        py,
+        &json::calibrate_json(method, &c, opts.min_speed_mps, steering.as_ref()),
+    )
 }
 
 /// `nominal`, a params.toml path, or a dict with the six parameters (extra

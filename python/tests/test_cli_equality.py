@@ -87,8 +87,17 @@ def test_run_tracks_equal_the_cli_csv(sim_drive, cli, tmp_path):
         theirs = csv[csv["track"] == name].drop(columns="track").reset_index(drop=True)
         assert list(df.columns) == list(theirs.columns)
         assert len(df) == len(theirs) > 100
+        # The CSV has a fixed precision per column (docs/drive-format.md):
+        # times, positions and angles to 1e-9, speed to 1e-6, uncertainties to
+        # 7 significant digits; the DataFrames carry the full doubles.
         for c in df.columns:
-            assert np.array_equal(df[c].to_numpy(), theirs[c].to_numpy()), (name, c)
+            ours_c, theirs_c = df[c].to_numpy(), theirs[c].to_numpy()
+            if c.startswith("std_") or c.startswith("cov_"):
+                ok = np.allclose(ours_c, theirs_c, rtol=1e-6, atol=0.0)
+            else:
+                atol = 1e-6 if c == "speed_mps" else 1e-9
+                ok = np.allclose(ours_c, theirs_c, rtol=0.0, atol=atol * 0.51)
+            assert ok, (name, c, np.max(np.abs(ours_c - theirs_c)))
 
 
 def test_tedris_train_and_run_equal_cli(sim_drive, cli, cli_json, tmp_path):

@@ -8,8 +8,7 @@ use anyhow::{Context, Result};
 use clap::Args;
 use deadreckon_core::calibrate::{self, CalibrationOptions, Iteration, Method, PassState};
 use deadreckon_core::ekf::FilterOptions;
-use deadreckon_core::kinematics::steering::{calibrate_steering, SteeringCalibration};
-use deadreckon_core::reference::Reference;
+use deadreckon_core::kinematics::steering::SteeringCalibration;
 
 use deadreckon_core::kinematics::diff_drive::{calibrate_diff_drive, DiffDriveOptions};
 use deadreckon_core::kinematics::{self, KinematicOptions, Shape};
@@ -132,28 +131,10 @@ pub fn run(a: CalibrateArgs) -> Result<()> {
         .with_context(|| format!("calibrating {}", a.dir.display()))?;
     // Parameters no sample above the threshold informed keep their nominal
     // value: say so instead of reporting them as calibrated.
-    let not_estimated: Vec<(&str, String)> = deadreckon_core::Params::NAMES
-        .iter()
-        .zip(c.samples)
-        .filter(|(_, n)| *n == 0)
-        .map(|(name, _)| {
-            (
-                *name,
-                format!(
-                    "0 samples above the speed threshold {} m/s: nominal kept",
-                    opts.min_speed_mps
-                ),
-            )
-        })
-        .collect();
+    let not_estimated = deadreckon_api::json::not_estimated(&c, opts.min_speed_mps);
     // With the truth, the steering ratio and offset too.
-    let steering = match (method, Reference::from_truth(&drive.truth)) {
-        (Method::Truth, Some(r)) if !drive.steering.is_empty() => Some(
-            calibrate_steering(&drive, &r, opts.min_speed_mps)
-                .context("calibrating the steering")?,
-        ),
-        _ => None,
-    };
+    let steering = deadreckon_api::json::car_steering(&drive, method, opts.min_speed_mps)
+        .context("calibrating the steering")?;
     let mut written = Vec::new();
     if let Some(out) = &a.out {
         let export = || deadreckon_io::stack_params::StackExport {
@@ -208,17 +189,12 @@ pub fn run(a: CalibrateArgs) -> Result<()> {
         );
     }
     if a.json {
-        let mut v = common::calibration_json(&method_name, &c);
-        v["not_estimated"] = not_estimated
-            .iter()
-            .map(|(k, why)| (k.to_string(), serde_json::Value::from(why.clone())))
-            .collect::<serde_json::Map<_, _>>()
-            .into();
-        if let Some(st) = &steering {
-            v["steering"] = serde_json::json!({
-                "ratio": st.ratio, "offset_rad": st.offset, "samples": st.samples, "rms_rad": st.rms_rad,
-            });
-        }
+        let v = deadreckon_api::json::calibrate_json(
+            &method_name,
+            &c,
+            opts.min_speed_mps,
+            steering.as_ref(),
+        );
         outln!("{}", serde_json::to_string_pretty(&v)?);
     } else {
         outln!("{}", common::params_header());

@@ -117,7 +117,7 @@ pub fn params_row(name: &str, p: &ParamsWithStd) -> String {
     )
 }
 
-pub use deadreckon_api::json::{calibration_json, gates_json};
+pub use deadreckon_api::json::gates_json;
 
 /// A one-line account of what the filter used and gated.
 pub fn stats_line(st: &deadreckon_core::ekf::FilterStats) -> String {

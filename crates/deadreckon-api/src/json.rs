@@ -65,6 +65,69 @@ pub fn summary_json(s: &Summary) -> Value {
     json!({"mean": s.mean, "median": s.median, "p95": s.p95, "min": s.min, "max": s.max, "std": s.std, "n": s.n})
 }
 
+/// The parameters of `c` no sample above `min_speed_mps` informed (they keep
+/// their nominal value), with why: `(name, reason)`.
+pub fn not_estimated(c: &Calibration, min_speed_mps: f64) -> Vec<(&'static str, String)> {
+    Params::NAMES
+        .iter()
+        .zip(c.samples)
+        .filter(|(_, n)| *n == 0)
+        .map(|(name, _)| {
+            (
+                *name,
+                format!("0 samples above the speed threshold {min_speed_mps} m/s: nominal kept"),
+            )
+        })
+        .collect()
+}
+
+/// The steering calibration of a car, as `calibrate --json` reports it.
+pub fn steering_json(st: &deadreckon_core::kinematics::steering::SteeringCalibration) -> Value {
+    json!({"ratio": st.ratio, "offset_rad": st.offset, "samples": st.samples, "rms_rad": st.rms_rad})
+}
+
+/// The car's steering ratio and offset against the truth, as `calibrate
+/// --method truth` fits them beside the six parameters (`None` for other
+/// methods, or without truth or steering).
+pub fn car_steering(
+    drive: &deadreckon_core::Drive,
+    method: deadreckon_core::calibrate::Method,
+    min_speed_mps: f64,
+) -> Result<
+    Option<deadreckon_core::kinematics::steering::SteeringCalibration>,
+    deadreckon_core::Error,
+> {
+    use deadreckon_core::calibrate::Method;
+    use deadreckon_core::reference::Reference;
+    match (method, Reference::from_truth(&drive.truth)) {
+        (Method::Truth, Some(r)) if !drive.steering.is_empty() => {
+            deadreckon_core::kinematics::steering::calibrate_steering(drive, &r, min_speed_mps)
+                .map(Some)
+        }
+        _ => Ok(None),
+    }
+}
+
+/// The `calibrate --json` object: [`calibration_json`] with the parameters
+/// not estimated and, when fitted, the steering.
+pub fn calibrate_json(
+    method: &str,
+    c: &Calibration,
+    min_speed_mps: f64,
+    steering: Option<&deadreckon_core::kinematics::steering::SteeringCalibration>,
+) -> Value {
+    let mut v = calibration_json(method, c);
+    v["not_estimated"] = not_estimated(c, min_speed_mps)
+        .into_iter()
+        .map(|(k, why)| (k.to_string(), Value::from(why)))
+        .collect::<serde_json::Map<_, _>>()
+        .into();
+    if let Some(st) = steering {
+        v["steering"] = steering_json(st);
+    }
+    v
+}
+
 /// `evaluate --outage LEN --json`: sliding outages of `outage_s` with the
 /// parameters from `params` (their source, as printed).
 pub fn outage_json(outage_s: f64, params: &str, ev: &OutageEvaluation) -> Value {
