@@ -291,22 +291,7 @@ fn run_tricycle(a: &EvaluateArgs) -> Result<()> {
             "{} outage windows of {len} s from the reference pose (parameters: {source})",
             ev.windows.len()
         );
-        outln!(
-            "{:<28} {:>9} {:>9} {:>9} {:>9}",
-            "",
-            "mean",
-            "median",
-            "p95",
-            "max"
-        );
-        outln!(
-            "{:<28} {:>9.3} {:>9.3} {:>9.3} {:>9.3}",
-            "final error (m)",
-            s.mean,
-            s.median,
-            s.p95,
-            s.max
-        );
+        final_error_table(&s)?;
     }
     Ok(())
 }
@@ -352,22 +337,28 @@ fn run_diff_drive(a: &EvaluateArgs) -> Result<()> {
             ev.windows.len(),
             a.align
         );
-        outln!(
-            "{:<28} {:>9} {:>9} {:>9} {:>9}",
-            "",
-            "mean",
-            "median",
-            "p95",
-            "max"
-        );
-        outln!(
-            "{:<28} {:>9.3} {:>9.3} {:>9.3} {:>9.3}",
-            "final error (m)",
-            s.mean,
-            s.median,
-            s.p95,
-            s.max
-        );
+        final_error_table(&s)?;
     }
+    Ok(())
+}
+
+/// The final-error line of the kinematic shapes' outage evaluations.
+fn final_error_table(s: &deadreckon_core::metrics::Summary) -> Result<()> {
+    outln!(
+        "{:<28} {:>9} {:>9} {:>9} {:>9}",
+        "",
+        "mean",
+        "median",
+        "p95",
+        "max"
+    );
+    outln!(
+        "{:<28} {:>9.3} {:>9.3} {:>9.3} {:>9.3}",
+        "final error (m)",
+        s.mean,
+        s.median,
+        s.p95,
+        s.max
+    );
     Ok(())
 }

@@ -57,13 +57,14 @@ pub fn check(drive: &Drive) -> Vec<Finding> {
     let mut out = Vec::new();
     vehicle_lengths(drive, &mut out);
     time_overlap(drive, &mut out);
-    let speed = wheel_speed(drive);
+    let rows = wheel_rows(drive);
+    let speed = wheel_speed(drive, &rows);
     wheel_speed_range(&speed, &mut out);
     // The ratios mean nothing when the wheel speed itself is impossible.
     if !out.iter().any(|f| f.check == "wheel_speed_range") {
         can_vs_wheel_speed(drive, &speed, &mut out);
         gnss_vs_wheel_distance(drive, &speed, &mut out);
-        gyro_vs_wheel_yaw_rate(drive, &mut out);
+        gyro_vs_wheel_yaw_rate(drive, &rows, &mut out);
     }
     course_vs_track(drive, &mut out);
     stuck_gnss(drive, &speed, &mut out);
@@ -178,15 +179,10 @@ fn time_overlap(d: &Drive, out: &mut Vec<Finding>) {
     }
 }
 
-/// The vehicle speed the wheel rows imply, `(t, m/s)`: the mean of the present
-/// wheels (ticks over the row interval with the nominal circumference).
-fn wheel_speed(d: &Drive) -> Vec<(f64, f64)> {
+/// Each wheel row as the four wheels' speeds, `(t, [FL, FR, RL, RR] m/s)`
+/// (ticks over the row interval with the nominal circumference).
+fn wheel_rows(d: &Drive) -> Vec<(f64, [f64; 4])> {
     let v = &d.vehicle;
-    let present: Vec<usize> = (0..4).filter(|&i| v.wheels_present[i]).collect();
-    if present.is_empty() {
-        return Vec::new();
-    }
-    let mean = |w: [f64; 4]| present.iter().map(|&i| w[i]).sum::<f64>() / present.len() as f64;
     match &d.wheels {
         Wheels::Ticks(rows) => {
             let per_tick = v.wheel_circumference_m / v.ticks_per_rev as f64;
@@ -195,17 +191,35 @@ fn wheel_speed(d: &Drive) -> Vec<(f64, f64)> {
                     let dt = p[1].t_s - p[0].t_s;
                     let r = &p[1];
                     (dt > 0.0).then(|| {
-                        let w = [r.fl, r.fr, r.rl, r.rr].map(|k| k as f64 * per_tick / dt);
-                        (r.t_s, mean(w))
+                        (
+                            r.t_s,
+                            [r.fl, r.fr, r.rl, r.rr].map(|k| k as f64 * per_tick / dt),
+                        )
                     })
                 })
                 .collect()
         }
         Wheels::Speeds(rows) => rows
             .iter()
-            .map(|r| (r.t_s, mean([r.fl_mps, r.fr_mps, r.rl_mps, r.rr_mps])))
+            .map(|r| (r.t_s, [r.fl_mps, r.fr_mps, r.rl_mps, r.rr_mps]))
             .collect(),
     }
+}
+
+/// The vehicle speed the wheel rows imply, `(t, m/s)`: the mean of the present wheels.
+fn wheel_speed(d: &Drive, rows: &[(f64, [f64; 4])]) -> Vec<(f64, f64)> {
+    let present: Vec<usize> = (0..4).filter(|&i| d.vehicle.wheels_present[i]).collect();
+    if present.is_empty() {
+        return Vec::new();
+    }
+    rows.iter()
+        .map(|(t, w)| {
+            (
+                *t,
+                present.iter().map(|&i| w[i]).sum::<f64>() / present.len() as f64,
+            )
+        })
+        .collect()
 }
 
 fn wheel_speed_range(speed: &[(f64, f64)], out: &mut Vec<Finding>) {
@@ -343,7 +357,7 @@ fn gnss_vs_wheel_distance(d: &Drive, speed: &[(f64, f64)], out: &mut Vec<Finding
     ));
 }
 
-fn gyro_vs_wheel_yaw_rate(d: &Drive, out: &mut Vec<Finding>) {
+fn gyro_vs_wheel_yaw_rate(d: &Drive, rows: &[(f64, [f64; 4])], out: &mut Vec<Finding>) {
     let v = &d.vehicle;
     // The yaw rate of an axle whose two wheels carry sensors: (right − left) / track.
     let pair = if v.wheels_present[2] && v.wheels_present[3] {
@@ -354,25 +368,10 @@ fn gyro_vs_wheel_yaw_rate(d: &Drive, out: &mut Vec<Finding>) {
         None
     };
     let Some((l, r, track)) = pair else { return };
-    let rate: Vec<(f64, f64)> = match &d.wheels {
-        Wheels::Ticks(rows) => {
-            let per_tick = v.wheel_circumference_m / v.ticks_per_rev as f64;
-            rows.windows(2)
-                .filter_map(|p| {
-                    let dt = p[1].t_s - p[0].t_s;
-                    let w = [p[1].fl, p[1].fr, p[1].rl, p[1].rr];
-                    (dt > 0.0).then(|| (p[1].t_s, (w[r] - w[l]) as f64 * per_tick / dt / track))
-                })
-                .collect()
-        }
-        Wheels::Speeds(rows) => rows
-            .iter()
-            .map(|s| {
-                let w = [s.fl_mps, s.fr_mps, s.rl_mps, s.rr_mps];
-                (s.t_s, (w[r] - w[l]) / track)
-            })
-            .collect(),
-    };
+    let rate: Vec<(f64, f64)> = rows
+        .iter()
+        .map(|(t, w)| (*t, (w[r] - w[l]) / track))
+        .collect();
     // Smooth the wheel rate over about 0.5 s (ticks are coarse), then regress
     // the gyro on it through the origin after removing both means (the bias).
     let smooth: Vec<(f64, f64)> = rate

@@ -507,6 +507,38 @@ mod tests {
         Database::parse(text, Path::new("c.dbc")).unwrap()
     }
 
+    /// The wheel ticks the 8-bit counter mapping decodes from frames of
+    /// the four counters' bytes, 0.1 s apart.
+    fn decode_counters(data: &[[u8; 4]]) -> Vec<deadreckon_core::drive::WheelTicks> {
+        let db = counter_db();
+        let map = "[wheel_ticks]\nmessage=\"PULSES\"\nfl=\"FL\"\nfr=\"FR\"\nrl=\"RL\"\nrr=\"RR\"\ncounter_bits=8\n";
+        let m = Mapping::parse(map, &db, Path::new("m.toml")).unwrap();
+        let frames: Vec<CanFrame> = data
+            .iter()
+            .enumerate()
+            .map(|(k, d)| CanFrame {
+                t_s: 0.1 * k as f64,
+                bus: "can0".into(),
+                id: 256,
+                extended: false,
+                rtr: false,
+                data: d.to_vec(),
+            })
+            .collect();
+        let imp = decode_frames(
+            &frames,
+            &m,
+            crate::profiles::toyota_rav4(),
+            TimeOrderPolicy::Error,
+            Path::new("x"),
+        )
+        .unwrap();
+        let Wheels::Ticks(t) = imp.drive.wheels else {
+            panic!("wheel ticks expected")
+        };
+        t
+    }
+
     #[test]
     fn wheel_counters_unwrap_modulo_their_width() {
         let db = counter_db();
@@ -518,66 +550,15 @@ mod tests {
                 .byte_order,
             ByteOrder::LittleEndian
         );
-        let map = "[wheel_ticks]\nmessage=\"PULSES\"\nfl=\"FL\"\nfr=\"FR\"\nrl=\"RL\"\nrr=\"RR\"\ncounter_bits=8\n";
-        let m = Mapping::parse(map, &db, Path::new("m.toml")).unwrap();
-        let f = |t: f64, d: [u8; 4]| CanFrame {
-            t_s: t,
-            bus: "can0".into(),
-            id: 256,
-            extended: false,
-            rtr: false,
-            data: d.to_vec(),
-        };
-        let frames = [
-            f(0.0, [250, 0, 10, 255]),
-            f(0.1, [4, 0, 20, 3]),
-            f(0.2, [9, 1, 20, 3]),
-        ];
-        let imp = decode_frames(
-            &frames,
-            &m,
-            crate::profiles::toyota_rav4(),
-            TimeOrderPolicy::Error,
-            Path::new("x"),
-        )
-        .unwrap();
-        let Wheels::Ticks(t) = &imp.drive.wheels else {
-            panic!()
-        };
+        let t = decode_counters(&[[250, 0, 10, 255], [4, 0, 20, 3], [9, 1, 20, 3]]);
         assert_eq!((t[0].fl, t[1].fl, t[2].fl), (0, 10, 5));
         assert_eq!((t[1].rr, t[2].fr, t[1].rl), (4, 1, 10));
     }
 
     #[test]
     fn a_counter_stepping_back_by_one_was_255_ticks() {
-        let db = counter_db();
-        let map = "[wheel_ticks]\nmessage=\"PULSES\"\nfl=\"FL\"\nfr=\"FR\"\nrl=\"RL\"\nrr=\"RR\"\ncounter_bits=8\n";
-        let m = Mapping::parse(map, &db, Path::new("m.toml")).unwrap();
-        let f = |t: f64, d: [u8; 4]| CanFrame {
-            t_s: t,
-            bus: "can0".into(),
-            id: 256,
-            extended: false,
-            rtr: false,
-            data: d.to_vec(),
-        };
         // FL steps back by one, RR steps back across the wrap, FR reverses.
-        let frames = [
-            f(0.0, [10, 100, 0, 1]),
-            f(0.1, [9, 97, 0, 254]),
-            f(0.2, [11, 93, 0, 2]),
-        ];
-        let imp = decode_frames(
-            &frames,
-            &m,
-            crate::profiles::toyota_rav4(),
-            TimeOrderPolicy::Error,
-            Path::new("x"),
-        )
-        .unwrap();
-        let Wheels::Ticks(t) = &imp.drive.wheels else {
-            panic!()
-        };
+        let t = decode_counters(&[[10, 100, 0, 1], [9, 97, 0, 254], [11, 93, 0, 2]]);
         assert_eq!((t[1].fl, t[2].fl), (-1, 2));
         assert_eq!((t[1].fr, t[2].fr), (-3, -4));
         assert_eq!((t[1].rr, t[2].rr), (-3, 4));
