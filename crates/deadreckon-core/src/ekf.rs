@@ -571,28 +571,25 @@ impl Feeder {
                         return Ok(());
                     };
                     let prediction = self.predict(f, t);
-                    f.deferring_symmetry(|f| -> Result<(), Error> {
-                        if use_.wheels {
-                            if gap {
-                                self.stats.wheel_gaps += 1;
-                            } else {
-                                self.wheel_updates(f, &ev.measurement, interval)?;
-                            }
+                    if use_.wheels {
+                        if gap {
+                            self.stats.wheel_gaps += 1;
+                        } else {
+                            self.wheel_updates(f, &ev.measurement, interval)?;
                         }
-                        if let Some(v) = self.pending_gyro.take() {
-                            self.updates.push(f.update_gyro(v)?);
-                        }
-                        if let Some(v) = self.pending_speed.take() {
-                            self.updates.push(f.update_speed(v)?);
-                        }
-                        if let Some(v) = self.pending_steering.take() {
-                            self.updates.push(f.update_steering(v)?);
-                        }
-                        if let Some(fix) = self.pending_gnss.take() {
-                            self.gnss_update(f, &fix)?;
-                        }
-                        Ok(())
-                    })?;
+                    }
+                    if let Some(v) = self.pending_gyro.take() {
+                        self.updates.push(f.update_gyro(v)?);
+                    }
+                    if let Some(v) = self.pending_speed.take() {
+                        self.updates.push(f.update_speed(v)?);
+                    }
+                    if let Some(v) = self.pending_steering.take() {
+                        self.updates.push(f.update_steering(v)?);
+                    }
+                    if let Some(fix) = self.pending_gnss.take() {
+                        self.gnss_update(f, &fix)?;
+                    }
                     self.stats.epochs += 1;
                     epoch(
                         f,
@@ -638,9 +635,7 @@ impl Feeder {
                             if gap {
                                 self.stats.wheel_gaps += 1;
                             } else {
-                                f.deferring_symmetry(|f| {
-                                    self.wheel_updates(f, &ev.measurement, interval)
-                                })?;
+                                self.wheel_updates(f, &ev.measurement, interval)?;
                             }
                         }
                     }

@@ -265,10 +265,6 @@ pub struct Filter<L: Layout<N>, const N: usize> {
     /// Consecutive rejections per sensor (same order as [`GateCounts`]).
     consecutive: [u32; 9],
     gates: GateCounts,
-    /// Inside [`Filter::deferring_symmetry`]: scalar updates keep only the
-    /// lower triangle of `p` up to date.
-    #[serde(skip)]
-    deferred: bool,
     #[serde(skip)]
     layout: PhantomData<L>,
 }
@@ -325,7 +321,6 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
             wheels_present: vehicle.wheels_present,
             consecutive: [0; 9],
             gates: GateCounts::default(),
-            deferred: false,
             layout: PhantomData,
         })
     }
@@ -334,25 +329,6 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
     pub fn with_covariance_form(mut self, form: CovarianceForm) -> Self {
         self.form = form;
         self
-    }
-
-    /// Runs `updates` (several `update_*` calls in a row) with the covariance
-    /// mirrored once at the end instead of after every scalar update: the same
-    /// result to the last bit, about a third less work per scalar update. Inside,
-    /// [`Filter::covariance`] shows only its lower triangle up to date.
-    pub fn deferring_symmetry<R>(&mut self, updates: impl FnOnce(&mut Self) -> R) -> R {
-        self.deferred = true;
-        let r = updates(self);
-        self.symmetrise();
-        r
-    }
-
-    /// Ends a deferred stretch: the upper triangle from the lower one.
-    fn symmetrise(&mut self) {
-        if self.deferred {
-            kalman::mirror_lower(&mut self.p);
-            self.deferred = false;
-        }
     }
 
     /// Time of the state, s.
@@ -441,7 +417,6 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
     /// [`Filter::predict_to`] without copying the predicted state and
     /// covariance out: returns the car block of F only.
     pub fn advance_to(&mut self, t_s: f64) -> Mat {
-        self.symmetrise();
         let dt = (t_s - self.t_s).max(0.0);
         let car = self.car_state();
         let f5 = model::jacobian(&car, dt);
@@ -528,15 +503,12 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
         } else {
             z - h
         };
-        let pre = kalman::ScalarInnovation::sparse_lower(&self.p, &row[..n], r, y, self.t_s)?;
+        let pre = kalman::ScalarInnovation::sparse(&self.p, &row[..n], r, y, self.t_s)?;
         let (s, nis) = (pre.s, pre.nis());
         let (accepted, _) = self.decide(sensor, nis);
         if accepted {
             // Both covariance forms are the same for a scalar (see `apply`).
-            pre.apply_lower(&mut self.x, &mut self.p);
-            if !self.deferred {
-                kalman::mirror_lower(&mut self.p);
-            }
+            pre.apply(&mut self.x, &mut self.p, kalman::CovarianceForm::Joseph);
             self.refresh_params();
         }
         Ok(Update {
@@ -628,10 +600,6 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
     /// the filter takes itself to be lost: it widens its position (and yaw)
     /// covariance to cover the innovation and takes the fix (a recovery).
     pub fn update_gnss(&mut self, fix: &GnssFix) -> Result<Update, Error> {
-        // The vector update reads the whole covariance.
-        let deferred = self.deferred;
-        self.symmetrise();
-        self.deferred = deferred;
         let (h, jac5) = self.sensors.gnss(&self.car_state());
         let mut jac = SMatrix::<f64, 2, N>::zeros();
         jac.fixed_view_mut::<2, 5>(0, 0).copy_from(&jac5);
@@ -772,18 +740,14 @@ mod tests {
     }
 
     #[test]
-    fn deferring_symmetry_changes_no_bit() {
-        let (mut a, mut b) = (augmented(), augmented());
+    fn scalar_updates_keep_the_covariance_exactly_symmetric() {
+        let mut a = augmented();
         for k in 1..200 {
-            let t = 0.02 * k as f64;
-            a.predict_to(t);
-            b.predict_to(t);
+            a.predict_to(0.02 * k as f64);
             epoch(&mut a, k);
-            b.deferring_symmetry(|b| epoch(b, k));
-            assert_eq!(a, b, "epoch {k}");
+            let p = a.covariance();
+            assert_eq!(*p, p.transpose(), "epoch {k}");
         }
-        let p = a.covariance();
-        assert_eq!(*p, p.transpose());
     }
 
     #[test]

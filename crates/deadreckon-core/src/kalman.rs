@@ -125,32 +125,6 @@ impl<const N: usize> ScalarInnovation<N> {
         })
     }
 
-    /// As [`ScalarInnovation::sparse`], reading only the lower triangle of `p`
-    /// (entry (i, j) as (max, min)): the upper one may be out of date after
-    /// [`ScalarInnovation::apply_lower`]. Equal to `sparse` on a symmetric `p`.
-    pub fn sparse_lower(
-        p: &SMatrix<f64, N, N>,
-        h: &[(usize, f64)],
-        r: f64,
-        y: f64,
-        t_s: f64,
-    ) -> Result<Self, Error> {
-        let mut ph = [0.0f64; N];
-        let cols: &[[f64; N]; N] = &p.data.0;
-        for &(j, hj) in h {
-            let Some(col_j) = cols.get(j) else {
-                continue;
-            };
-            // Rows above the diagonal from row j of the earlier columns, from
-            // the diagonal down column j itself (a fixed-length loop, unrolled).
-            for (i, o) in ph.iter_mut().enumerate() {
-                let c = if i < j { cols[i][j] } else { col_j[i] };
-                *o += hj * c;
-            }
-        }
-        Self::finish(ph, h, r, y, t_s)
-    }
-
     /// The normalised innovation squared ỹ² / S.
     pub fn nis(&self) -> f64 {
         self.y * self.y / self.s
@@ -179,36 +153,17 @@ impl<const N: usize> ScalarInnovation<N> {
         p: &mut SMatrix<f64, N, N>,
         _form: CovarianceForm,
     ) {
-        self.apply_lower(x, p);
-        mirror_lower(p);
-    }
-
-    /// [`ScalarInnovation::apply`] on the lower triangle of `p` only (the
-    /// upper one is left out of date until [`mirror_lower`]), which saves the
-    /// mirroring when several scalar updates follow each other.
-    pub fn apply_lower(&self, x: &mut SVector<f64, N>, p: &mut SMatrix<f64, N, N>) {
         let (ph, s, y) = (&self.ph, self.s, self.y);
         // K = P Hᵀ S⁻¹   (15);  x̂ = x̂⁻ + K ỹ   (16)
         x.axpy(y / s, ph, 1.0);
         let inv_s = 1.0 / s;
-        let ph: &[f64] = ph.as_slice();
-        // The lower triangle, down contiguous columns.
-        let m = p.as_mut_slice();
-        for j in 0..N {
-            let phj = ph[j] * inv_s;
-            for (c, &phi) in m[j * N + j..(j + 1) * N].iter_mut().zip(&ph[j..]) {
-                *c -= phi * phj;
+        let ph: &[f64; N] = &ph.data.0[0];
+        // Every column at full length (vectorised); (P H)ᵢ (P H)ⱼ is the same
+        // product for (i, j) and (j, i), so P stays exactly symmetric.
+        for (col, &phj) in p.data.0.iter_mut().zip(ph) {
+            for (c, &phi) in col.iter_mut().zip(ph) {
+                *c -= (phi * phj) * inv_s;
             }
-        }
-    }
-}
-
-/// Copies the lower triangle of `p` onto the upper one.
-pub fn mirror_lower<const N: usize>(p: &mut SMatrix<f64, N, N>) {
-    let m = p.as_mut_slice();
-    for j in 0..N {
-        for i in j + 1..N {
-            m[i * N + j] = m[j * N + i];
         }
     }
 }
