@@ -54,6 +54,18 @@ enum Command {
 
 fn main() {
     let cli = Cli::parse();
+    // An interrupted command leaves no temporary file or directory behind:
+    // the writes register them (deadreckon_io::temporaries). Exit status as
+    // a shell reports a SIGINT (128 + 2).
+    if let Err(e) = ctrlc::set_handler(|| {
+        deadreckon_io::temporaries::remove_all();
+        eprintln!("interrupted");
+        std::process::exit(130);
+    }) {
+        eprintln!(
+            "warning: no signal handler ({e}): an interrupted write may leave a temporary file"
+        );
+    }
     if let Err(e) = run(cli) {
         // A closed standard output (`| head`) ends the command quietly.
         if closed_pipe(&e) {

@@ -241,3 +241,68 @@ fn calibrate_json_into_a_full_device_or_a_closed_pipe_panicked() {
     assert!(out.status.success(), "{err}");
     assert!(!err.contains("panicked"), "{err}");
 }
+
+/// Issue 12: temporary files were left after SIGINT. `simulate` into a new
+/// directory is interrupted while its temporary directory exists; the handler
+/// removes it and the target is never created.
+#[cfg(unix)]
+#[test]
+fn simulate_interrupted_by_sigint_left_its_temporary_directory() {
+    let tmp = tempfile::tempdir().unwrap();
+    let target = tmp.path().join("d");
+    let mut child = bin()
+        .args([
+            "simulate",
+            "--scenario",
+            "calibration",
+            "--laps",
+            "8",
+            "--seed",
+            "2",
+            "--out",
+        ])
+        .arg(&target)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let temporaries = || -> Vec<String> {
+        std::fs::read_dir(tmp.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|n| n.starts_with(".d."))
+            .collect()
+    };
+    // Wait until the write has its temporary directory, then interrupt.
+    let start = std::time::Instant::now();
+    loop {
+        if !temporaries().is_empty() {
+            break;
+        }
+        if let Some(status) = child.try_wait().unwrap() {
+            panic!("simulate finished ({status}) before its temporary directory was seen");
+        }
+        assert!(
+            start.elapsed().as_secs() < 300,
+            "simulate never started writing"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(1));
+    }
+    let st = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(st.success());
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(130),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(
+        temporaries(),
+        Vec::<String>::new(),
+        "temporary directory left"
+    );
+    assert!(!target.exists(), "a partial drive was left at the target");
+}

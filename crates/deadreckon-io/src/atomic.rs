@@ -16,7 +16,9 @@ use crate::IoError;
 /// or with its previous content. The parent directory is not created.
 ///
 /// The new file keeps the permissions of the file it replaces, or gets `0o644`
-/// on Unix when it is new (temporary files are created `0o600`).
+/// on Unix when it is new (temporary files are created `0o600`). While it
+/// exists the temporary file is registered in [`crate::temporaries`], so an
+/// interrupted program can remove it.
 ///
 /// ```
 /// # let dir = tempfile::tempdir().unwrap();
@@ -47,6 +49,7 @@ where
         .suffix(".tmp")
         .tempfile_in(parent)
         .map_err(|e| IoError::io(path, in_dir(parent, e)))?;
+    let _registered = crate::temporaries::register(tmp.path());
     let previous_permissions = fs::metadata(path).ok().map(|m| m.permissions());
     {
         let mut w = BufWriter::new(tmp.as_file());

@@ -49,6 +49,7 @@ pub mod kinematic_toml;
 mod write;
 
 pub mod stack_params;
+pub mod temporaries;
 
 pub mod events;
 pub use atomic::atomic_write;

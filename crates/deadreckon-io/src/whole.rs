@@ -1,7 +1,10 @@
 //! Whole drive directories: written beside the target under a temporary name
 //! and renamed into place, so a reader sees the old drive or the new one,
 //! never a mixture (a full disk, an error or a signal half-way leaves the
-//! target as it was).
+//! target as it was). The temporary directories are registered in
+//! [`crate::temporaries`] and the final renames run in
+//! [`crate::temporaries::critical`], so an interrupted program removes them
+//! without ever removing the previous drive while it is moved aside.
 
 use std::fs;
 use std::path::Path;
@@ -48,12 +51,26 @@ pub fn write_drive_whole(
     }
     fs::create_dir_all(parent).map_err(|e| IoError::io(parent, e))?;
     let tmp = temp_dir(parent, &name)?;
+    let _registered = crate::temporaries::register(tmp.path());
     write_drive(tmp.path(), drive)?;
     extra(tmp.path())?;
+    crate::temporaries::critical(|| swap_in(dir, tmp, exists, parent, &name))
+}
+
+/// Moves the finished temporary directory `tmp` to `dir`, the previous drive
+/// (if `exists`) aside and then away.
+fn swap_in(
+    dir: &Path,
+    tmp: tempfile::TempDir,
+    exists: bool,
+    parent: &Path,
+    name: &str,
+) -> Result<(), IoError> {
     if exists {
         // Move the old directory aside (into a temporary directory removed
         // when it drops), the new one in; put the old one back on failure.
-        let aside = temp_dir(parent, &name)?;
+        let aside = temp_dir(parent, name)?;
+        let _registered = crate::temporaries::register(aside.path());
         let old = aside.path().join("previous");
         fs::rename(dir, &old).map_err(|e| IoError::io(dir, e))?;
         if let Err(e) = fs::rename(tmp.path(), dir) {

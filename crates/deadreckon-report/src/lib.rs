@@ -44,8 +44,7 @@ pub mod sample;
 mod sections;
 mod stats;
 
-use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 pub use model::*;
 
@@ -83,14 +82,9 @@ pub enum ReportError {
     /// The HTML template failed.
     #[error("HTML template: {0}")]
     Template(String),
-    /// The report could not be written.
-    #[error("writing {path}: {source}")]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// The cause.
-        source: std::io::Error,
-    },
+    /// The report file could not be written (names the file).
+    #[error(transparent)]
+    Write(deadreckon_io::IoError),
 }
 
 pub(crate) fn check_len(
@@ -131,30 +125,13 @@ pub fn render_html(input: &ReportInput) -> Result<String, ReportError> {
     page::render_page(&input.header, &input.footer, &sections)
 }
 
-/// Renders the report and writes it to `path` atomically (a temporary file in the
-/// same directory, then a rename), so a reader never sees a half-written page.
+/// Renders the report and writes it to `path` atomically
+/// ([`deadreckon_io::atomic_write`]: a temporary file in the same directory,
+/// then a rename), so a reader never sees a half-written page; a replaced
+/// report keeps its permissions, and an interrupted program can remove the
+/// temporary file ([`deadreckon_io::temporaries`]).
 pub fn write_report(path: impl AsRef<Path>, input: &ReportInput) -> Result<(), ReportError> {
     let path = path.as_ref();
     let html = render_html(input)?;
-    let io = |source| ReportError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    let mut tmp = tempfile::NamedTempFile::new_in(dir).map_err(io)?;
-    tmp.write_all(html.as_bytes()).map_err(io)?;
-    // Temporary files are private (0600); a report is an ordinary document.
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        tmp.as_file()
-            .set_permissions(std::fs::Permissions::from_mode(0o644))
-            .map_err(io)?;
-    }
-    tmp.as_file().sync_all().map_err(io)?;
-    tmp.persist(path).map_err(|e| io(e.error))?;
-    Ok(())
+    deadreckon_io::atomic_write(path, |w| w.write_all(html.as_bytes())).map_err(ReportError::Write)
 }

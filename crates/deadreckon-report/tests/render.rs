@@ -377,8 +377,26 @@ fn write_report_replaces_the_file_atomically() {
     let missing = dir.path().join("no/such/dir/report.html");
     assert!(matches!(
         write_report(&missing, &ReportInput::default()),
-        Err(ReportError::Io { .. })
+        Err(ReportError::Write(_))
     ));
+}
+
+/// Issue 12: `report` replaced a 0600 file with a 0644 one.
+#[cfg(unix)]
+#[test]
+fn report_replacing_a_private_file_made_it_world_readable() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("report.html");
+    std::fs::write(&path, "old").unwrap();
+    std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o600)).unwrap();
+    write_report(&path, &sample_input(60.0)).unwrap();
+    let mode = std::fs::metadata(&path).unwrap().permissions().mode() & 0o777;
+    assert_eq!(mode, 0o600);
+    let fresh = dir.path().join("new.html");
+    write_report(&fresh, &sample_input(60.0)).unwrap();
+    let mode = std::fs::metadata(&fresh).unwrap().permissions().mode() & 0o777;
+    assert_eq!(mode, 0o644, "a new report is an ordinary document");
 }
 
 #[test]
