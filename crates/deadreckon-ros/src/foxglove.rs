@@ -37,6 +37,7 @@ fn time_schema(description: &str) -> Value {
             "sec": {"type": "integer", "minimum": 0},
             "nsec": {"type": "integer", "minimum": 0, "maximum": 999_999_999}
         },
+        "required": ["sec", "nsec"],
         "description": description
     })
 }
@@ -46,7 +47,7 @@ fn xyz(title: &str, names: &[&str]) -> Value {
         .iter()
         .map(|n| (n.to_string(), json!({"type": "number"})))
         .collect();
-    json!({"title": title, "type": "object", "properties": props})
+    json!({"title": title, "type": "object", "properties": props, "required": names})
 }
 
 /// The JSON schema of `foxglove.PoseInFrame` (as published in Foxglove's schemas).
@@ -65,9 +66,11 @@ pub fn pose_in_frame_schema() -> Value {
                 "properties": {
                     "position": xyz("foxglove.Vector3", &["x", "y", "z"]),
                     "orientation": xyz("foxglove.Quaternion", &["x", "y", "z", "w"])
-                }
+                },
+                "required": ["position", "orientation"]
             }
-        }
+        },
+        "required": ["timestamp", "frame_id", "pose"]
     })
 }
 
@@ -90,7 +93,11 @@ pub fn location_fix_schema() -> Value {
             "altitude": {"type": "number", "description": "Altitude in meters"},
             "position_covariance": {"type": "array", "items": {"type": "number"}, "minItems": 9, "maxItems": 9},
             "position_covariance_type": {"title": "foxglove.PositionCovarianceType", "oneOf": kinds}
-        }
+        },
+        "required": [
+            "timestamp", "frame_id", "latitude", "longitude", "altitude",
+            "position_covariance", "position_covariance_type"
+        ]
     })
 }
 
@@ -133,12 +140,27 @@ fn geodetic(origin: Origin, east_m: f64, north_m: f64) -> (f64, f64, f64) {
     (lat, lon, 0.0)
 }
 
+/// `foxglove.PositionCovarianceType` DIAGONAL_KNOWN: per-axis variances (a
+/// GNSS fix's isotropic standard deviation).
+const COVARIANCE_DIAGONAL_KNOWN: u8 = 2;
+/// `foxglove.PositionCovarianceType` KNOWN: the full east/north covariance of
+/// a filtered or dead-reckoned position (the up row and column are 0: the
+/// tracks are planar).
+const COVARIANCE_KNOWN: u8 = 3;
+
+/// Chunk compression of the MCAP files written: zstd with the `zstd-write`
+/// feature (default; mcap's C zstd), none without it.
+#[cfg(feature = "zstd-write")]
+const CHUNK_COMPRESSION: Option<mcap::Compression> = Some(mcap::Compression::Zstd);
+#[cfg(not(feature = "zstd-write"))]
+const CHUNK_COMPRESSION: Option<mcap::Compression> = None;
+
 fn location_fix(
     ts: Value,
     origin: Origin,
-    e: f64,
-    n: f64,
+    (e, n): (f64, f64),
     cov_en: [f64; 4],
+    covariance_type: u8,
     file: &str,
 ) -> Result<Vec<u8>, RosError> {
     let (lat, lon, alt) = geodetic(origin, e, n);
@@ -152,7 +174,7 @@ fn location_fix(
         "longitude": lon,
         "altitude": alt,
         "position_covariance": cov,
-        "position_covariance_type": 1
+        "position_covariance_type": covariance_type
     });
     serde_json::to_vec(&v).map_err(|e| RosError::Write {
         file: file.into(),
@@ -245,6 +267,7 @@ pub fn write_mcap_with(
         file: file.clone(),
         source: e,
     };
+    let _registered = deadreckon_io::temporaries::register(&tmp);
     let result = (|| -> Result<(), RosError> {
         let f = std::fs::File::create(&tmp).map_err(io)?;
         let mut w = BufWriter::new(f);
@@ -276,7 +299,7 @@ fn write_into<W: Write + std::io::Seek>(
     };
     let profile = if options.foxglove { "" } else { "ros2" };
     let opts = mcap::WriteOptions::new()
-        .compression(None)
+        .compression(CHUNK_COMPRESSION)
         .profile(profile)
         .library("deadreckon-ros");
     let mut out = opts.create(w).map_err(werr)?;
@@ -399,9 +422,9 @@ fn write_into<W: Write + std::io::Seek>(
                 let data = location_fix(
                     ts,
                     origin,
-                    p.east_m,
-                    p.north_m,
+                    (p.east_m, p.north_m),
                     [c[0], c[1], c[3], c[4]],
+                    COVARIANCE_KNOWN,
                     file,
                 )?;
                 out.write_to_known_channel(&header(ch), &data)
@@ -413,7 +436,14 @@ fn write_into<W: Write + std::io::Seek>(
         for (seq, g) in fixes.iter().enumerate() {
             let (ns, ts) = stamp(g.t_s, file)?;
             let v = g.std_m * g.std_m;
-            let data = location_fix(ts, origin, g.east_m, g.north_m, [v, 0.0, 0.0, v], file)?;
+            let data = location_fix(
+                ts,
+                origin,
+                (g.east_m, g.north_m),
+                [v, 0.0, 0.0, v],
+                COVARIANCE_DIAGONAL_KNOWN,
+                file,
+            )?;
             let header = mcap::records::MessageHeader {
                 channel_id: ch,
                 sequence: seq as u32,

@@ -183,6 +183,7 @@ fn foxglove_writer_round_trip() {
     let bytes = std::fs::read(&path).unwrap();
     let mut counts: BTreeMap<String, (String, String, String, usize)> = BTreeMap::new();
     let mut first_fix = None;
+    let mut first_gnss = None;
     for m in mcap::MessageStream::new(&bytes).unwrap() {
         let m = m.unwrap();
         let schema = m.channel.schema.as_ref().unwrap();
@@ -198,6 +199,9 @@ fn foxglove_writer_round_trip() {
         let v: serde_json::Value = serde_json::from_slice(&m.data).unwrap();
         if m.channel.topic == "/deadreckon/smoothed/fix" && first_fix.is_none() {
             first_fix = Some(v.clone());
+        }
+        if m.channel.topic == "/deadreckon/gnss/fix" && first_gnss.is_none() {
+            first_gnss = Some(v.clone());
         }
         if m.channel.topic.ends_with("/pose") {
             assert_eq!(v["frame_id"], "enu");
@@ -237,6 +241,10 @@ fn foxglove_writer_round_trip() {
             && (f["longitude"].as_f64().unwrap() - LON0).abs() < 1e-9
     );
     assert_eq!(f["position_covariance"][0], 0.25);
+    // Issue 12: the covariance type said "approximated" where it is known
+    // (the filter's east/north covariance), "diagonal known" for a GNSS fix.
+    assert_eq!(f["position_covariance_type"], 3);
+    assert_eq!(first_gnss.unwrap()["position_covariance_type"], 2);
 
     // The schemas are valid JSON naming the Foxglove type.
     let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
@@ -244,6 +252,30 @@ fn foxglove_writer_round_trip() {
     for s in summary.schemas.values() {
         let v: serde_json::Value = serde_json::from_slice(&s.data).unwrap();
         assert_eq!(v["title"], s.name.as_str());
+        // Issue 12: the embedded schemas had no `required` fields.
+        let required: Vec<&str> = v["required"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|r| r.as_str().unwrap())
+            .collect();
+        assert!(required.contains(&"timestamp") && required.contains(&"frame_id"));
+        for (name, p) in v["properties"].as_object().unwrap() {
+            assert!(required.contains(&name.as_str()), "{} lacks {name}", s.name);
+            if p["type"] == "object" {
+                assert!(
+                    p["required"].is_array(),
+                    "{}.{name} has no `required`",
+                    s.name
+                );
+            }
+        }
+    }
+    // Issue 12: the chunks were written uncompressed.
+    assert!(!summary.chunk_indexes.is_empty());
+    for c in &summary.chunk_indexes {
+        assert_eq!(c.compression, "zstd");
+        assert!(c.compressed_size < c.uncompressed_size);
     }
     // A track with the same topic name as another is refused, and nothing is written.
     let p2 = dir.path().join("bad.mcap");
