@@ -68,6 +68,15 @@ pub enum ImportError {
         /// What is wrong (TOML errors carry their line and column).
         message: String,
     },
+    /// The source is not the kind of file or directory the importer reads
+    /// (the message says what it looks like and what to give instead).
+    #[error("{}: {message}", path.display())]
+    WrongSource {
+        /// The source given.
+        path: PathBuf,
+        /// What it is, and what the importer wants.
+        message: String,
+    },
     /// The vehicle or the assembled drive does not pass validation.
     #[error("{}: {source}", path.display())]
     Invalid {

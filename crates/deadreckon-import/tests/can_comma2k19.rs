@@ -136,3 +136,19 @@ fn candump_text_of_the_segment_decodes_like_the_arrays() {
         b.steering.iter().map(|s| s.value).collect::<Vec<_>>()
     );
 }
+
+/// Issue 12: `import can` on a comma2k19 segment directory failed with
+/// "…/t: No such file or directory" instead of naming the raw_can folder.
+#[test]
+fn import_can_of_a_segment_directory_did_not_say_it_wants_raw_can() {
+    let seg = common::data("comma2k19-rav4");
+    for given in [seg.clone(), seg.join("processed_log")] {
+        let e = read_raw_can(&given).unwrap_err().to_string();
+        assert!(
+            e.contains("not a raw_can folder")
+                && e.contains("CAN/raw_can")
+                && e.contains("import comma2k19"),
+            "{e}"
+        );
+    }
+}

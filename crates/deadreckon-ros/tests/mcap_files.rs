@@ -458,3 +458,21 @@ fn a_rosbag2_directory_is_read_through_its_mcap_file() {
         .to_string();
     assert!(e.contains("split over 2"), "{e}");
 }
+
+/// docs/ros.md's mapping example is a mapping this crate reads, equal to the
+/// one in the `mapping` module's documentation.
+#[test]
+fn the_mapping_in_docs_ros_md_parses() {
+    let doc = include_str!("../../../docs/ros.md");
+    let toml: String = doc
+        .lines()
+        .skip_while(|l| *l != "```toml")
+        .skip(1)
+        .take_while(|l| *l != "```")
+        .collect::<Vec<_>>()
+        .join("\n");
+    let m = Mapping::from_toml_str(&toml).unwrap();
+    assert_eq!(m.streams.len(), 3);
+    assert_eq!(m.streams[0].topic, "/husky_velocity_controller/odom");
+    assert!(m.require_topics);
+}

@@ -10,6 +10,22 @@ use crate::ImportError;
 
 /// Reads a `raw_can` directory (holding `t`, `src`, `address`, `data`).
 pub fn read_raw_can(dir: &Path) -> Result<Vec<CanFrame>, ImportError> {
+    if !dir.join("t").exists() {
+        // A comma2k19 segment (or its processed_log) given where its raw_can
+        // folder belongs: say where that folder is.
+        for inner in ["processed_log/CAN/raw_can", "CAN/raw_can"] {
+            if dir.join(inner).join("t").exists() {
+                return Err(ImportError::WrongSource {
+                    path: dir.to_path_buf(),
+                    message: format!(
+                        "a comma2k19 segment directory, not a raw_can folder: give `import can` \
+                         {} (or import the whole segment with `import comma2k19`)",
+                        dir.join(inner).display()
+                    ),
+                });
+            }
+        }
+    }
     let load = |name: &str| {
         let p = dir.join(name);
         read_npy(&p).map(|a| (a, p))
