@@ -51,8 +51,13 @@ pub(crate) fn histogram_chart(
     let frame = Frame::new(x0..x1, 0.0..top * 1.1, x_desc, y_desc);
     let svg = render_chart(figure, &frame, |chart, keys| {
         data_begin(chart)?;
-        for (s, f) in samples.iter().zip(&fractions) {
+        // Outlines drawn from the thickest to the thinnest: two methods with the
+        // same bins (RTS and truth within the first bin) both stay visible, the
+        // later one inside the earlier.
+        let k = samples.len() as u32;
+        for (j, (s, f)) in samples.iter().zip(&fractions).enumerate() {
             let c = s.color;
+            let width = 2 + 2 * (k - 1 - j as u32);
             chart
                 .draw_series(
                     f.iter()
@@ -78,7 +83,7 @@ pub(crate) fn histogram_chart(
                 keys,
                 vec![step],
                 c,
-                2,
+                width,
                 Some(&format!("{} (n = {n})", s.name)),
             )?;
         }

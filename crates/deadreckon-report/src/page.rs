@@ -111,11 +111,11 @@ struct Page<'a> {
 fn header_view(h: &Header) -> HeaderView {
     let mut facts = Vec::new();
     if let Some(d) = h.duration_s.filter(|d| d.is_finite()) {
-        let m = (d / 60.0).floor();
-        facts.push((
-            "duration".into(),
-            format!("{d:.1} s ({m:.0} min {:.0} s)", d - 60.0 * m),
-        ));
+        // Minutes and seconds of the rounded whole seconds: 59.96 s is
+        // "1 min 0 s", not "0 min 60 s".
+        let whole = d.round();
+        let (m, s) = ((whole / 60.0).floor(), whole % 60.0);
+        facts.push(("duration".into(), format!("{d:.1} s ({m:.0} min {s:.0} s)")));
     }
     if let Some(d) = h.distance_m.filter(|d| d.is_finite()) {
         facts.push(("distance".into(), format!("{:.3} km", d / 1000.0)));

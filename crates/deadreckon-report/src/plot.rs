@@ -180,6 +180,8 @@ pub(crate) struct Frame {
     pub legend: Legend,
     /// Names of the integer y values (box plots by category).
     pub y_categories: Option<Vec<String>>,
+    /// The x values are counts (iterations): labelled at integers only, without decimals.
+    pub x_integer: bool,
 }
 
 impl Frame {
@@ -199,7 +201,14 @@ impl Frame {
             height: 340,
             legend: Legend::Right,
             y_categories: None,
+            x_integer: false,
         }
+    }
+
+    /// Labels x at whole numbers only, without decimals (an iteration axis).
+    pub fn x_integer(mut self) -> Self {
+        self.x_integer = true;
+        self
     }
 
     /// Labels the integer y values 0, 1, … with names.
@@ -266,7 +275,19 @@ pub(crate) fn render_chart(
             .build_cartesian_2d(frame.x.clone(), frame.y.clone())
             .or_plot()
             .map_err(err)?;
-        let x_fmt = tick_formatter(&frame.x);
+        let x_num = tick_formatter(&frame.x);
+        let x_fmt = |v: &f64| {
+            if frame.x_integer {
+                let r = v.round();
+                if (v - r).abs() < 1e-6 {
+                    format!("{r:.0}")
+                } else {
+                    String::new()
+                }
+            } else {
+                x_num(v)
+            }
+        };
         let y_num = tick_formatter(&frame.y);
         let y_fmt = |v: &f64| match &frame.y_categories {
             Some(names) => {

@@ -481,3 +481,53 @@ fn series_without_finite_values_give_no_empty_frames() {
     assert_eq!(section_ids(&html), ["calibration"]);
     assert_eq!(figures(&html).len(), 4);
 }
+
+/// Issue 12, the report looked at: a 59.96 s drive read "60.0 s (0 min 60 s)".
+#[test]
+fn a_duration_just_under_a_minute_read_0_min_60_s() {
+    let mut input = sample_input(60.0);
+    input.header.duration_s = Some(59.96);
+    let html = render_html(&input).unwrap();
+    assert!(html.contains("60.0 s (1 min 0 s)"), "no rounded duration");
+    assert!(!html.contains("0 min 60 s"));
+}
+
+/// Issue 12: the trajectories were framed by a nominal dead-reckoning spiral
+/// hundreds of metres off; the frame follows the anchored tracks, and the
+/// wandering one is shown whole in a second figure.
+#[test]
+fn a_dead_reckoned_spiral_set_the_trajectory_frame() {
+    let mut input = sample_input(120.0);
+    let far = {
+        let t = input.trajectories.as_ref().unwrap().truth.as_ref().unwrap();
+        EnPath {
+            east_m: t
+                .east_m
+                .iter()
+                .enumerate()
+                .map(|(k, e)| e + 5.0 * k as f64)
+                .collect(),
+            north_m: t.north_m.clone(),
+        }
+    };
+    input.trajectories.as_mut().unwrap().dead_reckoned[0].path = far;
+    let html = render_html(&input).unwrap();
+    assert!(html.contains("trajectories-whole"), "no full-extent figure");
+    assert!(
+        html.contains("DR (nominal) leaves it"),
+        "the caption does not name the track"
+    );
+    // Without a wandering track there is one figure.
+    let html = render_html(&sample_input(120.0)).unwrap();
+    assert!(!html.contains("trajectories-whole"));
+}
+
+/// Issue 12: the NIS frame reached the gate (1000), flattening every NIS at 0.
+#[test]
+fn the_gate_flattened_the_nis_figure() {
+    let html = render_html(&sample_input(120.0)).unwrap();
+    assert!(
+        html.contains("(above the frame)"),
+        "the gate outside the frame is not named in the caption"
+    );
+}

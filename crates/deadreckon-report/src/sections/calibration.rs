@@ -96,6 +96,7 @@ pub(crate) fn section(
                 continue;
             };
             let frame = Frame::new(-0.3..(n as f64 - 0.7), yr, "iteration", *label)
+                .x_integer()
                 .size(SMALL_WIDTH, 250)
                 .legend(Legend::None);
             let name = format!("calibration-iterations-{}", k);

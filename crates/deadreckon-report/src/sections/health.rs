@@ -8,8 +8,8 @@ use super::{rel_time, time_desc};
 use crate::model::{FilterHealth, InnovationSeries, NisSeries};
 use crate::page::{Block, FigureView, SectionView};
 use crate::plot::{
-    data_begin, data_end, draw_hline, draw_line, fmt_sig, padded_range, render_chart, segments,
-    Frame, Legend, OrPlot, Swatch, GATED, REFERENCE, WIDTH,
+    data_begin, data_end, draw_hline, fmt_sig, padded_range, render_chart, segments, Frame, Legend,
+    OrPlot, Swatch, GATED, REFERENCE, WIDTH,
 };
 use crate::stats::{chi2_quantile, minmax_indices, quantile_sorted, sorted_finite, stride_indices};
 use crate::{check_len, check_optional_len, ReportError, MAX_POINTS, MAX_SCATTER_POINTS};
@@ -123,6 +123,22 @@ fn innovation_figure(
     .legend(Legend::Right);
     let name = format!("health-innovation-{i}");
     let svg = render_chart(&name, &frame, |chart, keys| {
+        if !upper.is_empty() {
+            // The ±2σ band as a light area under the points: a predicted σ that
+            // changes from one sample to the next (front wheels at large
+            // steering angles) drawn as two lines painted a solid black block.
+            let iu = minmax_indices(&upper, MAX_POINTS);
+            let ups = segments(&t, &upper, &iu);
+            let lows = segments(&t, &lower, &iu);
+            let fill = BAND.mix(0.16).filled();
+            chart
+                .draw_series(ups.iter().zip(&lows).map(|(u, l)| {
+                    let ring: Vec<(f64, f64)> = u.iter().chain(l.iter().rev()).copied().collect();
+                    Polygon::new(ring, fill)
+                }))
+                .or_plot()?;
+            keys.add("±2σ predicted", Swatch::Bar(RGBColor(205, 205, 205)));
+        }
         data_begin(chart)?;
         // Points, thinned evenly so the cloud keeps its shape (a min–max envelope
         // would paint noise as a solid block).
@@ -146,20 +162,7 @@ fn innovation_figure(
                 .or_plot()?;
             keys.add("gated", Swatch::Cross(GATED));
         }
-        data_end(chart)?;
-        if !upper.is_empty() {
-            let iu = minmax_indices(&upper, MAX_POINTS);
-            draw_line(
-                chart,
-                keys,
-                segments(&t, &upper, &iu),
-                BAND,
-                2,
-                Some("±2σ predicted"),
-            )?;
-            draw_line(chart, keys, segments(&t, &lower, &iu), BAND, 2, None)?;
-        }
-        Ok(())
+        data_end(chart)
     })?;
     let outside = (0..n)
         .filter(|&k| !s.gated.get(k).copied().unwrap_or(false))
@@ -231,7 +234,9 @@ fn nis_figure(
     } else {
         quantile_sorted(&acc_sorted, 0.99)
     };
-    let top = hi.max(s.gate_chi2.unwrap_or(0.0)).max(p99) * 1.15;
+    // The gate (often 1000) is not in the range: it squashed every NIS to a
+    // flat line at 0. It is drawn when it falls inside, and named otherwise.
+    let top = hi.max(p99) * 1.15;
     let yr = 0.0..top;
     let clamped: Vec<f64> = accepted.iter().map(|v| v.min(top)).collect();
     let gated = gated_points(&t, &s.nis, &s.gated);
@@ -249,7 +254,7 @@ fn nis_figure(
             Some(&format!("{pc}% bounds χ²({dof})")),
         )?;
         draw_hline(chart, keys, lo, BAND, None)?;
-        if let Some(g) = s.gate_chi2 {
+        if let Some(g) = s.gate_chi2.filter(|g| *g <= top) {
             draw_hline(chart, keys, g, REFERENCE, Some("gate"))?;
         }
         data_begin(chart)?;
@@ -286,6 +291,12 @@ fn nis_figure(
     );
     if !s.gated.is_empty() {
         caption.push_str(&format!("; {n_gated} rejected by the gate (crosses)"));
+    }
+    if let Some(g) = s.gate_chi2.filter(|g| *g > top) {
+        caption.push_str(&format!(
+            "; the gate is at {} (above the frame)",
+            fmt_sig(g, 3)
+        ));
     }
     caption.push_str(". Values above the frame are drawn at its top edge.");
     Ok(Some(FigureView { name, caption, svg }))
