@@ -306,3 +306,46 @@ fn simulate_interrupted_by_sigint_left_its_temporary_directory() {
     );
     assert!(!target.exists(), "a partial drive was left at the target");
 }
+
+/// Issue 12, the report looked at: on the Husky (no truth) the report with a
+/// TedriS model drew no dead-reckoned track (its start needed the truth) and
+/// no TedriS curve through the outages (measured against the truth only),
+/// though the captions named them.
+#[test]
+fn husky_report_drew_no_dead_reckoned_track_and_no_tedris_outage() {
+    let husky = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../shared/data/husky-gps-bag/husky_gps.bag"
+    );
+    let tmp = tempfile::tempdir().unwrap();
+    let model = tmp.path().join("model.json");
+    let st = bin()
+        .args(["tedris", "train", husky, "--out"])
+        .arg(&model)
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let html = tmp.path().join("h.html");
+    let st = bin()
+        .args(["report", husky, "--model"])
+        .arg(&model)
+        .arg("--out")
+        .arg(&html)
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let html = std::fs::read_to_string(&html).unwrap();
+    assert!(html.contains("DR (RTS)"), "no dead-reckoned track");
+    assert!(
+        html.contains("final error TedriS"),
+        "no TedriS outage curve"
+    );
+}

@@ -200,6 +200,12 @@ pub(crate) fn lines_chart(
     if yr.start > 0.0 && yr.start < 0.3 * yr.end {
         yr.start = 0.0;
     }
+    if matches!(legend, Legend::Inside(_)) {
+        // Headroom for a legend inside the frame, above the data (it covered
+        // the curves of the small outage figures).
+        let rows = lines.len() + hlines.len();
+        yr.end += (0.12 * rows as f64 + 0.1) * (yr.end - yr.start);
+    }
     let frame = Frame::new(xr, yr, x_desc, y_desc)
         .size(size.0, size.1)
         .legend(legend);

@@ -280,7 +280,7 @@ pub(crate) fn render_chart(
             if frame.x_integer {
                 let r = v.round();
                 if (v - r).abs() < 1e-6 {
-                    format!("{r:.0}")
+                    format!("{:.0}", r + 0.0)
                 } else {
                     String::new()
                 }

@@ -336,31 +336,47 @@ fn gnss_errors(
     o: &Outage,
     threshold: f64,
 ) -> OutageError {
-    let l = drive.vehicle.gnss_lever_arm_m;
     let mut errs = Vec::new();
     let (mut pred, mut total) = (0, 0);
+    for (g_t, i, e) in gnss_error_points(drive, pts, o.start_s, o.end_s) {
+        total += 1;
+        pred += usize::from(phases[i] == Phase::Predicting);
+        errs.push((g_t, e));
+    }
+    summarise_errors(o, &errs, pred, total, threshold)
+}
+
+/// The horizontal error of a TedriS track (`pts`, rear axle) against the
+/// (hidden) GNSS fixes of `drive` in `[start_s, end_s)`, each fix moved from
+/// the antenna to the rear axle along its course: `(fix time, index of the
+/// track point used, error m)`. Fixes without a track point within 0.5 s are
+/// left out. The reference of outage errors on drives without truth.
+pub fn gnss_error_points(
+    drive: &Drive,
+    pts: &[TrackPoint],
+    start_s: f64,
+    end_s: f64,
+) -> Vec<(f64, usize, f64)> {
+    let l = drive.vehicle.gnss_lever_arm_m;
+    let mut out = Vec::new();
     for g in drive
         .gnss
         .iter()
-        .filter(|g| g.t_s >= o.start_s && g.t_s < o.end_s)
+        .filter(|g| g.t_s >= start_s && g.t_s < end_s)
     {
-        let i = pts.partition_point(|p| p.t_s < g.t_s);
-        let Some(p) = pts
-            .get(i.saturating_sub(1))
-            .filter(|p| (p.t_s - g.t_s).abs() < 0.5)
-        else {
+        let i = pts.partition_point(|p| p.t_s < g.t_s).saturating_sub(1);
+        let Some(p) = pts.get(i).filter(|p| (p.t_s - g.t_s).abs() < 0.5) else {
             continue;
         };
-        total += 1;
-        pred += usize::from(phases[i.saturating_sub(1)] == Phase::Predicting);
         let yaw = g.course_yaw_rad().unwrap_or(p.yaw_rad);
         let (me, mn) = (g.east_m - l * yaw.cos(), g.north_m - l * yaw.sin());
         let ahead = (g.t_s - p.t_s) * p.speed_mps;
-        errs.push((
+        out.push((
             g.t_s,
+            i,
             (p.east_m + ahead * p.yaw_rad.cos() - me)
                 .hypot(p.north_m + ahead * p.yaw_rad.sin() - mn),
         ));
     }
-    summarise_errors(o, &errs, pred, total, threshold)
+    out
 }

@@ -47,7 +47,14 @@ pub(crate) fn section(
                 let std = r.std.map(|s| s.to_array());
                 for (i, v) in r.values.to_array().into_iter().enumerate() {
                     cells.push(fmt_sig(v, if i == 0 { 3 } else { 5 }));
-                    cells.push(std.map(|s| fmt_sig(s[i], 2)).unwrap_or_else(|| "–".into()));
+                    // A standard error of exactly 0 is a parameter the method
+                    // held fixed (the data could not determine it): "± 0"
+                    // read as perfectly known.
+                    cells.push(match std.map(|s| s[i]) {
+                        None => "–".into(),
+                        Some(s) if s == 0.0 => "not estimated".into(),
+                        Some(s) => fmt_sig(s, 2),
+                    });
                 }
                 RowView {
                     swatch: Some(palette.css(&r.method)),
@@ -57,7 +64,10 @@ pub(crate) fn section(
             .collect();
         blocks.push(Block::Tables {
             tables: vec![TableView {
-                caption: "Calibrated parameters (table III); ± is one standard error.".into(),
+                caption: "Calibrated parameters (table III); ± is one standard error; \
+                          \"not estimated\": held at its starting value because the drive \
+                          cannot determine it."
+                    .into(),
                 headers,
                 rows,
             }],

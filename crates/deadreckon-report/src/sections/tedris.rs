@@ -295,7 +295,8 @@ fn repositories(
         0.0..top,
         "repository index n (R_n)",
         "stored tuples",
-    );
+    )
+    .x_integer();
     let color = palette.color("TedriS");
     let below = |f: u64| r.min_fill.is_some_and(|m| f < m);
     let n_below = r.fill.iter().filter(|f| below(**f)).count();

@@ -92,7 +92,7 @@ pub(crate) fn section(
         .iter()
         .filter(|(_, p, _)| {
             p.east_m.iter().zip(&p.north_m).any(|(e, n)| {
-                let (dx, dy) = (0.1 * span(&xr), 0.1 * span(&yr));
+                let (dx, dy) = (0.5 * span(&xr), 0.5 * span(&yr));
                 *e < xr.start - dx || *e > xr.end + dx || *n < yr.start - dy || *n > yr.end + dy
             })
         })
@@ -207,8 +207,9 @@ pub(crate) fn section(
         }));
     } else {
         caption.push_str(&format!(
-            " The frame covers the reference, the GNSS fixes and the filtered tracks; {} \
-             leave{} it (clipped here, whole in the next figure).",
+            " The frame covers the tracks anchored to the ground (reference, GNSS fixes, \
+             filtered, smoothed); {} leave{} it by more than half its size (clipped \
+             here, whole in the next figure).",
             outside.join(", "),
             if outside.len() == 1 { "s" } else { "" }
         ));
