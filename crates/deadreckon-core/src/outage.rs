@@ -13,7 +13,7 @@ use crate::drive::Drive;
 use crate::ekf::{self, EpochHook, FilterOptions, Init, SensorSet};
 use crate::filter::GateCounts;
 use crate::metrics::Summary;
-use crate::model::{Mat, State, X, Y, YAW};
+use crate::model::{Mat, State, V, X, Y, YAW};
 use crate::reference::Reference;
 use crate::vehicle::Params;
 use crate::Error;
@@ -106,6 +106,34 @@ impl OutageEvaluation {
     }
 }
 
+/// The speed above which the vehicle counts as moving for the sliding windows, m/s.
+pub const MOVING_MPS: f64 = 0.5;
+
+/// Refuses outage windows that are empty or not inside the drive's wheel time
+/// span, naming the span: a window after the end gave a four-wheel error and
+/// "NaN … never" for TedriS.
+pub fn check_windows(drive: &Drive, windows: &[(f64, f64)]) -> Result<(), Error> {
+    let n = drive.wheels.len();
+    if n == 0 {
+        return Err(Error::Insufficient("the drive has no wheel rows".into()));
+    }
+    let (t0, t1) = (drive.wheels.t_s(0), drive.wheels.t_s(n - 1));
+    for &(a, b) in windows {
+        if !(a.is_finite() && b.is_finite() && a < b) {
+            return Err(Error::InvalidParams(format!(
+                "outage window {a}:{b} s is empty or not a number"
+            )));
+        }
+        if a < t0 || b > t1 {
+            return Err(Error::InvalidParams(format!(
+                "outage window {a}:{b} s is not inside the drive, which runs {t0:.3}–{t1:.3} s \
+                 (drive times, e.g. UNIX time for bags)"
+            )));
+        }
+    }
+    Ok(())
+}
+
 struct Collect(Vec<(f64, State)>);
 
 impl EpochHook for Collect {
@@ -116,8 +144,11 @@ impl EpochHook for Collect {
 
 /// Runs the sliding-window outage evaluation.
 ///
-/// The first window starts `warmup_s` after the filter's start; windows start
-/// every `step_s` and must end before the last GNSS fix (and the truth's end).
+/// The first window starts `warmup_s` after the filter's start, and not before
+/// the vehicle first moves (the aided speed above [`MOVING_MPS`]: windows
+/// parked at the start measured a standing filter converging, 20 m where the
+/// moving ones gave 1.5 m); windows start every `step_s` and must end before
+/// the last GNSS fix (and the truth's end).
 pub fn evaluate(
     drive: &Drive,
     params: &Params,
@@ -163,7 +194,12 @@ pub fn evaluate(
     }
     let mut windows = Vec::new();
     let mut gates = aided.stats.gates;
-    let mut start = first.t_s + warmup_s;
+    let Some(moving) = aided.epochs.iter().find(|e| e.x[V].abs() > MOVING_MPS) else {
+        return Err(Error::Insufficient(format!(
+            "the vehicle never moves faster than {MOVING_MPS} m/s: no outage to evaluate"
+        )));
+    };
+    let mut start = (first.t_s + warmup_s).max(moving.t_s);
     while start + outage_s <= end_limit {
         let end = start + outage_s;
         let i = aided.epochs.partition_point(|e| e.t_s <= start);
@@ -191,7 +227,9 @@ pub fn evaluate(
     }
     if windows.is_empty() {
         return Err(Error::Insufficient(format!(
-            "the drive is too short for a {outage_s} s outage after {warmup_s} s of warm-up"
+            "the drive ({:.1}–{:.1} s, moving from {:.1} s) is too short for a {outage_s} s \
+             outage after {warmup_s} s of warm-up",
+            first.t_s, end_limit, moving.t_s
         )));
     }
     Ok(OutageEvaluation {
@@ -276,6 +314,7 @@ pub fn through_windows(
     windows: &[(f64, f64)],
     base: &FilterOptions,
 ) -> Result<OutageEvaluation, Error> {
+    check_windows(drive, windows)?;
     let truth = Reference::from_truth(&drive.truth);
     let reference = if truth.is_some() {
         ReferenceKind::Truth
@@ -304,4 +343,60 @@ pub fn through_windows(
         windows: out,
         gates: run.stats.gates,
     })
+}
+
+#[cfg(test)]
+mod window_tests {
+    use super::*;
+    use crate::drive::{Scalar, WheelTicks, Wheels};
+    use crate::Vehicle;
+
+    fn drive() -> Drive {
+        Drive {
+            vehicle: Vehicle::paper_car(),
+            wheels: Wheels::Ticks(
+                (0..=500)
+                    .map(|k| WheelTicks {
+                        t_s: 100.0 + k as f64 * 0.02,
+                        fl: 1,
+                        fr: 1,
+                        rl: 1,
+                        rr: 1,
+                    })
+                    .collect(),
+            ),
+            yaw_rate: vec![Scalar {
+                t_s: 100.0,
+                value: 0.0,
+            }],
+            speed: Vec::new(),
+            steering: Vec::new(),
+            gnss: Vec::new(),
+            truth: Vec::new(),
+        }
+    }
+
+    /// Issue 12: a window after the end of the drive was accepted (compare
+    /// printed a four-wheel error for it and "NaN … never" for TedriS).
+    #[test]
+    fn a_window_outside_the_drive_was_accepted() {
+        let d = drive();
+        assert!(check_windows(&d, &[(101.0, 105.0)]).is_ok());
+        for w in [
+            (200.0, 280.0),
+            (99.0, 101.0),
+            (105.0, 104.0),
+            (f64::NAN, 104.0),
+        ] {
+            let e = check_windows(&d, &[w]).unwrap_err().to_string();
+            assert!(e.contains("outage window"), "{e}");
+        }
+        let e = check_windows(&d, &[(200.0, 280.0)])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("100.000–110.000 s"),
+            "the message names the drive's span: {e}"
+        );
+    }
 }

@@ -192,6 +192,7 @@ pub fn run_outages_with(
     opts: &RunOptions,
 ) -> Result<OutageReport, Error> {
     let windows: Vec<(f64, f64)> = outages.iter().map(|o| (o.start_s, o.end_s)).collect();
+    deadreckon_core::outage::check_windows(drive, &windows)?;
     let input = drive_input_with(drive, opts.source, &windows, model.gyro_bias)?;
     let mut m = Tedris::with_model(model.clone(), input.geometry)?;
     if let Some((e, n, y)) = input.initial_pose {
