@@ -157,6 +157,13 @@ fn units(nominal_circumference: f64) -> [f64; 6] {
 /// Runs a calibration.
 pub fn calibrate(drive: &Drive, opts: &CalibrationOptions) -> Result<Calibration, Error> {
     drive.validate()?;
+    if !(opts.min_speed_mps.is_finite() && opts.min_speed_mps >= 0.0) {
+        // `--min-speed nan` calibrated on no epoch at all.
+        return Err(Error::InvalidParams(format!(
+            "the minimum speed must be a number of m/s, 0 or more, not {}",
+            opts.min_speed_mps
+        )));
+    }
     let nominal = Params::nominal(&drive.vehicle);
     let start = opts.initial.unwrap_or(nominal);
     start.validate()?;

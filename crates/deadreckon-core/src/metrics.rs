@@ -178,6 +178,18 @@ impl EpochHook for ResetHook<'_> {
     }
 }
 
+/// Refuses a length that is not a finite positive number (`--segment-m 0`,
+/// `--threshold-m=-1` and NaN printed inf/NaN tables).
+fn positive(what: &str, v: f64) -> Result<(), Error> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(Error::InvalidParams(format!(
+            "{what} must be a positive number, not {v}"
+        )))
+    }
+}
+
 fn run_with_resets(
     drive: &Drive,
     params: &Params,
@@ -213,8 +225,15 @@ pub fn drift(
     segment_m: f64,
     timing: Timing,
 ) -> Result<DriftResult, Error> {
+    positive("segment length (m)", segment_m)?;
     let (errors_m, times_s, gates) =
         run_with_resets(drive, params, timing, Rule::Every(segment_m))?;
+    if errors_m.is_empty() {
+        // "mean 0.000%" over no segment read as perfect dead reckoning.
+        return Err(Error::Insufficient(format!(
+            "the drive has no complete segment of {segment_m} m to measure drift on"
+        )));
+    }
     Ok(DriftResult {
         segment_m,
         errors_m,
@@ -230,6 +249,7 @@ pub fn reset_on_error(
     threshold_m: f64,
     timing: Timing,
 ) -> Result<ResetResult, Error> {
+    positive("error threshold (m)", threshold_m)?;
     let (distances_m, times_s, gates) =
         run_with_resets(drive, params, timing, Rule::OnError(threshold_m))?;
     Ok(ResetResult {
@@ -243,6 +263,15 @@ pub fn reset_on_error(
 #[cfg(test)]
 mod tests {
     use super::*;
+    /// Issue 12: `--segment-m 0`, `--threshold-m=-1` and NaN were accepted.
+    #[test]
+    fn a_zero_or_negative_length_was_accepted() {
+        for v in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            assert!(positive("x", v).is_err(), "{v}");
+        }
+        assert!(positive("x", 100.0).is_ok());
+    }
+
     #[test]
     fn summary_and_quantiles() {
         let s = Summary::of(&[4.0, 1.0, 3.0, 2.0]);
