@@ -6,23 +6,42 @@ use anyhow::{Context, Result};
 use deadreckon_core::ekf::Timing;
 use deadreckon_core::{Drive, Params, ParamsWithStd};
 
-/// Reads a drive from a drive directory or, directly, from a recording that a
-/// reader understands: a comma2k19 segment directory, a ROS1 `.bag`, a ROS2
-/// `.mcap` (with the `--mapping` file or the built-in mapping) or a rosbag2
-/// directory holding one, or a tricycle `dataset.txt`
-/// ([`deadreckon_api::read_drive`]).
-pub fn load_drive(path: &Path) -> Result<Drive> {
-    load_drive_with(path, &deadreckon_io::ReadOptions::default())
+/// How the commands read drives: the global options `--mapping` and
+/// `--skip-checks`, passed to each command explicitly.
+#[derive(Debug, Clone, Default)]
+pub struct Loader {
+    /// The `--mapping` file for ROS recordings (`None`: the built-in mapping).
+    pub mapping: Option<std::path::PathBuf>,
+    /// `--skip-checks`: read drives without the cross-stream plausibility checks.
+    pub skip_checks: bool,
 }
 
-/// [`load_drive`] with reading options for drive directories (recordings are
-/// read whole).
-pub fn load_drive_with(path: &Path, options: &deadreckon_io::ReadOptions) -> Result<Drive> {
-    let drive = read_drive_any(path, options)?;
-    if !super::SKIP_CHECKS.get().copied().unwrap_or(false) {
-        plausible(path, &drive)?;
+impl Loader {
+    /// Reads a drive from a drive directory or, directly, from a recording that a
+    /// reader understands: a comma2k19 segment directory, a ROS1 `.bag`, a ROS2
+    /// `.mcap` (with the `--mapping` file or the built-in mapping) or a rosbag2
+    /// directory holding one, or a tricycle `dataset.txt`
+    /// ([`deadreckon_api::read_drive`]).
+    pub fn drive(&self, path: &Path) -> Result<Drive> {
+        self.drive_with(path, &deadreckon_io::ReadOptions::default())
     }
-    Ok(drive)
+
+    /// [`Loader::drive`] with reading options for drive directories (recordings
+    /// are read whole).
+    pub fn drive_with(&self, path: &Path, options: &deadreckon_io::ReadOptions) -> Result<Drive> {
+        let drive = deadreckon_api::read_drive_with(path, options, self.mapping.as_deref())?;
+        if !self.skip_checks {
+            plausible(path, &drive)?;
+        }
+        Ok(drive)
+    }
+
+    /// Reads a ROS1 bag or ROS2 MCAP recording with the `--mapping` file, or the
+    /// built-in mapping (Husky, or Jackal when the file name says so), with the
+    /// reader's report of what was used, dropped and counted.
+    pub fn ros_with_report(&self, path: &Path) -> Result<(Drive, deadreckon_ros::ImportReport)> {
+        Ok(deadreckon_api::read_ros(path, self.mapping.as_deref())?)
+    }
 }
 
 /// The cross-stream plausibility checks: warnings on standard error, errors
@@ -47,11 +66,6 @@ pub fn plausible(path: &Path, drive: &Drive) -> Result<()> {
         errors.join("\n")
     );
     Ok(())
-}
-
-fn read_drive_any(path: &Path, options: &deadreckon_io::ReadOptions) -> Result<Drive> {
-    let mapping = super::ROS_MAPPING.get().map(|m| m.as_path());
-    Ok(deadreckon_api::read_drive_with(path, options, mapping)?)
 }
 
 /// `--params nominal` or a `params.toml` path.

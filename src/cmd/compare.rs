@@ -215,8 +215,8 @@ pub fn print(c: &Comparison, t0: f64) -> anyhow::Result<()> {
 }
 
 /// Runs `compare`.
-pub fn run(a: CompareArgs) -> Result<()> {
-    let drive = common::load_drive(&a.dir)?;
+pub fn run(a: CompareArgs, load: &common::Loader) -> Result<()> {
+    let drive = load.drive(&a.dir)?;
     let outages: Vec<Outage> = a
         .outage
         .iter()

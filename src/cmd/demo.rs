@@ -91,7 +91,7 @@ pub fn calibrate_and_evaluate(
 }
 
 /// Runs `demo`.
-pub fn run(a: DemoArgs, quiet: bool) -> Result<()> {
+pub fn run(a: DemoArgs, quiet: bool, load: &common::Loader) -> Result<()> {
     let steps = super::progress::Steps::new(16, quiet);
     steps.step("simulating");
     let cal_dir = a.out.join("calibration");
@@ -99,8 +99,8 @@ pub fn run(a: DemoArgs, quiet: bool) -> Result<()> {
     let sim_cal = simulate::simulate_to("calibration", a.seed, &cal_dir)?;
     let sim_eval = simulate::simulate_to("evaluation", a.seed + 1, &eval_dir)?;
     // Read back what was written, as a user's drive would be.
-    let cal = common::load_drive(&cal_dir)?;
-    let eval = common::load_drive(&eval_dir)?;
+    let cal = load.drive(&cal_dir)?;
+    let eval = load.drive(&eval_dir)?;
     steps.step("calibrating and evaluating");
     let results = calibrate_and_evaluate(&cal, &eval)?;
     for r in &results {
@@ -144,7 +144,7 @@ pub fn run(a: DemoArgs, quiet: bool) -> Result<()> {
         },
     )?;
     let truth = sim_cal.truth_params;
-    let tedris = tedris_part(&a, &steps)?;
+    let tedris = tedris_part(&a, &steps, load)?;
     steps.finish();
     if a.json {
         let rows: Vec<serde_json::Value> = results
@@ -271,11 +271,12 @@ pub fn run(a: DemoArgs, quiet: bool) -> Result<()> {
 fn tedris_part(
     a: &DemoArgs,
     steps: &super::progress::Steps,
+    load: &common::Loader,
 ) -> Result<(super::compare::Comparison, f64, PathBuf)> {
     steps.step("TedriS campus drive");
     let dir = a.out.join("tedris-car");
     simulate::simulate_to("tedris-car", a.seed + 2, &dir)?;
-    let drive = common::load_drive(&dir)?;
+    let drive = load.drive(&dir)?;
     let (t0, t1) = drive.time_span().context("empty drive")?;
     let outages: Vec<deadreckon_tedris::Outage> = [0.3, 0.55, 0.8]
         .iter()

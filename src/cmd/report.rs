@@ -358,10 +358,10 @@ pub fn footer() -> rp::Footer {
 }
 
 /// Runs `report`.
-pub fn run(a: ReportArgs, quiet: bool) -> Result<()> {
+pub fn run(a: ReportArgs, quiet: bool, load: &common::Loader) -> Result<()> {
     let steps = Steps::new(8, quiet);
     steps.step("reading the drive");
-    let drive = common::load_drive(&a.dir)?;
+    let drive = load.drive(&a.dir)?;
     let mut methods = calibrations(&drive, &steps);
     if let Some(p) = &a.params {
         let params = common::load_params(p, &drive)?;
