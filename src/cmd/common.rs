@@ -131,8 +131,6 @@ pub fn params_row(name: &str, p: &ParamsWithStd) -> String {
     )
 }
 
-pub use deadreckon_api::json::gates_json;
-
 /// A one-line account of what the filter used and gated.
 pub fn stats_line(st: &deadreckon_core::ekf::FilterStats) -> String {
     format!(
@@ -174,4 +172,45 @@ pub fn all_tracks(
     let mut t = deadreckon_core::track::drive_tracks(drive, params, opts, init_pose)?;
     t.extend(deadreckon_core::Track::from_truth(drive));
     Ok(t)
+}
+
+/// Prints the comparison table of `compare` and `demo`; `t0` is subtracted from the outage times.
+pub fn print_comparison(c: &deadreckon_eval::compare::Comparison, t0: f64) -> anyhow::Result<()> {
+    outln!(
+        "four-wheel EKF: {}; errors against the {}",
+        c.params_source,
+        c.four_wheel_reference
+    );
+    outln!(
+        "TedriS: {}; errors against the {}",
+        c.model_source,
+        c.tedris_reference
+    );
+    outln!(
+        "{:<20} {:<12} {:>10} {:>10} {:>10} {:>16}",
+        "outage (s)",
+        "method",
+        "mean (m)",
+        "max (m)",
+        "final (m)",
+        "time to 1 m (s)"
+    );
+    let fmt = |r: &Option<deadreckon_eval::compare::Row>| match r {
+        Some(r) => format!(
+            "{:>10.2} {:>10.2} {:>10.2} {:>16}",
+            r.mean,
+            r.max,
+            r.fin,
+            r.to_1m
+                .map(|t| format!("{t:.1}"))
+                .unwrap_or_else(|| "never".into())
+        ),
+        None => format!("{:>10} {:>10} {:>10} {:>16}", "-", "-", "-", "-"),
+    };
+    for (o, f, t) in &c.rows {
+        let w = format!("{:.1}:{:.1}", o.start_s - t0, o.end_s - t0);
+        outln!("{:<20} {:<12} {}", w, "four-wheel", fmt(f));
+        outln!("{:<20} {:<12} {}", "", "TedriS", fmt(t));
+    }
+    Ok(())
 }

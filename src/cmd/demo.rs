@@ -166,7 +166,7 @@ pub fn run(a: DemoArgs, quiet: bool, load: &common::Loader) -> Result<()> {
             "truth_params": truth.to_array(),
             "methods": rows,
             "plain_iterations": plain.iterations,
-            "tedris_comparison": super::compare::to_json(&tedris.0),
+            "tedris_comparison": deadreckon_api::json::comparison_json(&tedris.0),
         });
         outln!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
@@ -260,7 +260,7 @@ pub fn run(a: DemoArgs, quiet: bool, load: &common::Loader) -> Result<()> {
     );
     outln!();
     outln!("TedriS and the four-wheel EKF through 80 s GNSS outages on the simulated campus drive");
-    super::compare::print(&tedris.0, tedris.1)?;
+    common::print_comparison(&tedris.0, tedris.1)?;
     outln!("report in {}", tedris.2.display());
     Ok(())
 }
@@ -272,7 +272,7 @@ fn tedris_part(
     a: &DemoArgs,
     steps: &super::progress::Steps,
     load: &common::Loader,
-) -> Result<(super::compare::Comparison, f64, PathBuf)> {
+) -> Result<(deadreckon_eval::compare::Comparison, f64, PathBuf)> {
     steps.step("TedriS campus drive");
     let dir = a.out.join("tedris-car");
     simulate::simulate_to("tedris-car", a.seed + 2, &dir)?;
@@ -288,7 +288,7 @@ fn tedris_part(
             }
         })
         .collect();
-    let c = super::compare::compare(&drive, &outages, None, None)?;
+    let c = deadreckon_eval::compare::compare(&drive, &outages, None, None)?;
     // The report of the campus drive, with the TedriS sections.
     steps.step("TedriS report");
     let methods = report::calibrations(&drive, steps);
