@@ -214,3 +214,11 @@ pub fn print_comparison(c: &deadreckon_eval::compare::Comparison, t0: f64) -> an
     }
     Ok(())
 }
+
+/// The footer: version and command line.
+pub fn footer() -> deadreckon_report::Footer {
+    deadreckon_report::Footer {
+        version: env!("CARGO_PKG_VERSION").into(),
+        command_line: std::env::args().collect::<Vec<_>>().join(" "),
+    }
+}

@@ -14,7 +14,8 @@ use deadreckon_core::ekf::Timing;
 use deadreckon_core::metrics::{self, Summary};
 use deadreckon_core::{Params, ParamsWithStd};
 
-use super::{common, report, simulate};
+use super::{common, simulate};
+use deadreckon_eval::report;
 
 /// Arguments of `demo`.
 #[derive(Args, Debug)]
@@ -129,7 +130,7 @@ pub fn run(a: DemoArgs, quiet: bool, load: &common::Loader) -> Result<()> {
             ("evaluation drive".into(), eval_dir.display().to_string()),
         ],
     );
-    input.footer = report::footer();
+    input.footer = common::footer();
     let report_path = a.out.join("report.html");
     deadreckon_report::write_report(&report_path, &input)?;
     steps.step("paper's plain iteration");
@@ -299,7 +300,7 @@ fn tedris_part(
         "demo: TedriS campus drive",
         vec![("drive".into(), dir.display().to_string())],
     );
-    input.footer = report::footer();
+    input.footer = common::footer();
     let path = a.out.join("tedris-report.html");
     deadreckon_report::write_report(&path, &input)?;
     Ok((c, t0, path))
