@@ -222,3 +222,36 @@ pub fn footer() -> deadreckon_report::Footer {
         command_line: std::env::args().collect::<Vec<_>>().join(" "),
     }
 }
+
+/// Resolves a scenario name or file.
+pub fn scenario(spec: &str) -> Result<deadreckon_sim::Scenario> {
+    let path = std::path::Path::new(spec);
+    if path.extension().is_some_and(|e| e == "toml") || path.is_file() {
+        return Ok(deadreckon_sim::Scenario::load(path)?);
+    }
+    Ok(deadreckon_sim::Scenario::builtin(spec)?)
+}
+
+/// Simulates and writes `drive` + `truth_params.toml` into `dir`.
+pub fn simulate_to(
+    spec: &str,
+    seed: u64,
+    dir: &std::path::Path,
+) -> Result<deadreckon_sim::SimOutput> {
+    write_scenario(scenario(spec)?, spec, seed, dir)
+}
+
+pub fn write_scenario(
+    sc: deadreckon_sim::Scenario,
+    spec: &str,
+    seed: u64,
+    dir: &std::path::Path,
+) -> Result<deadreckon_sim::SimOutput> {
+    let out = deadreckon_sim::simulate(&sc, seed).with_context(|| format!("simulating {spec}"))?;
+    // Written whole: a failure leaves no partial drive.
+    deadreckon_io::write_drive_whole(dir, &out.drive, |tmp| {
+        deadreckon_io::write_truth_params(&tmp.join("truth_params.toml"), &out.truth_params)
+    })
+    .with_context(|| format!("writing {}", dir.display()))?;
+    Ok(out)
+}

@@ -14,7 +14,7 @@ use deadreckon_core::ekf::Timing;
 use deadreckon_core::metrics::{self, Summary};
 use deadreckon_core::{Params, ParamsWithStd};
 
-use super::{common, simulate};
+use super::common;
 use deadreckon_eval::report;
 
 /// Arguments of `demo`.
@@ -97,8 +97,8 @@ pub fn run(a: DemoArgs, quiet: bool, load: &common::Loader) -> Result<()> {
     steps.step("simulating");
     let cal_dir = a.out.join("calibration");
     let eval_dir = a.out.join("evaluation");
-    let sim_cal = simulate::simulate_to("calibration", a.seed, &cal_dir)?;
-    let sim_eval = simulate::simulate_to("evaluation", a.seed + 1, &eval_dir)?;
+    let sim_cal = common::simulate_to("calibration", a.seed, &cal_dir)?;
+    let sim_eval = common::simulate_to("evaluation", a.seed + 1, &eval_dir)?;
     // Read back what was written, as a user's drive would be.
     let cal = load.drive(&cal_dir)?;
     let eval = load.drive(&eval_dir)?;
@@ -276,7 +276,7 @@ fn tedris_part(
 ) -> Result<(deadreckon_eval::compare::Comparison, f64, PathBuf)> {
     steps.step("TedriS campus drive");
     let dir = a.out.join("tedris-car");
-    simulate::simulate_to("tedris-car", a.seed + 2, &dir)?;
+    common::simulate_to("tedris-car", a.seed + 2, &dir)?;
     let drive = load.drive(&dir)?;
     let (t0, t1) = drive.time_span().context("empty drive")?;
     let outages: Vec<deadreckon_tedris::Outage> = [0.3, 0.55, 0.8]
