@@ -101,22 +101,23 @@ fn message(e: &anyhow::Error) -> String {
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
-    if let Some(m) = &cli.mapping {
-        let _ = cmd::ROS_MAPPING.set(m.clone());
-    }
-    let _ = cmd::SKIP_CHECKS.set(cli.skip_checks);
+    // The global reading options, passed to each command (no global state).
+    let load = cmd::Loader {
+        mapping: cli.mapping,
+        skip_checks: cli.skip_checks,
+    };
     match cli.command {
         Command::Simulate(a) => cmd::simulate::run(a),
-        Command::Calibrate(a) => cmd::calibrate::run(a),
-        Command::Events(a) => cmd::events::run(a),
+        Command::Calibrate(a) => cmd::calibrate::run(a, &load),
+        Command::Events(a) => cmd::events::run(a, &load),
         Command::Stream(a) => cmd::stream::run(a),
-        Command::Evaluate(a) => cmd::evaluate::run(a),
-        Command::Run(a) => cmd::run::run(a),
-        Command::Demo(a) => cmd::demo::run(a, cli.quiet),
-        Command::Compare(a) => cmd::compare::run(a),
-        Command::Report(a) => cmd::report::run(a, cli.quiet),
-        Command::Tedris(c) => cmd::tedris::run(c),
-        Command::Import(a) => cmd::import::run(a),
-        Command::Batch(a) => cmd::batch::run(a, cli.quiet),
+        Command::Evaluate(a) => cmd::evaluate::run(a, &load),
+        Command::Run(a) => cmd::run::run(a, &load),
+        Command::Demo(a) => cmd::demo::run(a, cli.quiet, &load),
+        Command::Compare(a) => cmd::compare::run(a, &load),
+        Command::Report(a) => cmd::report::run(a, cli.quiet, &load),
+        Command::Tedris(c) => cmd::tedris::run(c, &load),
+        Command::Import(a) => cmd::import::run(a, &load),
+        Command::Batch(a) => cmd::batch::run(a, cli.quiet, &load),
     }
 }

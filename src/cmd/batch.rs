@@ -103,7 +103,7 @@ fn bar(total: usize, quiet: bool) -> Option<ProgressBar> {
 }
 
 /// Runs `batch`.
-pub fn run(a: BatchArgs, quiet: bool) -> Result<()> {
+pub fn run(a: BatchArgs, quiet: bool, loader: &common::Loader) -> Result<()> {
     let method: Method = a.method.parse()?;
     let hist_opts = history_options(&a)?;
     let options = BatchOptions {
@@ -138,8 +138,7 @@ pub fn run(a: BatchArgs, quiet: bool) -> Result<()> {
     } else {
         read.without_truth()
     };
-    let load =
-        |p: &std::path::Path| common::load_drive_with(p, &read).map_err(|e| format!("{e:#}"));
+    let load = |p: &std::path::Path| loader.drive_with(p, &read).map_err(|e| format!("{e:#}"));
     let progress = bar(drives.len(), quiet);
     let start = Instant::now();
     let results = batch::run(&drives, &load, &options, &|r: &batch::DriveResult| {

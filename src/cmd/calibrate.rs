@@ -80,13 +80,13 @@ pub struct CalibrateArgs {
 }
 
 /// Runs `calibrate`.
-pub fn run(a: CalibrateArgs) -> Result<()> {
+pub fn run(a: CalibrateArgs, load: &common::Loader) -> Result<()> {
     kinematic::check_range(a.from_s, a.until_s)?;
     if kinematic::is_tricycle_log(&a.dir) {
         return run_tricycle(&a);
     }
     if a.shape == ShapeArg::DiffDrive {
-        return run_diff_drive(&a);
+        return run_diff_drive(&a, load);
     }
     let method_name = a.method.clone().unwrap_or_else(|| "rts".into());
     let method: Method = method_name.parse()?;
@@ -97,7 +97,7 @@ pub fn run(a: CalibrateArgs) -> Result<()> {
     } else {
         read.without_truth()
     };
-    let drive = common::load_drive_with(&a.dir, &read)?;
+    let drive = load.drive_with(&a.dir, &read)?;
     let drive = if a.from_s.is_some() || a.until_s.is_some() {
         drive.time_range(a.from_s, a.until_s)
     } else {
@@ -288,13 +288,13 @@ fn steering_toml(st: &SteeringCalibration) -> toml::Table {
 }
 
 /// The differential drive: five parameters against the GNSS fixes.
-fn run_diff_drive(a: &CalibrateArgs) -> Result<()> {
+fn run_diff_drive(a: &CalibrateArgs, load: &common::Loader) -> Result<()> {
     let method = a.method.as_deref().unwrap_or("gnss");
     anyhow::ensure!(
         method == "gnss",
         "a differential drive is calibrated against its GNSS fixes with --method gnss (got `{method}`)"
     );
-    let drive = common::load_drive(&a.dir)?;
+    let drive = load.drive(&a.dir)?;
     let dd = kinematic::diff_drive(&drive, a.yaw, a.from_s, a.until_s)?;
     let shape = Shape::DiffDrive;
     let opts = DiffDriveOptions {

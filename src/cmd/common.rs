@@ -6,23 +6,42 @@ use anyhow::{Context, Result};
 use deadreckon_core::ekf::Timing;
 use deadreckon_core::{Drive, Params, ParamsWithStd};
 
-/// Reads a drive from a drive directory or, directly, from a recording that a
-/// reader understands: a comma2k19 segment directory, a ROS1 `.bag`, a ROS2
-/// `.mcap` (with the `--mapping` file or the built-in mapping) or a rosbag2
-/// directory holding one, or a tricycle `dataset.txt`
-/// ([`deadreckon_api::read_drive`]).
-pub fn load_drive(path: &Path) -> Result<Drive> {
-    load_drive_with(path, &deadreckon_io::ReadOptions::default())
+/// How the commands read drives: the global options `--mapping` and
+/// `--skip-checks`, passed to each command explicitly.
+#[derive(Debug, Clone, Default)]
+pub struct Loader {
+    /// The `--mapping` file for ROS recordings (`None`: the built-in mapping).
+    pub mapping: Option<std::path::PathBuf>,
+    /// `--skip-checks`: read drives without the cross-stream plausibility checks.
+    pub skip_checks: bool,
 }
 
-/// [`load_drive`] with reading options for drive directories (recordings are
-/// read whole).
-pub fn load_drive_with(path: &Path, options: &deadreckon_io::ReadOptions) -> Result<Drive> {
-    let drive = read_drive_any(path, options)?;
-    if !super::SKIP_CHECKS.get().copied().unwrap_or(false) {
-        plausible(path, &drive)?;
+impl Loader {
+    /// Reads a drive from a drive directory or, directly, from a recording that a
+    /// reader understands: a comma2k19 segment directory, a ROS1 `.bag`, a ROS2
+    /// `.mcap` (with the `--mapping` file or the built-in mapping) or a rosbag2
+    /// directory holding one, or a tricycle `dataset.txt`
+    /// ([`deadreckon_api::read_drive`]).
+    pub fn drive(&self, path: &Path) -> Result<Drive> {
+        self.drive_with(path, &deadreckon_io::ReadOptions::default())
     }
-    Ok(drive)
+
+    /// [`Loader::drive`] with reading options for drive directories (recordings
+    /// are read whole).
+    pub fn drive_with(&self, path: &Path, options: &deadreckon_io::ReadOptions) -> Result<Drive> {
+        let drive = deadreckon_api::read_drive_with(path, options, self.mapping.as_deref())?;
+        if !self.skip_checks {
+            plausible(path, &drive)?;
+        }
+        Ok(drive)
+    }
+
+    /// Reads a ROS1 bag or ROS2 MCAP recording with the `--mapping` file, or the
+    /// built-in mapping (Husky, or Jackal when the file name says so), with the
+    /// reader's report of what was used, dropped and counted.
+    pub fn ros_with_report(&self, path: &Path) -> Result<(Drive, deadreckon_ros::ImportReport)> {
+        Ok(deadreckon_api::read_ros(path, self.mapping.as_deref())?)
+    }
 }
 
 /// The cross-stream plausibility checks: warnings on standard error, errors
@@ -47,11 +66,6 @@ pub fn plausible(path: &Path, drive: &Drive) -> Result<()> {
         errors.join("\n")
     );
     Ok(())
-}
-
-fn read_drive_any(path: &Path, options: &deadreckon_io::ReadOptions) -> Result<Drive> {
-    let mapping = super::ROS_MAPPING.get().map(|m| m.as_path());
-    Ok(deadreckon_api::read_drive_with(path, options, mapping)?)
 }
 
 /// `--params nominal` or a `params.toml` path.
@@ -117,8 +131,6 @@ pub fn params_row(name: &str, p: &ParamsWithStd) -> String {
     )
 }
 
-pub use deadreckon_api::json::gates_json;
-
 /// A one-line account of what the filter used and gated.
 pub fn stats_line(st: &deadreckon_core::ekf::FilterStats) -> String {
     format!(
@@ -160,4 +172,86 @@ pub fn all_tracks(
     let mut t = deadreckon_core::track::drive_tracks(drive, params, opts, init_pose)?;
     t.extend(deadreckon_core::Track::from_truth(drive));
     Ok(t)
+}
+
+/// Prints the comparison table of `compare` and `demo`; `t0` is subtracted from the outage times.
+pub fn print_comparison(c: &deadreckon_eval::compare::Comparison, t0: f64) -> anyhow::Result<()> {
+    outln!(
+        "four-wheel EKF: {}; errors against the {}",
+        c.params_source,
+        c.four_wheel_reference
+    );
+    outln!(
+        "TedriS: {}; errors against the {}",
+        c.model_source,
+        c.tedris_reference
+    );
+    outln!(
+        "{:<20} {:<12} {:>10} {:>10} {:>10} {:>16}",
+        "outage (s)",
+        "method",
+        "mean (m)",
+        "max (m)",
+        "final (m)",
+        "time to 1 m (s)"
+    );
+    let fmt = |r: &Option<deadreckon_eval::compare::Row>| match r {
+        Some(r) => format!(
+            "{:>10.2} {:>10.2} {:>10.2} {:>16}",
+            r.mean,
+            r.max,
+            r.fin,
+            r.to_1m
+                .map(|t| format!("{t:.1}"))
+                .unwrap_or_else(|| "never".into())
+        ),
+        None => format!("{:>10} {:>10} {:>10} {:>16}", "-", "-", "-", "-"),
+    };
+    for (o, f, t) in &c.rows {
+        let w = format!("{:.1}:{:.1}", o.start_s - t0, o.end_s - t0);
+        outln!("{:<20} {:<12} {}", w, "four-wheel", fmt(f));
+        outln!("{:<20} {:<12} {}", "", "TedriS", fmt(t));
+    }
+    Ok(())
+}
+
+/// The footer: version and command line.
+pub fn footer() -> deadreckon_report::Footer {
+    deadreckon_report::Footer {
+        version: env!("CARGO_PKG_VERSION").into(),
+        command_line: std::env::args().collect::<Vec<_>>().join(" "),
+    }
+}
+
+/// Resolves a scenario name or file.
+pub fn scenario(spec: &str) -> Result<deadreckon_sim::Scenario> {
+    let path = std::path::Path::new(spec);
+    if path.extension().is_some_and(|e| e == "toml") || path.is_file() {
+        return Ok(deadreckon_sim::Scenario::load(path)?);
+    }
+    Ok(deadreckon_sim::Scenario::builtin(spec)?)
+}
+
+/// Simulates and writes `drive` + `truth_params.toml` into `dir`.
+pub fn simulate_to(
+    spec: &str,
+    seed: u64,
+    dir: &std::path::Path,
+) -> Result<deadreckon_sim::SimOutput> {
+    write_scenario(scenario(spec)?, spec, seed, dir)
+}
+
+pub fn write_scenario(
+    sc: deadreckon_sim::Scenario,
+    spec: &str,
+    seed: u64,
+    dir: &std::path::Path,
+) -> Result<deadreckon_sim::SimOutput> {
+    let out = deadreckon_sim::simulate(&sc, seed).with_context(|| format!("simulating {spec}"))?;
+    // Written whole: a failure leaves no partial drive.
+    deadreckon_io::write_drive_whole(dir, &out.drive, |tmp| {
+        deadreckon_io::write_truth_params(&tmp.join("truth_params.toml"), &out.truth_params)
+    })
+    .with_context(|| format!("writing {}", dir.display()))?;
+    Ok(out)
 }

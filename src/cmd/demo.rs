@@ -14,7 +14,8 @@ use deadreckon_core::ekf::Timing;
 use deadreckon_core::metrics::{self, Summary};
 use deadreckon_core::{Params, ParamsWithStd};
 
-use super::{common, report, simulate};
+use super::common;
+use deadreckon_eval::report;
 
 /// Arguments of `demo`.
 #[derive(Args, Debug)]
@@ -91,16 +92,16 @@ pub fn calibrate_and_evaluate(
 }
 
 /// Runs `demo`.
-pub fn run(a: DemoArgs, quiet: bool) -> Result<()> {
+pub fn run(a: DemoArgs, quiet: bool, load: &common::Loader) -> Result<()> {
     let steps = super::progress::Steps::new(16, quiet);
     steps.step("simulating");
     let cal_dir = a.out.join("calibration");
     let eval_dir = a.out.join("evaluation");
-    let sim_cal = simulate::simulate_to("calibration", a.seed, &cal_dir)?;
-    let sim_eval = simulate::simulate_to("evaluation", a.seed + 1, &eval_dir)?;
+    let sim_cal = common::simulate_to("calibration", a.seed, &cal_dir)?;
+    let sim_eval = common::simulate_to("evaluation", a.seed + 1, &eval_dir)?;
     // Read back what was written, as a user's drive would be.
-    let cal = common::load_drive(&cal_dir)?;
-    let eval = common::load_drive(&eval_dir)?;
+    let cal = load.drive(&cal_dir)?;
+    let eval = load.drive(&eval_dir)?;
     steps.step("calibrating and evaluating");
     let results = calibrate_and_evaluate(&cal, &eval)?;
     for r in &results {
@@ -129,7 +130,7 @@ pub fn run(a: DemoArgs, quiet: bool) -> Result<()> {
             ("evaluation drive".into(), eval_dir.display().to_string()),
         ],
     );
-    input.footer = report::footer();
+    input.footer = common::footer();
     let report_path = a.out.join("report.html");
     deadreckon_report::write_report(&report_path, &input)?;
     steps.step("paper's plain iteration");
@@ -144,7 +145,7 @@ pub fn run(a: DemoArgs, quiet: bool) -> Result<()> {
         },
     )?;
     let truth = sim_cal.truth_params;
-    let tedris = tedris_part(&a, &steps)?;
+    let tedris = tedris_part(&a, &steps, load)?;
     steps.finish();
     if a.json {
         let rows: Vec<serde_json::Value> = results
@@ -166,7 +167,7 @@ pub fn run(a: DemoArgs, quiet: bool) -> Result<()> {
             "truth_params": truth.to_array(),
             "methods": rows,
             "plain_iterations": plain.iterations,
-            "tedris_comparison": super::compare::to_json(&tedris.0),
+            "tedris_comparison": deadreckon_api::json::comparison_json(&tedris.0),
         });
         outln!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
@@ -260,7 +261,7 @@ pub fn run(a: DemoArgs, quiet: bool) -> Result<()> {
     );
     outln!();
     outln!("TedriS and the four-wheel EKF through 80 s GNSS outages on the simulated campus drive");
-    super::compare::print(&tedris.0, tedris.1)?;
+    common::print_comparison(&tedris.0, tedris.1)?;
     outln!("report in {}", tedris.2.display());
     Ok(())
 }
@@ -271,11 +272,12 @@ pub fn run(a: DemoArgs, quiet: bool) -> Result<()> {
 fn tedris_part(
     a: &DemoArgs,
     steps: &super::progress::Steps,
-) -> Result<(super::compare::Comparison, f64, PathBuf)> {
+    load: &common::Loader,
+) -> Result<(deadreckon_eval::compare::Comparison, f64, PathBuf)> {
     steps.step("TedriS campus drive");
     let dir = a.out.join("tedris-car");
-    simulate::simulate_to("tedris-car", a.seed + 2, &dir)?;
-    let drive = common::load_drive(&dir)?;
+    common::simulate_to("tedris-car", a.seed + 2, &dir)?;
+    let drive = load.drive(&dir)?;
     let (t0, t1) = drive.time_span().context("empty drive")?;
     let outages: Vec<deadreckon_tedris::Outage> = [0.3, 0.55, 0.8]
         .iter()
@@ -287,7 +289,7 @@ fn tedris_part(
             }
         })
         .collect();
-    let c = super::compare::compare(&drive, &outages, None, None)?;
+    let c = deadreckon_eval::compare::compare(&drive, &outages, None, None)?;
     // The report of the campus drive, with the TedriS sections.
     steps.step("TedriS report");
     let methods = report::calibrations(&drive, steps);
@@ -298,7 +300,7 @@ fn tedris_part(
         "demo: TedriS campus drive",
         vec![("drive".into(), dir.display().to_string())],
     );
-    input.footer = report::footer();
+    input.footer = common::footer();
     let path = a.out.join("tedris-report.html");
     deadreckon_report::write_report(&path, &input)?;
     Ok((c, t0, path))

@@ -85,15 +85,15 @@ pub struct EvaluateArgs {
 }
 
 /// Runs `evaluate`.
-pub fn run(a: EvaluateArgs) -> Result<()> {
+pub fn run(a: EvaluateArgs, load: &common::Loader) -> Result<()> {
     kinematic::check_range(a.from_s, a.until_s)?;
     if kinematic::is_tricycle_log(&a.dir) {
         return run_tricycle(&a);
     }
     if a.shape == ShapeArg::DiffDrive {
-        return run_diff_drive(&a);
+        return run_diff_drive(&a, load);
     }
-    let drive = common::load_drive(&a.dir)?;
+    let drive = load.drive(&a.dir)?;
     let drive = if a.from_s.is_some() || a.until_s.is_some() {
         drive.time_range(a.from_s, a.until_s)
     } else {
@@ -299,7 +299,7 @@ fn run_tricycle(a: &EvaluateArgs) -> Result<()> {
 /// The differential drive: sliding outages, each started from the
 /// alignment of the preceding dead reckoning to the fixes, scored against
 /// the hidden fix at its end.
-fn run_diff_drive(a: &EvaluateArgs) -> Result<()> {
+fn run_diff_drive(a: &EvaluateArgs, load: &common::Loader) -> Result<()> {
     let Some(len) = a.outage else {
         anyhow::bail!("a differential drive is evaluated over sliding GNSS outages: give --outage LEN (and --step S)");
     };
@@ -321,7 +321,7 @@ fn run_diff_drive(a: &EvaluateArgs) -> Result<()> {
     } else {
         kinematic::load_params_file(spec, Shape::DiffDrive, &diff_drive::NAMES, Some(yaw.name()))?
     };
-    let drive = common::load_drive(&a.dir)?;
+    let drive = load.drive(&a.dir)?;
     let dd = kinematic::diff_drive(&drive, yaw, a.from_s, a.until_s)?;
     let ev = evaluate_diff_drive(&dd, &params, len, a.step.unwrap_or(len / 2.0), a.align)?;
     let source = format!("{source}, yaw {}", yaw.name());

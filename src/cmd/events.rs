@@ -18,8 +18,8 @@ pub struct EventsArgs {
 }
 
 /// Runs `events`.
-pub fn run(a: EventsArgs) -> Result<()> {
-    let drive = common::load_drive(&a.dir)?;
+pub fn run(a: EventsArgs, load: &common::Loader) -> Result<()> {
+    let drive = load.drive(&a.dir)?;
     let stdout = std::io::stdout();
     let mut w = std::io::BufWriter::new(stdout.lock());
     let result = (|| -> std::io::Result<()> {

@@ -57,7 +57,7 @@ pub struct ImportArgs {
 }
 
 /// Runs an import.
-pub fn run(a: ImportArgs) -> Result<()> {
+pub fn run(a: ImportArgs, load: &super::common::Loader) -> Result<()> {
     let policy = if a.gate {
         TimeOrderPolicy::Gate
     } else {
@@ -153,7 +153,7 @@ pub fn run(a: ImportArgs) -> Result<()> {
             if a.gate {
                 bail!("--gate does not apply to rosbag/mcap: their readers always drop and count bad samples");
             }
-            let (mut drive, report) = super::load_ros_with_report(&a.source)?;
+            let (mut drive, report) = load.ros_with_report(&a.source)?;
             if let Some(v) = vehicle {
                 let origin = drive.vehicle.origin;
                 drive.vehicle = deadreckon_core::Vehicle {

@@ -46,3 +46,9 @@ impl Drop for Steps {
         self.finish();
     }
 }
+
+impl deadreckon_eval::Progress for Steps {
+    fn step(&self, what: &str) {
+        Steps::step(self, what)
+    }
+}

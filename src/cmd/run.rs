@@ -121,7 +121,7 @@ pub fn write_tracks(
 }
 
 /// Runs `run`.
-pub fn run(a: RunArgs) -> Result<()> {
+pub fn run(a: RunArgs, load: &common::Loader) -> Result<()> {
     deadreckon_io::check_not_an_input(&a.out, &a.dir)?;
     if kinematic::is_tricycle_log(&a.dir) {
         // The tricycle is dead-reckoned through its own kinematics (the car
@@ -145,7 +145,7 @@ pub fn run(a: RunArgs) -> Result<()> {
         outln!("wrote {}", a.out.display());
         return Ok(());
     }
-    let drive = common::load_drive(&a.dir)?;
+    let drive = load.drive(&a.dir)?;
     let params = common::load_params(&a.params, &drive)?;
     let init_pose = match &a.init_pose {
         Some(s) => {

@@ -6,6 +6,8 @@ use anyhow::{Context, Result};
 use clap::Args;
 use deadreckon_sim::Scenario;
 
+use super::common;
+
 /// Arguments of `simulate`.
 #[derive(Args, Debug)]
 pub struct SimulateArgs {
@@ -99,43 +101,10 @@ fn with_overrides(mut sc: Scenario, a: &SimulateArgs) -> Result<Scenario> {
     Ok(sc)
 }
 
-/// Resolves a scenario name or file.
-pub fn scenario(spec: &str) -> Result<Scenario> {
-    let path = std::path::Path::new(spec);
-    if path.extension().is_some_and(|e| e == "toml") || path.is_file() {
-        return Ok(Scenario::load(path)?);
-    }
-    Ok(Scenario::builtin(spec)?)
-}
-
-/// Simulates and writes `drive` + `truth_params.toml` into `dir`.
-pub fn simulate_to(
-    spec: &str,
-    seed: u64,
-    dir: &std::path::Path,
-) -> Result<deadreckon_sim::SimOutput> {
-    write_scenario(scenario(spec)?, spec, seed, dir)
-}
-
-fn write_scenario(
-    sc: Scenario,
-    spec: &str,
-    seed: u64,
-    dir: &std::path::Path,
-) -> Result<deadreckon_sim::SimOutput> {
-    let out = deadreckon_sim::simulate(&sc, seed).with_context(|| format!("simulating {spec}"))?;
-    // Written whole: a failure leaves no partial drive.
-    deadreckon_io::write_drive_whole(dir, &out.drive, |tmp| {
-        deadreckon_io::write_truth_params(&tmp.join("truth_params.toml"), &out.truth_params)
-    })
-    .with_context(|| format!("writing {}", dir.display()))?;
-    Ok(out)
-}
-
 /// Runs `simulate`.
 pub fn run(a: SimulateArgs) -> Result<()> {
-    let sc = with_overrides(scenario(&a.scenario)?, &a)?;
-    let out = write_scenario(sc, &a.scenario, a.seed, &a.out)?;
+    let sc = with_overrides(common::scenario(&a.scenario)?, &a)?;
+    let out = common::write_scenario(sc, &a.scenario, a.seed, &a.out)?;
     let s = &out.stats;
     outln!(
         "simulated {} (seed {}): {:.2} km in {:.0} s, mean {:.1} km/h, max {:.1} km/h, {} stops -> {}",

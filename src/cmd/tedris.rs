@@ -133,7 +133,7 @@ pub enum TedrisCommand {
 }
 
 /// Runs a TedriS subcommand.
-pub fn run(c: TedrisCommand) -> Result<()> {
+pub fn run(c: TedrisCommand, load: &super::common::Loader) -> Result<()> {
     match c {
         TedrisCommand::Train {
             dir,
@@ -154,7 +154,7 @@ pub fn run(c: TedrisCommand) -> Result<()> {
                     bail!("--from {a} must be before --until {b}");
                 }
             }
-            let drive = super::common::load_drive(&dir)?;
+            let drive = load.drive(&dir)?;
             let drive = if from_s.is_some() || until_s.is_some() {
                 time_range(&drive, from_s, until_s)
             } else {
@@ -242,7 +242,7 @@ pub fn run(c: TedrisCommand) -> Result<()> {
             if !(threshold_m.is_finite() && threshold_m > 0.0) {
                 bail!("--threshold-m must be a positive number");
             }
-            let drive = super::common::load_drive(&dir)?;
+            let drive = load.drive(&dir)?;
             let opts = RunOptions {
                 source: reference.source(),
                 threshold_m: Some(threshold_m),

@@ -224,3 +224,29 @@ pub fn tedris_train_json(m: &TedrisModel, source: ReferenceSource) -> Value {
         "fits": m.fits,
     })
 }
+
+/// The object of `compare --json` (and the demo's `tedris_comparison`).
+pub fn comparison_json(c: &deadreckon_eval::compare::Comparison) -> Value {
+    let row_json = |r: &Option<deadreckon_eval::compare::Row>| match r {
+        Some(r) => {
+            json!({"mean_error_m": r.mean, "max_error_m": r.max, "final_error_m": r.fin, "time_to_1m_s": r.to_1m})
+        }
+        None => Value::Null,
+    };
+    json!({
+        "reference": {"four_wheel": c.four_wheel_reference, "tedris": c.tedris_reference},
+        "four_wheel_params": c.params_source,
+        "tedris_model": c.model_source,
+        "four_wheel_gates": gates_json(&c.four_wheel_gates),
+        "tedris_checks": {
+            "inconsistent_headings": c.tedris_checks.0,
+            "refused_calibrations": c.tedris_checks.1,
+            "heading_segments": c.tedris_checks.2,
+            "model_alarms": c.tedris_checks.3,
+        },
+        "outages": c.rows.iter().map(|(o, f, t)| json!({
+            "start_s": o.start_s, "end_s": o.end_s,
+            "four_wheel": row_json(f), "tedris": row_json(t),
+        })).collect::<Vec<_>>(),
+    })
+}

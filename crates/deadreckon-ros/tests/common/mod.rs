@@ -280,3 +280,86 @@ pub fn recompress_mcap(f: &[u8], compression: &str) -> Vec<u8> {
     out.extend_from_slice(&f[pos..]);
     out
 }
+
+/// One ROS1 bag record: header fields (`name=value`) and data, with lengths.
+pub fn record(fields: &[(&str, &[u8])], data: &[u8]) -> Vec<u8> {
+    let mut h = Vec::new();
+    for (k, v) in fields {
+        h.extend_from_slice(&((k.len() + 1 + v.len()) as u32).to_le_bytes());
+        h.extend_from_slice(k.as_bytes());
+        h.push(b'=');
+        h.extend_from_slice(v);
+    }
+    let mut r = (h.len() as u32).to_le_bytes().to_vec();
+    r.extend_from_slice(&h);
+    r.extend_from_slice(&(data.len() as u32).to_le_bytes());
+    r.extend_from_slice(data);
+    r
+}
+
+/// A bag with a bag header, one uncompressed chunk holding a connection and
+/// one message of `payload`.
+pub fn tiny_bag(payload: &[u8]) -> Vec<u8> {
+    tiny_bag_with(payload, "none")
+}
+
+/// [`tiny_bag`] with its chunk stored with `compression` (`none` or `lz4`).
+pub fn tiny_bag_with(payload: &[u8], compression: &str) -> Vec<u8> {
+    let mut conn_hdr = Vec::new();
+    for (k, v) in [
+        ("topic", "/husky_velocity_controller/odom"),
+        ("type", "nav_msgs/Odometry"),
+        ("md5sum", "cd5e73d190d741a2f92e81eda573aca7"),
+    ] {
+        conn_hdr.extend_from_slice(&((k.len() + 1 + v.len()) as u32).to_le_bytes());
+        conn_hdr.extend_from_slice(format!("{k}={v}").as_bytes());
+    }
+    let conn = record(
+        &[
+            ("op", &[7]),
+            ("conn", &0u32.to_le_bytes()),
+            ("topic", b"/husky_velocity_controller/odom"),
+        ],
+        &conn_hdr,
+    );
+    let time = [1u32.to_le_bytes(), 0u32.to_le_bytes()].concat();
+    let msg = record(
+        &[("op", &[2]), ("conn", &0u32.to_le_bytes()), ("time", &time)],
+        payload,
+    );
+    let inner = [conn, msg].concat();
+    let stored = match compression {
+        "none" => inner.clone(),
+        "lz4" => {
+            let mut e = lz4_flex::frame::FrameEncoder::new(Vec::new());
+            std::io::Write::write_all(&mut e, &inner).unwrap();
+            e.finish().unwrap()
+        }
+        c => panic!("{c}"),
+    };
+    let chunk = record(
+        &[
+            ("op", &[5]),
+            ("compression", compression.as_bytes()),
+            ("size", &(inner.len() as u32).to_le_bytes()),
+        ],
+        &stored,
+    );
+    let mut out = b"#ROSBAG V2.0\n".to_vec();
+    let header = |index_pos: u64| {
+        record(
+            &[
+                ("op", &[3]),
+                ("index_pos", &index_pos.to_le_bytes()),
+                ("conn_count", &1u32.to_le_bytes()),
+                ("chunk_count", &1u32.to_le_bytes()),
+            ],
+            &[],
+        )
+    };
+    // The bag ends after the chunk: index_pos points at the end (an empty index).
+    let h = header((13 + header(0).len() + chunk.len()) as u64);
+    out.extend_from_slice(&h);
+    out.extend_from_slice(&chunk);
+    out
+}

@@ -1,0 +1,124 @@
+//! TedriS and the calibrated four-wheel EKF through the same GNSS outages (moved
+//! unchanged from the command line's `compare`). Neither method sees GNSS
+//! inside the outages, not even for calibration or training.
+
+use deadreckon_core::calibrate::{self, CalibrationOptions};
+use deadreckon_core::ekf::FilterOptions;
+use deadreckon_core::{outage, Drive, Params};
+use deadreckon_tedris::{Outage, TedrisConfig, TedrisModel};
+
+use crate::Error;
+
+/// One method's errors through one outage.
+pub struct Row {
+    /// Mean horizontal error, m.
+    pub mean: f64,
+    /// Largest error, m.
+    pub max: f64,
+    /// Error at the end, m.
+    pub fin: f64,
+    /// Time until the error first reaches 1 m, s.
+    pub to_1m: Option<f64>,
+}
+
+/// The comparison through a set of outages.
+pub struct Comparison {
+    /// Where the four-wheel parameters came from.
+    pub params_source: String,
+    /// Where the TedriS model came from.
+    pub model_source: String,
+    /// The four-wheel reference ("truth" or "gnss").
+    pub four_wheel_reference: String,
+    /// The TedriS reference.
+    pub tedris_reference: String,
+    /// Per outage: the window, the four-wheel row, the TedriS row.
+    pub rows: Vec<(Outage, Option<Row>, Option<Row>)>,
+    /// The TedriS model used.
+    pub model: TedrisModel,
+    /// The four-wheel filter's χ² gate counters over the run.
+    pub four_wheel_gates: deadreckon_core::filter::GateCounts,
+    /// TedriS's checks over the run: (headings refused as inconsistent with
+    /// the wheels, calibrations refused, heading segments, watchdog alarms).
+    pub tedris_checks: (u64, u64, u32, u64),
+}
+
+/// The drive without GNSS inside the windows.
+pub fn hide(drive: &Drive, windows: &[(f64, f64)]) -> Drive {
+    let mut d = drive.clone();
+    d.gnss
+        .retain(|g| !windows.iter().any(|&(a, b)| g.t_s >= a && g.t_s < b));
+    d
+}
+
+/// Runs both methods through `outages`. Without `params`, the four-wheel
+/// parameters are calibrated (RTS) on the drive with the outages hidden; without
+/// `model`, TedriS is trained on the drive with the outages hidden.
+pub fn compare(
+    drive: &Drive,
+    outages: &[Outage],
+    params: Option<(Params, String)>,
+    model: Option<(TedrisModel, String)>,
+) -> Result<Comparison, Error> {
+    let windows: Vec<(f64, f64)> = outages.iter().map(|o| (o.start_s, o.end_s)).collect();
+    let hidden = hide(drive, &windows);
+    let (params, params_source) = match params {
+        Some(p) => p,
+        None => {
+            let c = calibrate::calibrate(&hidden, &CalibrationOptions::default())
+                .map_err(Error::HiddenCalibration)?;
+            (
+                c.estimate.params,
+                format!("RTS on the drive, outages hidden ({} passes)", c.iterations),
+            )
+        }
+    };
+    let fw = outage::through_windows(drive, &params, &windows, &FilterOptions::default())?;
+    let (model, model_source) = match model {
+        Some(m) => m,
+        None => {
+            let (m, _) = deadreckon_tedris::train(&hidden, TedrisConfig::default(), None)
+                .map_err(Error::HiddenTraining)?;
+            (m, "TedriS trained on the drive, outages hidden".into())
+        }
+    };
+    let td = deadreckon_tedris::run_outages(drive, &model, outages)?;
+    let mut rows = Vec::new();
+    for o in outages {
+        let f = fw
+            .windows
+            .iter()
+            .find(|w| w.start_s == o.start_s)
+            .map(|w| Row {
+                mean: w.errors.iter().map(|e| e.1).sum::<f64>() / w.errors.len().max(1) as f64,
+                max: w.max_error_m,
+                fin: w.final_error_m,
+                to_1m: w.errors.iter().find(|e| e.1 >= 1.0).map(|e| e.0),
+            });
+        let t = td
+            .outages
+            .iter()
+            .find(|e| e.start_s == o.start_s)
+            .map(|e| Row {
+                mean: e.mean_error_m,
+                max: e.max_error_m,
+                fin: e.final_error_m,
+                to_1m: e.time_to_1m_s,
+            });
+        rows.push((*o, f, t));
+    }
+    Ok(Comparison {
+        params_source,
+        model_source,
+        four_wheel_reference: fw.reference.name().into(),
+        tedris_reference: td.reference.clone(),
+        rows,
+        model,
+        four_wheel_gates: fw.gates,
+        tedris_checks: (
+            td.machine.inconsistent_headings(),
+            td.machine.refused_calibrations(),
+            td.machine.segments(),
+            td.machine.model_alarms(),
+        ),
+    })
+}

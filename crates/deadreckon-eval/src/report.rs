@@ -1,0 +1,476 @@
+//! Estimator results as the HTML report's plain data model
+//! (`deadreckon_report::ReportInput`): the calibrations made on a drive, the
+//! filter's health, dead reckoning, drift, outages and the TedriS sections
+//! (moved unchanged from the command line's `report`).
+
+use deadreckon_core::calibrate::{self, Calibration, CalibrationOptions, Method};
+use deadreckon_core::ekf::{self, FilterOptions, FilterStats, SensorKind};
+use deadreckon_core::metrics;
+use deadreckon_core::track as tracks;
+use deadreckon_core::{outage, Drive, Params, ParamsWithStd, Track};
+use deadreckon_report as rp;
+
+use crate::{Error, Progress};
+
+/// A named parameter set for the report.
+pub struct NamedParams {
+    /// Display name.
+    pub name: String,
+    /// Parameters.
+    pub params: ParamsWithStd,
+    /// The calibration that produced them, if any.
+    pub calibration: Option<Calibration>,
+}
+
+fn param_set(p: &Params) -> rp::ParamSet {
+    rp::ParamSet {
+        gyro_bias_rps: p.gyro_bias_rps,
+        speed_scale: p.speed_scale,
+        circumference_fl_m: p.circumference_fl_m,
+        circumference_fr_m: p.circumference_fr_m,
+        circumference_rl_m: p.circumference_rl_m,
+        circumference_rr_m: p.circumference_rr_m,
+    }
+}
+
+fn path_of(t: &Track) -> rp::EnPath {
+    rp::EnPath {
+        east_m: t.points.iter().map(|p| p.east_m).collect(),
+        north_m: t.points.iter().map(|p| p.north_m).collect(),
+    }
+}
+
+fn stream(name: &str, t: &[f64]) -> Option<rp::StreamInfo> {
+    if t.is_empty() {
+        return None;
+    }
+    let span = t[t.len() - 1] - t[0];
+    Some(rp::StreamInfo {
+        name: name.into(),
+        samples: t.len(),
+        rate_hz: (span > 0.0).then(|| (t.len() - 1) as f64 / span),
+    })
+}
+
+/// The header: drive name, duration, distance, streams.
+pub fn header(drive: &Drive, name: &str, inputs: Vec<(String, String)>) -> rp::Header {
+    let wheels: Vec<f64> = (0..drive.wheels.len())
+        .map(|k| drive.wheels.t_s(k))
+        .collect();
+    let wheel_name = match drive.wheels {
+        deadreckon_core::drive::Wheels::Ticks(_) => "wheel_ticks",
+        deadreckon_core::drive::Wheels::Speeds(_) => "wheel_speeds",
+    };
+    let streams = [
+        stream(wheel_name, &wheels),
+        stream(
+            "yaw_rate",
+            &drive.yaw_rate.iter().map(|s| s.t_s).collect::<Vec<_>>(),
+        ),
+        stream(
+            "speed",
+            &drive.speed.iter().map(|s| s.t_s).collect::<Vec<_>>(),
+        ),
+        stream(
+            "steering",
+            &drive.steering.iter().map(|s| s.t_s).collect::<Vec<_>>(),
+        ),
+        stream(
+            "gnss",
+            &drive.gnss.iter().map(|s| s.t_s).collect::<Vec<_>>(),
+        ),
+        stream(
+            "truth",
+            &drive.truth.iter().map(|s| s.t_s).collect::<Vec<_>>(),
+        ),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    let distance_m = deadreckon_core::reference::Reference::from_truth(&drive.truth)
+        .and_then(|r| r.distance().last().copied());
+    rp::Header {
+        drive_name: name.into(),
+        duration_s: drive.time_span().map(|(a, b)| b - a),
+        distance_m,
+        start_t_s: drive.time_span().map(|s| s.0),
+        streams,
+        inputs: inputs
+            .into_iter()
+            .map(|(name, value)| rp::NamedText { name, value })
+            .collect(),
+    }
+}
+
+/// The calibrations a drive supports: nominal always, ZUPT with a standstill,
+/// RTS with GNSS, truth with a reference.
+pub fn calibrations(drive: &Drive, steps: &dyn Progress) -> Vec<NamedParams> {
+    let nominal = Params::nominal(&drive.vehicle);
+    let mut out = vec![NamedParams {
+        name: "nominal".into(),
+        params: ParamsWithStd {
+            params: nominal,
+            std: Params::from_array([0.0; 6]),
+        },
+        calibration: None,
+    }];
+    for (name, method) in [
+        ("ZUPT", Method::Zupt),
+        ("RTS", Method::Rts),
+        ("truth", Method::Truth),
+    ] {
+        steps.step(&format!("{name} calibration"));
+        if let Ok(c) = calibrate::calibrate(
+            drive,
+            &CalibrationOptions {
+                method,
+                ..Default::default()
+            },
+        ) {
+            out.push(NamedParams {
+                name: name.into(),
+                params: c.estimate,
+                calibration: Some(c),
+            });
+        }
+    }
+    out
+}
+
+fn sensor_unit(k: SensorKind, ticks: bool) -> &'static str {
+    match k {
+        SensorKind::Wheel(_) if ticks => "ticks",
+        SensorKind::Wheel(_) | SensorKind::Speed => "m/s",
+        SensorKind::Gyro => "rad/s",
+        SensorKind::Steering => "m/s",
+        SensorKind::Gnss => "m",
+        SensorKind::Course => "rad",
+    }
+}
+
+/// Filter health from a GNSS-aided run with innovations recorded.
+pub fn health(
+    drive: &Drive,
+    params: &Params,
+) -> Result<(rp::FilterHealth, FilterStats, Vec<Track>), Error> {
+    let opts = FilterOptions {
+        record_innovations: true,
+        record_epochs: true,
+        ..Default::default()
+    };
+    let out = ekf::run(drive, params, &opts, &mut ())?;
+    let sm = deadreckon_core::rts::smooth(&out.epochs)?;
+    let origin = drive.vehicle.origin;
+    let tracks = vec![
+        Track::from_epochs("filtered", &out.epochs, origin),
+        Track::from_smoothed("smoothed", &sm, origin),
+    ];
+    let ticks = matches!(drive.wheels, deadreckon_core::drive::Wheels::Ticks(_));
+    let mut kinds: Vec<SensorKind> = out.innovations.iter().map(|i| i.sensor).collect();
+    kinds.sort();
+    kinds.dedup();
+    let mut h = rp::FilterHealth {
+        nis_bound_probability: Some(0.95),
+        ..Default::default()
+    };
+    for k in kinds {
+        let recs: Vec<_> = out.innovations.iter().filter(|i| i.sensor == k).collect();
+        h.innovations.push(rp::InnovationSeries {
+            sensor: k.name().into(),
+            unit: sensor_unit(k, ticks).into(),
+            t_s: recs.iter().map(|r| r.t_s).collect(),
+            innovation: recs.iter().map(|r| r.y).collect(),
+            std: recs.iter().map(|r| r.s.sqrt()).collect(),
+            gated: recs.iter().map(|r| !r.accepted).collect(),
+        });
+        h.nis.push(rp::NisSeries {
+            sensor: k.name().into(),
+            dof: k.dof() as u32,
+            t_s: recs.iter().map(|r| r.t_s).collect(),
+            nis: recs.iter().map(|r| r.nis).collect(),
+            gated: recs.iter().map(|r| !r.accepted).collect(),
+            gate_chi2: Some(deadreckon_core::filter::gate_chi2(&drive.vehicle.noise, k))
+                .filter(|g| g.is_finite()),
+        });
+    }
+    Ok((h, out.stats, tracks))
+}
+
+/// Builds the four-wheel part of a report for `drive` with the given parameter sets.
+pub fn four_wheel_input(
+    drive: &Drive,
+    methods: &[NamedParams],
+    outage_s: Option<f64>,
+    steps: &dyn Progress,
+) -> Result<rp::ReportInput, Error> {
+    let mut input = rp::ReportInput::default();
+    let mut traj = rp::Trajectories::default();
+    if let Some(r) = deadreckon_core::reference::Reference::from_truth(&drive.truth) {
+        traj.truth = Some(rp::EnPath {
+            east_m: r.x.iter().map(|x| x[0]).collect(),
+            north_m: r.x.iter().map(|x| x[1]).collect(),
+        });
+    }
+    // Filter health and the aided tracks with the best parameters available.
+    let best = methods
+        .iter()
+        .find(|m| m.name == "RTS")
+        .or_else(|| methods.last())
+        .map(|m| m.params.params);
+    if let (Some(best), true) = (best, drive.gnss.len() >= 2) {
+        steps.step("filter health");
+        if let Ok((h, st, tracks)) = health(drive, &best) {
+            let gated: Vec<f64> = h
+                .innovations
+                .iter()
+                .filter(|s| s.sensor == "gnss")
+                .flat_map(|s| {
+                    s.t_s
+                        .iter()
+                        .zip(&s.gated)
+                        .filter(|(_, g)| **g)
+                        .map(|(t, _)| *t)
+                })
+                .collect();
+            let is_gated = |t: f64| gated.iter().any(|g| (g - t).abs() < 0.011);
+            traj.gnss = Some(rp::EnPath {
+                east_m: drive.gnss.iter().map(|g| g.east_m).collect(),
+                north_m: drive.gnss.iter().map(|g| g.north_m).collect(),
+            });
+            if st.gnss_rejected > 0 {
+                let gg: Vec<_> = drive.gnss.iter().filter(|g| is_gated(g.t_s)).collect();
+                traj.gnss_gated = Some(rp::EnPath {
+                    east_m: gg.iter().map(|g| g.east_m).collect(),
+                    north_m: gg.iter().map(|g| g.north_m).collect(),
+                });
+            }
+            traj.filtered = tracks.first().map(path_of);
+            traj.smoothed = tracks.get(1).map(path_of);
+            input.health = Some(h);
+        }
+    }
+    // Dead reckoning with each parameter set.
+    let opts = FilterOptions::default();
+    for m in methods {
+        steps.step(&format!("dead reckoning with {}", m.name));
+        let init = tracks::dead_reckoning_init(drive, None, None);
+        if let Ok(dr) = init.and_then(|i| tracks::dead_reckoned(drive, &m.params.params, &opts, i))
+        {
+            traj.dead_reckoned.push(rp::MethodPath {
+                method: m.name.clone(),
+                path: path_of(&dr),
+            });
+        }
+    }
+    input.trajectories = Some(traj);
+    // Calibration table and the iterations of the RTS calibration.
+    let mut cal = rp::Calibration::default();
+    for m in methods {
+        let has_std = m.params.std.to_array().iter().any(|s| *s > 0.0);
+        cal.rows.push(rp::CalibrationRow {
+            method: m.name.clone(),
+            values: param_set(&m.params.params),
+            std: has_std.then(|| param_set(&m.params.std)),
+        });
+    }
+    if let Some(c) = methods
+        .iter()
+        .find(|m| m.name == "RTS")
+        .and_then(|m| m.calibration.as_ref())
+    {
+        cal.iterated_method = "RTS".into();
+        cal.iterations = std::iter::once(Params::nominal(&drive.vehicle))
+            .chain(c.history.iter().copied())
+            .map(|p| param_set(&p))
+            .collect();
+    }
+    input.calibration = Some(cal);
+    // Drift and distance before 1 m, against the truth.
+    if !drive.truth.is_empty() {
+        let mut d = rp::Drift::default();
+        for m in methods {
+            steps.step(&format!("drift with {}", m.name));
+            let p = &m.params.params;
+            let (Ok(dr), Ok(rs)) = (
+                metrics::drift(drive, p, 100.0, opts.timing),
+                metrics::reset_on_error(drive, p, 1.0, opts.timing),
+            ) else {
+                continue;
+            };
+            d.methods.push(rp::DriftMethod {
+                method: m.name.clone(),
+                error_after_segment_m: dr.errors_m,
+                distance_to_threshold_m: rs.distances_m,
+            });
+        }
+        input.drift = Some(d);
+    }
+    // Sliding outages.
+    if let Some(len) = outage_s {
+        let mut ev = rp::OutageEvaluation {
+            window_s: Some(len),
+            methods: Vec::new(),
+        };
+        for m in methods {
+            steps.step(&format!("{len} s outages with {}", m.name));
+            if let Ok(o) = outage::evaluate(drive, &m.params.params, len, len / 2.0, 5.0, &opts) {
+                ev.methods.push(rp::MethodSample {
+                    method: m.name.clone(),
+                    final_error_m: o.windows.iter().map(|w| w.final_error_m).collect(),
+                });
+            }
+        }
+        if !ev.methods.is_empty() {
+            input.outages = Some(ev);
+        }
+    }
+    Ok(input)
+}
+
+/// [`tedris_section`] for a model in memory.
+pub fn tedris_from_model(
+    drive: &Drive,
+    m: &deadreckon_tedris::TedrisModel,
+    outage_s: Option<f64>,
+) -> Result<rp::Tedris, Error> {
+    let mut t = rp::Tedris {
+        cross_correlation: Some(rp::CrossCorrelation {
+            lag: m.ccf.lags.clone(),
+            correlation: m.ccf.values.clone(),
+            chosen_lag: Some(m.lag_samples),
+        }),
+        ..Default::default()
+    };
+    for f in &m.fits {
+        let nv = |name: &str, value: f64| rp::NamedValue {
+            name: name.into(),
+            value,
+        };
+        let name = if f.kind == m.chosen {
+            format!("{} (chosen)", f.kind.name())
+        } else {
+            f.kind.name().to_string()
+        };
+        t.models.push(rp::RegressionModel {
+            name,
+            coefficients: f
+                .global
+                .coefficients
+                .iter()
+                .map(|c| rp::Coefficient {
+                    name: c.name.clone(),
+                    estimate: c.estimate,
+                    std_error: c.std_error,
+                    t_value: c.t_value,
+                    p_value: c.p_value,
+                })
+                .collect(),
+            statistics: vec![
+                nv("n", f.global.n as f64),
+                nv("R²", f.global.r_squared),
+                nv("AIC", f.global.aic),
+                nv("BIC", f.global.bic),
+                nv("Box–Pierce Q", f.box_pierce.statistic),
+                nv("Box–Pierce p", f.box_pierce.p_value),
+                nv("Ljung–Box Q*", f.ljung_box.statistic),
+                nv("Ljung–Box p", f.ljung_box.p_value),
+            ],
+        });
+    }
+    let fill = m.repositories.fill(m.config.required_bins);
+    t.repositories = Some(rp::Repositories {
+        index: fill.iter().map(|f| f.index as i64).collect(),
+        fill: fill.iter().map(|f| f.tuples as u64).collect(),
+        min_fill: Some(m.config.min_fill as u64),
+        max_fill: Some(m.config.max_fill as u64),
+    });
+    // Outages spread over the drive.
+    let (t0, t1) = drive.time_span().ok_or(Error::EmptyDrive)?;
+    let len = outage_s.unwrap_or(80.0).min(0.2 * (t1 - t0));
+    let outages: Vec<deadreckon_tedris::Outage> = [0.25, 0.5, 0.75]
+        .iter()
+        .map(|f| {
+            let a = t0 + f * (t1 - t0) - 0.5 * len;
+            deadreckon_tedris::Outage {
+                start_s: a,
+                end_s: a + len,
+            }
+        })
+        .collect();
+    let run = deadreckon_tedris::run_outages(drive, m, &outages)?;
+    // Training heading (TedriS's own estimate outside outages) against the reference course.
+    let course: Vec<(f64, f64)> = drive
+        .gnss
+        .iter()
+        .filter_map(|g| g.course_yaw_rad().map(|c| (g.t_s, c)))
+        .collect();
+    if !course.is_empty() {
+        let unwrap = |v: Vec<(f64, f64)>| -> rp::TimeSeries {
+            let a = deadreckon_core::angle::unwrap(&v.iter().map(|x| x.1).collect::<Vec<_>>());
+            rp::TimeSeries {
+                t_s: v.iter().map(|x| x.0).collect(),
+                value: a,
+            }
+        };
+        t.gnss_heading_rad = Some(unwrap(course));
+        t.training_heading_rad = Some(unwrap(
+            run.track
+                .points
+                .iter()
+                .map(|p| (p.t_s, p.yaw_rad))
+                .collect(),
+        ));
+    }
+    // Error through each outage for TedriS and the four-wheel EKF (calibrated with the outages hidden).
+    let windows: Vec<(f64, f64)> = outages.iter().map(|o| (o.start_s, o.end_s)).collect();
+    let hidden = crate::compare::hide(drive, &windows);
+    let fw = calibrate::calibrate(&hidden, &CalibrationOptions::default())
+        .ok()
+        .and_then(|c| {
+            outage::through_windows(
+                drive,
+                &c.estimate.params,
+                &windows,
+                &FilterOptions::default(),
+            )
+            .ok()
+        });
+    let truth = deadreckon_core::reference::Reference::from_truth(&drive.truth);
+    for o in &outages {
+        let mut series = Vec::new();
+        if let Some(tr) = &truth {
+            let pts: Vec<(f64, f64)> = run
+                .track
+                .points
+                .iter()
+                .filter(|p| p.t_s >= o.start_s && p.t_s <= o.end_s)
+                .filter_map(|p| {
+                    tr.state_at(p.t_s)
+                        .map(|x| (p.t_s - o.start_s, (p.east_m - x[0]).hypot(p.north_m - x[1])))
+                })
+                .collect();
+            series.push(rp::MethodSeries {
+                method: "TedriS".into(),
+                t_s: pts.iter().map(|p| p.0).collect(),
+                error_m: pts.iter().map(|p| p.1).collect(),
+            });
+        }
+        if let Some(w) = fw
+            .as_ref()
+            .and_then(|f| f.windows.iter().find(|w| w.start_s == o.start_s))
+        {
+            series.push(rp::MethodSeries {
+                method: "RTS".into(),
+                t_s: w.errors.iter().map(|e| e.0).collect(),
+                error_m: w.errors.iter().map(|e| e.1).collect(),
+            });
+        }
+        if !series.is_empty() {
+            t.outages.push(rp::OutageRun {
+                name: format!("outage {:.0}–{:.0} s", o.start_s - t0, o.end_s - t0),
+                series,
+            });
+        }
+    }
+    Ok(t)
+}
