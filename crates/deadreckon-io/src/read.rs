@@ -199,6 +199,7 @@ pub fn read_drive_with(dir: &Path, options: &ReadOptions) -> Result<Drive, IoErr
         steering,
         gnss,
         truth,
+        imu: Default::default(),
     };
     drive.validate().map_err(|source| IoError::Invalid {
         path: dir.to_path_buf(),

@@ -115,6 +115,7 @@ mod tests {
             steering: Vec::new(),
             gnss: Vec::new(),
             truth: Vec::new(),
+            imu: Default::default(),
         }
     }
 

@@ -620,6 +620,7 @@ impl Suite {
             steering: self.steering,
             gnss: self.gnss,
             truth: self.truth,
+            imu: Default::default(),
         }
     }
 }
