@@ -66,9 +66,9 @@ pub fn load_params(spec: &str, drive: &Drive) -> Result<Params> {
 /// applied before calibrating (see `deadreckon_core::timing`).
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum CorrectionsArg {
-    /// IMU tilt and every stream's delay.
+    /// IMU tilt, every stream's delay and the gyro scale.
     All,
-    /// IMU tilt and the GNSS delay (the other delays reported, not applied).
+    /// IMU tilt, GNSS delay and gyro scale (the other delays reported, not applied).
     Gnss,
     /// None.
     None,
@@ -140,6 +140,17 @@ pub fn corrections_lines(c: &deadreckon_core::timing::Corrections) -> Vec<String
             ),
             Some(r) => format!("imu tilt: not estimated: {r}"),
         }),
+    }
+    if let Some(g) = &c.gyro_scale {
+        out.push(match g.status.reason() {
+            None => format!(
+                "gyro scale error: {:+.3}% ± {:.3}% ({} turns), applied",
+                100.0 * g.scale_error,
+                100.0 * g.std,
+                g.turns
+            ),
+            Some(r) => format!("gyro scale error: not estimated: {r}"),
+        });
     }
     out
 }

@@ -1,7 +1,7 @@
 //! The timing and mounting corrections ([`deadreckon_core::timing`],
 //! [`deadreckon_core::imu`]) as the CLI and the Python bindings show and store
 //! them: JSON (`calibrate --json`, `evaluate --outage --json`), the
-//! `[delays]` and `[imu]` tables of params.toml, and those tables read back
+//! `[delays]`, `[imu]` and `[gyro_scale]` tables of params.toml, and those tables read back
 //! and applied to another drive. A params.toml without them (older files)
 //! applies nothing.
 
@@ -37,7 +37,18 @@ fn tilt_json(t: &Tilt) -> Value {
     })
 }
 
-/// `{"delays": {stream: {...}}, "imu": {...} | null}`.
+fn scale_json(g: &deadreckon_core::gyro_scale::GyroScale) -> Value {
+    let num = |x: f64| if x.is_finite() { json!(x) } else { Value::Null };
+    json!({
+        "scale_error": num(g.scale_error),
+        "std": num(g.std),
+        "turns": g.turns,
+        "estimated": g.is_estimated(),
+        "reason": g.status.reason(),
+    })
+}
+
+/// `{"delays": {stream: {...}}, "imu": {...} | null, "gyro_scale": {...} | null}`.
 pub fn corrections_json(c: &Corrections) -> Value {
     let delays: serde_json::Map<String, Value> = Stream::ALL
         .iter()
@@ -46,10 +57,11 @@ pub fn corrections_json(c: &Corrections) -> Value {
     json!({
         "delays": delays,
         "imu": c.tilt.as_ref().map(tilt_json),
+        "gyro_scale": c.gyro_scale.as_ref().map(scale_json),
     })
 }
 
-/// The `[delays.<stream>]` and `[imu]` tables of params.toml.
+/// The `[delays.<stream>]`, `[imu]` and `[gyro_scale]` tables of params.toml.
 pub fn corrections_toml(c: &Corrections) -> toml::Table {
     let mut out = toml::Table::new();
     let mut delays = toml::Table::new();
@@ -79,6 +91,17 @@ pub fn corrections_toml(c: &Corrections) -> toml::Table {
         }
         out.insert("imu".into(), t.into());
     }
+    if let Some(g) = &c.gyro_scale {
+        let mut t = toml::Table::new();
+        if g.is_estimated() {
+            t.insert("scale_error".into(), g.scale_error.into());
+            t.insert("std".into(), g.std.into());
+            t.insert("turns".into(), (g.turns as i64).into());
+        } else if let Some(r) = g.status.reason() {
+            t.insert("not_estimated".into(), r.into());
+        }
+        out.insert("gyro_scale".into(), t.into());
+    }
     out
 }
 
@@ -89,12 +112,14 @@ pub struct Stored {
     pub delays_s: [f64; 4],
     /// The IMU's vertical in its own axes, when estimated.
     pub up: Option<[f64; 3]>,
+    /// The gyro's relative scale error (0 when absent or not estimated).
+    pub gyro_scale_error: f64,
 }
 
 impl Stored {
     /// Applies them to `drive` ([`timing::apply_known`]).
     pub fn apply(&self, drive: &Drive) -> Drive {
-        timing::apply_known(drive, self.delays_s, self.up)
+        timing::apply_known(drive, self.delays_s, self.up, self.gyro_scale_error)
     }
 }
 
@@ -132,6 +157,20 @@ pub fn stored_corrections(extra: &toml::Table) -> Result<Stored, String> {
                 return Err("`imu.up` must be a unit vector of 3 numbers".into());
             }
             s.up = Some([v[0], v[1], v[2]]);
+        }
+    }
+    if let Some(g) = extra.get("gyro_scale") {
+        let g = g.as_table().ok_or("`gyro_scale` must be a table")?;
+        if let Some(v) = g.get("scale_error") {
+            let v = v
+                .as_float()
+                .ok_or("`gyro_scale.scale_error` must be a number")?;
+            if !(v.is_finite() && v.abs() <= deadreckon_core::gyro_scale::MAX_SCALE_ERROR) {
+                return Err(format!(
+                    "`gyro_scale.scale_error` = {v} is not a plausible gyro scale error"
+                ));
+            }
+            s.gyro_scale_error = v;
         }
     }
     Ok(s)

@@ -6,20 +6,27 @@
 //! - **Gyro, CAN speed, steering** ([`scalar_delay`]): the stream against a
 //!   signal derived from the wheels (yaw rate from the rear wheels' speed
 //!   difference, the wheels' mean speed, the curvature yaw rate / speed above
-//!   [`MIN_CURVATURE_SPEED_MPS`]). For each lag on a grid the stream is fitted
-//!   as `a + b·x(t − d)` by least squares; the lag of the smallest residual is
+//!   [`MIN_CURVATURE_SPEED_MPS`]), both smoothed by a 0.2 s triangle. For
+//!   each lag on a grid the stream is fitted as `a + b·x(t − d)` by least
+//!   squares; the lag of the smallest residual is
 //!   refined by a parabola through its neighbours. The standard error is the
 //!   Gauss–Newton one, `σ²/Σ(b·x′ − mean)²`, inflated by `(1 + ρ)/(1 − ρ)` for
 //!   the lag-one autocorrelation `ρ` of the residuals. Steering's delay is
 //!   the lag of the car's yaw response behind the steering wheel (tyre and
 //!   body dynamics included), as openpilot's `lagd` measures it.
 //! - **GNSS** ([`gnss_delay`]): a parameter of the least squares between the
-//!   fixes and the smoothed track. The drive is calibrated (RTS) with the fixes
-//!   moved back by the current delay, smoothed, and the fixes' residuals
-//!   against the antenna's smoothed position at `t − d` are regressed on its
-//!   velocity (`r = −δ·V + bias`); `d += δ` until `δ` settles. The smoother
-//!   absorbs part of a wrong delay, so one step under-corrects and the steps
-//!   are repeated.
+//!   fixes and the dead-reckoned track. The drive is calibrated (RTS) with
+//!   the fixes moved back by the current delay, dead-reckoned from the
+//!   smoothed start (wheels and gyro only), and the fixes' residuals against
+//!   the antenna's dead-reckoned position are regressed on its velocity, with
+//!   a bias, a rotation and a stretch per 20 s window for the dead
+//!   reckoning's drift (`r = −δ·V + b + θ·J(p − p_c) + λ(p − p_c)`), until
+//!   `δ` settles. (Against the
+//!   smoothed track, which the fixes pull along, a 0.18 s delay read
+//!   0.11 s.) The smoother absorbs
+//!   part of a wrong delay, so one step under-corrects (`δ ≈ (1 − α)(d* − d)`):
+//!   after a first plain step the delay moves by secant steps on `δ(d) = 0`,
+//!   and the standard error of `δ` is divided by the slope `1 − α`.
 //!
 //! **Status**: a delay is *not estimated* (and not applied) with too few
 //! samples, when the best lag lies on the search bound ([`DelayOptions::max_delay_s`]:
@@ -29,7 +36,7 @@
 
 use crate::calibrate::{self, CalibrationOptions};
 use crate::drive::{Drive, Scalar};
-use crate::ekf::{self, FilterOptions};
+use crate::ekf::{self, FilterOptions, Init, SensorSet};
 use crate::imu::{interp, wheel_speed};
 use crate::model::{V, X, Y, YAW, YAW_RATE};
 use crate::reference::Reference;
@@ -189,8 +196,12 @@ pub struct DelayOptions {
     pub step_s: f64,
     /// Largest standard error of an accepted delay, s.
     pub max_std_s: f64,
-    /// Fewest samples.
+    /// Fewest samples (GNSS fixes, or windows of the scalar streams).
     pub min_samples: usize,
+    /// Half-width of the triangle smoothing both scalar streams, s, and the
+    /// spacing of the points compared (several sample periods of the
+    /// slowest stream).
+    pub window_s: f64,
     /// Largest number of calibrate-and-regress steps of the GNSS delay.
     pub gnss_iterations: usize,
     /// Window of the GNSS regression's biases, s (each window its own east
@@ -205,8 +216,9 @@ impl Default for DelayOptions {
             step_s: 0.005,
             max_std_s: 0.02,
             min_samples: 50,
+            window_s: 0.2,
             gnss_iterations: 8,
-            gnss_window_s: f64::INFINITY,
+            gnss_window_s: 20.0,
         }
     }
 }
@@ -241,43 +253,117 @@ fn line_fit(x: &[f64], y: &[f64]) -> Option<(f64, f64, Vec<f64>)> {
     Some((a, b, r))
 }
 
+/// Exact first and second integrals of a linearly interpolated series.
+struct Integral<'a> {
+    s: &'a [(f64, f64)],
+    cum: Vec<f64>,
+    cum2: Vec<f64>,
+}
+
+impl<'a> Integral<'a> {
+    fn new(s: &'a [(f64, f64)]) -> Self {
+        let mut cum = Vec::with_capacity(s.len());
+        let mut cum2 = Vec::with_capacity(s.len());
+        let (mut c1, mut c2) = (0.0, 0.0);
+        cum.push(0.0);
+        cum2.push(0.0);
+        for w in s.windows(2) {
+            let h = w[1].0 - w[0].0;
+            let m = if h > 0.0 { (w[1].1 - w[0].1) / h } else { 0.0 };
+            c2 += c1 * h + w[0].1 * h * h / 2.0 + m * h * h * h / 6.0;
+            c1 += 0.5 * (w[0].1 + w[1].1) * h;
+            cum.push(c1);
+            cum2.push(c2);
+        }
+        Integral { s, cum, cum2 }
+    }
+    /// First and second integral up to `t`.
+    fn at(&self, t: f64) -> Option<(f64, f64)> {
+        let n = self.s.len();
+        if n < 2 || !(t >= self.s[0].0 && t <= self.s[n - 1].0) {
+            return None;
+        }
+        let i = self.s.partition_point(|p| p.0 <= t).clamp(1, n - 1);
+        let (a, b) = (self.s[i - 1], self.s[i]);
+        let h = b.0 - a.0;
+        let tau = t - a.0;
+        let m = if h > 0.0 { (b.1 - a.1) / h } else { 0.0 };
+        let c1 = self.cum[i - 1] + a.1 * tau + 0.5 * m * tau * tau;
+        let c2 = self.cum2[i - 1]
+            + self.cum[i - 1] * tau
+            + a.1 * tau * tau / 2.0
+            + m * tau * tau * tau / 6.0;
+        Some((c1, c2))
+    }
+    /// The triangle-weighted mean over `[t − w, t + w]` and its derivative in `t`.
+    fn smooth(&self, t: f64, w: f64) -> Option<(f64, f64)> {
+        let (p1, p2) = self.at(t + w)?;
+        let (c1, c2) = self.at(t)?;
+        let (m1, m2) = self.at(t - w)?;
+        Some((
+            (p2 - 2.0 * c2 + m2) / (w * w),
+            (p1 - 2.0 * c1 + m1) / (w * w),
+        ))
+    }
+}
+
 /// The delay of `signal` (`(t, value)`, stream clock) behind `reference`
-/// (`(t, value)`, wheel clock, sorted); `keep(t)` selects the samples used.
+/// (`(t, value)`, wheel clock, sorted); `keep(t)` selects the windows used.
+///
+/// Both series are compared smoothed by a triangle of half-width
+/// [`DelayOptions::window_s`] (exact double integrals of the linearly
+/// interpolated samples), at points that far apart: interpolating a noisy
+/// series at shifted times favours lags that put those times midway between
+/// its samples (where interpolation averages the noise), a bias of up to a
+/// quarter of a sample period when the two rates are commensurate; a smooth
+/// kernel over many samples weighs every phase alike.
 pub fn scalar_delay(
     reference: &[(f64, f64)],
     signal: &[(f64, f64)],
     keep: &dyn Fn(f64) -> bool,
     o: &DelayOptions,
 ) -> Delay {
-    if reference.len() < 3 {
-        return Delay::not_estimated("too few reference samples");
+    if reference.len() < 3 || signal.len() < 3 {
+        return Delay::not_estimated("too few samples");
+    }
+    if signal.iter().any(|s| !s.1.is_finite()) || reference.iter().any(|s| !s.1.is_finite()) {
+        return Delay::not_estimated("non-finite samples");
     }
     let (r0, r1) = (reference[0].0, reference[reference.len() - 1].0);
-    // Samples whose reference exists at every lag searched.
-    let sig: Vec<(f64, f64)> = signal
-        .iter()
-        .copied()
-        .filter(|&(t, v)| {
-            v.is_finite()
-                && t - o.max_delay_s - o.step_s >= r0
-                && t + o.max_delay_s + o.step_s <= r1
-                && keep(t)
-        })
-        .collect();
-    if sig.len() < o.min_samples {
+    let (s0, s1) = (signal[0].0, signal[signal.len() - 1].0);
+    let w = o.window_s;
+    let margin = o.max_delay_s + o.step_s;
+    let isig = Integral::new(signal);
+    let iref = Integral::new(reference);
+    // Points spaced w on the reference clock, inside both spans at every lag
+    // searched; the signal is read at the point + the lag.
+    let (start, end) = (r0.max(s0 + margin) + w, r1.min(s1 - margin) - w);
+    let mut pts: Vec<(f64, f64)> = Vec::new();
+    let mut t = start;
+    while t <= end {
+        if keep(t) {
+            if let Some((m, _)) = iref.smooth(t, w) {
+                pts.push((t, m));
+            }
+        }
+        t += w;
+    }
+    if pts.len() < o.min_samples {
         return Delay::not_estimated(format!(
-            "{} usable samples, need {}",
-            sig.len(),
+            "{} usable points {w} s apart, need {}",
+            pts.len(),
             o.min_samples
         ));
     }
-    let y: Vec<f64> = sig.iter().map(|s| s.1).collect();
+    let x: Vec<f64> = pts.iter().map(|s| s.1).collect();
+    let ys = |d: f64| -> Vec<(f64, f64)> {
+        pts.iter()
+            .map(|&(t, _)| isig.smooth(t + d, w).unwrap_or((f64::NAN, 0.0)))
+            .collect()
+    };
     let sse = |d: f64| -> Option<f64> {
-        let x: Vec<f64> = sig
-            .iter()
-            .map(|s| interp(reference, s.0 - d).unwrap_or(f64::NAN))
-            .collect();
-        line_fit(&x, &y).map(|(_, _, r)| r.iter().map(|e| e * e).sum())
+        let y: Vec<f64> = ys(d).iter().map(|p| p.0).collect();
+        line_fit(&x, &y).map(|(_, _, r)| r.iter().map(|e| e * e).sum::<f64>())
     };
     let k = (o.max_delay_s / o.step_s).round() as i64;
     let grid: Vec<(f64, f64)> = (-k..=k)
@@ -289,12 +375,11 @@ pub fn scalar_delay(
     if grid.len() < 3 {
         return Delay::not_estimated("the reference does not vary");
     }
-    let (ib, _) = grid
+    let ib = grid
         .iter()
         .enumerate()
         .min_by(|a, b| a.1 .1.total_cmp(&b.1 .1))
-        .map(|(i, g)| (i, g.1))
-        .unwrap_or((0, f64::NAN));
+        .map_or(0, |(i, _)| i);
     if ib == 0 || ib + 1 == grid.len() {
         return Delay::not_estimated(format!(
             "best lag {:+.3} s on the search bound ±{} s",
@@ -310,27 +395,14 @@ pub fn scalar_delay(
         } else {
             0.0
         };
-    // Gauss–Newton standard error at the refined lag.
-    let x: Vec<f64> = sig
-        .iter()
-        .map(|s| interp(reference, s.0 - d).unwrap_or(f64::NAN))
-        .collect();
-    let Some((_, b, r)) = line_fit(&x, &y) else {
+    // Gauss–Newton standard error at the refined lag, with the derivative of
+    // the smoothed signal.
+    let yd = ys(d);
+    let y: Vec<f64> = yd.iter().map(|p| p.0).collect();
+    let Some((_, _, r)) = line_fit(&x, &y) else {
         return Delay::not_estimated("the reference does not vary");
     };
-    let h = 0.01;
-    let j: Vec<f64> = sig
-        .iter()
-        .map(|s| {
-            let (Some(p), Some(m)) = (
-                interp(reference, s.0 - d + h),
-                interp(reference, s.0 - d - h),
-            ) else {
-                return 0.0;
-            };
-            b * (p - m) / (2.0 * h)
-        })
-        .collect();
+    let j: Vec<f64> = yd.iter().map(|p| p.1).collect();
     let n = j.len();
     let mj = j.iter().sum::<f64>() / n as f64;
     let sjj: f64 = j.iter().map(|v| (v - mj).powi(2)).sum();
@@ -415,11 +487,14 @@ pub fn steering_delay(drive: &Drive, o: &DelayOptions) -> Delay {
         return Delay::not_estimated("needs both rear wheels");
     };
     let v = wheel_speed(drive);
+    let (ratio, wheelbase) = (drive.vehicle.steering_ratio, drive.vehicle.wheelbase_m);
     let curvature: Vec<(f64, f64)> = w
         .iter()
         .filter_map(|&(t, wz)| {
             let s = interp(&v, t)?;
-            (s > MIN_CURVATURE_SPEED_MPS).then(|| (t, wz / s))
+            // The wheel angle of that curvature, in steering-wheel units
+            // with the nominal ratio (the fit absorbs a ratio error).
+            (s > MIN_CURVATURE_SPEED_MPS).then(|| (t, ratio * (wheelbase * wz / s).atan()))
         })
         .collect();
     let keep = |t: f64| interp(&v, t).is_some_and(|s| s > MIN_CURVATURE_SPEED_MPS + 0.5);
@@ -447,6 +522,7 @@ pub fn gnss_delay(
     let lever = drive.vehicle.gnss_lever_arm_m;
     let mut d = 0.0;
     let mut last = None;
+    let mut prev: Option<(f64, f64)> = None;
     for _ in 0..o.gnss_iterations.max(1) {
         let shifted = shift(drive, [0.0, 0.0, 0.0, d]);
         let cal = calibrate::calibrate(&shifted, copts)?;
@@ -461,9 +537,29 @@ pub fn gnss_delay(
             &mut (),
         )?;
         let sm = rts::smooth(&f.epochs)?;
+        // Dead reckoning (no GNSS) from the smoothed start: a reference the
+        // fixes' timing cannot pull along, its drift taken out per window.
+        let Some(s0) = sm.first() else {
+            return Ok((Delay::not_estimated("no smoothed track"), None));
+        };
+        let dr = ekf::run(
+            &shifted,
+            &params,
+            &FilterOptions {
+                record_epochs: true,
+                init: Init::Given {
+                    t_s: s0.t_s,
+                    x: s0.x,
+                    p: s0.p,
+                },
+                sensors: SensorSet::dead_reckoning(),
+                ..copts.filter.clone()
+            },
+            &mut (),
+        )?;
         let reference = Reference::from_states(
-            sm.iter().map(|s| s.t_s).collect(),
-            sm.iter().map(|s| s.x).collect(),
+            dr.epochs.iter().map(|e| e.t_s).collect(),
+            dr.epochs.iter().map(|e| e.x).collect(),
         );
         let Some((delta, std, n)) = regress_gnss(&shifted.gnss, &reference, lever, o.gnss_window_s)
         else {
@@ -474,12 +570,28 @@ pub fn gnss_delay(
                 None,
             ));
         };
-        d += delta;
-        last = Some((std, n, params));
-        if d.abs() > o.max_delay_s {
+        // The step under-corrects by the part of the error the smoother
+        // absorbed: δ(d) ≈ (1 − α)(d* − d). Secant steps on δ(d) = 0
+        // converge in a few passes; the standard error of d* is that of δ
+        // divided by the slope (1 − α).
+        let slope = match prev {
+            Some((dp, fp)) if (d - dp).abs() > 1e-9 => {
+                let s = (delta - fp) / (d - dp);
+                (s < -0.05 && s > -2.0).then_some(s)
+            }
+            _ => None,
+        };
+        prev = Some((d, delta));
+        let (next, scale) = match slope {
+            Some(s) => (d - delta / s, -1.0 / s),
+            None => (d + delta, 1.0),
+        };
+        last = Some((std * scale, n, params));
+        if delta.abs() < 1e-4 {
             break;
         }
-        if delta.abs() < 1e-4 {
+        d = next;
+        if d.abs() > o.max_delay_s {
             break;
         }
     }
@@ -493,8 +605,9 @@ pub fn gnss_delay(
 
 /// One regression step of the GNSS delay: the fixes' residuals against the
 /// antenna's position on `reference` at the fixes' times, regressed on the
-/// antenna's velocity with one bias per coordinate and `window_s` window
-/// (`r = −δ·V + b`). Returns `(δ, std, fixes)`: `δ` is how much later the
+/// antenna's velocity with an east and north bias and a small rotation about
+/// the window's centre per `window_s` window (`r = −δ·V + b + θ·J(p − p_c) + λ(p − p_c)`:
+/// the heading and scale drift of a dead-reckoned reference). Returns `(δ, std, fixes)`: `δ` is how much later the
 /// fixes still are than `reference`. `None` with fewer than 10 fixes per
 /// window on average or a velocity that does not vary.
 pub fn regress_gnss(
@@ -503,8 +616,8 @@ pub fn regress_gnss(
     lever_m: f64,
     window_s: f64,
 ) -> Option<(f64, f64, usize)> {
-    // (window, residual, antenna velocity)
-    let mut rows: Vec<(i64, [f64; 2], [f64; 2])> = Vec::new();
+    // (window, residual, antenna velocity, antenna position)
+    let mut rows: Vec<(i64, [f64; 2], [f64; 2], [f64; 2])> = Vec::new();
     let t0 = fixes.first()?.t_s;
     for g in fixes {
         let Some(x) = reference.state_at(g.t_s) else {
@@ -517,28 +630,73 @@ pub fn regress_gnss(
             x[V] * s + lever_m * x[YAW_RATE] * c,
         ];
         let w = ((g.t_s - t0) / window_s).floor() as i64;
-        rows.push((w, [g.east_m - ant[0], g.north_m - ant[1]], va));
+        rows.push((w, [g.east_m - ant[0], g.north_m - ant[1]], va, ant));
     }
     let n = rows.len();
     let windows = rows.last().map_or(0, |r| r.0 + 1) as usize;
     if n < 10 * windows.max(1) || n < 10 {
         return None;
     }
-    // Remove each window's means.
+    // Partial out each window's east and north bias and small rotation
+    // about its centre (the reference's drift) from the residuals and the
+    // velocities.
     let mut centred: Vec<([f64; 2], [f64; 2])> = Vec::with_capacity(n);
     let mut i = 0;
     while i < n {
         let w = rows[i].0;
         let j = i + rows[i..].iter().take_while(|r| r.0 == w).count();
         let m = (j - i) as f64;
-        let mr = [0, 1].map(|k| rows[i..j].iter().map(|r| r.1[k]).sum::<f64>() / m);
-        let mv = [0, 1].map(|k| rows[i..j].iter().map(|r| r.2[k]).sum::<f64>() / m);
-        for r in &rows[i..j] {
-            centred.push((
-                [0, 1].map(|k| r.1[k] - mr[k]),
-                [0, 1].map(|k| r.2[k] - mv[k]),
-            ));
+        let pc = [0, 1].map(|k| rows[i..j].iter().map(|r| r.3[k]).sum::<f64>() / m);
+        // Nuisance columns besides the biases: a rotation J·(p − p_c) and a
+        // stretch (p − p_c) about the window's centre (the reference's
+        // heading and scale drift), made orthogonal to each other.
+        let mut cols: Vec<Vec<[f64; 2]>> = vec![
+            rows[i..j]
+                .iter()
+                .map(|r| [-(r.3[1] - pc[1]), r.3[0] - pc[0]])
+                .collect(),
+            rows[i..j]
+                .iter()
+                .map(|r| [r.3[0] - pc[0], r.3[1] - pc[1]])
+                .collect(),
+        ];
+        let centre = |v: &mut Vec<[f64; 2]>| {
+            let m = [0, 1].map(|k| v.iter().map(|a| a[k]).sum::<f64>() / v.len() as f64);
+            for a in v.iter_mut() {
+                a[0] -= m[0];
+                a[1] -= m[1];
+            }
+        };
+        let dot = |a: &[[f64; 2]], b: &[[f64; 2]]| -> f64 {
+            a.iter()
+                .zip(b)
+                .map(|(p, q)| p[0] * q[0] + p[1] * q[1])
+                .sum()
+        };
+        let remove = |v: &mut Vec<[f64; 2]>, q: &[[f64; 2]]| {
+            let qq = dot(q, q);
+            if qq > 1e-9 {
+                let c = dot(v, q) / qq;
+                for (a, b) in v.iter_mut().zip(q) {
+                    a[0] -= c * b[0];
+                    a[1] -= c * b[1];
+                }
+            }
+        };
+        for c in cols.iter_mut() {
+            centre(c);
         }
+        let first = cols[0].clone();
+        remove(&mut cols[1], &first);
+        let mut rr: Vec<[f64; 2]> = rows[i..j].iter().map(|r| r.1).collect();
+        let mut vv: Vec<[f64; 2]> = rows[i..j].iter().map(|r| r.2).collect();
+        for v in [&mut rr, &mut vv] {
+            centre(v);
+            for c in &cols {
+                remove(v, c);
+            }
+        }
+        centred.extend(rr.into_iter().zip(vv));
         i = j;
     }
     let svv: f64 = centred.iter().map(|(_, v)| v[0] * v[0] + v[1] * v[1]).sum();
@@ -551,7 +709,7 @@ pub fn regress_gnss(
         .iter()
         .map(|(r, v)| [0, 1].map(|k| r[k] + delta * v[k]))
         .collect();
-    let dof = (2 * n) as f64 - (2 * windows.max(1)) as f64 - 1.0;
+    let dof = (2 * n) as f64 - (4 * windows.max(1)) as f64 - 1.0;
     let s2 = res.iter().map(|p| p[0] * p[0] + p[1] * p[1]).sum::<f64>() / dof.max(1.0);
     let rho = 0.5
         * (lag1(&res.iter().map(|p| p[0]).collect::<Vec<_>>())
@@ -567,6 +725,16 @@ pub fn estimate(
     copts: &CalibrationOptions,
     o: &DelayOptions,
 ) -> Result<Delays, Error> {
+    estimate_with_params(drive, copts, o).map(|(d, _)| d)
+}
+
+/// [`estimate`], also returning the calibration at the final GNSS delay
+/// (with the scalar delays applied), when the GNSS delay was estimated.
+pub fn estimate_with_params(
+    drive: &Drive,
+    copts: &CalibrationOptions,
+    o: &DelayOptions,
+) -> Result<(Delays, Option<Params>), Error> {
     let mut delays = Delays {
         gyro: gyro_delay(drive, o),
         speed: speed_delay(drive, o),
@@ -574,8 +742,9 @@ pub fn estimate(
         gnss: Delay::not_estimated("not estimated"),
     };
     let partly = delays.apply(drive);
-    delays.gnss = gnss_delay(&partly, copts, o)?.0;
-    Ok(delays)
+    let (g, params) = gnss_delay(&partly, copts, o)?;
+    delays.gnss = g;
+    Ok((delays, params))
 }
 
 /// Which corrections [`prepare_with`] estimates and applies.
@@ -583,8 +752,8 @@ pub fn estimate(
 pub enum Which {
     /// The IMU tilt and every stream's delay.
     All,
-    /// The IMU tilt and the GNSS delay only (the other streams' delays
-    /// estimated and reported, not applied).
+    /// The IMU tilt, the GNSS delay and the gyro scale (the other streams'
+    /// delays estimated and reported, not applied).
     Gnss,
     /// Nothing estimated or applied.
     None,
@@ -597,11 +766,15 @@ pub struct Corrections {
     pub tilt: Option<crate::imu::Tilt>,
     /// The streams' delays.
     pub delays: Delays,
+    /// The gyro's scale error (`None` when not attempted: no GNSS delay, so
+    /// no calibration to take the bias from).
+    pub gyro_scale: Option<crate::gyro_scale::GyroScale>,
 }
 
 /// Estimates the IMU tilt (projecting the gyro on the vertical when
-/// estimated) and every stream's delay, and returns the drive with both
-/// applied.
+/// estimated), every stream's delay and the gyro scale error
+/// ([`crate::gyro_scale`], with the bias of a calibration at the final
+/// delays), and returns the drive with them applied.
 pub fn prepare(
     drive: &Drive,
     copts: &CalibrationOptions,
@@ -624,11 +797,12 @@ pub fn prepare_with(
             Corrections {
                 tilt: None,
                 delays: Delays::none(),
+                gyro_scale: None,
             },
         ));
     }
     let (levelled, tilt) = crate::imu::level(drive);
-    let mut delays = estimate(&levelled, copts, o)?;
+    let (mut delays, params) = estimate_with_params(&levelled, copts, o)?;
     if which == Which::Gnss {
         for d in [&mut delays.gyro, &mut delays.speed, &mut delays.steering] {
             if d.status.is_estimated() {
@@ -640,16 +814,47 @@ pub fn prepare_with(
         }
     }
     let out = delays.apply(&levelled);
-    Ok((out, Corrections { tilt, delays }))
+    // The bias of the calibration at the final GNSS delay (a time shift of
+    // the gyro does not change its bias), else of a calibration here.
+    let params = match params {
+        Some(p) => Some(p),
+        None => calibrate::calibrate(&out, copts)
+            .ok()
+            .map(|c| c.estimate.params),
+    };
+    let gyro_scale = params.map(|p| crate::gyro_scale::estimate(&out, p.gyro_bias_rps));
+    let out = match &gyro_scale {
+        Some(g) if g.is_estimated() => crate::gyro_scale::apply(&out, g.scale_error),
+        _ => out,
+    };
+    Ok((
+        out,
+        Corrections {
+            tilt,
+            delays,
+            gyro_scale,
+        },
+    ))
 }
 
 /// Applies known corrections (e.g. from a params.toml): the yaw rate
 /// projected on `up` (sensor axes) when given and the drive has a three-axis
-/// gyro, then the delays, s, in [`Stream::ALL`] order.
-pub fn apply_known(drive: &Drive, delays_s: [f64; 4], up: Option<[f64; 3]>) -> Drive {
+/// gyro, then the delays, s, in [`Stream::ALL`] order, then the gyro scale
+/// error.
+pub fn apply_known(
+    drive: &Drive,
+    delays_s: [f64; 4],
+    up: Option<[f64; 3]>,
+    gyro_scale_error: f64,
+) -> Drive {
     let d = match up {
         Some(u) => crate::imu::level_with(drive, u),
         None => drive.clone(),
     };
-    shift(&d, delays_s)
+    let d = shift(&d, delays_s);
+    if gyro_scale_error != 0.0 {
+        crate::gyro_scale::apply(&d, gyro_scale_error)
+    } else {
+        d
+    }
 }

@@ -291,7 +291,10 @@ fn gnss_delay_is_estimated_without_being_told() {
     let (est, params) =
         timing::gnss_delay(&d, &CalibrationOptions::default(), &DelayOptions::default()).unwrap();
     assert!(est.status.is_estimated() && params.is_some(), "{est:?}");
-    assert!((est.delay_s - 0.1).abs() < 0.03, "{est:?}");
+    // The "done": within 0.02 s of the u-blox's known 0.1 s
+    // (measured 0.108 ± 0.007 s against the wheel clock; the reference
+    // trajectory's own clock gives about 0.06 s, printed above).
+    assert!((est.delay_s - 0.1).abs() < 0.02, "{est:?}");
 }
 
 #[test]
@@ -307,4 +310,6 @@ fn phone_tilt_is_estimated_from_gravity() {
         t.std_rad.to_degrees()
     );
     assert!(t.is_estimated());
+    // Measured 8.31° ± 0.16° (60 one-second blocks while driving).
+    assert!(t.std_rad.to_degrees() < 0.5, "{t:?}");
 }
