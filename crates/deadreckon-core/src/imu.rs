@@ -188,8 +188,8 @@ pub fn estimate_tilt(drive: &Drive) -> Option<Tilt> {
         let mut sum = [0.0; 3];
         let mut n = 0usize;
         while i < samples.len() && samples[i].0 < t0 + 1.0 {
-            for k in 0..3 {
-                sum[k] += samples[i].1[k];
+            for (s, v) in sum.iter_mut().zip(samples[i].1) {
+                *s += v;
             }
             n += 1;
             i += 1;

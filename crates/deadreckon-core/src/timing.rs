@@ -243,7 +243,7 @@ fn line_fit(x: &[f64], y: &[f64]) -> Option<(f64, f64, Vec<f64>)> {
     let n = x.len() as f64;
     let (mx, my) = (x.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
     let sxx: f64 = x.iter().map(|v| (v - mx).powi(2)).sum();
-    if !(sxx > 0.0) {
+    if sxx.is_nan() || sxx <= 0.0 {
         return None;
     }
     let sxy: f64 = x.iter().zip(y).map(|(a, b)| (a - mx) * (b - my)).sum();
@@ -617,7 +617,8 @@ pub fn regress_gnss(
     window_s: f64,
 ) -> Option<(f64, f64, usize)> {
     // (window, residual, antenna velocity, antenna position)
-    let mut rows: Vec<(i64, [f64; 2], [f64; 2], [f64; 2])> = Vec::new();
+    type Row = (i64, [f64; 2], [f64; 2], [f64; 2]);
+    let mut rows: Vec<Row> = Vec::new();
     let t0 = fixes.first()?.t_s;
     for g in fixes {
         let Some(x) = reference.state_at(g.t_s) else {
@@ -701,7 +702,7 @@ pub fn regress_gnss(
     }
     let svv: f64 = centred.iter().map(|(_, v)| v[0] * v[0] + v[1] * v[1]).sum();
     let svr: f64 = centred.iter().map(|(r, v)| v[0] * r[0] + v[1] * r[1]).sum();
-    if !(svv > 0.0) {
+    if svv.is_nan() || svv <= 0.0 {
         return None;
     }
     let delta = -svr / svv;
