@@ -257,6 +257,7 @@ impl Drive {
             steering: scalar(get("steering")?, "steering_wheel_rad")?,
             gnss,
             truth,
+            imu: Default::default(),
         };
         drive.validate().map_err(|e| {
             DeadreckonError::new_err(format!("invalid drive: {}", deadreckon_api::chain_text(&e)))

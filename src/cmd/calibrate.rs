@@ -77,6 +77,12 @@ pub struct CalibrateArgs {
     /// Print JSON instead of a table.
     #[arg(long)]
     pub json: bool,
+    /// The timing and mounting corrections estimated and applied before
+    /// calibrating, and written to params.toml: all (IMU tilt and every
+    /// stream's delay), gnss (tilt and GNSS delay; the others reported, not
+    /// applied) or none.
+    #[arg(long, value_enum, default_value_t = common::CorrectionsArg::Gnss)]
+    pub corrections: common::CorrectionsArg,
 }
 
 /// Runs `calibrate`.
@@ -127,6 +133,7 @@ pub fn run(a: CalibrateArgs, load: &common::Loader) -> Result<()> {
         },
         ..Default::default()
     };
+    let (drive, corrections) = common::prepare(&drive, a.corrections, &opts)?;
     let c = calibrate::calibrate(&drive, &opts)
         .with_context(|| format!("calibrating {}", a.dir.display()))?;
     // Parameters no sample above the threshold informed keep their nominal
@@ -170,6 +177,9 @@ pub fn run(a: CalibrateArgs, load: &common::Loader) -> Result<()> {
                 if let Some(st) = &steering {
                     extra.insert("steering".into(), steering_toml(st).into());
                 }
+                if a.corrections != common::CorrectionsArg::None {
+                    extra.extend(deadreckon_api::corrections::corrections_toml(&corrections));
+                }
                 deadreckon_io::write_params(out, &c.estimate, Some(&extra))
                     .with_context(context)?;
                 written.push(out.clone());
@@ -195,6 +205,8 @@ pub fn run(a: CalibrateArgs, load: &common::Loader) -> Result<()> {
             opts.min_speed_mps,
             steering.as_ref(),
         );
+        let mut v = v;
+        v["corrections"] = deadreckon_api::corrections::corrections_json(&corrections);
         outln!("{}", serde_json::to_string_pretty(&v)?);
     } else {
         outln!("{}", common::params_header());
@@ -226,6 +238,11 @@ pub fn run(a: CalibrateArgs, load: &common::Loader) -> Result<()> {
         }
         if let Some(st) = &c.filter_stats {
             outln!("{}", common::stats_line(st));
+        }
+        if a.corrections != common::CorrectionsArg::None {
+            for line in common::corrections_lines(&corrections) {
+                outln!("{line}");
+            }
         }
         for w in &written {
             outln!("wrote {}", w.display());

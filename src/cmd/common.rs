@@ -76,6 +76,99 @@ pub fn load_params(spec: &str, drive: &Drive) -> Result<Params> {
     Ok(read_params_file(spec)?.params)
 }
 
+/// `--corrections`: which timing and mounting corrections are estimated and
+/// applied before calibrating (see `deadreckon_core::timing`).
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CorrectionsArg {
+    /// IMU tilt, every stream's delay and the gyro scale.
+    All,
+    /// IMU tilt, GNSS delay and gyro scale (the other delays reported, not applied).
+    Gnss,
+    /// None.
+    None,
+}
+
+/// Estimates and applies the corrections `which` asks for.
+pub fn prepare(
+    drive: &Drive,
+    which: CorrectionsArg,
+    copts: &deadreckon_core::calibrate::CalibrationOptions,
+) -> Result<(Drive, deadreckon_core::timing::Corrections)> {
+    use deadreckon_core::timing::{self, DelayOptions, Which};
+    let w = match which {
+        CorrectionsArg::All => Which::All,
+        CorrectionsArg::Gnss => Which::Gnss,
+        CorrectionsArg::None => Which::None,
+    };
+    timing::prepare_with(drive, copts, &DelayOptions::default(), w)
+        .context("estimating the streams' delays and the IMU tilt")
+}
+
+/// The drive with the corrections stored in the params.toml `spec` applied
+/// (none for `nominal` or a file without them).
+pub fn apply_stored(spec: &str, drive: Drive) -> Result<Drive> {
+    if spec == "nominal" {
+        return Ok(drive);
+    }
+    let (_, extra) = deadreckon_io::read_params_with_extra(Path::new(spec))
+        .with_context(|| format!("reading parameters {spec}"))?;
+    let s = deadreckon_api::corrections::stored_corrections(&extra)
+        .map_err(|e| anyhow::anyhow!("parameters {spec}: {e}"))?;
+    Ok(s.apply(&drive))
+}
+
+/// The corrections as text lines (one per stream, and the tilt).
+pub fn corrections_lines(c: &deadreckon_core::timing::Corrections) -> Vec<String> {
+    use deadreckon_core::timing::Stream;
+    let mut out = vec![format!(
+        "{:<10} {:>10} {:>9}  status",
+        "delay of", "s", "std s"
+    )];
+    for s in Stream::ALL {
+        let d = c.delays.get(s);
+        out.push(match d.status.reason() {
+            None => format!(
+                "{:<10} {:>+10.4} {:>9.4}  estimated, applied",
+                s.name(),
+                d.delay_s,
+                d.std_s
+            ),
+            Some(r) => format!(
+                "{:<10} {:>10} {:>9}  not estimated: {r}",
+                s.name(),
+                "-",
+                "-"
+            ),
+        });
+    }
+    match &c.tilt {
+        None => out.push("imu tilt: no three-axis IMU in the drive".into()),
+        Some(t) => out.push(match t.status.reason() {
+            None => format!(
+                "imu tilt: {:.2}° ± {:.2}° (pitch {:+.2}°, roll {:+.2}°, from gravity while {}), yaw rate projected on the vertical",
+                t.tilt_rad.to_degrees(),
+                t.std_rad.to_degrees(),
+                t.pitch_rad.to_degrees(),
+                t.roll_rad.to_degrees(),
+                t.source.name()
+            ),
+            Some(r) => format!("imu tilt: not estimated: {r}"),
+        }),
+    }
+    if let Some(g) = &c.gyro_scale {
+        out.push(match g.status.reason() {
+            None => format!(
+                "gyro scale error: {:+.3}% ± {:.3}% ({} turns), applied",
+                100.0 * g.scale_error,
+                100.0 * g.std,
+                g.turns
+            ),
+            Some(r) => format!("gyro scale error: not estimated: {r}"),
+        });
+    }
+    out
+}
+
 /// Reads a params.toml with its standard errors, validated.
 pub fn read_params_file(spec: &str) -> Result<deadreckon_core::ParamsWithStd> {
     let p = deadreckon_io::read_params(Path::new(spec))

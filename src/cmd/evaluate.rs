@@ -76,6 +76,12 @@ pub struct EvaluateArgs {
     /// Differential drive: seconds of fixes before each outage the dead reckoning is aligned to.
     #[arg(long, default_value_t = 60.0)]
     pub align: f64,
+    /// Without --params: the timing and mounting corrections estimated and
+    /// applied before the calibration (all: IMU tilt and every stream's
+    /// delay; gnss: tilt and GNSS delay; none). With --params: those stored
+    /// in the file are applied.
+    #[arg(long, value_enum, default_value_t = common::CorrectionsArg::Gnss)]
+    pub corrections: common::CorrectionsArg,
     /// Evaluate only data from this time on, s (drive clock).
     #[arg(long = "from")]
     pub from_s: Option<f64>,
@@ -101,12 +107,24 @@ pub fn run(a: EvaluateArgs, load: &common::Loader) -> Result<()> {
     };
     let timing = common::parse_timing(&a.timing)?;
     if let Some(len) = a.outage {
-        let (params, source) = match &a.params {
-            Some(p) => (common::load_params(p, &drive)?, p.clone()),
+        let (params, source, drive, corrections) = match &a.params {
+            Some(p) => (
+                common::load_params(p, &drive)?,
+                p.clone(),
+                common::apply_stored(p, drive)?,
+                None,
+            ),
             None => {
-                let c = calibrate::calibrate(&drive, &CalibrationOptions::default())
-                    .context("RTS calibration with GNSS")?;
-                (c.estimate.params, format!("rts ({} passes)", c.iterations))
+                let copts = CalibrationOptions::default();
+                let (drive, corr) = common::prepare(&drive, a.corrections, &copts)?;
+                let c =
+                    calibrate::calibrate(&drive, &copts).context("RTS calibration with GNSS")?;
+                (
+                    c.estimate.params,
+                    format!("rts ({} passes)", c.iterations),
+                    drive,
+                    Some(corr),
+                )
             }
         };
         let base = FilterOptions {
@@ -123,7 +141,10 @@ pub fn run(a: EvaluateArgs, load: &common::Loader) -> Result<()> {
         )?;
         let (fe, dr, d1) = (ev.final_error(), ev.drift_pct(), ev.distance_to_1m());
         if a.json {
-            let v = deadreckon_api::json::outage_json(len, &source, &ev);
+            let mut v = deadreckon_api::json::outage_json(len, &source, &ev);
+            if let Some(c) = &corrections {
+                v["corrections"] = deadreckon_api::corrections::corrections_json(c);
+            }
             outln!("{}", serde_json::to_string_pretty(&v)?);
         } else {
             outln!(
@@ -157,10 +178,17 @@ pub fn run(a: EvaluateArgs, load: &common::Loader) -> Result<()> {
                 "rejected by the χ² gates: {}",
                 common::gated_text(&ev.gates)
             );
+            if let Some(c) = &corrections {
+                for line in common::corrections_lines(c) {
+                    outln!("{line}");
+                }
+            }
         }
         return Ok(());
     }
-    let params = common::load_params(a.params.as_deref().unwrap_or("nominal"), &drive)?;
+    let spec = a.params.as_deref().unwrap_or("nominal");
+    let params = common::load_params(spec, &drive)?;
+    let drive = common::apply_stored(spec, drive)?;
     match a.metric.as_str() {
         "drift" => {
             let r = metrics::drift(&drive, &params, a.segment_m, timing)?;

@@ -19,6 +19,7 @@
 //! exception's text read the same.
 #![deny(missing_docs)]
 
+pub mod corrections;
 pub mod json;
 pub mod options;
 pub mod source;

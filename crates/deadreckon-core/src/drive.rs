@@ -130,6 +130,39 @@ pub struct TruthPose {
     pub speed_mps: Option<f64>,
 }
 
+/// One three-axis reading in the vehicle's axes: x forward, y left, z up
+/// (the axes a perfectly mounted sensor would have).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Axes {
+    /// Timestamp, s.
+    pub t_s: f64,
+    /// Forward component.
+    pub x: f64,
+    /// Left component.
+    pub y: f64,
+    /// Up component.
+    pub z: f64,
+}
+
+impl Axes {
+    /// The components as an array `[x, y, z]`.
+    pub fn xyz(&self) -> [f64; 3] {
+        [self.x, self.y, self.z]
+    }
+}
+
+/// Optional three-axis inertial streams (`gyro.csv` with three axes,
+/// `accel.csv`): what [`crate::imu`] needs to find the sensor's tilt. Empty
+/// when the drive has a one-axis yaw-rate gyro only.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Imu {
+    /// Angular rate, rad/s, about the sensor's x, y, z axes (bias included).
+    /// When present, the drive's `yaw_rate` is its z axis.
+    pub gyro: Vec<Axes>,
+    /// Specific force, m/s² (at rest and level: z = +9.81).
+    pub accel: Vec<Axes>,
+}
+
 /// A whole recording.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Drive {
@@ -147,6 +180,8 @@ pub struct Drive {
     pub gnss: Vec<GnssFix>,
     /// Reference trajectory.
     pub truth: Vec<TruthPose>,
+    /// Three-axis gyro and accelerometer, when the drive has them.
+    pub imu: Imu,
 }
 
 impl Drive {
@@ -167,6 +202,8 @@ impl Drive {
         d.steering.retain(|s| keep(s.t_s));
         d.gnss.retain(|g| keep(g.t_s));
         d.truth.retain(|p| keep(p.t_s));
+        d.imu.gyro.retain(|s| keep(s.t_s));
+        d.imu.accel.retain(|s| keep(s.t_s));
         d
     }
 
@@ -180,6 +217,7 @@ impl Drive {
             steering: Vec::new(),
             gnss: Vec::new(),
             truth: Vec::new(),
+            imu: Imu::default(),
         }
     }
 
@@ -251,6 +289,15 @@ impl Drive {
             ));
         }
         check("truth", self.truth.iter().map(|s| s.t_s))?;
+        for (name, s) in [
+            ("gyro (3 axes)", &self.imu.gyro),
+            ("accel", &self.imu.accel),
+        ] {
+            check(name, s.iter().map(|s| s.t_s))?;
+            if s.iter().any(|s| s.xyz().iter().any(|v| !v.is_finite())) {
+                return Err(Error::InvalidDrive(format!("{name}: non-finite value")));
+            }
+        }
         Ok(())
     }
 }

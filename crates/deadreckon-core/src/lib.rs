@@ -28,6 +28,8 @@ pub mod event;
 pub mod evo;
 pub mod filter;
 pub mod geo;
+pub mod gyro_scale;
+pub mod imu;
 pub mod init;
 pub mod kalman;
 pub mod kinematics;
@@ -39,6 +41,7 @@ pub mod outage;
 pub mod plausibility;
 pub mod reference;
 pub mod rts;
+pub mod timing;
 pub mod track;
 pub mod vehicle;
 

@@ -181,7 +181,7 @@ fn time_overlap(d: &Drive, out: &mut Vec<Finding>) {
 
 /// Each wheel row as the four wheels' speeds, `(t, [FL, FR, RL, RR] m/s)`
 /// (ticks over the row interval with the nominal circumference).
-fn wheel_rows(d: &Drive) -> Vec<(f64, [f64; 4])> {
+pub(crate) fn wheel_rows(d: &Drive) -> Vec<(f64, [f64; 4])> {
     let v = &d.vehicle;
     match &d.wheels {
         Wheels::Ticks(rows) => {

@@ -8,7 +8,9 @@
 //! | `speed` | [`SpeedSource`]: by default the car's SPEED message (0xB4) in `CAN/raw_can`, or `CAN/speed` | km/h → m/s |
 //! | `steering` | `CAN/steering_angle`, degrees | → rad |
 //! | `yaw_rate` | [`GyroSource`]: by default `IMU/gyro_uncalibrated`, axes `[forward, right, down]` | CCW yaw rate = −gyro\[2\] |
-//! | `gnss` | `GNSS/live_gnss_ublox` `[lat, lon, speed, utc_ms, alt, bearing]` | WGS84 → east/north about the origin; time − latency |
+//! | `imu.gyro` | the same gyro stream, three axes | `[forward, right, down]` → `[x forward, y left, z up]`: (g0, −g1, −g2) |
+//! | `imu.accel` | `IMU/accelerometer`, m/s², axes `[forward, right, down]` | → `[x forward, y left, z up]`: (a0, −a1, −a2) |
+//! | `gnss` | `GNSS/live_gnss_ublox` `[lat, lon, speed, utc_ms, alt, bearing]` | WGS84 → east/north about the origin; time − latency (default 0: log time) |
 //! | `truth` | `global_pose/frame_*`: ECEF position, ECEF velocity, quaternion `[w, x, y, z]` rotating device `[forward, right, down]` axes into ECEF | ECEF → ENU; yaw of the forward axis; moved back to the rear axle |
 //!
 //! Decisions (also written into the [`ImportReport`] notes):
@@ -34,8 +36,16 @@
 //!   truth yaw drifts sideways by 1.6 m per 100 m.
 //! - **GNSS time**: a u-blox fix is logged about 0.1 s after the instant it
 //!   describes: against the reference, the RMS position difference is 1.47 m
-//!   with the log time and 0.55 m with the time moved back by 0.1 s. The default
-//!   [`Comma2k19Options::gnss_latency_s`] is 0.1.
+//!   with the log time and 0.55 m with the time moved back by 0.1 s. The
+//!   importer does **not** correct this: the default
+//!   [`Comma2k19Options::gnss_latency_s`] is 0 (fixes at their log time), and
+//!   the tool estimates the delay from the data ([`deadreckon_core::timing`]).
+//!   A known latency can still be given here.
+//! - **IMU**: the phone's gyro (the chosen [`GyroSource`]) and accelerometer
+//!   are also kept as three-axis streams ([`deadreckon_core::drive::Imu`]), so
+//!   that the phone's mounting tilt can be estimated from gravity and the
+//!   angular rate projected on the vertical ([`deadreckon_core::imu`]); the
+//!   drive's `yaw_rate` stays the phone's own down axis, as read.
 //! - **GNSS accuracy**: `live_gnss_ublox` carries no accuracy. `std_m` is
 //!   [`Comma2k19Options::gnss_std_m`], default 1.0 m (the RMS difference to the
 //!   reference above is 0.55 m; 1 m leaves room for worse sky).
@@ -44,7 +54,7 @@
 
 use std::path::{Path, PathBuf};
 
-use deadreckon_core::drive::{GnssFix, Scalar, TruthPose, WheelSpeeds, Wheels};
+use deadreckon_core::drive::{Axes, GnssFix, Imu, Scalar, TruthPose, WheelSpeeds, Wheels};
 use deadreckon_core::vehicle::Origin;
 use deadreckon_core::{Drive, Vehicle};
 
@@ -85,7 +95,8 @@ pub struct Comma2k19Options {
     /// Forward distance from the rear-axle centre to the device whose pose
     /// `global_pose` gives, m (default [`profiles::RAV4_DEVICE_FORWARD_M`]).
     pub device_forward_m: f64,
-    /// Delay between a u-blox fix's instant and its log time, s (default 0.1).
+    /// Delay between a u-blox fix's instant and its log time, s (default 0:
+    /// the tool estimates it, see [`deadreckon_core::timing`]).
     pub gnss_latency_s: f64,
     /// Standard deviation given to every u-blox fix, m (default 1.0).
     pub gnss_std_m: f64,
@@ -100,7 +111,7 @@ impl Default for Comma2k19Options {
             gyro: GyroSource::default(),
             speed: SpeedSource::default(),
             device_forward_m: profiles::RAV4_DEVICE_FORWARD_M,
-            gnss_latency_s: 0.1,
+            gnss_latency_s: 0.0,
             gnss_std_m: 1.0,
             policy: TimeOrderPolicy::Error,
         }
@@ -282,6 +293,13 @@ pub fn read_comma2k19_with(dir: &Path, o: &Comma2k19Options) -> Result<Import, I
     report.notes.push(format!(
         "yaw_rate: -{gyro_dir}[2] (axes forward, right, down), bias not removed by the import"
     ));
+    let imu_gyro = axes_stream("imu_gyro", &g.dir, &g.t, &axes, o.policy, &mut report)?;
+    let ac = Pair::read(log.join("IMU/accelerometer"))?;
+    let acc = ac.value.f64_rows::<3>(&ac.value_path())?;
+    let imu_accel = axes_stream("imu_accel", &ac.dir, &ac.t, &acc, o.policy, &mut report)?;
+    report.notes.push(format!(
+        "imu: {gyro_dir} and IMU/accelerometer as three axes [forward, left, up] = (v0, -v1, -v2)"
+    ));
 
     // GNSS and origin.
     let gn = Pair::read(log.join("GNSS/live_gnss_ublox"))?;
@@ -359,9 +377,37 @@ pub fn read_comma2k19_with(dir: &Path, o: &Comma2k19Options) -> Result<Import, I
         steering,
         gnss,
         truth,
+        imu: Imu {
+            gyro: imu_gyro,
+            accel: imu_accel,
+        },
     };
     drive.validate().map_err(|e| invalid(dir, e))?;
     Ok(Import { drive, report })
+}
+
+/// A three-axis stream in `[forward, right, down]` axes as `[forward, left, up]`.
+fn axes_stream(
+    name: &'static str,
+    dir: &Path,
+    t: &[f64],
+    v: &[[f64; 3]],
+    policy: TimeOrderPolicy,
+    report: &mut ImportReport,
+) -> Result<Vec<Axes>, ImportError> {
+    let mut b = StreamBuilder::new(name, dir, policy);
+    for (i, (&t, a)) in t.iter().zip(v).enumerate() {
+        let s = Axes {
+            t_s: t,
+            x: a[0],
+            y: -a[1],
+            z: -a[2],
+        };
+        b.push(i, t, a, s)?;
+    }
+    let (v, r) = b.finish(|s| s.t_s);
+    report.streams.push(r);
+    Ok(v)
 }
 
 fn scalar_stream(

@@ -575,6 +575,7 @@ pub fn tricycle_drive(
         steering,
         gnss: Vec::new(),
         truth,
+        imu: Default::default(),
     };
     drive.validate().map_err(|source| ImportError::Invalid {
         path: path.to_path_buf(),

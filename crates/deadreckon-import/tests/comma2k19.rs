@@ -106,7 +106,17 @@ fn segment_reads_with_plausible_streams() {
 #[test]
 fn gnss_agrees_with_truth_plus_lever_arm() {
     let dir = common::data("comma2k19-rav4");
-    let d = read_comma2k19(&dir, None).unwrap();
+    // The known u-blox latency given by hand (the default is 0: the tool
+    // estimates it, see the timing tests below).
+    let d = read_comma2k19_with(
+        &dir,
+        &Comma2k19Options {
+            gnss_latency_s: 0.1,
+            ..Default::default()
+        },
+    )
+    .unwrap()
+    .drive;
     let t: Vec<f64> = d.truth.iter().map(|p| p.t_s).collect();
     let e: Vec<f64> = d
         .truth
@@ -238,4 +248,68 @@ fn gyro_and_steering_signs_agree_with_the_truth_yaw_rate() {
     println!("correlation with the truth yaw rate: gyro {cg:.3}, steering {cs:.3}");
     assert!(cg > 0.9, "gyro {cg}");
     assert!(cs > 0.7, "steering {cs}");
+}
+
+/// The GNSS delay against the reference trajectory: the regression step
+/// repeated until it settles.
+fn gnss_delay_against_truth(d: &deadreckon_core::Drive, window_s: f64) -> (f64, f64) {
+    use deadreckon_core::reference::Reference;
+    use deadreckon_core::timing;
+    let reference = Reference::from_truth(&d.truth).unwrap();
+    let mut delay = 0.0;
+    let mut std = f64::NAN;
+    for _ in 0..10 {
+        let s = timing::shift(d, [0.0, 0.0, 0.0, delay]);
+        let (step, sd, _) =
+            timing::regress_gnss(&s.gnss, &reference, d.vehicle.gnss_lever_arm_m, window_s)
+                .unwrap();
+        delay += step;
+        std = sd;
+        if step.abs() < 1e-5 {
+            break;
+        }
+    }
+    (delay, std)
+}
+
+#[test]
+fn gnss_delay_is_estimated_without_being_told() {
+    use deadreckon_core::calibrate::CalibrationOptions;
+    use deadreckon_core::timing::{self, DelayOptions};
+    let dir = common::data("comma2k19-rav4");
+    let d = read_comma2k19(&dir, None).unwrap();
+    for w in [f64::INFINITY, 20.0, 10.0] {
+        let (t, ts) = gnss_delay_against_truth(&d, w);
+        println!("window {w} s: delay against the reference {t:.4} ± {ts:.4} s");
+        let o = DelayOptions {
+            gnss_window_s: w,
+            ..Default::default()
+        };
+        let (est, _) = timing::gnss_delay(&d, &CalibrationOptions::default(), &o).unwrap();
+        println!("window {w} s: delay from the drive alone {est:?}");
+    }
+    let (est, params) =
+        timing::gnss_delay(&d, &CalibrationOptions::default(), &DelayOptions::default()).unwrap();
+    assert!(est.status.is_estimated() && params.is_some(), "{est:?}");
+    // The "done": within 0.02 s of the u-blox's known 0.1 s
+    // (measured 0.108 ± 0.007 s against the wheel clock; the reference
+    // trajectory's own clock gives about 0.06 s, printed above).
+    assert!((est.delay_s - 0.1).abs() < 0.02, "{est:?}");
+}
+
+#[test]
+fn phone_tilt_is_estimated_from_gravity() {
+    let dir = common::data("comma2k19-rav4");
+    let d = read_comma2k19(&dir, None).unwrap();
+    assert_eq!(d.imu.gyro.len(), d.yaw_rate.len());
+    assert!(d.imu.accel.len() > 6000);
+    let t = deadreckon_core::imu::estimate_tilt(&d).unwrap();
+    println!(
+        "{t:?} ({:.2}° ± {:.2}°)",
+        t.tilt_rad.to_degrees(),
+        t.std_rad.to_degrees()
+    );
+    assert!(t.is_estimated());
+    // Measured 8.31° ± 0.16° (60 one-second blocks while driving).
+    assert!(t.std_rad.to_degrees() < 0.5, "{t:?}");
 }

@@ -81,8 +81,10 @@ pub mod files {
     pub const WHEEL_TICKS: &str = "wheel_ticks.csv";
     /// Wheel speeds (this or [`WHEEL_TICKS`] required).
     pub const WHEEL_SPEEDS: &str = "wheel_speeds.csv";
-    /// Raw gyro yaw rate (optional).
+    /// Raw gyro yaw rate, or a three-axis gyro (optional).
     pub const YAW_RATE: &str = "yaw_rate.csv";
+    /// Three-axis accelerometer, specific force (optional).
+    pub const ACCEL: &str = "accel.csv";
     /// CAN vehicle speed (optional).
     pub const SPEED: &str = "speed.csv";
     /// Steering wheel angle (optional).
@@ -92,10 +94,11 @@ pub mod files {
     /// Reference trajectory (optional).
     pub const TRUTH: &str = "truth.csv";
     /// Every CSV stream of the contract.
-    pub const STREAMS: [&str; 7] = [
+    pub const STREAMS: [&str; 8] = [
         WHEEL_TICKS,
         WHEEL_SPEEDS,
         YAW_RATE,
+        ACCEL,
         SPEED,
         STEERING,
         GNSS,

@@ -3,7 +3,7 @@
 use std::fs;
 use std::path::Path;
 
-use deadreckon_core::drive::{GnssFix, Scalar, TruthPose, WheelSpeeds, WheelTicks, Wheels};
+use deadreckon_core::drive::{Axes, GnssFix, Scalar, TruthPose, WheelSpeeds, WheelTicks, Wheels};
 use deadreckon_core::vehicle::Origin;
 use deadreckon_core::Drive;
 
@@ -122,7 +122,21 @@ pub fn read_drive_with(dir: &Path, options: &ReadOptions) -> Result<Drive, IoErr
             None => Ok(Vec::new()),
         }
     };
-    let yaw_rate = scalar(files::YAW_RATE, "yaw_rate_rps", Limit::YawRate)?;
+    let yaw_path = dir.join(files::YAW_RATE);
+    let (yaw_rate, imu_gyro) = match read_optional(&yaw_path)? {
+        Some(b) => parse_gyro(&yaw_path, &b)?,
+        None => (Vec::new(), Vec::new()),
+    };
+    let accel_path = dir.join(files::ACCEL);
+    let imu_accel = match read_optional(&accel_path)? {
+        Some(b) => parse_axes(
+            &accel_path,
+            &b,
+            ["x_mps2", "y_mps2", "z_mps2"],
+            Limit::Accel,
+        )?,
+        None => Vec::new(),
+    };
     let speed = scalar(files::SPEED, "speed_mps", Limit::Speed)?;
     let steering = scalar(files::STEERING, "steering_wheel_rad", Limit::SteeringWheel)?;
 
@@ -199,6 +213,10 @@ pub fn read_drive_with(dir: &Path, options: &ReadOptions) -> Result<Drive, IoErr
         steering,
         gnss,
         truth,
+        imu: deadreckon_core::drive::Imu {
+            gyro: imu_gyro,
+            accel: imu_accel,
+        },
     };
     drive.validate().map_err(|source| IoError::Invalid {
         path: dir.to_path_buf(),
@@ -255,6 +273,50 @@ pub(crate) fn parse_speeds(file: &Path, bytes: &[u8]) -> Result<Vec<WheelSpeeds>
 }
 
 /// Parses a `t_s,<column>` stream.
+/// Three columns `[x, y, z]` of a CSV as [`Axes`].
+pub(crate) fn parse_axes(
+    file: &Path,
+    bytes: &[u8],
+    columns: [&'static str; 3],
+    limit: Limit,
+) -> Result<Vec<Axes>, IoError> {
+    let t = Table::new(file, bytes)?;
+    let ts = t.col("t_s")?;
+    let c = [t.col(columns[0])?, t.col(columns[1])?, t.col(columns[2])?];
+    t.rows(|r| {
+        Ok(Axes {
+            t_s: r.f64(ts)?,
+            x: r.checked(c[0], limit)?,
+            y: r.checked(c[1], limit)?,
+            z: r.checked(c[2], limit)?,
+        })
+    })
+}
+
+/// `yaw_rate.csv`: one axis (`yaw_rate_rps`), or three (`x_rps`, `y_rps`,
+/// `z_rps`, with `yaw_rate_rps` optional: the z axis when absent).
+pub(crate) fn parse_gyro(file: &Path, bytes: &[u8]) -> Result<(Vec<Scalar>, Vec<Axes>), IoError> {
+    let t = Table::new(file, bytes)?;
+    if !(t.has("x_rps") || t.has("y_rps") || t.has("z_rps")) {
+        return Ok((
+            parse_scalar(file, bytes, "yaw_rate_rps", Limit::YawRate)?,
+            Vec::new(),
+        ));
+    }
+    let axes = parse_axes(file, bytes, ["x_rps", "y_rps", "z_rps"], Limit::YawRate)?;
+    let yaw = if t.has("yaw_rate_rps") {
+        parse_scalar(file, bytes, "yaw_rate_rps", Limit::YawRate)?
+    } else {
+        axes.iter()
+            .map(|a| Scalar {
+                t_s: a.t_s,
+                value: a.z,
+            })
+            .collect()
+    };
+    Ok((yaw, axes))
+}
+
 pub(crate) fn parse_scalar(
     file: &Path,
     bytes: &[u8],

@@ -27,7 +27,12 @@ pub(crate) enum Limit {
     Lat,
     /// Longitude, degrees: |v| ≤ 180.
     Lon,
+    /// Specific force, m/s²: |v| ≤ 200.
+    Accel,
 }
+
+/// Largest accepted |specific force|, m/s² (about 20 g).
+pub(crate) const MAX_ACCEL_MPS2: f64 = 200.0;
 
 /// Largest accepted |yaw rate|, rad/s.
 pub(crate) const MAX_YAW_RATE_RPS: f64 = 5.0;
@@ -52,6 +57,7 @@ impl Limit {
             Limit::Speed => v.abs() <= MAX_SPEED_MPS,
             Limit::Lat => v.abs() <= 90.0,
             Limit::Lon => v.abs() <= 180.0,
+            Limit::Accel => v.abs() <= MAX_ACCEL_MPS2,
         };
         if ok {
             return None;
@@ -72,6 +78,9 @@ impl Limit {
                 Limit::Speed => "|speed| > 100 m/s looks like km/h or mph; expected m/s",
                 Limit::Lat => "not a latitude in degrees (expected -90 to 90)",
                 Limit::Lon => "not a longitude in degrees (expected -180 to 180)",
+                Limit::Accel => {
+                    "|specific force| > 200 m/s² looks like mm/s² or cm/s²; expected m/s²"
+                }
             }
             .to_string(),
         )

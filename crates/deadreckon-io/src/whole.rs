@@ -132,6 +132,7 @@ mod tests {
             steering: Vec::new(),
             gnss: Vec::new(),
             truth: Vec::new(),
+            imu: Default::default(),
         }
     }
 

@@ -7,7 +7,9 @@ use std::path::{Path, PathBuf};
 use deadreckon_core::drive::Wheels;
 use deadreckon_core::Drive;
 
-use crate::read::{parse_gnss, parse_scalar, parse_speeds, parse_ticks, parse_truth};
+use crate::read::{
+    parse_axes, parse_gnss, parse_gyro, parse_scalar, parse_speeds, parse_ticks, parse_truth,
+};
 use crate::table::Limit;
 use crate::{atomic_write, files, IoError};
 
@@ -61,13 +63,45 @@ pub fn write_drive(dir: &Path, drive: &Drive) -> Result<(), IoError> {
     }
     out.push((path, wheel_csv));
 
+    // The three-axis gyro beside the yaw rate when it has the same times
+    // (as the importers and the simulator give it).
+    let g3 = &drive.imu.gyro;
+    let three_axes = !g3.is_empty()
+        && g3.len() == drive.yaw_rate.len()
+        && g3.iter().zip(&drive.yaw_rate).all(|(a, s)| a.t_s == s.t_s);
+    if three_axes {
+        let text = csv(
+            &["t_s", "yaw_rate_rps", "x_rps", "y_rps", "z_rps"],
+            g3.iter()
+                .zip(&drive.yaw_rate)
+                .map(|(a, s)| vec![num(a.t_s), num(s.value), num(a.x), num(a.y), num(a.z)]),
+        );
+        let path = dir.join(files::YAW_RATE);
+        parse_gyro(&path, text.as_bytes())?;
+        out.push((path, text));
+    }
+    if !drive.imu.accel.is_empty() {
+        let text = csv(
+            &["t_s", "x_mps2", "y_mps2", "z_mps2"],
+            drive
+                .imu
+                .accel
+                .iter()
+                .map(|a| vec![num(a.t_s), num(a.x), num(a.y), num(a.z)]),
+        );
+        let path = dir.join(files::ACCEL);
+        parse_axes(
+            &path,
+            text.as_bytes(),
+            ["x_mps2", "y_mps2", "z_mps2"],
+            Limit::Accel,
+        )?;
+        out.push((path, text));
+    }
+    let one_axis: &[deadreckon_core::drive::Scalar] =
+        if three_axes { &[] } else { &drive.yaw_rate };
     for (name, column, limit, stream) in [
-        (
-            files::YAW_RATE,
-            "yaw_rate_rps",
-            Limit::YawRate,
-            &drive.yaw_rate,
-        ),
+        (files::YAW_RATE, "yaw_rate_rps", Limit::YawRate, one_axis),
         (files::SPEED, "speed_mps", Limit::Speed, &drive.speed),
         (
             files::STEERING,

@@ -7,7 +7,7 @@
 //! generator per stream, seeded from the simulation seed and the stream, so
 //! adding a stream does not change the noise of the others.
 
-use deadreckon_core::drive::{GnssFix, Scalar, TruthPose, WheelSpeeds, WheelTicks, Wheels};
+use deadreckon_core::drive::{Axes, GnssFix, Scalar, TruthPose, WheelSpeeds, WheelTicks, Wheels};
 use deadreckon_core::{angle, drive::yaw_rad_to_course_deg, Drive, Params, Vehicle};
 use rand::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
@@ -74,6 +74,46 @@ pub struct ScalarSpec {
     /// White-noise standard deviation in the stream's unit: rad/s for the gyro
     /// (table II: 0.003), m/s for the CAN speed (table II: 0.1).
     pub noise_std: f64,
+    /// Delay of the stream: a sample describing time t is stamped t + this, s
+    /// (default 0).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub latency_s: f64,
+    /// Gyro only: relative scale error, the reading is (1 + this) × the
+    /// angular rate (default 0).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub scale_error: f64,
+    /// Gyro only: a three-axis IMU mounted with this `[pitch, roll]`, degrees
+    /// (nose up, left side up): the drive then has `imu.gyro` (three axes,
+    /// whose z is the yaw-rate stream) and `imu.accel` (specific force, noise
+    /// [`ACCEL_NOISE_STD_MPS2`]) at the gyro's times.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tilt_deg: Option<[f64; 2]>,
+}
+
+/// White noise of the simulated accelerometer, m/s².
+pub const ACCEL_NOISE_STD_MPS2: f64 = 0.05;
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
+}
+
+/// Rows of the rotation taking vehicle axes to the axes of a sensor pitched
+/// (nose up) by `pitch` and rolled (left side up) by `roll`, rad: a vehicle
+/// vector `v` reads `R·v` in the sensor.
+pub fn tilt_rotation(pitch: f64, roll: f64) -> [[f64; 3]; 3] {
+    // Sensor = R_x(roll)ᵀ·R_y(−pitch)ᵀ-style: x_s tipped up by pitch, y_s by roll.
+    let (sp, cp) = pitch.sin_cos();
+    let (sr, cr) = roll.sin_cos();
+    // Rotation about y by −pitch (nose up), then about x by roll (left up).
+    let ry = [[cp, 0.0, sp], [0.0, 1.0, 0.0], [-sp, 0.0, cp]];
+    let rx = [[1.0, 0.0, 0.0], [0.0, cr, sr], [0.0, -sr, cr]];
+    let mut m = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            m[i][j] = (0..3).map(|k| rx[i][k] * ry[k][j]).sum();
+        }
+    }
+    m
 }
 
 /// The steering-wheel stream (`[sensors.steering]`).
@@ -92,6 +132,10 @@ pub struct SteeringSpec {
     pub offset_s: f64,
     /// Standard deviation of the error on tan(δ/r_s), unitless (table II: 0.02).
     pub noise_std: f64,
+    /// Delay of the stream: a sample describing time t is stamped t + this, s
+    /// (default 0).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub latency_s: f64,
     /// The true steering ratio r_s (default: the vehicle's nominal one), for
     /// drives on which the ratio is to be calibrated.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -251,12 +295,15 @@ impl SensorsSpec {
         ];
         if let Some(g) = &self.gyro {
             v.push(("sensors.gyro.noise_std", g.noise_std));
+            v.push(("sensors.gyro.latency_s", g.latency_s));
         }
         if let Some(g) = &self.speed {
             v.push(("sensors.speed.noise_std", g.noise_std));
+            v.push(("sensors.speed.latency_s", g.latency_s));
         }
         if let Some(g) = &self.steering {
             v.push(("sensors.steering.noise_std", g.noise_std));
+            v.push(("sensors.steering.latency_s", g.latency_s));
         }
         if let Some(g) = &self.gnss {
             v.push(("sensors.gnss.std_m", g.std_m));
@@ -362,6 +409,8 @@ pub(crate) struct Suite {
     gnss: Vec<GnssFix>,
     gnss_state: GnssState,
     truth: Vec<TruthPose>,
+    imu_gyro: Vec<Axes>,
+    imu_accel: Vec<Axes>,
 }
 
 const WHEELS: usize = 0;
@@ -431,6 +480,8 @@ impl Suite {
             gnss: Vec::new(),
             gnss_state: GnssState::default(),
             truth: Vec::new(),
+            imu_gyro: Vec::new(),
+            imu_accel: Vec::new(),
         }
     }
 
@@ -455,24 +506,65 @@ impl Suite {
         match stream {
             WHEELS => self.emit_wheels(st),
             GYRO => {
-                let std = self.spec.gyro.as_ref().map_or(0.0, |g| g.noise_std);
-                let value = st.yaw_rate + self.params.gyro_bias_rps + self.noise[GYRO].gauss(std);
-                self.yaw_rate.push(Scalar { t_s, value });
+                let Some(g) = self.spec.gyro.clone() else {
+                    return;
+                };
+                let t_s = t_s + g.latency_s;
+                let k = 1.0 + g.scale_error;
+                let bias = self.params.gyro_bias_rps;
+                match g.tilt_deg {
+                    None => {
+                        let value = k * st.yaw_rate + bias + self.noise[GYRO].gauss(g.noise_std);
+                        self.yaw_rate.push(Scalar { t_s, value });
+                    }
+                    Some([p, r]) => {
+                        let m = tilt_rotation(p.to_radians(), r.to_radians());
+                        let n = &mut self.noise[GYRO];
+                        let w = [0, 1, 2].map(|i| {
+                            k * m[i][2] * st.yaw_rate
+                                + if i == 2 { bias } else { 0.0 }
+                                + n.gauss(g.noise_std)
+                        });
+                        let f_v = [st.a, st.v * st.yaw_rate, deadreckon_core::imu::GRAVITY_MPS2];
+                        let f = [0, 1, 2].map(|i| {
+                            (0..3).map(|j| m[i][j] * f_v[j]).sum::<f64>()
+                                + n.gauss(ACCEL_NOISE_STD_MPS2)
+                        });
+                        self.yaw_rate.push(Scalar { t_s, value: w[2] });
+                        self.imu_gyro.push(Axes {
+                            t_s,
+                            x: w[0],
+                            y: w[1],
+                            z: w[2],
+                        });
+                        self.imu_accel.push(Axes {
+                            t_s,
+                            x: f[0],
+                            y: f[1],
+                            z: f[2],
+                        });
+                    }
+                }
             }
             SPEED => {
-                let std = self.spec.speed.as_ref().map_or(0.0, |g| g.noise_std);
+                let (std, lat) = self
+                    .spec
+                    .speed
+                    .as_ref()
+                    .map_or((0.0, 0.0), |g| (g.noise_std, g.latency_s));
                 let value = self.params.speed_scale * st.v + self.noise[SPEED].gauss(std);
-                self.speed.push(Scalar { t_s, value });
+                self.speed.push(Scalar {
+                    t_s: t_s + lat,
+                    value,
+                });
             }
             STEERING => {
-                let (std, offset) = self
-                    .spec
-                    .steering
-                    .as_ref()
-                    .map_or((0.0, 0.0), |g| (g.noise_std, g.wheel_offset_rad));
+                let (std, offset, lat) = self.spec.steering.as_ref().map_or((0.0, 0.0, 0.0), |g| {
+                    (g.noise_std, g.wheel_offset_rad, g.latency_s)
+                });
                 let tan = self.wheelbase * st.kappa + self.noise[STEERING].gauss(std);
                 self.steering.push(Scalar {
-                    t_s,
+                    t_s: t_s + lat,
                     value: self.steering_ratio * tan.atan() + offset,
                 });
             }
@@ -620,6 +712,10 @@ impl Suite {
             steering: self.steering,
             gnss: self.gnss,
             truth: self.truth,
+            imu: deadreckon_core::drive::Imu {
+                gyro: self.imu_gyro,
+                accel: self.imu_accel,
+            },
         }
     }
 }

@@ -455,6 +455,7 @@ pub fn decode_frames(
         steering,
         gnss: Vec::new(),
         truth: Vec::new(),
+        imu: Default::default(),
     };
     drive.validate().map_err(|source| ImportError::Invalid {
         path: path.to_path_buf(),

@@ -1,0 +1,177 @@
+//! The timing and mounting corrections ([`deadreckon_core::timing`],
+//! [`deadreckon_core::imu`]) as the CLI and the Python bindings show and store
+//! them: JSON (`calibrate --json`, `evaluate --outage --json`), the
+//! `[delays]`, `[imu]` and `[gyro_scale]` tables of params.toml, and those tables read back
+//! and applied to another drive. A params.toml without them (older files)
+//! applies nothing.
+
+use deadreckon_core::imu::Tilt;
+use deadreckon_core::timing::{self, Corrections, Delay, Stream};
+use deadreckon_core::Drive;
+use serde_json::{json, Value};
+
+fn delay_json(d: &Delay) -> Value {
+    let num = |x: f64| if x.is_finite() { json!(x) } else { Value::Null };
+    json!({
+        "delay_s": num(d.delay_s),
+        "std_s": num(d.std_s),
+        "applied_s": d.applied_s(),
+        "samples": d.samples,
+        "estimated": d.status.is_estimated(),
+        "reason": d.status.reason(),
+    })
+}
+
+fn tilt_json(t: &Tilt) -> Value {
+    let num = |x: f64| if x.is_finite() { json!(x) } else { Value::Null };
+    json!({
+        "tilt_deg": num(t.tilt_rad.to_degrees()),
+        "std_deg": num(t.std_rad.to_degrees()),
+        "pitch_deg": num(t.pitch_rad.to_degrees()),
+        "roll_deg": num(t.roll_rad.to_degrees()),
+        "up": t.up,
+        "source": t.source.name(),
+        "blocks": t.blocks,
+        "estimated": t.is_estimated(),
+        "reason": t.status.reason(),
+    })
+}
+
+fn scale_json(g: &deadreckon_core::gyro_scale::GyroScale) -> Value {
+    let num = |x: f64| if x.is_finite() { json!(x) } else { Value::Null };
+    json!({
+        "scale_error": num(g.scale_error),
+        "std": num(g.std),
+        "turns": g.turns,
+        "estimated": g.is_estimated(),
+        "reason": g.status.reason(),
+    })
+}
+
+/// `{"delays": {stream: {...}}, "imu": {...} | null, "gyro_scale": {...} | null}`.
+pub fn corrections_json(c: &Corrections) -> Value {
+    let delays: serde_json::Map<String, Value> = Stream::ALL
+        .iter()
+        .map(|&s| (s.name().to_string(), delay_json(c.delays.get(s))))
+        .collect();
+    json!({
+        "delays": delays,
+        "imu": c.tilt.as_ref().map(tilt_json),
+        "gyro_scale": c.gyro_scale.as_ref().map(scale_json),
+    })
+}
+
+/// The `[delays.<stream>]`, `[imu]` and `[gyro_scale]` tables of params.toml.
+pub fn corrections_toml(c: &Corrections) -> toml::Table {
+    let mut out = toml::Table::new();
+    let mut delays = toml::Table::new();
+    for s in Stream::ALL {
+        let d = c.delays.get(s);
+        let mut t = toml::Table::new();
+        t.insert("delay_s".into(), d.applied_s().into());
+        if d.status.is_estimated() {
+            t.insert("std_s".into(), d.std_s.into());
+        } else if let Some(r) = d.status.reason() {
+            t.insert("not_estimated".into(), r.into());
+        }
+        delays.insert(s.name().into(), t.into());
+    }
+    out.insert("delays".into(), delays.into());
+    if let Some(tilt) = &c.tilt {
+        let mut t = toml::Table::new();
+        if tilt.is_estimated() {
+            t.insert("tilt_deg".into(), tilt.tilt_rad.to_degrees().into());
+            t.insert("std_deg".into(), tilt.std_rad.to_degrees().into());
+            t.insert(
+                "up".into(),
+                toml::Value::Array(tilt.up.iter().map(|&u| u.into()).collect()),
+            );
+        } else if let Some(r) = tilt.status.reason() {
+            t.insert("not_estimated".into(), r.into());
+        }
+        out.insert("imu".into(), t.into());
+    }
+    if let Some(g) = &c.gyro_scale {
+        let mut t = toml::Table::new();
+        if g.is_estimated() {
+            t.insert("scale_error".into(), g.scale_error.into());
+            t.insert("std".into(), g.std.into());
+            t.insert("turns".into(), (g.turns as i64).into());
+        } else if let Some(r) = g.status.reason() {
+            t.insert("not_estimated".into(), r.into());
+        }
+        out.insert("gyro_scale".into(), t.into());
+    }
+    out
+}
+
+/// Corrections read back from params.toml.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Stored {
+    /// Delays, s, in [`Stream::ALL`] order (0 where absent or not estimated).
+    pub delays_s: [f64; 4],
+    /// The IMU's vertical in its own axes, when estimated.
+    pub up: Option<[f64; 3]>,
+    /// The gyro's relative scale error (0 when absent or not estimated).
+    pub gyro_scale_error: f64,
+}
+
+impl Stored {
+    /// Applies them to `drive` ([`timing::apply_known`]).
+    pub fn apply(&self, drive: &Drive) -> Drive {
+        timing::apply_known(drive, self.delays_s, self.up, self.gyro_scale_error)
+    }
+}
+
+/// Reads the `[delays]` and `[imu]` tables from the extra keys of a
+/// params.toml (absent: nothing to apply).
+pub fn stored_corrections(extra: &toml::Table) -> Result<Stored, String> {
+    let mut s = Stored::default();
+    if let Some(d) = extra.get("delays") {
+        let d = d.as_table().ok_or("`delays` must be a table")?;
+        for (i, st) in Stream::ALL.iter().enumerate() {
+            if let Some(t) = d.get(st.name()) {
+                let v = t
+                    .get("delay_s")
+                    .and_then(|v| v.as_float().or(v.as_integer().map(|i| i as f64)))
+                    .ok_or_else(|| format!("`delays.{}.delay_s` must be a number", st.name()))?;
+                if !(v.is_finite() && v.abs() < 10.0) {
+                    return Err(format!(
+                        "`delays.{}.delay_s` = {v} is not a plausible delay (|d| < 10 s)",
+                        st.name()
+                    ));
+                }
+                s.delays_s[i] = v;
+            }
+        }
+    }
+    if let Some(imu) = extra.get("imu") {
+        let imu = imu.as_table().ok_or("`imu` must be a table")?;
+        if let Some(up) = imu.get("up") {
+            let a = up
+                .as_array()
+                .ok_or("`imu.up` must be an array of 3 numbers")?;
+            let v: Vec<f64> = a.iter().filter_map(|x| x.as_float()).collect();
+            let n = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+            if v.len() != 3 || !(n - 1.0).abs().lt(&1e-3) {
+                return Err("`imu.up` must be a unit vector of 3 numbers".into());
+            }
+            s.up = Some([v[0], v[1], v[2]]);
+        }
+    }
+    if let Some(g) = extra.get("gyro_scale") {
+        let g = g.as_table().ok_or("`gyro_scale` must be a table")?;
+        if let Some(v) = g.get("scale_error") {
+            let v = v
+                .as_float()
+                .ok_or("`gyro_scale.scale_error` must be a number")?;
+            if !(v.is_finite() && v.abs() <= deadreckon_core::gyro_scale::MAX_SCALE_ERROR) {
+                return Err(format!(
+                    "`gyro_scale.scale_error` = {v} is not a plausible gyro scale error"
+                ));
+            }
+            s.gyro_scale_error = v;
+        }
+    }
+    Ok(s)
+}

@@ -1,0 +1,861 @@
+//! Time offsets of the streams against the wheel clock.
+//!
+//! A stream logged late by `d` seconds carries at `t` what happened at `t − d`;
+//! the correction moves its timestamps back by `d` ([`Delays::apply`]).
+//!
+//! - **Gyro, CAN speed, steering** ([`scalar_delay`]): the stream against a
+//!   signal derived from the wheels (yaw rate from the rear wheels' speed
+//!   difference, the wheels' mean speed, the curvature yaw rate / speed above
+//!   [`MIN_CURVATURE_SPEED_MPS`]), both smoothed by a 0.2 s triangle. For
+//!   each lag on a grid the stream is fitted as `a + b·x(t − d)` by least
+//!   squares; the lag of the smallest residual is
+//!   refined by a parabola through its neighbours. The standard error is the
+//!   Gauss–Newton one, `σ²/Σ(b·x′ − mean)²`, inflated by `(1 + ρ)/(1 − ρ)` for
+//!   the lag-one autocorrelation `ρ` of the residuals. Steering's delay is
+//!   the lag of the car's yaw response behind the steering wheel (tyre and
+//!   body dynamics included), as openpilot's `lagd` measures it.
+//! - **GNSS** ([`gnss_delay`]): a parameter of the least squares between the
+//!   fixes and the dead-reckoned track. The drive is calibrated (RTS) with
+//!   the fixes moved back by the current delay, dead-reckoned from the
+//!   smoothed start (wheels and gyro only), and the fixes' residuals against
+//!   the antenna's dead-reckoned position are regressed on its velocity, with
+//!   a bias, a rotation and a stretch per 20 s window for the dead
+//!   reckoning's drift (`r = −δ·V + b + θ·J(p − p_c) + λ(p − p_c)`), until
+//!   `δ` settles. (Against the
+//!   smoothed track, which the fixes pull along, a 0.18 s delay read
+//!   0.11 s.) The smoother absorbs
+//!   part of a wrong delay, so one step under-corrects (`δ ≈ (1 − α)(d* − d)`):
+//!   after a first plain step the delay moves by secant steps on `δ(d) = 0`,
+//!   and the standard error of `δ` is divided by the slope `1 − α`.
+//!
+//! **Status**: a delay is *not estimated* (and not applied) with too few
+//! samples, when the best lag lies on the search bound ([`DelayOptions::max_delay_s`]:
+//! rejected, never clamped), or when its standard error exceeds
+//! [`DelayOptions::max_std_s`] (too little excitation: no turns for the gyro,
+//! no speed changes for the CAN speed).
+
+use crate::calibrate::{self, CalibrationOptions};
+use crate::drive::{Drive, Scalar};
+use crate::ekf::{self, FilterOptions, Init, SensorSet};
+use crate::imu::{interp, wheel_speed};
+use crate::model::{V, X, Y, YAW, YAW_RATE};
+use crate::reference::Reference;
+use crate::{rts, Error, Params};
+
+/// Speed above which the steering is compared with the curvature, m/s.
+pub const MIN_CURVATURE_SPEED_MPS: f64 = 2.0;
+
+/// Estimated, or not with the reason.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Status {
+    /// Estimated and applied.
+    Estimated,
+    /// Not estimated (and not applied): why.
+    NotEstimated(String),
+}
+
+impl Status {
+    /// True when estimated.
+    pub fn is_estimated(&self) -> bool {
+        matches!(self, Status::Estimated)
+    }
+    /// The reason it was not estimated, if not.
+    pub fn reason(&self) -> Option<&str> {
+        match self {
+            Status::Estimated => None,
+            Status::NotEstimated(r) => Some(r),
+        }
+    }
+}
+
+/// The streams with a delay.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stream {
+    /// The gyro's yaw rate.
+    Gyro,
+    /// The CAN vehicle speed.
+    Speed,
+    /// The steering wheel angle.
+    Steering,
+    /// The GNSS fixes.
+    Gnss,
+}
+
+impl Stream {
+    /// Every stream, in report order.
+    pub const ALL: [Stream; 4] = [Stream::Gyro, Stream::Speed, Stream::Steering, Stream::Gnss];
+    /// `gyro`, `speed`, `steering`, `gnss`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Stream::Gyro => "gyro",
+            Stream::Speed => "speed",
+            Stream::Steering => "steering",
+            Stream::Gnss => "gnss",
+        }
+    }
+}
+
+/// One stream's delay.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Delay {
+    /// How late the stream is, s (positive: logged after the instant it describes).
+    pub delay_s: f64,
+    /// Standard error, s.
+    pub std_s: f64,
+    /// Samples used.
+    pub samples: usize,
+    /// Estimated, or why not.
+    pub status: Status,
+}
+
+impl Delay {
+    fn not_estimated(reason: impl Into<String>) -> Delay {
+        Delay {
+            delay_s: f64::NAN,
+            std_s: f64::NAN,
+            samples: 0,
+            status: Status::NotEstimated(reason.into()),
+        }
+    }
+    /// The delay to apply: the estimate, or 0 when not estimated.
+    pub fn applied_s(&self) -> f64 {
+        if self.status.is_estimated() {
+            self.delay_s
+        } else {
+            0.0
+        }
+    }
+}
+
+/// The delays of a drive's streams.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Delays {
+    /// Gyro vs the rear wheels' yaw rate.
+    pub gyro: Delay,
+    /// CAN speed vs the wheels' mean speed.
+    pub speed: Delay,
+    /// Steering vs the wheels' curvature.
+    pub steering: Delay,
+    /// GNSS position vs the smoothed track.
+    pub gnss: Delay,
+}
+
+impl Delays {
+    /// No delay known for any stream.
+    pub fn none() -> Delays {
+        let n = || Delay::not_estimated("not estimated");
+        Delays {
+            gyro: n(),
+            speed: n(),
+            steering: n(),
+            gnss: n(),
+        }
+    }
+    /// The delay of `s`.
+    pub fn get(&self, s: Stream) -> &Delay {
+        match s {
+            Stream::Gyro => &self.gyro,
+            Stream::Speed => &self.speed,
+            Stream::Steering => &self.steering,
+            Stream::Gnss => &self.gnss,
+        }
+    }
+    /// The drive with every estimated delay removed (timestamps moved back).
+    pub fn apply(&self, drive: &Drive) -> Drive {
+        shift(
+            drive,
+            [
+                self.gyro.applied_s(),
+                self.speed.applied_s(),
+                self.steering.applied_s(),
+                self.gnss.applied_s(),
+            ],
+        )
+    }
+}
+
+/// The drive with the gyro (one- and three-axis), speed, steering and GNSS
+/// timestamps moved back by the given delays, s, in [`Stream::ALL`] order.
+pub fn shift(drive: &Drive, delays_s: [f64; 4]) -> Drive {
+    let [g, s, st, gn] = delays_s;
+    let mut d = drive.clone();
+    d.yaw_rate.iter_mut().for_each(|x| x.t_s -= g);
+    d.imu.gyro.iter_mut().for_each(|x| x.t_s -= g);
+    d.speed.iter_mut().for_each(|x| x.t_s -= s);
+    d.steering.iter_mut().for_each(|x| x.t_s -= st);
+    d.gnss.iter_mut().for_each(|x| x.t_s -= gn);
+    d
+}
+
+/// Options of the delay estimation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DelayOptions {
+    /// Largest delay searched, either sign, s: a best lag on this bound is rejected.
+    pub max_delay_s: f64,
+    /// Grid step of the lag search, s.
+    pub step_s: f64,
+    /// Largest standard error of an accepted delay, s.
+    pub max_std_s: f64,
+    /// Fewest samples (GNSS fixes, or windows of the scalar streams).
+    pub min_samples: usize,
+    /// Half-width of the triangle smoothing both scalar streams, s, and the
+    /// spacing of the points compared (several sample periods of the
+    /// slowest stream).
+    pub window_s: f64,
+    /// Largest number of calibrate-and-regress steps of the GNSS delay.
+    pub gnss_iterations: usize,
+    /// Window of the GNSS regression's biases, s (each window its own east
+    /// and north bias: the receiver's slowly wandering error).
+    pub gnss_window_s: f64,
+}
+
+impl Default for DelayOptions {
+    fn default() -> Self {
+        DelayOptions {
+            max_delay_s: 0.5,
+            step_s: 0.005,
+            max_std_s: 0.02,
+            min_samples: 50,
+            window_s: 0.2,
+            gnss_iterations: 8,
+            gnss_window_s: 20.0,
+        }
+    }
+}
+
+/// Lag-one autocorrelation of `r`.
+fn lag1(r: &[f64]) -> f64 {
+    if r.len() < 3 {
+        return 0.0;
+    }
+    let m = r.iter().sum::<f64>() / r.len() as f64;
+    let c0: f64 = r.iter().map(|x| (x - m).powi(2)).sum();
+    let c1: f64 = r.windows(2).map(|p| (p[0] - m) * (p[1] - m)).sum();
+    if c0 > 0.0 {
+        (c1 / c0).clamp(-0.99, 0.99)
+    } else {
+        0.0
+    }
+}
+
+/// Least squares `y ≈ a + b·x`: `(a, b, residuals)`, `None` if `x` is constant.
+fn line_fit(x: &[f64], y: &[f64]) -> Option<(f64, f64, Vec<f64>)> {
+    let n = x.len() as f64;
+    let (mx, my) = (x.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
+    let sxx: f64 = x.iter().map(|v| (v - mx).powi(2)).sum();
+    if sxx.is_nan() || sxx <= 0.0 {
+        return None;
+    }
+    let sxy: f64 = x.iter().zip(y).map(|(a, b)| (a - mx) * (b - my)).sum();
+    let b = sxy / sxx;
+    let a = my - b * mx;
+    let r = x.iter().zip(y).map(|(xi, yi)| yi - a - b * xi).collect();
+    Some((a, b, r))
+}
+
+/// Exact first and second integrals of a linearly interpolated series.
+struct Integral<'a> {
+    s: &'a [(f64, f64)],
+    cum: Vec<f64>,
+    cum2: Vec<f64>,
+}
+
+impl<'a> Integral<'a> {
+    fn new(s: &'a [(f64, f64)]) -> Self {
+        let mut cum = Vec::with_capacity(s.len());
+        let mut cum2 = Vec::with_capacity(s.len());
+        let (mut c1, mut c2) = (0.0, 0.0);
+        cum.push(0.0);
+        cum2.push(0.0);
+        for w in s.windows(2) {
+            let h = w[1].0 - w[0].0;
+            let m = if h > 0.0 { (w[1].1 - w[0].1) / h } else { 0.0 };
+            c2 += c1 * h + w[0].1 * h * h / 2.0 + m * h * h * h / 6.0;
+            c1 += 0.5 * (w[0].1 + w[1].1) * h;
+            cum.push(c1);
+            cum2.push(c2);
+        }
+        Integral { s, cum, cum2 }
+    }
+    /// First and second integral up to `t`.
+    fn at(&self, t: f64) -> Option<(f64, f64)> {
+        let n = self.s.len();
+        if n < 2 || !(t >= self.s[0].0 && t <= self.s[n - 1].0) {
+            return None;
+        }
+        let i = self.s.partition_point(|p| p.0 <= t).clamp(1, n - 1);
+        let (a, b) = (self.s[i - 1], self.s[i]);
+        let h = b.0 - a.0;
+        let tau = t - a.0;
+        let m = if h > 0.0 { (b.1 - a.1) / h } else { 0.0 };
+        let c1 = self.cum[i - 1] + a.1 * tau + 0.5 * m * tau * tau;
+        let c2 = self.cum2[i - 1]
+            + self.cum[i - 1] * tau
+            + a.1 * tau * tau / 2.0
+            + m * tau * tau * tau / 6.0;
+        Some((c1, c2))
+    }
+    /// The triangle-weighted mean over `[t − w, t + w]` and its derivative in `t`.
+    fn smooth(&self, t: f64, w: f64) -> Option<(f64, f64)> {
+        let (p1, p2) = self.at(t + w)?;
+        let (c1, c2) = self.at(t)?;
+        let (m1, m2) = self.at(t - w)?;
+        Some((
+            (p2 - 2.0 * c2 + m2) / (w * w),
+            (p1 - 2.0 * c1 + m1) / (w * w),
+        ))
+    }
+}
+
+/// The delay of `signal` (`(t, value)`, stream clock) behind `reference`
+/// (`(t, value)`, wheel clock, sorted); `keep(t)` selects the windows used.
+///
+/// Both series are compared smoothed by a triangle of half-width
+/// [`DelayOptions::window_s`] (exact double integrals of the linearly
+/// interpolated samples), at points that far apart: interpolating a noisy
+/// series at shifted times favours lags that put those times midway between
+/// its samples (where interpolation averages the noise), a bias of up to a
+/// quarter of a sample period when the two rates are commensurate; a smooth
+/// kernel over many samples weighs every phase alike.
+pub fn scalar_delay(
+    reference: &[(f64, f64)],
+    signal: &[(f64, f64)],
+    keep: &dyn Fn(f64) -> bool,
+    o: &DelayOptions,
+) -> Delay {
+    if reference.len() < 3 || signal.len() < 3 {
+        return Delay::not_estimated("too few samples");
+    }
+    if signal.iter().any(|s| !s.1.is_finite()) || reference.iter().any(|s| !s.1.is_finite()) {
+        return Delay::not_estimated("non-finite samples");
+    }
+    let (r0, r1) = (reference[0].0, reference[reference.len() - 1].0);
+    let (s0, s1) = (signal[0].0, signal[signal.len() - 1].0);
+    let w = o.window_s;
+    let margin = o.max_delay_s + o.step_s;
+    let isig = Integral::new(signal);
+    let iref = Integral::new(reference);
+    // Points spaced w on the reference clock, inside both spans at every lag
+    // searched; the signal is read at the point + the lag.
+    let (start, end) = (r0.max(s0 + margin) + w, r1.min(s1 - margin) - w);
+    let mut pts: Vec<(f64, f64)> = Vec::new();
+    let mut t = start;
+    while t <= end {
+        if keep(t) {
+            if let Some((m, _)) = iref.smooth(t, w) {
+                pts.push((t, m));
+            }
+        }
+        t += w;
+    }
+    if pts.len() < o.min_samples {
+        return Delay::not_estimated(format!(
+            "{} usable points {w} s apart, need {}",
+            pts.len(),
+            o.min_samples
+        ));
+    }
+    let x: Vec<f64> = pts.iter().map(|s| s.1).collect();
+    let ys = |d: f64| -> Vec<(f64, f64)> {
+        pts.iter()
+            .map(|&(t, _)| isig.smooth(t + d, w).unwrap_or((f64::NAN, 0.0)))
+            .collect()
+    };
+    let sse = |d: f64| -> Option<f64> {
+        let y: Vec<f64> = ys(d).iter().map(|p| p.0).collect();
+        line_fit(&x, &y).map(|(_, _, r)| r.iter().map(|e| e * e).sum::<f64>())
+    };
+    let k = (o.max_delay_s / o.step_s).round() as i64;
+    let grid: Vec<(f64, f64)> = (-k..=k)
+        .filter_map(|i| {
+            let d = i as f64 * o.step_s;
+            sse(d).map(|e| (d, e))
+        })
+        .collect();
+    if grid.len() < 3 {
+        return Delay::not_estimated("the reference does not vary");
+    }
+    let ib = grid
+        .iter()
+        .enumerate()
+        .min_by(|a, b| a.1 .1.total_cmp(&b.1 .1))
+        .map_or(0, |(i, _)| i);
+    if ib == 0 || ib + 1 == grid.len() {
+        return Delay::not_estimated(format!(
+            "best lag {:+.3} s on the search bound ±{} s",
+            grid[ib].0, o.max_delay_s
+        ));
+    }
+    // Parabola through the minimum and its neighbours.
+    let (e0, e1, e2) = (grid[ib - 1].1, grid[ib].1, grid[ib + 1].1);
+    let den = e0 - 2.0 * e1 + e2;
+    let d = grid[ib].0
+        + if den > 0.0 {
+            0.5 * o.step_s * (e0 - e2) / den
+        } else {
+            0.0
+        };
+    // Gauss–Newton standard error at the refined lag, with the derivative of
+    // the smoothed signal.
+    let yd = ys(d);
+    let y: Vec<f64> = yd.iter().map(|p| p.0).collect();
+    let Some((_, _, r)) = line_fit(&x, &y) else {
+        return Delay::not_estimated("the reference does not vary");
+    };
+    let j: Vec<f64> = yd.iter().map(|p| p.1).collect();
+    let n = j.len();
+    let mj = j.iter().sum::<f64>() / n as f64;
+    let sjj: f64 = j.iter().map(|v| (v - mj).powi(2)).sum();
+    let s2 = r.iter().map(|e| e * e).sum::<f64>() / (n as f64 - 3.0);
+    let rho = lag1(&r);
+    let std = if sjj > 0.0 {
+        (s2 / sjj * (1.0 + rho) / (1.0 - rho)).sqrt()
+    } else {
+        f64::INFINITY
+    };
+    status_of(d, std, n, o)
+}
+
+fn status_of(d: f64, std: f64, n: usize, o: &DelayOptions) -> Delay {
+    let status = if !(std.is_finite() && std <= o.max_std_s) {
+        Status::NotEstimated(format!(
+            "too little excitation: standard error {std:.3} s above {} s",
+            o.max_std_s
+        ))
+    } else if d.abs() >= o.max_delay_s {
+        Status::NotEstimated(format!(
+            "delay {d:+.3} s on the search bound ±{} s",
+            o.max_delay_s
+        ))
+    } else {
+        Status::Estimated
+    };
+    Delay {
+        delay_s: d,
+        std_s: std,
+        samples: n,
+        status,
+    }
+}
+
+/// The rear wheels' yaw rate, `(t, rad/s)`, or `None` without both rear wheels.
+fn wheel_yaw_rate(drive: &Drive) -> Option<Vec<(f64, f64)>> {
+    let w = drive.vehicle.wheels_present;
+    if !(w[2] && w[3]) {
+        return None;
+    }
+    let track = drive.vehicle.track_rear_m;
+    Some(
+        crate::plausibility::wheel_rows(drive)
+            .into_iter()
+            .map(|(t, v)| (t, (v[3] - v[2]) / track))
+            .collect(),
+    )
+}
+
+fn pairs(s: &[Scalar]) -> Vec<(f64, f64)> {
+    s.iter().map(|x| (x.t_s, x.value)).collect()
+}
+
+/// The gyro's delay behind the rear wheels' yaw rate.
+pub fn gyro_delay(drive: &Drive, o: &DelayOptions) -> Delay {
+    if drive.yaw_rate.is_empty() {
+        return Delay::not_estimated("no gyro");
+    }
+    let Some(reference) = wheel_yaw_rate(drive) else {
+        return Delay::not_estimated("needs both rear wheels");
+    };
+    scalar_delay(&reference, &pairs(&drive.yaw_rate), &|_| true, o)
+}
+
+/// The CAN speed's delay behind the wheels' mean speed.
+pub fn speed_delay(drive: &Drive, o: &DelayOptions) -> Delay {
+    if drive.speed.is_empty() {
+        return Delay::not_estimated("no CAN speed");
+    }
+    scalar_delay(&wheel_speed(drive), &pairs(&drive.speed), &|_| true, o)
+}
+
+/// The steering's delay behind the wheels' curvature. The car's yaw response
+/// lags the steering wheel, so a steering logged on time shows a negative
+/// delay of that response lag.
+pub fn steering_delay(drive: &Drive, o: &DelayOptions) -> Delay {
+    if drive.steering.is_empty() {
+        return Delay::not_estimated("no steering");
+    }
+    let Some(w) = wheel_yaw_rate(drive) else {
+        return Delay::not_estimated("needs both rear wheels");
+    };
+    let v = wheel_speed(drive);
+    let (ratio, wheelbase) = (drive.vehicle.steering_ratio, drive.vehicle.wheelbase_m);
+    let curvature: Vec<(f64, f64)> = w
+        .iter()
+        .filter_map(|&(t, wz)| {
+            let s = interp(&v, t)?;
+            // The wheel angle of that curvature, in steering-wheel units
+            // with the nominal ratio (the fit absorbs a ratio error).
+            (s > MIN_CURVATURE_SPEED_MPS).then(|| (t, ratio * (wheelbase * wz / s).atan()))
+        })
+        .collect();
+    let keep = |t: f64| interp(&v, t).is_some_and(|s| s > MIN_CURVATURE_SPEED_MPS + 0.5);
+    scalar_delay(&curvature, &pairs(&drive.steering), &keep, o)
+}
+
+/// The GNSS delay against the smoothed track, calibrating with `copts` at
+/// each step (see the module documentation). `params` (the calibration's
+/// result at the final delay) is returned with it.
+pub fn gnss_delay(
+    drive: &Drive,
+    copts: &CalibrationOptions,
+    o: &DelayOptions,
+) -> Result<(Delay, Option<Params>), Error> {
+    if drive.gnss.len() < o.min_samples {
+        return Ok((
+            Delay::not_estimated(format!(
+                "{} GNSS fixes, need {}",
+                drive.gnss.len(),
+                o.min_samples
+            )),
+            None,
+        ));
+    }
+    let lever = drive.vehicle.gnss_lever_arm_m;
+    let mut d = 0.0;
+    let mut last = None;
+    let mut prev: Option<(f64, f64)> = None;
+    for _ in 0..o.gnss_iterations.max(1) {
+        let shifted = shift(drive, [0.0, 0.0, 0.0, d]);
+        let cal = calibrate::calibrate(&shifted, copts)?;
+        let params = cal.estimate.params;
+        let f = ekf::run(
+            &shifted,
+            &params,
+            &FilterOptions {
+                record_epochs: true,
+                ..copts.filter.clone()
+            },
+            &mut (),
+        )?;
+        let sm = rts::smooth(&f.epochs)?;
+        // Dead reckoning (no GNSS) from the smoothed start: a reference the
+        // fixes' timing cannot pull along, its drift taken out per window.
+        let Some(s0) = sm.first() else {
+            return Ok((Delay::not_estimated("no smoothed track"), None));
+        };
+        let dr = ekf::run(
+            &shifted,
+            &params,
+            &FilterOptions {
+                record_epochs: true,
+                init: Init::Given {
+                    t_s: s0.t_s,
+                    x: s0.x,
+                    p: s0.p,
+                },
+                sensors: SensorSet::dead_reckoning(),
+                ..copts.filter.clone()
+            },
+            &mut (),
+        )?;
+        let reference = Reference::from_states(
+            dr.epochs.iter().map(|e| e.t_s).collect(),
+            dr.epochs.iter().map(|e| e.x).collect(),
+        );
+        let Some((delta, std, n)) = regress_gnss(&shifted.gnss, &reference, lever, o.gnss_window_s)
+        else {
+            return Ok((
+                Delay::not_estimated(
+                    "too few fixes inside the smoothed track, or no velocity change",
+                ),
+                None,
+            ));
+        };
+        // The step under-corrects by the part of the error the smoother
+        // absorbed: δ(d) ≈ (1 − α)(d* − d). Secant steps on δ(d) = 0
+        // converge in a few passes; the standard error of d* is that of δ
+        // divided by the slope (1 − α).
+        let slope = match prev {
+            Some((dp, fp)) if (d - dp).abs() > 1e-9 => {
+                let s = (delta - fp) / (d - dp);
+                (s < -0.05 && s > -2.0).then_some(s)
+            }
+            _ => None,
+        };
+        prev = Some((d, delta));
+        let (next, scale) = match slope {
+            Some(s) => (d - delta / s, -1.0 / s),
+            None => (d + delta, 1.0),
+        };
+        last = Some((std * scale, n, params));
+        if delta.abs() < 1e-4 {
+            break;
+        }
+        d = next;
+        if d.abs() > o.max_delay_s {
+            break;
+        }
+    }
+    let Some((std, n, params)) = last else {
+        return Ok((Delay::not_estimated("no step"), None));
+    };
+    let delay = status_of(d, std, n, o);
+    let params = delay.status.is_estimated().then_some(params);
+    Ok((delay, params))
+}
+
+/// One regression step of the GNSS delay: the fixes' residuals against the
+/// antenna's position on `reference` at the fixes' times, regressed on the
+/// antenna's velocity with an east and north bias and a small rotation about
+/// the window's centre per `window_s` window (`r = −δ·V + b + θ·J(p − p_c) + λ(p − p_c)`:
+/// the heading and scale drift of a dead-reckoned reference). Returns `(δ, std, fixes)`: `δ` is how much later the
+/// fixes still are than `reference`. `None` with fewer than 10 fixes per
+/// window on average or a velocity that does not vary.
+pub fn regress_gnss(
+    fixes: &[crate::drive::GnssFix],
+    reference: &Reference,
+    lever_m: f64,
+    window_s: f64,
+) -> Option<(f64, f64, usize)> {
+    // (window, residual, antenna velocity, antenna position)
+    type Row = (i64, [f64; 2], [f64; 2], [f64; 2]);
+    let mut rows: Vec<Row> = Vec::new();
+    let t0 = fixes.first()?.t_s;
+    for g in fixes {
+        let Some(x) = reference.state_at(g.t_s) else {
+            continue;
+        };
+        let (c, s) = (x[YAW].cos(), x[YAW].sin());
+        let ant = [x[X] + lever_m * c, x[Y] + lever_m * s];
+        let va = [
+            x[V] * c - lever_m * x[YAW_RATE] * s,
+            x[V] * s + lever_m * x[YAW_RATE] * c,
+        ];
+        let w = ((g.t_s - t0) / window_s).floor() as i64;
+        rows.push((w, [g.east_m - ant[0], g.north_m - ant[1]], va, ant));
+    }
+    let n = rows.len();
+    let windows = rows.last().map_or(0, |r| r.0 + 1) as usize;
+    if n < 10 * windows.max(1) || n < 10 {
+        return None;
+    }
+    // Partial out each window's east and north bias and small rotation
+    // about its centre (the reference's drift) from the residuals and the
+    // velocities.
+    let mut centred: Vec<([f64; 2], [f64; 2])> = Vec::with_capacity(n);
+    let mut i = 0;
+    while i < n {
+        let w = rows[i].0;
+        let j = i + rows[i..].iter().take_while(|r| r.0 == w).count();
+        let m = (j - i) as f64;
+        let pc = [0, 1].map(|k| rows[i..j].iter().map(|r| r.3[k]).sum::<f64>() / m);
+        // Nuisance columns besides the biases: a rotation J·(p − p_c) and a
+        // stretch (p − p_c) about the window's centre (the reference's
+        // heading and scale drift), made orthogonal to each other.
+        let mut cols: Vec<Vec<[f64; 2]>> = vec![
+            rows[i..j]
+                .iter()
+                .map(|r| [-(r.3[1] - pc[1]), r.3[0] - pc[0]])
+                .collect(),
+            rows[i..j]
+                .iter()
+                .map(|r| [r.3[0] - pc[0], r.3[1] - pc[1]])
+                .collect(),
+        ];
+        let centre = |v: &mut Vec<[f64; 2]>| {
+            let m = [0, 1].map(|k| v.iter().map(|a| a[k]).sum::<f64>() / v.len() as f64);
+            for a in v.iter_mut() {
+                a[0] -= m[0];
+                a[1] -= m[1];
+            }
+        };
+        let dot = |a: &[[f64; 2]], b: &[[f64; 2]]| -> f64 {
+            a.iter()
+                .zip(b)
+                .map(|(p, q)| p[0] * q[0] + p[1] * q[1])
+                .sum()
+        };
+        let remove = |v: &mut Vec<[f64; 2]>, q: &[[f64; 2]]| {
+            let qq = dot(q, q);
+            if qq > 1e-9 {
+                let c = dot(v, q) / qq;
+                for (a, b) in v.iter_mut().zip(q) {
+                    a[0] -= c * b[0];
+                    a[1] -= c * b[1];
+                }
+            }
+        };
+        for c in cols.iter_mut() {
+            centre(c);
+        }
+        let first = cols[0].clone();
+        remove(&mut cols[1], &first);
+        let mut rr: Vec<[f64; 2]> = rows[i..j].iter().map(|r| r.1).collect();
+        let mut vv: Vec<[f64; 2]> = rows[i..j].iter().map(|r| r.2).collect();
+        for v in [&mut rr, &mut vv] {
+            centre(v);
+            for c in &cols {
+                remove(v, c);
+            }
+        }
+        centred.extend(rr.into_iter().zip(vv));
+        i = j;
+    }
+    let svv: f64 = centred.iter().map(|(_, v)| v[0] * v[0] + v[1] * v[1]).sum();
+    let svr: f64 = centred.iter().map(|(r, v)| v[0] * r[0] + v[1] * r[1]).sum();
+    if svv.is_nan() || svv <= 0.0 {
+        return None;
+    }
+    let delta = -svr / svv;
+    let res: Vec<[f64; 2]> = centred
+        .iter()
+        .map(|(r, v)| [0, 1].map(|k| r[k] + delta * v[k]))
+        .collect();
+    let dof = (2 * n) as f64 - (4 * windows.max(1)) as f64 - 1.0;
+    let s2 = res.iter().map(|p| p[0] * p[0] + p[1] * p[1]).sum::<f64>() / dof.max(1.0);
+    let rho = 0.5
+        * (lag1(&res.iter().map(|p| p[0]).collect::<Vec<_>>())
+            + lag1(&res.iter().map(|p| p[1]).collect::<Vec<_>>()));
+    let std = (s2 / svv * (1.0 + rho) / (1.0 - rho)).sqrt();
+    Some((delta, std, n))
+}
+
+/// Every stream's delay: the scalar streams on `drive` as given, then the
+/// GNSS on the drive with the scalar delays applied.
+pub fn estimate(
+    drive: &Drive,
+    copts: &CalibrationOptions,
+    o: &DelayOptions,
+) -> Result<Delays, Error> {
+    estimate_with_params(drive, copts, o).map(|(d, _)| d)
+}
+
+/// [`estimate`], also returning the calibration at the final GNSS delay
+/// (with the scalar delays applied), when the GNSS delay was estimated.
+pub fn estimate_with_params(
+    drive: &Drive,
+    copts: &CalibrationOptions,
+    o: &DelayOptions,
+) -> Result<(Delays, Option<Params>), Error> {
+    let mut delays = Delays {
+        gyro: gyro_delay(drive, o),
+        speed: speed_delay(drive, o),
+        steering: steering_delay(drive, o),
+        gnss: Delay::not_estimated("not estimated"),
+    };
+    let partly = delays.apply(drive);
+    let (g, params) = gnss_delay(&partly, copts, o)?;
+    delays.gnss = g;
+    Ok((delays, params))
+}
+
+/// Which corrections [`prepare_with`] estimates and applies.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Which {
+    /// The IMU tilt and every stream's delay.
+    All,
+    /// The IMU tilt, the GNSS delay and the gyro scale (the other streams'
+    /// delays estimated and reported, not applied).
+    Gnss,
+    /// Nothing estimated or applied.
+    None,
+}
+
+/// What [`prepare`] found and applied.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Corrections {
+    /// The IMU's tilt (`None`: no three-axis IMU in the drive).
+    pub tilt: Option<crate::imu::Tilt>,
+    /// The streams' delays.
+    pub delays: Delays,
+    /// The gyro's scale error (`None` when not attempted: no GNSS delay, so
+    /// no calibration to take the bias from).
+    pub gyro_scale: Option<crate::gyro_scale::GyroScale>,
+}
+
+/// Estimates the IMU tilt (projecting the gyro on the vertical when
+/// estimated), every stream's delay and the gyro scale error
+/// ([`crate::gyro_scale`], with the bias of a calibration at the final
+/// delays), and returns the drive with them applied.
+pub fn prepare(
+    drive: &Drive,
+    copts: &CalibrationOptions,
+    o: &DelayOptions,
+) -> Result<(Drive, Corrections), Error> {
+    prepare_with(drive, copts, o, Which::All)
+}
+
+/// [`prepare`] with a choice of what is applied (see [`Which`]); an
+/// unapplied delay is marked not estimated with the reason.
+pub fn prepare_with(
+    drive: &Drive,
+    copts: &CalibrationOptions,
+    o: &DelayOptions,
+    which: Which,
+) -> Result<(Drive, Corrections), Error> {
+    if which == Which::None {
+        return Ok((
+            drive.clone(),
+            Corrections {
+                tilt: None,
+                delays: Delays::none(),
+                gyro_scale: None,
+            },
+        ));
+    }
+    let (levelled, tilt) = crate::imu::level(drive);
+    let (mut delays, params) = estimate_with_params(&levelled, copts, o)?;
+    if which == Which::Gnss {
+        for d in [&mut delays.gyro, &mut delays.speed, &mut delays.steering] {
+            if d.status.is_estimated() {
+                d.status = Status::NotEstimated(format!(
+                    "not applied (GNSS delay only): {:+.4} ± {:.4} s measured",
+                    d.delay_s, d.std_s
+                ));
+            }
+        }
+    }
+    let out = delays.apply(&levelled);
+    // The bias of the calibration at the final GNSS delay (a time shift of
+    // the gyro does not change its bias), else of a calibration here.
+    let params = match params {
+        Some(p) => Some(p),
+        None => calibrate::calibrate(&out, copts)
+            .ok()
+            .map(|c| c.estimate.params),
+    };
+    let gyro_scale = params.map(|p| crate::gyro_scale::estimate(&out, p.gyro_bias_rps));
+    let out = match &gyro_scale {
+        Some(g) if g.is_estimated() => crate::gyro_scale::apply(&out, g.scale_error),
+        _ => out,
+    };
+    Ok((
+        out,
+        Corrections {
+            tilt,
+            delays,
+            gyro_scale,
+        },
+    ))
+}
+
+/// Applies known corrections (e.g. from a params.toml): the yaw rate
+/// projected on `up` (sensor axes) when given and the drive has a three-axis
+/// gyro, then the delays, s, in [`Stream::ALL`] order, then the gyro scale
+/// error.
+pub fn apply_known(
+    drive: &Drive,
+    delays_s: [f64; 4],
+    up: Option<[f64; 3]>,
+    gyro_scale_error: f64,
+) -> Drive {
+    let d = match up {
+        Some(u) => crate::imu::level_with(drive, u),
+        None => drive.clone(),
+    };
+    let d = shift(&d, delays_s);
+    if gyro_scale_error != 0.0 {
+        crate::gyro_scale::apply(&d, gyro_scale_error)
+    } else {
+        d
+    }
+}
