@@ -184,6 +184,7 @@ def calibrate(
     timing: str = "wheel",
     min_speed: float = 2.0,
     mapping: Optional[PathLike] = None,
+    corrections: str = "gnss",
 ) -> Dict[str, Any]:
     """Calibrates the six parameters; returns ``deadreckon calibrate --json``'s object.
 
@@ -191,12 +192,23 @@ def calibrate(
     gyro bias) or ``truth``. The options are ``calibrate``'s: ``state``
     (``augmented`` or ``paper``), ``iteration`` (``anderson`` or ``plain``),
     ``max_iterations``, ``timing`` (``wheel`` or ``each``), ``min_speed``
-    (m/s). Keys: the six parameters, ``std``, ``iterations``, ``converged``,
+    (m/s), ``corrections`` (``gnss``: estimate the streams' delays, the IMU
+    tilt and the gyro scale, apply the tilt, the GNSS delay and the scale;
+    ``all``: apply every delay too; ``none``). Keys: the six parameters,
+    ``std``, ``iterations``, ``converged``, ``corrections``,
     ``method``, ``samples``, ``history`` and, when the filter ran, ``gnss``,
     ``wheel_gaps``, ``gates``. The computation runs without the GIL.
     """
     return _native.calibrate(
-        _source(drive), method, state, iteration, max_iterations, timing, min_speed, _opt_path(mapping)
+        _source(drive),
+        method,
+        state,
+        iteration,
+        max_iterations,
+        timing,
+        min_speed,
+        _opt_path(mapping),
+        corrections,
     )
 
 
@@ -248,6 +260,7 @@ def evaluate(
     max_diff_s: float = _native.EVO_DEFAULT_MAX_DIFF_S,
     timing: str = "wheel",
     mapping: Optional[PathLike] = None,
+    corrections: str = "gnss",
 ) -> Dict[str, Any]:
     """Dead-reckoning accuracy; returns ``deadreckon evaluate --json``'s object.
 
@@ -256,7 +269,9 @@ def evaluate(
     path) or ``ape``. With ``outage`` (s), sliding GNSS outages every
     ``step`` s (default half the outage) after ``warmup`` s instead; without
     ``params`` the drive is then calibrated with RTS first, as the command
-    does. ``params`` as in :func:`run` (default nominal).
+    does, with the ``corrections`` of :func:`calibrate`. ``params`` as in
+    :func:`run` (default nominal); a ``params.toml`` path applies the
+    corrections it stores, a dict carries the six parameters only.
     """
     return _native.evaluate(
         _source(drive),
@@ -274,6 +289,7 @@ def evaluate(
         max_diff_s,
         timing,
         _opt_path(mapping),
+        corrections,
     )
 
 

@@ -105,6 +105,7 @@ def calibrate(
     timing: str = "wheel",
     min_speed: float = 2.0,
     mapping: Optional[str] = None,
+    corrections: str = "gnss",
 ) -> Dict[str, Any]: ...
 def run_tracks(
     source: Union[Drive, str],
@@ -129,6 +130,7 @@ def evaluate(
     max_diff_s: float = ...,
     timing: str = "wheel",
     mapping: Optional[str] = None,
+    corrections: str = "gnss",
 ) -> Dict[str, Any]: ...
 def tedris_train(
     source: Union[Drive, str],

@@ -17,13 +17,68 @@ use crate::drive::drive_arg;
 use crate::pyjson::to_py;
 use crate::{to_py_err, with_context, DeadreckonError};
 
+/// The `--corrections` word of `calibrate` and `evaluate`.
+fn corrections_which(s: &str) -> PyResult<deadreckon_core::timing::Which> {
+    use deadreckon_core::timing::Which;
+    match s {
+        "gnss" => Ok(Which::Gnss),
+        "all" => Ok(Which::All),
+        "none" => Ok(Which::None),
+        other => Err(err(format!(
+            "unknown corrections `{other}` (gnss, all, none)"
+        ))),
+    }
+}
+
+/// The drive with the timing and mounting corrections estimated and applied
+/// (as the CLI's `--corrections`), and the corrections.
+fn prepared(
+    drive: &deadreckon_core::Drive,
+    opts: &CalibrationOptions,
+    which: deadreckon_core::timing::Which,
+) -> PyResult<(deadreckon_core::Drive, deadreckon_core::timing::Corrections)> {
+    deadreckon_core::timing::prepare_with(
+        drive,
+        opts,
+        &deadreckon_core::timing::DelayOptions::default(),
+        which,
+    )
+    .map_err(with_context(
+        "estimating the streams' delays and the IMU tilt".to_string(),
+    ))
+}
+
+/// The drive with the corrections a params.toml `p` stores applied (none for
+/// `nominal`, a dict or a file without them), as the CLI's `--params`.
+fn with_stored(
+    p: Option<&Bound<'_, PyAny>>,
+    drive: deadreckon_core::Drive,
+) -> PyResult<deadreckon_core::Drive> {
+    let Some(spec) = p.and_then(|p| p.extract::<PathBuf>().ok()) else {
+        return Ok(drive);
+    };
+    if spec.as_os_str() == "nominal" {
+        return Ok(drive);
+    }
+    let (_, extra) = deadreckon_io::read_params_with_extra(&spec).map_err(|e| {
+        err(format!(
+            "reading parameters {}: {}",
+            spec.display(),
+            deadreckon_api::chain_text(&e)
+        ))
+    })?;
+    let s = deadreckon_api::corrections::stored_corrections(&extra)
+        .map_err(|e| err(format!("parameters {}: {e}", spec.display())))?;
+    Ok(s.apply(&drive))
+}
+
 fn err(e: impl std::fmt::Display) -> PyErr {
     DeadreckonError::new_err(e.to_string())
 }
 
 /// `calibrate --json` as a dict; the options are the command's.
 #[pyfunction]
-#[pyo3(signature = (source, method="rts", state="augmented", iteration="anderson", max_iterations=60, timing="wheel", min_speed=2.0, mapping=None))]
+#[pyo3(signature = (source, method="rts", state="augmented", iteration="anderson", max_iterations=60, timing="wheel", min_speed=2.0, mapping=None, corrections="gnss"))]
 #[allow(clippy::too_many_arguments)]
 pub fn calibrate(
     py: Python<'_>,
@@ -35,7 +90,9 @@ pub fn calibrate(
     timing: &str,
     min_speed: f64,
     mapping: Option<PathBuf>,
+    corrections: &str,
 ) -> PyResult<Py<PyAny>> {
+    let which = corrections_which(corrections)?;
     let m: Method = method.parse().map_err(to_py_err)?;
     let opts = CalibrationOptions {
         method: m,
@@ -61,16 +118,16 @@ pub fn calibrate(
         .map(|p| p.display().to_string())
         .unwrap_or_else(|_| "the drive".into());
     let drive = drive_arg(py, source, &read, mapping)?;
+    let (drive, corr) = py.detach(|| prepared(&drive, &opts, which))?;
     let c = py
         .detach(|| core_calibrate::calibrate(&drive, &opts))
         .map_err(with_context(format!("calibrating {what}")))?;
     let steering = py
         .detach(|| json::car_steering(&drive, m, opts.min_speed_mps))
         .map_err(with_context("calibrating the steering".to_string()))?;
-    to_py(
-        py,
-        &json::calibrate_json(method, &c, opts.min_speed_mps, steering.as_ref()),
-    )
+    let mut v = json::calibrate_json(method, &c, opts.min_speed_mps, steering.as_ref());
+    v["corrections"] = deadreckon_api::corrections::corrections_json(&corr);
+    to_py(py, &v)
 }
 
 /// `nominal`, a params.toml path, or a dict with the six parameters (extra
@@ -174,7 +231,7 @@ pub fn track_columns<'py>(py: Python<'py>, t: &track::Track) -> PyResult<Bound<'
 
 /// `evaluate --json` as a dict; the options are the command's.
 #[pyfunction]
-#[pyo3(signature = (source, params=None, metric="drift", outage=None, step=None, warmup=5.0, segment_m=100.0, threshold_m=1.0, track="dead-reckoned", reference="truth", delta_m=100.0, pairs_from="estimate", max_diff_s=evo::DEFAULT_MAX_DIFF_S, timing="wheel", mapping=None))]
+#[pyo3(signature = (source, params=None, metric="drift", outage=None, step=None, warmup=5.0, segment_m=100.0, threshold_m=1.0, track="dead-reckoned", reference="truth", delta_m=100.0, pairs_from="estimate", max_diff_s=evo::DEFAULT_MAX_DIFF_S, timing="wheel", mapping=None, corrections="gnss"))]
 #[allow(clippy::too_many_arguments)]
 pub fn evaluate(
     py: Python<'_>,
@@ -193,22 +250,32 @@ pub fn evaluate(
     max_diff_s: f64,
     timing: &str,
     mapping: Option<PathBuf>,
+    corrections: &str,
 ) -> PyResult<Py<PyAny>> {
+    let which = corrections_which(corrections)?;
     let drive = drive_arg(py, source, &Default::default(), mapping)?;
     let timing = parse_timing(timing).map_err(to_py_err)?;
     if let Some(len) = outage {
         let given = params.map(|p| params_arg(p, &drive.vehicle)).transpose()?;
+        let stored = with_stored(params, (*drive).clone())?;
         let base = FilterOptions {
             timing,
             ..Default::default()
         };
         let v = py.detach(|| -> PyResult<serde_json::Value> {
-            let (params, label) = match given {
-                Some(g) => g,
+            let (params, label, drive, corr) = match given {
+                Some((p, l)) => (p, l, stored, None),
                 None => {
-                    let c = core_calibrate::calibrate(&drive, &CalibrationOptions::default())
+                    let copts = CalibrationOptions::default();
+                    let (drive, corr) = prepared(&drive, &copts, which)?;
+                    let c = core_calibrate::calibrate(&drive, &copts)
                         .map_err(with_context("RTS calibration with GNSS"))?;
-                    (c.estimate.params, format!("rts ({} passes)", c.iterations))
+                    (
+                        c.estimate.params,
+                        format!("rts ({} passes)", c.iterations),
+                        drive,
+                        Some(corr),
+                    )
                 }
             };
             let ev = outage::evaluate(
@@ -220,10 +287,15 @@ pub fn evaluate(
                 &base,
             )
             .map_err(to_py_err)?;
-            Ok(json::outage_json(len, &label, &ev))
+            let mut v = json::outage_json(len, &label, &ev);
+            if let Some(c) = &corr {
+                v["corrections"] = deadreckon_api::corrections::corrections_json(c);
+            }
+            Ok(v)
         })?;
         return to_py(py, &v);
     }
+    let drive = with_stored(params, (*drive).clone())?;
     let params = match params {
         Some(p) => params_arg(p, &drive.vehicle)?.0,
         None => Params::nominal(&drive.vehicle),

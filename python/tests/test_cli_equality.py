@@ -70,9 +70,14 @@ def test_evaluate_with_calibrated_params_equals_cli(sim_drive, cli, cli_json, tm
     cli("calibrate", sim_drive, "--out", params)
     theirs = cli_json("evaluate", sim_drive, "--params", params, "--json")
     assert deadreckon.evaluate(sim_drive, params=params) == theirs
-    # The dict calibrate returns works as parameters too (the same six numbers
-    # as params.toml, which writes them exactly).
-    cal = deadreckon.calibrate(sim_drive)
+    # The dict calibrate returns works as parameters too: the same six numbers
+    # as params.toml, which writes them exactly. A dict carries no timing or
+    # mounting corrections (params.toml's [delays]/[imu]/[gyro_scale] tables),
+    # so it equals a params.toml calibrated without them.
+    plain = tmp_path / "plain.toml"
+    cli("calibrate", sim_drive, "--corrections", "none", "--out", plain)
+    theirs = cli_json("evaluate", sim_drive, "--params", plain, "--json")
+    cal = deadreckon.calibrate(sim_drive, corrections="none")
     assert deadreckon.evaluate(sim_drive, params=cal) == theirs
 
 

@@ -253,9 +253,15 @@ pub fn four_wheel_input(
     let opts = FilterOptions::default();
     for m in methods {
         steps.step(&format!("dead reckoning with {}", m.name));
-        let init = tracks::dead_reckoning_init(drive, None, None);
-        if let Ok(dr) = init.and_then(|i| tracks::dead_reckoned(drive, &m.params.params, &opts, i))
-        {
+        // From the truth's start, or (no truth: the Husky) from the start of
+        // the smoothed track as `run` does; the report drew no DR track there.
+        let dr = if drive.truth.is_empty() {
+            tracks::drive_tracks(drive, &m.params.params, &opts, None).map(|mut t| t.remove(0))
+        } else {
+            tracks::dead_reckoning_init(drive, None, None)
+                .and_then(|i| tracks::dead_reckoned(drive, &m.params.params, &opts, i))
+        };
+        if let Ok(dr) = dr {
             traj.dead_reckoned.push(rp::MethodPath {
                 method: m.name.clone(),
                 path: path_of(&dr),
@@ -453,6 +459,20 @@ pub fn tedris_from_model(
                 method: "TedriS".into(),
                 t_s: pts.iter().map(|p| p.0).collect(),
                 error_m: pts.iter().map(|p| p.1).collect(),
+            });
+        } else {
+            // Without truth, against the hidden GNSS fixes, as the four-wheel
+            // errors are (the TedriS curve was missing on the Husky).
+            let pts = deadreckon_tedris::outage::gnss_error_points(
+                drive,
+                &run.track.points,
+                o.start_s,
+                o.end_s,
+            );
+            series.push(rp::MethodSeries {
+                method: "TedriS".into(),
+                t_s: pts.iter().map(|p| p.0 - o.start_s).collect(),
+                error_m: pts.iter().map(|p| p.2).collect(),
             });
         }
         if let Some(w) = fw
