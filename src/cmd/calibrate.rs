@@ -77,6 +77,10 @@ pub struct CalibrateArgs {
     /// Print JSON instead of a table.
     #[arg(long)]
     pub json: bool,
+    /// Fuse every wheel reading: no wheel-health monitor (slipping and bad
+    /// wheels are then neither dropped nor reported).
+    #[arg(long)]
+    pub no_wheel_monitor: bool,
 }
 
 /// Runs `calibrate`.
@@ -123,6 +127,7 @@ pub fn run(a: CalibrateArgs) -> Result<()> {
             .unwrap_or(Shape::FourWheel.default_min_speed_mps()),
         filter: FilterOptions {
             timing: common::parse_timing(&a.timing)?,
+            wheel_monitor: common::wheel_monitor(a.no_wheel_monitor),
             ..Default::default()
         },
         ..Default::default()
@@ -226,6 +231,9 @@ pub fn run(a: CalibrateArgs) -> Result<()> {
         }
         if let Some(st) = &c.filter_stats {
             outln!("{}", common::stats_line(st));
+        }
+        if let Some(h) = &c.wheel_health {
+            common::print_wheel_health(h)?;
         }
         for w in &written {
             outln!("wrote {}", w.display());

@@ -146,6 +146,11 @@ pub struct Calibration {
     pub samples: [usize; 6],
     /// The filter's counters in the last smoothing pass (GNSS used, gated, ...).
     pub filter_stats: Option<ekf::FilterStats>,
+    /// The wheel-health monitor over the drive with the estimated parameters
+    /// (the 5-state GNSS-aided filter): wheels that slipped or read wrong,
+    /// and when. `None` without a monitor in the filter options, or when that
+    /// run cannot start (no GNSS for its initial state).
+    pub wheel_health: Option<crate::wheel_health::WheelHealth>,
 }
 
 /// Tolerance units of the parameters, in [`Params::to_array`] order.
@@ -178,10 +183,26 @@ pub fn calibrate(drive: &Drive, opts: &CalibrationOptions) -> Result<Calibration
                 converged: samples.iter().all(|&n| n > 0),
                 samples,
                 filter_stats: None,
+                wheel_health: None,
             })
         }
         Method::Rts => rts_calibration(drive, opts, start),
     }
+    .map(|mut c| {
+        if opts.filter.wheel_monitor.is_some() {
+            c.wheel_health = crate::wheel_health::check_drive(
+                drive,
+                &c.estimate.params,
+                &FilterOptions {
+                    record_epochs: false,
+                    record_innovations: false,
+                    ..opts.filter.clone()
+                },
+            )
+            .ok();
+        }
+        c
+    })
 }
 
 /// One pass: filter with `p`, smooth, least squares on the smoothed states.
@@ -278,6 +299,7 @@ fn rts_calibration(
         converged,
         samples,
         filter_stats: Some(stats),
+        wheel_health: None,
     })
 }
 
@@ -551,5 +573,6 @@ pub fn zupt(drive: &Drive, nominal: &Params) -> Result<Calibration, Error> {
         converged: true,
         samples,
         filter_stats: None,
+        wheel_health: None,
     })
 }

@@ -22,6 +22,7 @@
 pub mod angle;
 pub mod calibrate;
 pub mod checkpoint;
+pub mod consistency;
 pub mod drive;
 pub mod ekf;
 pub mod event;
@@ -41,6 +42,7 @@ pub mod reference;
 pub mod rts;
 pub mod track;
 pub mod vehicle;
+pub mod wheel_health;
 
 pub use drive::Drive;
 pub use track::{Track, TrackPoint};
