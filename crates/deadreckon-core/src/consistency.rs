@@ -88,9 +88,37 @@ pub struct BlockNees {
     pub dof: usize,
     /// One point per entry of [`WINDOW_POINTS`] that had windows.
     pub points: Vec<NeesPoint>,
+    /// The NEES of every window at every point (for merging runs).
+    pub values: Vec<Vec<f64>>,
 }
 
 impl BlockNees {
+    fn from_values(name: &str, n: usize, values: Vec<Vec<f64>>) -> Result<BlockNees, Error> {
+        let points = WINDOW_POINTS
+            .iter()
+            .zip(&values)
+            .filter(|(_, v)| !v.is_empty())
+            .map(|(f, v)| point(*f, n, v))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(BlockNees {
+            name: name.into(),
+            dof: n,
+            points,
+            values,
+        })
+    }
+
+    /// The windows of two runs together (e.g. several drives: M grows).
+    pub fn merged(&self, other: &BlockNees) -> Result<BlockNees, Error> {
+        let values = self
+            .values
+            .iter()
+            .zip(&other.values)
+            .map(|(a, b)| a.iter().chain(b).copied().collect())
+            .collect();
+        BlockNees::from_values(&self.name, self.dof, values)
+    }
+
     /// The verdict over every point: consistent when all are; otherwise the
     /// point farthest from its bounds (in factor).
     pub fn verdict(&self) -> Verdict {
@@ -115,6 +143,26 @@ pub struct Consistency {
     pub pose: BlockNees,
     /// The motion `[v, ψ̇]`.
     pub motion: BlockNees,
+}
+
+impl Consistency {
+    /// The windows of two runs together (several drives averaged).
+    pub fn merged(&self, other: &Consistency) -> Result<Consistency, Error> {
+        Ok(Consistency {
+            outage_s: self.outage_s.max(other.outage_s),
+            pose: self.pose.merged(&other.pose)?,
+            motion: self.motion.merged(&other.motion)?,
+        })
+    }
+
+    /// `pose: consistent; motion: over-confident by ×2.3`.
+    pub fn summary(&self) -> String {
+        format!(
+            "pose: {}; motion: {}",
+            self.pose.verdict(),
+            self.motion.verdict()
+        )
+    }
 }
 
 /// The 95 % bounds of the average of `m` NEES values of `n` degrees of freedom.
@@ -223,24 +271,11 @@ pub fn nees_through_windows(
             }
         }
     }
-    let block = |name: &str, n: usize, v: &[Vec<f64>]| -> Result<BlockNees, Error> {
-        let points = WINDOW_POINTS
-            .iter()
-            .zip(v)
-            .filter(|(_, v)| !v.is_empty())
-            .map(|(f, v)| point(*f, n, v))
-            .collect::<Result<Vec<_>, _>>()?;
-        Ok(BlockNees {
-            name: name.into(),
-            dof: n,
-            points,
-        })
-    };
     let outage_s = windows.iter().map(|w| w.1 - w.0).fold(0.0, f64::max);
     Ok(Consistency {
         outage_s,
-        pose: block("pose", 3, &pose)?,
-        motion: block("motion", 2, &motion)?,
+        pose: BlockNees::from_values("pose", 3, pose)?,
+        motion: BlockNees::from_values("motion", 2, motion)?,
     })
 }
 
