@@ -235,6 +235,26 @@ pub fn run(a: CalibrateArgs) -> Result<()> {
         if let Some(h) = &c.wheel_health {
             common::print_wheel_health(h)?;
         }
+        if let Some(mv) = &c.manoeuvres {
+            outln!(
+                "drive: {:.0} s, {:.0} s above {} m/s ({:.0} s left turns, {:.0} s right turns, {:.0} s straight), {} stops ({:.0} s)",
+                mv.duration_s,
+                mv.above_threshold_s,
+                opts.min_speed_mps,
+                mv.left_turn_s,
+                mv.right_turn_s,
+                mv.straight_s,
+                mv.stops,
+                mv.stopped_s
+            );
+            let lacks = mv.lacking();
+            if !lacks.is_empty() {
+                outln!("the drive lacked (drive more before trusting these):");
+            }
+            for l in lacks {
+                outln!("  {}: weakens {} ({})", l.what, l.weakens.join(", "), l.why);
+            }
+        }
         for w in &written {
             outln!("wrote {}", w.display());
         }

@@ -46,6 +46,10 @@ pub fn calibration_json(method: &str, c: &Calibration) -> Value {
     if let Some(h) = &c.wheel_health {
         m.insert("wheel_health".into(), wheel_health_json(h));
     }
+    if let Some(mv) = &c.manoeuvres {
+        m.insert("manoeuvres".into(), json!(mv));
+        m.insert("lacking".into(), json!(mv.lacking()));
+    }
     Value::Object(m)
 }
 

@@ -151,6 +151,10 @@ pub struct Calibration {
     /// and when. `None` without a monitor in the filter options, or when that
     /// run cannot start (no GNSS for its initial state).
     pub wheel_health: Option<crate::wheel_health::WheelHealth>,
+    /// What the drive contained (turns, stops, time above the speed
+    /// threshold), from which [`crate::observability::Manoeuvres::lacking`]
+    /// says what it lacked.
+    pub manoeuvres: Option<crate::observability::Manoeuvres>,
 }
 
 /// Tolerance units of the parameters, in [`Params::to_array`] order.
@@ -184,11 +188,13 @@ pub fn calibrate(drive: &Drive, opts: &CalibrationOptions) -> Result<Calibration
                 samples,
                 filter_stats: None,
                 wheel_health: None,
+                manoeuvres: None,
             })
         }
         Method::Rts => rts_calibration(drive, opts, start),
     }
     .map(|mut c| {
+        c.manoeuvres = Some(crate::observability::manoeuvres(drive, opts.min_speed_mps));
         if opts.filter.wheel_monitor.is_some() {
             c.wheel_health = crate::wheel_health::check_drive(
                 drive,
@@ -300,6 +306,7 @@ fn rts_calibration(
         samples,
         filter_stats: Some(stats),
         wheel_health: None,
+        manoeuvres: None,
     })
 }
 
@@ -574,5 +581,6 @@ pub fn zupt(drive: &Drive, nominal: &Params) -> Result<Calibration, Error> {
         samples,
         filter_stats: None,
         wheel_health: None,
+        manoeuvres: None,
     })
 }

@@ -34,6 +34,7 @@ pub mod kalman;
 pub mod kinematics;
 pub mod metrics;
 pub mod model;
+pub mod observability;
 pub mod observation;
 pub mod online;
 pub mod outage;
