@@ -37,7 +37,7 @@ fn case(seed: u64, spin: bool, shrink: bool) -> Case {
     let sim0 = simulate(&base, seed).unwrap();
     let mid = 0.5 * sim0.stats.duration_s;
     let faults = WheelFaultsSpec {
-        spin: spin.then(|| SpinSpec {
+        spin: spin.then_some(SpinSpec {
             wheel: 2,
             slip: 0.3,
             duration_s: 1.0,
