@@ -7,7 +7,10 @@
 //! of gyro bias, speed scale and wheel circumferences, dead reckoning, and the
 //! papers' evaluation metrics. Other vehicle shapes (a tricycle with a
 //! steered driven wheel, a differential drive) and their kinematic
-//! calibration against a reference live in [`kinematics`].
+//! calibration against a reference live in [`kinematics`]. Slipping and bad
+//! wheels are found and dropped from the fusion by [`wheel_health`]; the
+//! filter's consistency against the truth is [`consistency`] (NEES), and what a
+//! calibration drive lacked is [`observability`].
 //!
 //! ## Conventions
 //!
