@@ -139,10 +139,38 @@ fn a_slipping_wheel_is_gated_and_counted() {
     for r in rows[n / 2..n / 2 + 20].iter_mut() {
         r.rl += 40;
     }
-    let out = ekf::run(&d, &params, &FilterOptions::default(), &mut ()).unwrap();
+    // The χ² gate alone: without the wheel-health monitor, which would take
+    // the wheel out of the fusion after its first rows (checked below).
+    let gate_only = FilterOptions {
+        wheel_monitor: None,
+        ..Default::default()
+    };
+    let out = ekf::run(&d, &params, &gate_only, &mut ()).unwrap();
     let rl = out.stats.gates.rejected(ekf::SensorKind::Wheel(2));
     assert!((18..=20).contains(&rl), "{rl} rejected");
     assert_eq!(out.stats.gates.rejected(ekf::SensorKind::Wheel(0)), 0);
+    // With the monitor (the default) the spin is one slip stretch of the
+    // rear-left wheel, and no other wheel is touched.
+    let out = ekf::run(&d, &params, &FilterOptions::default(), &mut ()).unwrap();
+    let h = out.wheel_health.unwrap();
+    let t0 = rows_t(&d, n / 2);
+    let rl = &h.wheels[2].intervals;
+    assert_eq!(rl.len(), 1, "{rl:?}");
+    assert_eq!(
+        rl[0].reason,
+        deadreckon_core::wheel_health::DropReason::Slip
+    );
+    assert!(
+        rl[0].start_s >= t0 && rl[0].start_s < t0 + 0.1,
+        "{rl:?} from {t0}"
+    );
+    for w in [0, 1, 3] {
+        assert!(h.wheels[w].intervals.is_empty(), "wheel {w}");
+    }
+}
+
+fn rows_t(d: &deadreckon_core::Drive, k: usize) -> f64 {
+    d.wheels.t_s(k)
 }
 
 fn bin() -> Command {

@@ -83,6 +83,10 @@ pub struct CalibrateArgs {
     /// applied) or none.
     #[arg(long, value_enum, default_value_t = common::CorrectionsArg::Gnss)]
     pub corrections: common::CorrectionsArg,
+    /// Fuse every wheel reading: no wheel-health monitor (slipping and bad
+    /// wheels are then neither dropped nor reported).
+    #[arg(long)]
+    pub no_wheel_monitor: bool,
 }
 
 /// Runs `calibrate`.
@@ -129,6 +133,7 @@ pub fn run(a: CalibrateArgs, load: &common::Loader) -> Result<()> {
             .unwrap_or(Shape::FourWheel.default_min_speed_mps()),
         filter: FilterOptions {
             timing: common::parse_timing(&a.timing)?,
+            wheel_monitor: common::wheel_monitor(a.no_wheel_monitor),
             ..Default::default()
         },
         ..Default::default()
@@ -242,6 +247,29 @@ pub fn run(a: CalibrateArgs, load: &common::Loader) -> Result<()> {
         if a.corrections != common::CorrectionsArg::None {
             for line in common::corrections_lines(&corrections) {
                 outln!("{line}");
+            }
+        }
+        if let Some(h) = &c.wheel_health {
+            common::print_wheel_health(h)?;
+        }
+        if let Some(mv) = &c.manoeuvres {
+            outln!(
+                "drive: {:.0} s, {:.0} s above {} m/s ({:.0} s left turns, {:.0} s right turns, {:.0} s straight), {} stops ({:.0} s)",
+                mv.duration_s,
+                mv.above_threshold_s,
+                opts.min_speed_mps,
+                mv.left_turn_s,
+                mv.right_turn_s,
+                mv.straight_s,
+                mv.stops,
+                mv.stopped_s
+            );
+            let lacks = mv.lacking();
+            if !lacks.is_empty() {
+                outln!("the drive lacked (drive more before trusting these):");
+            }
+            for l in lacks {
+                outln!("  {}: weakens {} ({})", l.what, l.weakens.join(", "), l.why);
             }
         }
         for w in &written {

@@ -348,3 +348,32 @@ pub fn write_scenario(
     .with_context(|| format!("writing {}", dir.display()))?;
     Ok(out)
 }
+/// The wheel-health monitor's settings: the defaults, or none with `--no-wheel-monitor`.
+pub fn wheel_monitor(off: bool) -> Option<deadreckon_core::wheel_health::WheelMonitorConfig> {
+    (!off).then(Default::default)
+}
+
+/// The wheel-health lines of `run` and `calibrate`.
+pub fn print_wheel_health(h: &deadreckon_core::wheel_health::WheelHealth) -> Result<()> {
+    if h.all_good() {
+        outln!("wheel health: no wheel slipped or read wrong");
+    }
+    for l in h.lines() {
+        outln!("{l}");
+    }
+    for (name, w) in deadreckon_core::wheel_health::WHEEL_NAMES
+        .iter()
+        .zip(&h.wheels)
+    {
+        for i in &w.intervals {
+            outln!(
+                "  wheel {name} out {:.2}..{:.2} s ({}, peak |T| {:.1})",
+                i.start_s,
+                i.end_s,
+                i.reason.name(),
+                i.peak_sigma
+            );
+        }
+    }
+    Ok(())
+}

@@ -49,6 +49,12 @@ pub struct RunArgs {
     /// Initial pose for dead reckoning `EAST_M,NORTH_M,YAW_RAD` (default: the truth, else the smoothed GNSS track).
     #[arg(long)]
     pub init_pose: Option<String>,
+    /// Fuse every wheel reading: no wheel-health monitor.
+    #[arg(long)]
+    pub no_wheel_monitor: bool,
+    /// Print what was written and the wheel health as JSON.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// What `run --out x.mcap` writes.
@@ -164,6 +170,7 @@ pub fn run(a: RunArgs, load: &common::Loader) -> Result<()> {
     };
     let opts = FilterOptions {
         timing: common::parse_timing(&a.timing)?,
+        wheel_monitor: common::wheel_monitor(a.no_wheel_monitor),
         ..Default::default()
     };
     let format = TrackFormat::from_path(&a.out)?;
@@ -171,8 +178,28 @@ pub fn run(a: RunArgs, load: &common::Loader) -> Result<()> {
     let t = select(&all, &a, format)?;
     write_tracks(&a.out, format, &t, a.mcap)
         .with_context(|| format!("writing {}", a.out.display()))?;
+    // The monitor over the GNSS-aided run (the filtered track's).
+    // (A drive without GNSS has no aided run: the health is then not checked.)
+    let health = match opts.wheel_monitor {
+        Some(_) => deadreckon_core::wheel_health::check_drive(&drive, &params, &opts)
+            .map_err(|e| e.to_string()),
+        None => Err("--no-wheel-monitor".into()),
+    };
+    if a.json {
+        let v = serde_json::json!({
+            "wrote": a.out.display().to_string(),
+            "tracks": t.iter().map(|tr| serde_json::json!({"name": tr.name, "poses": tr.points.len()})).collect::<Vec<_>>(),
+            "wheel_health": health.as_ref().ok().map(deadreckon_api::json::wheel_health_json),
+        });
+        outln!("{}", serde_json::to_string_pretty(&v)?);
+        return Ok(());
+    }
     for tr in &t {
         outln!("{:<14} {:>7} poses", tr.name, tr.points.len());
+    }
+    match &health {
+        Ok(h) => common::print_wheel_health(h)?,
+        Err(why) => outln!("wheel health: not checked ({why})"),
     }
     outln!("wrote {}", a.out.display());
     if format == TrackFormat::Kitti {

@@ -43,6 +43,13 @@ pub fn calibration_json(method: &str, c: &Calibration) -> Value {
         m.insert("wheel_gaps".into(), st.wheel_gaps.into());
         m.insert("gates".into(), gates_json(&st.gates));
     }
+    if let Some(h) = &c.wheel_health {
+        m.insert("wheel_health".into(), wheel_health_json(h));
+    }
+    if let Some(mv) = &c.manoeuvres {
+        m.insert("manoeuvres".into(), json!(mv));
+        m.insert("lacking".into(), json!(mv.lacking()));
+    }
     Value::Object(m)
 }
 
@@ -126,6 +133,38 @@ pub fn calibrate_json(
         v["steering"] = steering_json(st);
     }
     v
+}
+
+/// The wheel-health monitor's report: per wheel (`fl`, `fr`, `rl`, `rr`)
+/// the epochs checked and dropped, the largest normalised window sums, and
+/// every dropped stretch (`start_s`, `end_s`, `reason` slip or bias,
+/// `peak_sigma`).
+pub fn wheel_health_json(h: &deadreckon_core::wheel_health::WheelHealth) -> Value {
+    let mut m = serde_json::Map::new();
+    for (name, w) in deadreckon_core::wheel_health::WHEEL_NAMES
+        .iter()
+        .zip(&h.wheels)
+    {
+        if w.epochs_checked == 0 {
+            continue;
+        }
+        m.insert(
+            (*name).into(),
+            json!({
+                "epochs_checked": w.epochs_checked,
+                "epochs_dropped": w.epochs_dropped,
+                "dropped_s": w.dropped_s(),
+                "slip_intervals": w.count(deadreckon_core::wheel_health::DropReason::Slip),
+                "bias_intervals": w.count(deadreckon_core::wheel_health::DropReason::Bias),
+                "max_short_sigma": w.max_short_sigma,
+                "max_long_sigma": w.max_long_sigma,
+                "intervals": w.intervals.iter().map(|i| json!({
+                    "start_s": i.start_s, "end_s": i.end_s, "reason": i.reason.name(), "peak_sigma": i.peak_sigma,
+                })).collect::<Vec<_>>(),
+            }),
+        );
+    }
+    Value::Object(m)
 }
 
 /// `evaluate --outage LEN --json`: sliding outages of `outage_s` with the

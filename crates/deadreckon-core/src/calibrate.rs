@@ -146,6 +146,15 @@ pub struct Calibration {
     pub samples: [usize; 6],
     /// The filter's counters in the last smoothing pass (GNSS used, gated, ...).
     pub filter_stats: Option<ekf::FilterStats>,
+    /// The wheel-health monitor over the drive with the estimated parameters
+    /// (the 5-state GNSS-aided filter): wheels that slipped or read wrong,
+    /// and when. `None` without a monitor in the filter options, or when that
+    /// run cannot start (no GNSS for its initial state).
+    pub wheel_health: Option<crate::wheel_health::WheelHealth>,
+    /// What the drive contained (turns, stops, time above the speed
+    /// threshold), from which [`crate::observability::Manoeuvres::lacking`]
+    /// says what it lacked.
+    pub manoeuvres: Option<crate::observability::Manoeuvres>,
 }
 
 /// Tolerance units of the parameters, in [`Params::to_array`] order.
@@ -185,10 +194,28 @@ pub fn calibrate(drive: &Drive, opts: &CalibrationOptions) -> Result<Calibration
                 converged: samples.iter().all(|&n| n > 0),
                 samples,
                 filter_stats: None,
+                wheel_health: None,
+                manoeuvres: None,
             })
         }
         Method::Rts => rts_calibration(drive, opts, start),
     }
+    .map(|mut c| {
+        c.manoeuvres = Some(crate::observability::manoeuvres(drive, opts.min_speed_mps));
+        if opts.filter.wheel_monitor.is_some() {
+            c.wheel_health = crate::wheel_health::check_drive(
+                drive,
+                &c.estimate.params,
+                &FilterOptions {
+                    record_epochs: false,
+                    record_innovations: false,
+                    ..opts.filter.clone()
+                },
+            )
+            .ok();
+        }
+        c
+    })
 }
 
 /// One pass: filter with `p`, smooth, least squares on the smoothed states.
@@ -285,6 +312,8 @@ fn rts_calibration(
         converged,
         samples,
         filter_stats: Some(stats),
+        wheel_health: None,
+        manoeuvres: None,
     })
 }
 
@@ -558,5 +587,7 @@ pub fn zupt(drive: &Drive, nominal: &Params) -> Result<Calibration, Error> {
         converged: true,
         samples,
         filter_stats: None,
+        wheel_health: None,
+        manoeuvres: None,
     })
 }

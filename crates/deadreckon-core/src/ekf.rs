@@ -27,6 +27,7 @@ use crate::filter::{AugmentedLayout, CarLayout, Filter, Layout, Prediction};
 use crate::kalman::CovarianceForm;
 use crate::model::{Mat, State};
 use crate::vehicle::Params;
+use crate::wheel_health::{WheelHealth, WheelMonitor, WheelMonitorConfig, WheelReading};
 use crate::Error;
 
 /// When the filter runs its epochs.
@@ -121,6 +122,11 @@ pub struct FilterOptions {
     pub record_innovations: bool,
     /// Stop after the last epoch at or before this time, s.
     pub end_s: Option<f64>,
+    /// The wheel-health monitor (slipping and bad wheels dropped from the
+    /// fusion while they misbehave, [`crate::wheel_health`]; on by default);
+    /// `None` fuses every wheel reading the χ² gate accepts.
+    #[serde(default)]
+    pub wheel_monitor: Option<WheelMonitorConfig>,
 }
 
 impl Default for FilterOptions {
@@ -134,6 +140,7 @@ impl Default for FilterOptions {
             record_epochs: true,
             record_innovations: false,
             end_s: None,
+            wheel_monitor: Some(WheelMonitorConfig::default()),
         }
     }
 }
@@ -237,6 +244,8 @@ pub struct FilterOutput<const N: usize = 5> {
     pub innovations: Vec<InnovationRecord>,
     /// Counters.
     pub stats: FilterStats,
+    /// What the wheel-health monitor saw (`None` without one).
+    pub wheel_health: Option<WheelHealth>,
 }
 
 impl<const N: usize> Default for FilterOutput<N> {
@@ -245,6 +254,7 @@ impl<const N: usize> Default for FilterOutput<N> {
             epochs: Vec::new(),
             innovations: Vec::new(),
             stats: FilterStats::default(),
+            wheel_health: None,
         }
     }
 }
@@ -307,6 +317,9 @@ pub struct Feeder {
     /// covariance, which a run that records no epochs does without).
     #[serde(default = "yes")]
     predictions: bool,
+    /// The wheel-health monitor, when asked for.
+    #[serde(default)]
+    monitor: Option<WheelMonitor>,
 }
 
 fn yes() -> bool {
@@ -344,6 +357,7 @@ impl Feeder {
             stats: FilterStats::default(),
             updates: Vec::new(),
             predictions: opts.record_epochs,
+            monitor: opts.wheel_monitor.map(WheelMonitor::new),
         }
     }
 
@@ -364,6 +378,45 @@ impl Feeder {
             f.advance_to(t);
             None
         }
+    }
+
+    /// What the wheel-health monitor has seen (`None` without one).
+    pub fn wheel_health(&self) -> Option<WheelHealth> {
+        self.monitor.as_ref().map(WheelMonitor::report)
+    }
+
+    /// Hands the epoch's wheel readings to the monitor (after the epoch's
+    /// updates: it compares them with the updated state).
+    fn monitor_wheels<L: Layout<N>, const N: usize>(
+        &mut self,
+        f: &mut Filter<L, N>,
+        m: &Measurement,
+        interval_s: f64,
+    ) {
+        let Some(mon) = self.monitor.as_mut() else {
+            return;
+        };
+        let readings = match *m {
+            Measurement::WheelTicks { fl, fr, rl, rr } => [fl, fr, rl, rr].map(|z| {
+                Some(WheelReading::Ticks {
+                    ticks: z as f64,
+                    interval_s,
+                })
+            }),
+            Measurement::WheelSpeeds {
+                fl_mps,
+                fr_mps,
+                rl_mps,
+                rr_mps,
+            } => [fl_mps, fr_mps, rl_mps, rr_mps].map(|z| {
+                Some(WheelReading::Speed {
+                    speed_mps: z,
+                    interval_s,
+                })
+            }),
+            _ => return,
+        };
+        mon.check(f, readings);
     }
 
     /// Counters so far (the gate counters are the filter's: see [`Feeder::stats_with`]).
@@ -590,6 +643,9 @@ impl Feeder {
                     if let Some(fix) = self.pending_gnss.take() {
                         self.gnss_update(f, &fix)?;
                     }
+                    if use_.wheels && !gap {
+                        self.monitor_wheels(f, &ev.measurement, interval);
+                    }
                     self.stats.epochs += 1;
                     epoch(
                         f,
@@ -636,6 +692,7 @@ impl Feeder {
                                 self.stats.wheel_gaps += 1;
                             } else {
                                 self.wheel_updates(f, &ev.measurement, interval)?;
+                                self.monitor_wheels(f, &ev.measurement, interval);
                             }
                         }
                     }
@@ -820,5 +877,6 @@ pub fn run_filter<L: Layout<N>, const N: usize>(
     }
     feeder.finish(&mut f, &mut record)?;
     out.stats = feeder.stats_with(&f);
+    out.wheel_health = feeder.wheel_health();
     Ok(out)
 }

@@ -262,6 +262,10 @@ pub struct Filter<L: Layout<N>, const N: usize> {
     p: SMatrix<f64, N, N>,
     t_s: f64,
     wheels_present: [bool; 4],
+    /// Wheels taken out of the fusion by the wheel-health monitor
+    /// ([`crate::wheel_health`]).
+    #[serde(default)]
+    wheels_excluded: [bool; 4],
     /// Consecutive rejections per sensor (same order as [`GateCounts`]).
     consecutive: [u32; 9],
     gates: GateCounts,
@@ -319,6 +323,7 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
             p,
             t_s: t0_s,
             wheels_present: vehicle.wheels_present,
+            wheels_excluded: [false; 4],
             consecutive: [0; 9],
             gates: GateCounts::default(),
             layout: PhantomData,
@@ -385,6 +390,32 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
     /// Whether wheel `i` has a sensor (`wheels_present`).
     pub fn wheel_present(&self, i: usize) -> bool {
         self.wheels_present.get(i).copied().unwrap_or(false)
+    }
+
+    /// Takes wheel `i` out of the fusion (`true`) or back in: while out, its
+    /// `update_wheel_*` return `None` as for an absent wheel. Used by the
+    /// wheel-health monitor ([`crate::wheel_health`]).
+    pub fn set_wheel_excluded(&mut self, i: usize, excluded: bool) {
+        if let Some(e) = self.wheels_excluded.get_mut(i) {
+            *e = excluded;
+        }
+    }
+    /// Whether wheel `i` is out of the fusion (see [`Filter::set_wheel_excluded`]).
+    pub fn wheel_excluded(&self, i: usize) -> bool {
+        self.wheels_excluded.get(i).copied().unwrap_or(false)
+    }
+    /// The noise and gate settings.
+    pub fn noise(&self) -> &Noise {
+        &self.noise
+    }
+    /// Eq. (6)/(8) at the current state: the ticks wheel `i` should count over
+    /// `interval_s`.
+    pub fn predicted_wheel_ticks(&self, i: usize, interval_s: f64) -> f64 {
+        self.sensors.wheel_ticks(&self.car_state(), i, interval_s).0
+    }
+    /// The speed wheel `i` should report at the current state, m/s.
+    pub fn predicted_wheel_speed(&self, i: usize) -> f64 {
+        self.sensors.wheel_speed(&self.car_state(), i).0
     }
 
     /// Points the sensor models at the parameters held in the state.
@@ -521,14 +552,15 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
     }
 
     /// Eq. (6)/(8): the ticks of wheel `i` over `interval_s`. `None` when the
-    /// wheel has no sensor (`wheels_present`).
+    /// wheel has no sensor (`wheels_present`) or is out of the fusion
+    /// ([`Filter::set_wheel_excluded`]).
     pub fn update_wheel_ticks(
         &mut self,
         i: usize,
         ticks: f64,
         interval_s: f64,
     ) -> Result<Option<Update>, Error> {
-        if !self.wheel_present(i) {
+        if !self.wheel_present(i) || self.wheel_excluded(i) {
             return Ok(None);
         }
         let pred = self.sensors.wheel_ticks(&self.car_state(), i, interval_s);
@@ -539,13 +571,14 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
             .map(Some)
     }
 
-    /// The speed of wheel `i`, m/s. `None` when the wheel has no sensor.
+    /// The speed of wheel `i`, m/s. `None` when the wheel has no sensor or is
+    /// out of the fusion.
     pub fn update_wheel_speed(
         &mut self,
         i: usize,
         speed_mps: f64,
     ) -> Result<Option<Update>, Error> {
-        if !self.wheel_present(i) {
+        if !self.wheel_present(i) || self.wheel_excluded(i) {
             return Ok(None);
         }
         let pred = self.sensors.wheel_speed(&self.car_state(), i);

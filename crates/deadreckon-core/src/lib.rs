@@ -7,7 +7,10 @@
 //! of gyro bias, speed scale and wheel circumferences, dead reckoning, and the
 //! papers' evaluation metrics. Other vehicle shapes (a tricycle with a
 //! steered driven wheel, a differential drive) and their kinematic
-//! calibration against a reference live in [`kinematics`].
+//! calibration against a reference live in [`kinematics`]. Slipping and bad
+//! wheels are found and dropped from the fusion by [`wheel_health`]; the
+//! filter's consistency against the truth is [`consistency`] (NEES), and what a
+//! calibration drive lacked is [`observability`].
 //!
 //! ## Conventions
 //!
@@ -22,6 +25,7 @@
 pub mod angle;
 pub mod calibrate;
 pub mod checkpoint;
+pub mod consistency;
 pub mod drive;
 pub mod ekf;
 pub mod event;
@@ -35,6 +39,7 @@ pub mod kalman;
 pub mod kinematics;
 pub mod metrics;
 pub mod model;
+pub mod observability;
 pub mod observation;
 pub mod online;
 pub mod outage;
@@ -44,6 +49,7 @@ pub mod rts;
 pub mod timing;
 pub mod track;
 pub mod vehicle;
+pub mod wheel_health;
 
 pub use drive::Drive;
 pub use track::{Track, TrackPoint};

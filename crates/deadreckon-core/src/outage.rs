@@ -373,6 +373,7 @@ mod window_tests {
             steering: Vec::new(),
             gnss: Vec::new(),
             truth: Vec::new(),
+            imu: Default::default(),
         }
     }
 

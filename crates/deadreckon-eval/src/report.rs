@@ -193,7 +193,52 @@ pub fn health(
                 .filter(|g| g.is_finite()),
         });
     }
+    h.consistency = consistency(drive, params);
+    if let Some(w) = &out.wheel_health {
+        h.wheel_health = w.lines();
+        for (name, r) in deadreckon_core::wheel_health::WHEEL_NAMES
+            .iter()
+            .zip(&w.wheels)
+        {
+            h.wheel_health.extend(r.intervals.iter().map(|i| {
+                format!(
+                    "wheel {name} out {:.2}..{:.2} s ({})",
+                    i.start_s,
+                    i.end_s,
+                    i.reason.name()
+                )
+            }));
+        }
+    }
     Ok((h, out.stats, tracks))
+}
+
+/// NEES through 30 s dead-reckoning windows every 60 s against the truth
+/// (`deadreckon_core::consistency`); `None` without truth or windows.
+fn consistency(drive: &Drive, params: &Params) -> Option<rp::NeesConsistency> {
+    use deadreckon_core::consistency as cs;
+    let w = cs::windows(drive, 30.0, 60.0, 60.0);
+    let c = cs::nees_through_windows(drive, params, &w, &FilterOptions::default()).ok()?;
+    let rows = [&c.pose, &c.motion]
+        .into_iter()
+        .flat_map(|b| {
+            b.points.iter().map(|p| rp::NeesRow {
+                block: b.name.clone(),
+                dof: b.dof as u32,
+                fraction: p.fraction,
+                windows: p.windows as u32,
+                nees: p.nees,
+                lower: p.lower,
+                upper: p.upper,
+                verdict: p.verdict.to_string(),
+            })
+        })
+        .collect();
+    Some(rp::NeesConsistency {
+        outage_s: c.outage_s,
+        summary: c.summary(),
+        rows,
+    })
 }
 
 /// Builds the four-wheel part of a report for `drive` with the given parameter sets.

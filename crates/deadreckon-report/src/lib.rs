@@ -9,8 +9,9 @@
 //! Sections, each rendered only when its data is present: header (drive, duration,
 //! distance, sensor streams), trajectories, calibration (table III of the
 //! four-wheel paper and the parameters over the iterations), drift (table IV,
-//! figures 4–5), filter health (innovations and NIS with chi-square bounds, gated
-//! fixes), TedriS (cross-correlation, regression models, headings, repositories,
+//! figures 4–5), filter health (the NEES verdict and table through dead-reckoning
+//! windows when the drive has truth, the wheel-health lines, innovations and NIS
+//! with chi-square bounds, gated fixes), TedriS (cross-correlation, regression models, headings, repositories,
 //! error through each outage), the outage evaluation, and a footer (version,
 //! command line).
 //!

@@ -272,6 +272,46 @@ pub struct FilterHealth {
     pub nis: Vec<NisSeries>,
     /// Two-sided probability of the NIS bounds drawn (default 0.95).
     pub nis_bound_probability: Option<f64>,
+    /// The NEES through dead-reckoning windows against the truth (drives
+    /// with truth only).
+    pub consistency: Option<NeesConsistency>,
+    /// The wheel-health monitor's lines (one per wheel, then each stretch a
+    /// wheel was out of the fusion).
+    pub wheel_health: Vec<String>,
+}
+
+/// The averaged NEES of one block of the state at one point of the windows.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct NeesRow {
+    /// `pose` (x, y, yaw) or `motion` (speed, yaw rate).
+    pub block: String,
+    /// Degrees of freedom.
+    pub dof: u32,
+    /// Fraction of the window elapsed.
+    pub fraction: f64,
+    /// Windows averaged.
+    pub windows: u32,
+    /// Averaged NEES.
+    pub nees: f64,
+    /// Lower and upper 95 % bounds of the average.
+    pub lower: f64,
+    /// Upper bound.
+    pub upper: f64,
+    /// `consistent`, `over-confident by ×k` or `under-confident by ×k`.
+    pub verdict: String,
+}
+
+/// Filter consistency: NEES through dead-reckoning windows against the truth.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct NeesConsistency {
+    /// Window length, s.
+    pub outage_s: f64,
+    /// The verdict, e.g. `pose: consistent; motion: consistent`.
+    pub summary: String,
+    /// One row per block and point.
+    pub rows: Vec<NeesRow>,
 }
 
 /// A scalar time series.

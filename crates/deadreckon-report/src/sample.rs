@@ -304,6 +304,7 @@ pub fn sample_input(duration_s: f64) -> ReportInput {
             },
         ],
         nis_bound_probability: Some(0.95),
+        ..Default::default()
     };
 
     let lag: Vec<i64> = (-30..=30).collect();

@@ -224,6 +224,7 @@ impl CarFamily {
                 steering: None,
                 gnss: Some(gnss),
                 truth_rate_hz: 50.0,
+                wheel_faults: None,
             },
         }
     }

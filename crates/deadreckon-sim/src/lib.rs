@@ -21,6 +21,7 @@
 //! | gyro | yaw rate + bias + white noise (eq. 4) |
 //! | CAN speed | scale × speed + white noise (eq. 5, literally: at standstill it reads the noise, sign included) |
 //! | steering wheel | r_s · atan(l_RF · κ + β), β white: the noise of eq. 7 on tan(δ/r_s) |
+//! | wheel faults (optional) | spin bursts under traction on one wheel, one wheel smaller from some time on ([`faults`]) |
 //! | GNSS | antenna position (lever arm forward of M) + white noise; course and speed from the antenna velocity + white noise |
 //!
 //! Other vehicle shapes: [`tricycle`] simulates a steered, driven front
@@ -42,6 +43,7 @@
 #![deny(missing_docs)]
 
 pub mod family;
+pub mod faults;
 pub mod profile;
 pub mod route;
 pub mod scenario;
@@ -51,6 +53,7 @@ mod truth;
 
 use deadreckon_core::{Drive, Params};
 
+pub use faults::{ShrinkSpec, SpinSpec, WheelFaultsSpec};
 pub use profile::SpeedSpec;
 pub use route::{RouteSpec, Segment};
 pub use scenario::Scenario;
@@ -137,6 +140,8 @@ pub struct SimStats {
     pub wheel_distance_m: [f64; 4],
     /// Heading change from start to end, rad, unwrapped.
     pub heading_change_rad: f64,
+    /// Wheel-spin bursts simulated (`[sensors.wheel_faults.spin]`), `(start, end)` in s.
+    pub spin_bursts: Vec<(f64, f64)>,
 }
 
 /// Simulates `scenario` with the noise drawn from `seed` (a PCG-64 generator
@@ -201,6 +206,7 @@ pub fn simulate(scenario: &Scenario, seed: u64) -> Result<SimOutput, SimError> {
         stops: profile.stops_until(t_end),
         wheel_distance_m: prev.wheel_m,
         heading_change_rad: prev.psi - first.psi,
+        spin_bursts: suite.spin_bursts(),
     };
     let drive = suite.finish(scenario.vehicle.clone());
     drive.validate()?;

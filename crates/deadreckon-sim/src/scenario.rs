@@ -294,6 +294,12 @@ impl Scenario {
         self
     }
 
+    /// Adds wheel faults (spin bursts, a smaller wheel from mid-drive).
+    pub fn with_wheel_faults(mut self, faults: crate::faults::WheelFaultsSpec) -> Self {
+        self.sensors.wheel_faults = Some(faults);
+        self
+    }
+
     /// Replaces the sensors.
     pub fn with_sensors(mut self, sensors: SensorsSpec) -> Self {
         self.sensors = sensors;
@@ -388,6 +394,9 @@ impl Scenario {
                     "must be positive (it is written as the fix's std_m)".into(),
                 ));
             }
+        }
+        if let Some(f) = &self.sensors.wheel_faults {
+            f.check().map_err(|(k, m)| invalid(&k, m))?;
         }
         self.speed.check().map_err(|(k, m)| invalid(&k, m))?;
         Ok(())

@@ -14,6 +14,7 @@ use rand_distr::{Distribution, StandardNormal};
 use rand_pcg::Pcg64;
 use serde::{Deserialize, Serialize};
 
+use crate::faults::WheelFaults;
 use crate::truth::{Kinematics, State};
 
 /// What the wheel stream reports.
@@ -260,6 +261,9 @@ pub struct SensorsSpec {
     /// Rate of the written truth, Hz (default 100).
     #[serde(default = "default_truth_rate")]
     pub truth_rate_hz: f64,
+    /// Wheel faults: spin bursts, a smaller wheel from mid-drive (default none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wheel_faults: Option<crate::faults::WheelFaultsSpec>,
 }
 
 fn default_truth_rate() -> f64 {
@@ -411,6 +415,7 @@ pub(crate) struct Suite {
     truth: Vec<TruthPose>,
     imu_gyro: Vec<Axes>,
     imu_accel: Vec<Axes>,
+    faults: Option<(WheelFaults, Noise)>,
 }
 
 const WHEELS: usize = 0;
@@ -482,6 +487,10 @@ impl Suite {
             truth: Vec::new(),
             imu_gyro: Vec::new(),
             imu_accel: Vec::new(),
+            faults: spec
+                .wheel_faults
+                .clone()
+                .map(|f| (WheelFaults::new(f), Noise::new(seed, 6))),
         }
     }
 
@@ -581,7 +590,11 @@ impl Suite {
     }
 
     fn emit_wheels(&mut self, st: &State) {
-        let rot = [0, 1, 2, 3].map(|i| st.wheel_m[i] / self.circ[i]);
+        let counted = match &mut self.faults {
+            Some((f, n)) => f.counted(st.t, st.a, st.wheel_m, || n.uniform()),
+            None => st.wheel_m,
+        };
+        let rot = [0, 1, 2, 3].map(|i| counted[i] / self.circ[i]);
         match &mut self.wheels {
             WheelState::Ticks { out, emitted } => {
                 let mut d = [0i64; 4];
@@ -696,6 +709,14 @@ impl Suite {
             course_deg,
             speed_mps,
         });
+    }
+
+    /// The spin bursts simulated, `(start, end)` in s.
+    pub fn spin_bursts(&self) -> Vec<(f64, f64)> {
+        self.faults
+            .as_ref()
+            .map(|(f, _)| f.bursts.clone())
+            .unwrap_or_default()
     }
 
     /// The drive with every stream.

@@ -6,7 +6,7 @@ use plotters::prelude::*;
 
 use super::{rel_time, time_desc};
 use crate::model::{FilterHealth, InnovationSeries, NisSeries};
-use crate::page::{Block, FigureView, SectionView};
+use crate::page::{Block, FigureView, RowView, SectionView, TableView};
 use crate::plot::{
     data_begin, data_end, draw_hline, fmt_sig, padded_range, render_chart, segments, Frame, Legend,
     OrPlot, Swatch, GATED, REFERENCE, WIDTH,
@@ -23,6 +23,43 @@ pub(crate) fn section(
     start: Option<f64>,
 ) -> Result<Option<SectionView>, ReportError> {
     let mut blocks = Vec::new();
+    if let Some(c) = &h.consistency {
+        blocks.push(Block::Note {
+            text: format!(
+                "Consistency through {} s dead-reckoning windows (NEES against the truth, 95 % bounds of the average over the windows): {}.",
+                fmt_sig(c.outage_s, 3),
+                c.summary
+            ),
+        });
+        blocks.push(Block::Tables {
+            tables: vec![TableView {
+                caption: "NEES: pose (x, y, yaw; 3 dof) and motion (speed, yaw rate; 2 dof), averaged over the windows at a fraction of each.".into(),
+                headers: ["block", "at", "windows", "NEES", "95 % bounds", "verdict"]
+                    .map(String::from)
+                    .to_vec(),
+                rows: c
+                    .rows
+                    .iter()
+                    .map(|r| RowView {
+                        swatch: None,
+                        cells: vec![
+                            format!("{} ({} dof)", r.block, r.dof),
+                            format!("{:.0} %", 100.0 * r.fraction),
+                            r.windows.to_string(),
+                            format!("{:.2}", r.nees),
+                            format!("{:.2} – {:.2}", r.lower, r.upper),
+                            r.verdict.clone(),
+                        ],
+                    })
+                    .collect(),
+            }],
+        });
+    }
+    if !h.wheel_health.is_empty() {
+        blocks.push(Block::Note {
+            text: format!("Wheel health: {}", h.wheel_health.join("; ")),
+        });
+    }
     for (i, s) in h.innovations.iter().enumerate() {
         if let Some(f) = innovation_figure(i, s, start)? {
             blocks.push(Block::Figure(f));

@@ -1,0 +1,306 @@
+//! Filter consistency against the truth: the normalised estimation error
+//! squared (NEES) through dead-reckoning windows, with the χ² bounds of the
+//! average over the windows (Bar-Shalom, Li, Kirubarajan, *Estimation with
+//! Applications to Tracking and Navigation*, 2001, §5.4.2).
+//!
+//! The GNSS-aided filter runs once over the drive with GNSS hidden in each
+//! window (as [`crate::outage::through_windows`]). At a few points of every
+//! window (a quarter, half, three quarters and the end of it) the error
+//! `e = x̂ − x_true` of two blocks of the state is normalised by the filter's
+//! own covariance, `ε = eᵀ P⁻¹ e`:
+//!
+//! - the **pose** `[x, y, ψ]` (3 degrees of freedom; yaw error wrapped);
+//! - the **motion** `[v, ψ̇]` (2 degrees of freedom; the truth's speed and yaw
+//!   rate, derived by [`Reference::from_truth`] where `truth.csv` has none).
+//!
+//! For a consistent filter `ε ~ χ²(n)`; averaged over M windows, `M·ε̄ ~
+//! χ²(M n)`, so ε̄ lies within `[χ²⁻¹(0.025; Mn)/M, χ²⁻¹(0.975; Mn)/M]` with
+//! probability 0.95. Above the bound the filter is over-confident (its
+//! covariance too small) by about `ε̄/n` in variance, below it
+//! under-confident. The windows should be far enough apart for the errors of
+//! two windows to be nearly independent (GNSS between them resets the pose).
+
+use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
+use serde::{Deserialize, Serialize};
+use statrs::distribution::{ChiSquared, ContinuousCDF};
+
+use crate::angle;
+use crate::drive::Drive;
+use crate::ekf::{self, EpochHook, FilterOptions};
+use crate::model::{Mat, State, V, X, Y, YAW, YAW_RATE};
+use crate::reference::Reference;
+use crate::vehicle::Params;
+use crate::Error;
+
+/// The points of each window where the NEES is taken, as fractions of it.
+pub const WINDOW_POINTS: [f64; 4] = [0.25, 0.5, 0.75, 1.0];
+
+/// Two-sided probability of the bounds.
+pub const BOUND_PROBABILITY: f64 = 0.95;
+
+/// What the averaged NEES says.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", tag = "verdict", content = "factor")]
+pub enum Verdict {
+    /// Within the 95 % bounds.
+    Consistent,
+    /// Above the upper bound: the errors are larger than the covariance says,
+    /// by this factor in variance (ε̄ / n).
+    OverConfident(f64),
+    /// Below the lower bound: the covariance is larger than the errors, by
+    /// this factor in variance (n / ε̄).
+    UnderConfident(f64),
+}
+
+impl std::fmt::Display for Verdict {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Verdict::Consistent => f.write_str("consistent"),
+            Verdict::OverConfident(k) => write!(f, "over-confident by ×{k:.1}"),
+            Verdict::UnderConfident(k) => write!(f, "under-confident by ×{k:.1}"),
+        }
+    }
+}
+
+/// The averaged NEES of one block of the state at one point of the windows.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct NeesPoint {
+    /// Fraction of the window elapsed (0.25 … 1).
+    pub fraction: f64,
+    /// Windows averaged, M.
+    pub windows: usize,
+    /// Averaged NEES ε̄.
+    pub nees: f64,
+    /// Lower 95 % bound.
+    pub lower: f64,
+    /// Upper 95 % bound.
+    pub upper: f64,
+    /// Within, above or below the bounds.
+    pub verdict: Verdict,
+}
+
+/// The NEES of one block of the state through the windows.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BlockNees {
+    /// `pose` or `motion`.
+    pub name: String,
+    /// Degrees of freedom n.
+    pub dof: usize,
+    /// One point per entry of [`WINDOW_POINTS`] that had windows.
+    pub points: Vec<NeesPoint>,
+    /// The NEES of every window at every point (for merging runs).
+    pub values: Vec<Vec<f64>>,
+}
+
+impl BlockNees {
+    fn from_values(name: &str, n: usize, values: Vec<Vec<f64>>) -> Result<BlockNees, Error> {
+        let points = WINDOW_POINTS
+            .iter()
+            .zip(&values)
+            .filter(|(_, v)| !v.is_empty())
+            .map(|(f, v)| point(*f, n, v))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(BlockNees {
+            name: name.into(),
+            dof: n,
+            points,
+            values,
+        })
+    }
+
+    /// The windows of two runs together (e.g. several drives: M grows).
+    pub fn merged(&self, other: &BlockNees) -> Result<BlockNees, Error> {
+        let values = self
+            .values
+            .iter()
+            .zip(&other.values)
+            .map(|(a, b)| a.iter().chain(b).copied().collect())
+            .collect();
+        BlockNees::from_values(&self.name, self.dof, values)
+    }
+
+    /// The verdict over every point: consistent when all are; otherwise the
+    /// point farthest from its bounds (in factor).
+    pub fn verdict(&self) -> Verdict {
+        let factor = |v: &Verdict| match v {
+            Verdict::Consistent => 1.0,
+            Verdict::OverConfident(k) | Verdict::UnderConfident(k) => *k,
+        };
+        self.points
+            .iter()
+            .map(|p| p.verdict)
+            .max_by(|a, b| factor(a).total_cmp(&factor(b)))
+            .unwrap_or(Verdict::Consistent)
+    }
+}
+
+/// The consistency of a filter through dead-reckoning windows.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Consistency {
+    /// Window length, s.
+    pub outage_s: f64,
+    /// The pose `[x, y, ψ]`.
+    pub pose: BlockNees,
+    /// The motion `[v, ψ̇]`.
+    pub motion: BlockNees,
+}
+
+impl Consistency {
+    /// The windows of two runs together (several drives averaged).
+    pub fn merged(&self, other: &Consistency) -> Result<Consistency, Error> {
+        Ok(Consistency {
+            outage_s: self.outage_s.max(other.outage_s),
+            pose: self.pose.merged(&other.pose)?,
+            motion: self.motion.merged(&other.motion)?,
+        })
+    }
+
+    /// `pose: consistent; motion: over-confident by ×2.3`.
+    pub fn summary(&self) -> String {
+        format!(
+            "pose: {}; motion: {}",
+            self.pose.verdict(),
+            self.motion.verdict()
+        )
+    }
+}
+
+/// The 95 % bounds of the average of `m` NEES values of `n` degrees of freedom.
+pub fn averaged_nees_bounds(n: usize, m: usize) -> Result<(f64, f64), Error> {
+    let k = (n * m) as f64;
+    let chi = ChiSquared::new(k).map_err(|e| Error::Insufficient(format!("χ²({k}): {e}")))?;
+    let a = 0.5 * (1.0 - BOUND_PROBABILITY);
+    Ok((
+        chi.inverse_cdf(a) / m as f64,
+        chi.inverse_cdf(1.0 - a) / m as f64,
+    ))
+}
+
+fn point(fraction: f64, n: usize, values: &[f64]) -> Result<NeesPoint, Error> {
+    let m = values.len();
+    let nees = values.iter().sum::<f64>() / m as f64;
+    let (lower, upper) = averaged_nees_bounds(n, m)?;
+    let verdict = if nees > upper {
+        Verdict::OverConfident(nees / n as f64)
+    } else if nees < lower {
+        Verdict::UnderConfident(n as f64 / nees)
+    } else {
+        Verdict::Consistent
+    };
+    Ok(NeesPoint {
+        fraction,
+        windows: m,
+        nees,
+        lower,
+        upper,
+        verdict,
+    })
+}
+
+/// Collects `(t, x, P)` of every epoch.
+struct Collect(Vec<(f64, State, Mat)>);
+
+impl EpochHook for Collect {
+    fn after_epoch(&mut self, t: f64, x: &mut State, p: &mut Mat) {
+        self.0.push((t, *x, *p));
+    }
+}
+
+/// Windows of `outage_s` every `step_s` from `warmup_s` after the drive's
+/// first wheel row to the end of the truth.
+pub fn windows(drive: &Drive, outage_s: f64, step_s: f64, warmup_s: f64) -> Vec<(f64, f64)> {
+    let (false, Some(last)) = (drive.wheels.is_empty(), drive.truth.last()) else {
+        return Vec::new();
+    };
+    let first = drive.wheels.t_s(0);
+    let mut out = Vec::new();
+    let mut a = first + warmup_s;
+    while a + outage_s <= last.t_s - 1.0 && step_s > 0.0 {
+        out.push((a, a + outage_s));
+        a += step_s;
+    }
+    out
+}
+
+/// The NEES of pose and motion through `windows` (GNSS hidden in each, `base`
+/// otherwise), against the drive's truth.
+pub fn nees_through_windows(
+    drive: &Drive,
+    params: &Params,
+    windows: &[(f64, f64)],
+    base: &FilterOptions,
+) -> Result<Consistency, Error> {
+    let truth = Reference::from_truth(&drive.truth)
+        .ok_or_else(|| Error::Insufficient("NEES needs truth.csv".into()))?;
+    if windows.is_empty() {
+        return Err(Error::Insufficient("NEES needs at least one window".into()));
+    }
+    let opts = FilterOptions {
+        gnss_outages: windows.to_vec(),
+        record_epochs: false,
+        ..base.clone()
+    };
+    let mut hook = Collect(Vec::new());
+    ekf::run(drive, params, &opts, &mut hook)?;
+    let states = hook.0;
+    let mut pose = vec![Vec::new(); WINDOW_POINTS.len()];
+    let mut motion = vec![Vec::new(); WINDOW_POINTS.len()];
+    for &(a, b) in windows {
+        for (j, frac) in WINDOW_POINTS.iter().enumerate() {
+            let t = a + frac * (b - a);
+            // The last epoch at or before t, inside the window.
+            let k = states.partition_point(|s| s.0 <= t);
+            let Some((ts, x, p)) = k.checked_sub(1).map(|k| &states[k]) else {
+                continue;
+            };
+            if *ts < a {
+                continue;
+            }
+            let Some(r) = truth.state_at(*ts) else {
+                continue;
+            };
+            let e3 = Vector3::new(x[X] - r[X], x[Y] - r[Y], angle::diff(x[YAW], r[YAW]));
+            let p3: Matrix3<f64> = p.fixed_view::<3, 3>(0, 0).into_owned();
+            if let Some(inv) = p3.try_inverse() {
+                pose[j].push((e3.transpose() * inv * e3)[0]);
+            }
+            let e2 = Vector2::new(x[V] - r[V], x[YAW_RATE] - r[YAW_RATE]);
+            let p2: Matrix2<f64> = p.fixed_view::<2, 2>(V, V).into_owned();
+            if let Some(inv) = p2.try_inverse() {
+                motion[j].push((e2.transpose() * inv * e2)[0]);
+            }
+        }
+    }
+    let outage_s = windows.iter().map(|w| w.1 - w.0).fold(0.0, f64::max);
+    Ok(Consistency {
+        outage_s,
+        pose: BlockNees::from_values("pose", 3, pose)?,
+        motion: BlockNees::from_values("motion", 2, motion)?,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_averaged_bounds_match_tabulated_chi_square_quantiles() {
+        // χ²(3): 0.2158 and 9.3484 at 2.5 % and 97.5 %.
+        let (lo, hi) = averaged_nees_bounds(3, 1).unwrap();
+        assert!((lo - 0.2158).abs() < 1e-3 && (hi - 9.3484).abs() < 1e-3);
+        // 50 runs of 2 dof: χ²(100) 74.22 and 129.56, over 50.
+        let (lo, hi) = averaged_nees_bounds(2, 50).unwrap();
+        assert!((lo - 1.4844).abs() < 1e-3 && (hi - 2.5912).abs() < 1e-3);
+    }
+
+    #[test]
+    fn the_verdict_says_which_way_and_by_how_much() {
+        let p = point(1.0, 2, &[8.0; 50]).unwrap();
+        assert_eq!(p.verdict, Verdict::OverConfident(4.0));
+        assert_eq!(p.verdict.to_string(), "over-confident by ×4.0");
+        let p = point(1.0, 2, &[0.5; 50]).unwrap();
+        assert_eq!(p.verdict, Verdict::UnderConfident(4.0));
+        let p = point(1.0, 2, &[2.0; 50]).unwrap();
+        assert_eq!(p.verdict, Verdict::Consistent);
+    }
+}
