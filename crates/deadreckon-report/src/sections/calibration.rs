@@ -52,7 +52,7 @@ pub(crate) fn section(
                     // read as perfectly known.
                     cells.push(match std.map(|s| s[i]) {
                         None => "–".into(),
-                        Some(s) if s == 0.0 => "not estimated".into(),
+                        Some(0.0) => "not estimated".into(),
                         Some(s) => fmt_sig(s, 2),
                     });
                 }
