@@ -57,19 +57,8 @@ fn with_stored(
     let Some(spec) = p.and_then(|p| p.extract::<PathBuf>().ok()) else {
         return Ok(drive);
     };
-    if spec.as_os_str() == "nominal" {
-        return Ok(drive);
-    }
-    let (_, extra) = deadreckon_io::read_params_with_extra(&spec).map_err(|e| {
-        err(format!(
-            "reading parameters {}: {}",
-            spec.display(),
-            deadreckon_api::chain_text(&e)
-        ))
-    })?;
-    let s = deadreckon_api::corrections::stored_corrections(&extra)
-        .map_err(|e| err(format!("parameters {}: {e}", spec.display())))?;
-    Ok(s.apply(&drive))
+    let stored = deadreckon_api::corrections::stored_in_file(&spec).map_err(err)?;
+    Ok(stored.apply(&drive))
 }
 
 fn err(e: impl std::fmt::Display) -> PyErr {

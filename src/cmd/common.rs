@@ -107,14 +107,9 @@ pub fn prepare(
 /// The drive with the corrections stored in the params.toml `spec` applied
 /// (none for `nominal` or a file without them).
 pub fn apply_stored(spec: &str, drive: Drive) -> Result<Drive> {
-    if spec == "nominal" {
-        return Ok(drive);
-    }
-    let (_, extra) = deadreckon_io::read_params_with_extra(Path::new(spec))
-        .with_context(|| format!("reading parameters {spec}"))?;
-    let s = deadreckon_api::corrections::stored_corrections(&extra)
-        .map_err(|e| anyhow::anyhow!("parameters {spec}: {e}"))?;
-    Ok(s.apply(&drive))
+    let stored =
+        deadreckon_api::corrections::stored_in_file(Path::new(spec)).map_err(anyhow::Error::msg)?;
+    Ok(stored.apply(&drive))
 }
 
 /// The corrections as text lines (one per stream, and the tilt).

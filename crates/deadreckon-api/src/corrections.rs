@@ -123,6 +123,23 @@ impl Stored {
     }
 }
 
+/// The corrections stored in the params.toml at `spec` (nothing for
+/// `nominal`), as `--params` applies them in the CLI and the Python bindings.
+/// The error names the file.
+pub fn stored_in_file(spec: &std::path::Path) -> Result<Stored, String> {
+    if spec.as_os_str() == "nominal" {
+        return Ok(Stored::default());
+    }
+    let (_, extra) = deadreckon_io::read_params_with_extra(spec).map_err(|e| {
+        format!(
+            "reading parameters {}: {}",
+            spec.display(),
+            crate::chain_text(&e)
+        )
+    })?;
+    stored_corrections(&extra).map_err(|e| format!("parameters {}: {e}", spec.display()))
+}
+
 /// Reads the `[delays]` and `[imu]` tables from the extra keys of a
 /// params.toml (absent: nothing to apply).
 pub fn stored_corrections(extra: &toml::Table) -> Result<Stored, String> {
