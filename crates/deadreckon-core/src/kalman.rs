@@ -156,13 +156,14 @@ impl<const N: usize> ScalarInnovation<N> {
         let (ph, s, y) = (&self.ph, self.s, self.y);
         // K = P Hᵀ S⁻¹   (15);  x̂ = x̂⁻ + K ỹ   (16)
         x.axpy(y / s, ph, 1.0);
-        let inv_s = 1.0 / s;
-        let ph: &[f64; N] = &ph.data.0[0];
-        // Every column at full length (vectorised); (P H)ᵢ (P H)ⱼ is the same
+        // P − (P H)(P H)ᵀ / S = P − k kᵀ with k = P H / √S: one product per
+        // entry, every column at full length (vectorised). kᵢ kⱼ is the same
         // product for (i, j) and (j, i), so P stays exactly symmetric.
-        for (col, &phj) in p.data.0.iter_mut().zip(ph) {
-            for (c, &phi) in col.iter_mut().zip(ph) {
-                *c -= (phi * phj) * inv_s;
+        let scale = s.sqrt().recip();
+        let k: [f64; N] = std::array::from_fn(|i| ph[i] * scale);
+        for (col, &kj) in p.data.0.iter_mut().zip(&k) {
+            for (c, &ki) in col.iter_mut().zip(&k) {
+                *c -= ki * kj;
             }
         }
     }

@@ -253,16 +253,48 @@ impl Window {
     fn clear(&mut self) {
         *self = Window::default();
     }
-    /// The normalised sum `T`.
-    fn sigma(&self, quant_var: f64, eps: f64) -> f64 {
+    /// The normalised sum `T = r / sqrt(V)` as its numerator and variance
+    /// `(r, V)`, so that the hot path compares `r²` with `k²·V` and takes the
+    /// square root only when a figure is reported. An empty window, or one
+    /// without variance, is `(0, 1)` (T = 0).
+    fn sum(&self, quant_var: f64, eps: f64) -> Normalised {
         if self.entries.is_empty() {
-            return 0.0;
+            return Normalised::ZERO;
         }
         let v = self.var.max(0.0) + quant_var + (eps * self.h).powi(2);
         if v > 0.0 {
-            self.r / v.sqrt()
+            Normalised { r: self.r, v }
         } else {
-            0.0
+            Normalised::ZERO
+        }
+    }
+}
+
+/// A normalised sum kept as `T = r / sqrt(v)` without its square root.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Normalised {
+    r: f64,
+    v: f64,
+}
+
+impl Normalised {
+    const ZERO: Normalised = Normalised { r: 0.0, v: 1.0 };
+    /// `|T| > k` (for k ≥ 0), without a square root or a division.
+    fn above(self, k: f64) -> bool {
+        self.r * self.r > k * k * self.v
+    }
+    /// `|T| < k` (for k ≥ 0).
+    fn below(self, k: f64) -> bool {
+        self.r * self.r < k * k * self.v
+    }
+    /// `|T|`.
+    fn abs(self) -> f64 {
+        self.r.abs() / self.v.sqrt()
+    }
+    /// Raises `max` to `|T|` when it is larger (the division only then).
+    fn raise(self, max: &mut f64) {
+        if self.above(*max) {
+            *max = max.max(self.abs());
         }
     }
 }
@@ -403,8 +435,8 @@ impl WheelMonitor {
             {
                 st.short.pop();
             }
-            let ts = st.short.sigma(quant, cfg.slip_relative_error);
-            let slipping = ts.abs() > cfg.drop_sigma;
+            let ts = st.short.sum(quant, cfg.slip_relative_error);
+            let slipping = ts.above(cfg.drop_sigma);
             if slipping {
                 // Keep the burst out of the long window.
                 st.long.clear();
@@ -418,31 +450,31 @@ impl WheelMonitor {
             }
             // The long test needs a full window of travel.
             let tl = if st.long.dist_m >= cfg.long_window_m {
-                st.long.sigma(quant, cfg.relative_error)
+                st.long.sum(quant, cfg.relative_error)
             } else {
-                0.0
+                Normalised::ZERO
             };
-            rep.max_short_sigma = rep.max_short_sigma.max(ts.abs());
-            rep.max_long_sigma = rep.max_long_sigma.max(tl.abs());
-            let peak = ts.abs().max(tl.abs());
+            ts.raise(&mut rep.max_short_sigma);
+            tl.raise(&mut rep.max_long_sigma);
+            let peak = || ts.abs().max(tl.abs());
             match &mut st.out {
                 None => {
                     let reason = if slipping {
                         Some(DropReason::Slip)
-                    } else if tl.abs() > cfg.drop_sigma {
+                    } else if tl.above(cfg.drop_sigma) {
                         Some(DropReason::Bias)
                     } else {
                         None
                     };
                     if let Some(reason) = reason {
-                        st.out = Some((t, reason, peak));
+                        st.out = Some((t, reason, peak()));
                         f.set_wheel_excluded(i, true);
                     }
                 }
                 Some((since, reason, pk)) => {
-                    *pk = pk.max(peak);
-                    let settled = ts.abs() < cfg.readmit_sigma
-                        && tl.abs() < cfg.readmit_sigma
+                    *pk = pk.max(peak());
+                    let settled = ts.below(cfg.readmit_sigma)
+                        && tl.below(cfg.readmit_sigma)
                         && (*reason == DropReason::Slip || st.long.dist_m >= cfg.long_window_m);
                     if settled && t - *since >= cfg.min_drop_s {
                         rep.intervals.push(DroppedInterval {
