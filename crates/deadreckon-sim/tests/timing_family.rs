@@ -2,7 +2,10 @@
 //! family (issue 13): each recovered within 3 standard errors, and the drift
 //! per 100 m on a second drive of the same car, with the corrections and
 //! parameters found on the first, against the drift with the true ones
-//! (printed, and bounded above; the issue's 5 % is not reached).
+//! (printed, and bounded above; the issue's 5 % is not reached), and against
+//! the drift with the true corrections and the same RTS calibration, which
+//! separates what the estimated corrections cost from what the GNSS-based
+//! calibration itself leaves.
 //!
 //! The delays are against the wheel clock: a simulated wheel-speed row is the
 //! mean speed over the preceding wheel period, so the wheels themselves are
@@ -77,6 +80,7 @@ fn delays_tilt_and_gyro_scale_are_recovered_on_the_car_family() {
     let copts = CalibrationOptions::default();
     let o = DelayOptions::default();
     let mut drift_ratios = Vec::new();
+    let mut known_ratios = Vec::new();
     for seed in 1..=4u64 {
         let car = CarFamily::draw(seed);
         let inst = Install::draw(seed);
@@ -157,10 +161,39 @@ fn delays_tilt_and_gyro_scale_are_recovered_on_the_car_family() {
         let mut tp = test.truth_params;
         tp.gyro_bias_rps *= inst.up()[2] / (1.0 + inst.scale_error);
         let d_truth = mean(metrics::drift(&truth, &tp, 100.0, Timing::WheelEpochs).unwrap());
-        eprintln!("  drift per 100 m: {d_ours:.4}% ours, {d_truth:.4}% with the truth");
+        // What the corrections alone cost: the same RTS calibration on the
+        // training drive corrected with the true installation.
+        let train_known = timing::apply_known(
+            &train.drive,
+            inst.latency_s.map(|l| l - half_wheel),
+            Some(inst.up()),
+            inst.scale_error,
+        );
+        let cal_known = calibrate::calibrate(&train_known, &copts).unwrap();
+        let d_known = mean(
+            metrics::drift(
+                &truth,
+                &cal_known.estimate.params,
+                100.0,
+                Timing::WheelEpochs,
+            )
+            .unwrap(),
+        );
+        eprintln!(
+            "  drift per 100 m: {d_ours:.4}% ours, {d_known:.4}% with the true corrections and RTS parameters, {d_truth:.4}% with the truth"
+        );
         drift_ratios.push(d_ours / d_truth);
+        known_ratios.push(d_ours / d_known);
     }
     eprintln!("drift ours / truth: {drift_ratios:?}");
+    eprintln!("drift ours / true corrections with RTS parameters: {known_ratios:?}");
+    // What the estimated corrections cost against the true ones, the RTS
+    // calibration being the same: measured 1.054, 1.246, 1.042 and 1.018
+    // (seeds 1–4); most of the gap to the truth is the RTS calibration's
+    // own (true corrections: 1.06, 1.33, 1.02, 1.41 × the truth, and on
+    // the same cars without any installation effect 1.07, 1.36, 1.04,
+    // 1.62). Bound: 8 % above the worst.
+    assert!(known_ratios.iter().all(|&r| r <= 1.35), "{known_ratios:?}");
     // Not the issue's 5 %: measured 1.11, 1.66, 1.07 and 1.44 (seeds 1–4).
     // This bound (8 % above the worst) only pins that result.
     assert!(drift_ratios.iter().all(|&r| r <= 1.8), "{drift_ratios:?}");
