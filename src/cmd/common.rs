@@ -76,6 +76,18 @@ pub fn load_params(spec: &str, drive: &Drive) -> Result<Params> {
     Ok(read_params_file(spec)?.params)
 }
 
+/// `--params nominal` or a `params.toml` path, and the drive with the
+/// corrections that file stores applied (its delays, IMU tilt and gyro
+/// scale): the parameters were calibrated on the corrected streams, and on
+/// the raw ones they are wrong (a tilted, scaled gyro turns the track).
+pub fn load_params_corrected(spec: &str, drive: Drive) -> Result<(Params, Drive)> {
+    let params = load_params(spec, &drive)?;
+    if spec == "nominal" {
+        return Ok((params, drive));
+    }
+    Ok((params, apply_stored(spec, drive)?))
+}
+
 /// `--corrections`: which timing and mounting corrections are estimated and
 /// applied before calibrating (see `deadreckon_core::timing`).
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]

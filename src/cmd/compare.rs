@@ -38,9 +38,13 @@ pub fn run(a: CompareArgs, load: &common::Loader) -> Result<()> {
         .iter()
         .map(|s| s.parse::<Outage>())
         .collect::<Result<_, _>>()?;
-    let params = match &a.params {
-        Some(p) => Some((common::load_params(p, &drive)?, p.clone())),
-        None => None,
+    // A params.toml's stored corrections apply to the drive both estimators read.
+    let (params, drive) = match &a.params {
+        Some(p) => {
+            let (params, drive) = common::load_params_corrected(p, drive)?;
+            (Some((params, p.clone())), drive)
+        }
+        None => (None, drive),
     };
     let model = match &a.model {
         Some(m) => {

@@ -152,7 +152,7 @@ pub fn run(a: RunArgs, load: &common::Loader) -> Result<()> {
         return Ok(());
     }
     let drive = load.drive(&a.dir)?;
-    let params = common::load_params(&a.params, &drive)?;
+    let (params, drive) = common::load_params_corrected(&a.params, drive)?;
     let init_pose = match &a.init_pose {
         Some(s) => {
             let v: Vec<f64> = s

@@ -84,6 +84,16 @@ pub fn run(a: StreamArgs) -> Result<()> {
         (p, default_prior())
     } else {
         let p = common::read_params_file(&a.params)?;
+        let stored = deadreckon_api::corrections::stored_in_file(std::path::Path::new(&a.params))
+            .map_err(anyhow::Error::msg)?;
+        if stored != Default::default() {
+            // Live events cannot be re-timed or re-projected here: say so
+            // rather than run as if they had been.
+            eprintln!(
+                "warning: {} stores corrections that `stream` does not apply to the events                  (delays {:?} s, IMU vertical {:?}, gyro scale error {}); its parameters were                  calibrated on corrected streams (calibrate --corrections none gives parameters                  for raw events)",
+                a.params, stored.delays_s, stored.up, stored.gyro_scale_error
+            );
+        }
         // A std of 0 (a parameter the file fixes) would freeze it: keep the
         // default prior where the file's is not positive.
         let d = default_prior();

@@ -1,0 +1,99 @@
+//! The corrections a params.toml stores (issue 13: delays, IMU tilt, gyro
+//! scale) are applied wherever `--params` reads it, not only by `evaluate`.
+
+use std::path::Path;
+use std::process::Command;
+
+use deadreckon_sim::family::CarFamily;
+
+fn deadreckon(args: &[&str]) -> String {
+    let out = Command::new(env!("CARGO_BIN_EXE_deadreckon"))
+        .args(args)
+        .output()
+        .expect("binary runs");
+    assert!(
+        out.status.success(),
+        "deadreckon {args:?} failed:\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).expect("utf-8")
+}
+
+/// Mean horizontal distance between the dead-reckoned track and the truth
+/// in a track CSV (truth interpolated at the dead-reckoned times).
+fn mean_dr_error(csv_path: &Path) -> f64 {
+    let mut r = csv::Reader::from_path(csv_path).unwrap();
+    let (mut dr, mut truth) = (Vec::new(), Vec::new());
+    for rec in r.records() {
+        let rec = rec.unwrap();
+        let v = |i: usize| rec[i].parse::<f64>().unwrap();
+        let row = (v(0), v(2), v(3));
+        match &rec[1] {
+            "dead-reckoned" => dr.push(row),
+            "truth" => truth.push(row),
+            _ => {}
+        }
+    }
+    assert!(dr.len() > 100 && truth.len() > 100);
+    let mut sum = 0.0;
+    let mut n = 0;
+    for &(t, e, no) in &dr {
+        let k = truth.partition_point(|p| p.0 < t);
+        if k == 0 || k >= truth.len() {
+            continue;
+        }
+        let (a, b) = (truth[k - 1], truth[k]);
+        let f = (t - a.0) / (b.0 - a.0);
+        let (te, tn) = (a.1 + f * (b.1 - a.1), a.2 + f * (b.2 - a.2));
+        sum += (e - te).hypot(no - tn);
+        n += 1;
+    }
+    sum / n as f64
+}
+
+/// Regression (issue 13): `run --params` read the parameters of a
+/// params.toml but not the corrections stored beside them, so parameters
+/// calibrated on the levelled, rescaled gyro were used on the raw one.
+#[test]
+fn run_applied_the_parameters_without_the_corrections_they_were_calibrated_with() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("drive");
+    let seed = 5;
+    let mut sc = CarFamily::draw(seed).drive(seed, 300.0);
+    let g = sc.sensors.gyro.as_mut().expect("family gyro");
+    g.tilt_deg = Some([3.0, -2.5]);
+    g.scale_error = 0.02;
+    let sim = deadreckon_sim::simulate(&sc, seed).unwrap();
+    deadreckon_io::write_drive_whole(&dir, &sim.drive, |_| Ok(())).unwrap();
+    let d = dir.to_str().unwrap();
+
+    let p = tmp.path().join("params.toml");
+    deadreckon(&["calibrate", d, "--out", p.to_str().unwrap()]);
+    let text = std::fs::read_to_string(&p).unwrap();
+    assert!(text.contains("[imu]"), "{text}");
+    // The same parameters without the stored corrections.
+    let bare = tmp.path().join("bare.toml");
+    let cut = text.find("\n[delays").expect("stored delays");
+    let std_at = text.find("\n[std]").expect("[std]");
+    std::fs::write(&bare, format!("{}{}", &text[..cut], &text[std_at..])).unwrap();
+
+    let err = |params: &Path| {
+        let out = tmp.path().join("track.csv");
+        deadreckon(&[
+            "run",
+            d,
+            "--params",
+            params.to_str().unwrap(),
+            "--track",
+            "dead-reckoned",
+            "--track",
+            "truth",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        mean_dr_error(&out)
+    };
+    let (with, without) = (err(&p), err(&bare));
+    eprintln!("dead reckoning over the drive: {with:.2} m with the stored corrections, {without:.2} m without");
+    assert!(with < 0.5 * without, "{with} vs {without}");
+}
