@@ -419,6 +419,17 @@ impl Feeder {
         mon.check(f, readings);
     }
 
+    /// From now on, feeds no GNSS (fixes nor courses; a fix waiting for the
+    /// next wheel epoch is dropped): how a clone of a GNSS-aided run
+    /// dead-reckons through an outage, keeping everything else it had learnt
+    /// (the wheel monitor's windows and verdicts, the wheel-interval rule,
+    /// the readings waiting for the next epoch).
+    pub fn dead_reckon(&mut self) {
+        self.sensors.gnss = false;
+        self.sensors.gnss_course = false;
+        self.pending_gnss = None;
+    }
+
     /// Counters so far (the gate counters are the filter's: see [`Feeder::stats_with`]).
     pub fn stats(&self) -> &FilterStats {
         &self.stats
@@ -806,21 +817,6 @@ fn first_wheel_at_or_after(w: &Wheels, t: f64) -> usize {
         }
     }
     lo
-}
-
-/// [`run`] on a drive that has passed [`Drive::validate`] already: the outage
-/// evaluation runs one filter per window, and validating the whole drive each
-/// time made it quadratic in the drive's length.
-pub(crate) fn run_validated(
-    drive: &Drive,
-    params: &Params,
-    opts: &FilterOptions,
-    hook: &mut dyn EpochHook,
-) -> Result<FilterOutput, Error> {
-    let (t0, x0, p0) = start_validated(drive, opts)?;
-    let f = Filter::<CarLayout, 5>::new(&drive.vehicle, params, None, t0, x0, p0)?
-        .with_covariance_form(opts.covariance_form);
-    run_filter(drive, f, opts, hook)
 }
 
 /// The feeder of a filter started at `t0_s` and the drive's events it needs

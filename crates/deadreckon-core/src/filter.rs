@@ -219,6 +219,16 @@ impl GateCounts {
             self.recovered[i] += other.recovered[i];
         }
     }
+    /// The counts added since `earlier` (the same counters at an earlier
+    /// time: a filter cloned from it counts on from there).
+    pub fn since(&self, earlier: &GateCounts) -> GateCounts {
+        let d = |a: &[u64; 9], b: &[u64; 9]| std::array::from_fn(|k| a[k].saturating_sub(b[k]));
+        GateCounts {
+            accepted: d(&self.accepted, &earlier.accepted),
+            rejected: d(&self.rejected, &earlier.rejected),
+            recovered: d(&self.recovered, &earlier.recovered),
+        }
+    }
     /// Rejected measurements of every sensor.
     pub fn total_rejected(&self) -> u64 {
         self.rejected.iter().sum()

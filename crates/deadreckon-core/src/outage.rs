@@ -10,8 +10,8 @@
 //! never does, flagged as censored).
 
 use crate::drive::Drive;
-use crate::ekf::{self, EpochHook, FilterOptions, Init, SensorSet};
-use crate::filter::GateCounts;
+use crate::ekf::{self, EpochHook, EpochOut, FilterOptions};
+use crate::filter::{CarLayout, Filter, GateCounts};
 use crate::metrics::Summary;
 use crate::model::{Mat, State, V, X, Y, YAW};
 use crate::reference::Reference;
@@ -173,63 +173,87 @@ pub fn evaluate(
             "outage evaluation needs truth.csv or GNSS fixes".into(),
         ));
     }
-    // The GNSS-aided filter gives the state at every window start.
-    let aided = ekf::run(
-        drive,
-        params,
-        &FilterOptions {
-            record_epochs: true,
-            ..base.clone()
-        },
-        &mut (),
-    )?;
-    let (Some(first), Some(last_epoch)) = (aided.epochs.first(), aided.epochs.last()) else {
+    // A first GNSS-aided pass finds where windows can start and end.
+    let aided_opts = FilterOptions {
+        record_epochs: false,
+        record_innovations: false,
+        ..base.clone()
+    };
+    let mut epochs = Collect(Vec::new());
+    ekf::run(drive, params, &aided_opts, &mut epochs)?;
+    let (Some(first), Some(last_epoch)) = (epochs.0.first(), epochs.0.last()) else {
         return Err(Error::Insufficient("the filter produced no epochs".into()));
     };
-    let mut end_limit = last_epoch.t_s;
+    let mut end_limit = last_epoch.0;
     if let Some(t) = &truth {
         end_limit = end_limit.min(t.span().map(|s| s.1).unwrap_or(f64::NEG_INFINITY));
     } else if let Some(g) = drive.gnss.last() {
         end_limit = end_limit.min(g.t_s);
     }
-    let mut windows = Vec::new();
-    let mut gates = aided.stats.gates;
-    let Some(moving) = aided.epochs.iter().find(|e| e.x[V].abs() > MOVING_MPS) else {
+    let Some(moving) = epochs.0.iter().find(|e| e.1[V].abs() > MOVING_MPS) else {
         return Err(Error::Insufficient(format!(
             "the vehicle never moves faster than {MOVING_MPS} m/s: no outage to evaluate"
         )));
     };
-    let mut start = (first.t_s + warmup_s).max(moving.t_s);
+    let (first_t, moving_t) = (first.0, moving.0);
+    let mut starts = Vec::new();
+    let mut start = (first_t + warmup_s).max(moving_t);
     while start + outage_s <= end_limit {
-        let end = start + outage_s;
-        let i = aided.epochs.partition_point(|e| e.t_s <= start);
-        let e0 = &aided.epochs[i.saturating_sub(1)];
-        let opts = FilterOptions {
-            init: Init::Given {
-                t_s: e0.t_s,
-                x: e0.x,
-                p: e0.p,
-            },
-            sensors: SensorSet::dead_reckoning(),
-            record_epochs: false,
-            end_s: Some(end),
-            gnss_outages: Vec::new(),
-            ..base.clone()
-        };
-        let mut hook = Collect(Vec::new());
-        // Validated by the aided run above.
-        let out = ekf::run_validated(drive, params, &opts, &mut hook)?;
-        gates.add(&out.stats.gates);
-        if let Some(w) = window_errors(drive, truth.as_ref(), &hook.0, e0.t_s, start, end) {
-            windows.push(w);
-        }
+        starts.push(start);
         start += step_s;
     }
+    drop(epochs);
+
+    // The second pass steps the same filter; at each window start a clone of
+    // it (filter, feeder and the events still to come) goes on without GNSS
+    // to the window's end. The clone keeps what the aided run had learnt, the
+    // wheel monitor's verdicts included (a fresh filter started from the
+    // aided state forgot that a wheel was out).
+    let mut f = ekf::car_filter(drive, params, &aided_opts)?;
+    let (mut feeder, mut events) = ekf::feed(drive, &aided_opts, f.time_s());
+    let mut upcoming = events.next();
+    let mut noop = |_: &mut Filter<CarLayout, 5>, _: EpochOut<'_, 5>| {};
+    let mut windows = Vec::new();
+    let mut gates = GateCounts::default();
+    for &start in &starts {
+        let end = start + outage_s;
+        // Every epoch at or before the start, then the pending ones.
+        while let Some(ev) = upcoming.filter(|e| e.t_s <= start) {
+            feeder.push(&mut f, ev, &mut noop)?;
+            upcoming = events.next();
+        }
+        feeder.finish(&mut f, &mut noop)?;
+        let t0 = f.time_s();
+        let before = *f.gates();
+        let (mut g, mut fd, mut evs, mut next) =
+            (f.clone(), feeder.clone(), events.clone(), upcoming);
+        fd.dead_reckon();
+        let mut states: Vec<(f64, State)> = Vec::new();
+        let mut keep = |g: &mut Filter<CarLayout, 5>, _: EpochOut<'_, 5>| {
+            states.push((g.time_s(), g.car_state()));
+        };
+        while let Some(ev) = next.filter(|e| e.t_s <= end) {
+            fd.push(&mut g, ev, &mut keep)?;
+            next = evs.next();
+        }
+        fd.finish(&mut g, &mut keep)?;
+        gates.add(&g.gates().since(&before));
+        if let Some(w) = window_errors(drive, truth.as_ref(), &states, t0, start, end) {
+            windows.push(w);
+        }
+    }
+    // The aided run's own counts, through the end of the drive.
+    while let Some(ev) = upcoming {
+        feeder.push(&mut f, ev, &mut noop)?;
+        upcoming = events.next();
+    }
+    feeder.finish(&mut f, &mut noop)?;
+    gates.add(f.gates());
     if windows.is_empty() {
         return Err(Error::Insufficient(format!(
             "the drive ({:.1}–{:.1} s, moving from {:.1} s) is too short for a {outage_s} s \
              outage after {warmup_s} s of warm-up",
-            first.t_s, end_limit, moving.t_s
+            first_t, end_limit, moving_t
         )));
     }
     Ok(OutageEvaluation {
