@@ -19,6 +19,11 @@ struct Cli {
     /// clocks, signs: see the README's "What the tool checks").
     #[arg(long, global = true)]
     skip_checks: bool,
+    /// The wheel file to read when a drive directory has both
+    /// `wheel_ticks.csv` and `wheel_speeds.csv` (having both is otherwise an
+    /// error; with only one, that one is read).
+    #[arg(long, global = true, value_enum)]
+    wheels: Option<cmd::common::WheelsArg>,
     #[command(subcommand)]
     command: Command,
 }
@@ -105,6 +110,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
     let load = cmd::Loader {
         mapping: cli.mapping,
         skip_checks: cli.skip_checks,
+        wheels: cli.wheels.map(Into::into),
     };
     match cli.command {
         Command::Simulate(a) => cmd::simulate::run(a),

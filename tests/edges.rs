@@ -349,3 +349,282 @@ fn husky_report_drew_no_dead_reckoned_track_and_no_tedris_outage() {
         "no TedriS outage curve"
     );
 }
+
+#[test]
+fn a_drive_with_both_wheel_files_could_not_be_read_from_the_command_line() {
+    let tmp = vehicle_dir();
+    let d = tmp.path().join("d");
+    let track = |args: &[&str], out: &str| {
+        let st = bin()
+            .args(args)
+            .arg("run")
+            .arg(&d)
+            .arg("--out")
+            .arg(tmp.path().join(out))
+            .output()
+            .unwrap();
+        (
+            st.status.success(),
+            String::from_utf8_lossy(&st.stderr).into_owned(),
+        )
+    };
+    let (ok, err) = track(&[], "ticks_only.csv");
+    assert!(ok, "{err}");
+    // The same drive's wheels as speeds: ticks over the row interval, times
+    // the circumference over ticks per revolution.
+    let vehicle = std::fs::read_to_string(d.join("vehicle.toml")).unwrap();
+    let value = |key: &str| -> f64 {
+        let line = vehicle
+            .lines()
+            .find(|l| l.trim_start().starts_with(key))
+            .unwrap();
+        line.split('=').nth(1).unwrap().trim().parse().unwrap()
+    };
+    let metres_per_tick = value("wheel_circumference_m") / value("ticks_per_rev");
+    let ticks = std::fs::read_to_string(d.join("wheel_ticks.csv")).unwrap();
+    let mut speeds = String::from("t_s,fl_mps,fr_mps,rl_mps,rr_mps\n");
+    let mut previous: Option<f64> = None;
+    for l in ticks.lines().skip(1) {
+        let f: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+        let dt = previous.map_or(0.01, |p| f[0] - p);
+        previous = Some(f[0]);
+        let v: Vec<String> = f[1..5]
+            .iter()
+            .map(|n| format!("{:.6}", n * metres_per_tick / dt))
+            .collect();
+        speeds.push_str(&format!("{},{}\n", f[0], v.join(",")));
+    }
+    std::fs::write(d.join("wheel_speeds.csv"), speeds).unwrap();
+
+    let (ok, err) = track(&[], "neither.csv");
+    assert!(!ok);
+    assert!(
+        err.contains("both wheel_ticks.csv and wheel_speeds.csv") && err.contains("--wheels"),
+        "{err}"
+    );
+    let (ok, err) = track(&["--wheels", "ticks"], "ticks.csv");
+    assert!(ok, "{err}");
+    let (ok, err) = track(&["--wheels", "speeds"], "speeds.csv");
+    assert!(ok, "{err}");
+    let read = |f: &str| std::fs::read_to_string(tmp.path().join(f)).unwrap();
+    assert_eq!(read("ticks.csv"), read("ticks_only.csv"));
+    assert_ne!(read("speeds.csv"), read("ticks_only.csv"));
+}
+
+#[test]
+fn calibrate_report_tedris_and_stream_wrote_over_their_inputs() {
+    let tmp = vehicle_dir();
+    let d = tmp.path().join("d");
+    let before: Vec<(std::path::PathBuf, Vec<u8>)> = std::fs::read_dir(&d)
+        .unwrap()
+        .map(|e| {
+            let p = e.unwrap().path();
+            let b = std::fs::read(&p).unwrap();
+            (p, b)
+        })
+        .collect();
+    let p = d.join("p.toml");
+    let st = bin()
+        .args(["calibrate", "--corrections", "none"])
+        .arg(&d)
+        .arg("--out")
+        .arg(&p)
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let params = std::fs::read(&p).unwrap();
+    let refused = |args: Vec<std::ffi::OsString>| {
+        let st = bin().args(&args).output().unwrap();
+        let err = String::from_utf8_lossy(&st.stderr).into_owned();
+        assert!(!st.status.success(), "{args:?} was accepted");
+        assert!(err.contains("refusing to write over it"), "{args:?}: {err}");
+    };
+    let os = |v: &[&dyn AsRef<std::ffi::OsStr>]| -> Vec<std::ffi::OsString> {
+        v.iter().map(|s| s.as_ref().to_os_string()).collect()
+    };
+    let vehicle = d.join("vehicle.toml");
+    let gnss = d.join("gnss.csv");
+    refused(os(&[&"calibrate", &d, &"--out", &vehicle]));
+    refused(os(&[&"run", &d, &"--params", &p, &"--out", &p]));
+    refused(os(&[&"report", &d, &"--params", &p, &"--out", &p]));
+    refused(os(&[&"report", &d, &"--out", &gnss]));
+    refused(os(&[&"tedris", &"train", &d, &"--out", &gnss]));
+    refused(os(&[
+        &"stream",
+        &"--vehicle",
+        &vehicle,
+        &"--params",
+        &p,
+        &"--learn",
+        &"--params-out",
+        &p,
+    ]));
+    refused(os(&[
+        &"stream",
+        &"--vehicle",
+        &vehicle,
+        &"--state",
+        &vehicle,
+    ]));
+    for (path, bytes) in before {
+        assert_eq!(std::fs::read(&path).unwrap(), bytes, "{}", path.display());
+    }
+    assert_eq!(std::fs::read(&p).unwrap(), params);
+}
+
+#[test]
+fn nan_infinite_zero_and_negative_option_values_were_accepted() {
+    let tmp = vehicle_dir();
+    let d = tmp.path().join("d");
+    let d = d.to_str().unwrap();
+    let out = tmp.path().join("o");
+    let out = out.to_str().unwrap();
+    // (arguments, the option named in the refusal, what it says)
+    let cases: &[(&[&str], &str, &str)] = &[
+        (&["evaluate", d, "--outage", "nan"], "--outage", "finite"),
+        (
+            &["evaluate", d, "--outage", "20", "--step", "0"],
+            "--step",
+            "above 0",
+        ),
+        (
+            &["evaluate", d, "--segment-m", "0"],
+            "--segment-m",
+            "above 0",
+        ),
+        (
+            &["evaluate", d, "--threshold-m=-1"],
+            "--threshold-m",
+            "above 0",
+        ),
+        (&["evaluate", d, "--warmup", "inf"], "--warmup", "finite"),
+        (&["evaluate", d, "--from", "x"], "--from", "not a number"),
+        (
+            &["evaluate", d, "--metric", "rmse"],
+            "--metric",
+            "possible values",
+        ),
+        (
+            &["calibrate", d, "--min-speed", "nan"],
+            "--min-speed",
+            "finite",
+        ),
+        (
+            &["calibrate", d, "--min-speed=-1"],
+            "--min-speed",
+            "0 or above",
+        ),
+        (
+            &["calibrate", d, "--max-iterations", "0"],
+            "--max-iterations",
+            "0",
+        ),
+        (
+            &["calibrate", d, "--state", "full"],
+            "--state",
+            "possible values",
+        ),
+        (
+            &["calibrate", d, "--method", "lsq"],
+            "--method",
+            "possible values",
+        ),
+        (
+            &["calibrate", d, "--timing", "every"],
+            "--timing",
+            "possible values",
+        ),
+        (
+            &["batch", d, "--out", out, "--alpha", "2"],
+            "--alpha",
+            "between 0 and 1",
+        ),
+        (
+            &["report", d, "--out", out, "--outage=-30"],
+            "--outage",
+            "above 0",
+        ),
+        (
+            &[
+                "simulate",
+                "--scenario",
+                "evaluation",
+                "--out",
+                out,
+                "--duration",
+                "0",
+            ],
+            "--duration",
+            "above 0",
+        ),
+        (
+            &[
+                "simulate",
+                "--scenario",
+                "evaluation",
+                "--out",
+                out,
+                "--circumferences",
+                "1.9,1.9,nan,1.9",
+            ],
+            "--circumferences",
+            "finite",
+        ),
+        (
+            &["tedris", "train", d, "--out", out, "--epsilon-k=-1"],
+            "--epsilon-k",
+            "above 0",
+        ),
+        (
+            &[
+                "tedris",
+                "run",
+                d,
+                "--model",
+                out,
+                "--outage",
+                "1:2",
+                "--threshold-m",
+                "inf",
+            ],
+            "--threshold-m",
+            "finite",
+        ),
+        (
+            &["import", "kitti", d, "--out", out],
+            "<FORMAT>",
+            "possible values",
+        ),
+    ];
+    for (args, option, says) in cases {
+        let st = bin().args(*args).output().unwrap();
+        let err = String::from_utf8_lossy(&st.stderr);
+        assert_eq!(st.status.code(), Some(2), "{args:?}: {err}");
+        assert!(
+            err.contains(option) && err.contains(says),
+            "{args:?}: {err}"
+        );
+    }
+    // A value that needs a sign is still read as one.
+    let st = bin()
+        .args(["evaluate", d, "--metric", "ape", "--from=-5", "--json"])
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    // `--calibrate --method gnss` names the shape that takes it.
+    let st = bin()
+        .args(["calibrate", d, "--method", "gnss"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&st.stderr);
+    assert!(!st.status.success() && err.contains("diff-drive"), "{err}");
+    assert!(!std::path::Path::new(out).exists());
+}

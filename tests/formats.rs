@@ -167,7 +167,11 @@ fn evaluate_rpe_and_ape_json_and_errors() {
         "{e}"
     );
     let e = run_err(&["evaluate", d, "--metric", "rpe", "--pairs-from", "both"]);
-    assert!(e.contains("unknown --pairs-from `both`"), "{e}");
+    assert!(
+        e.contains("invalid value 'both' for '--pairs-from")
+            && e.contains("[possible values: estimate, reference]"),
+        "{e}"
+    );
 
     // Without truth.csv there is no `truth` track to compare with.
     std::fs::remove_file(drive.join("truth.csv")).unwrap();

@@ -34,28 +34,28 @@ pub struct BatchArgs {
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
     /// rts, zupt or truth (needs truth.csv).
-    #[arg(long, default_value = "rts")]
-    pub method: String,
+    #[arg(long, value_enum, default_value_t = common::MethodArg::Rts)]
+    pub method: common::MethodArg,
     /// Maximum smoothing passes per drive.
-    #[arg(long, default_value_t = 60)]
-    pub max_iterations: usize,
+    #[arg(long, default_value_t = 60, value_parser = clap::value_parser!(u32).range(1..))]
+    pub max_iterations: u32,
     /// Filter timing: wheel or each.
-    #[arg(long, default_value = "wheel")]
-    pub timing: String,
+    #[arg(long, value_enum, default_value_t = common::TimingArg::Wheel)]
+    pub timing: common::TimingArg,
     /// Speed below which epochs are dropped for speed-dependent parameters, m/s.
-    #[arg(long, default_value_t = 2.0)]
+    #[arg(long, default_value_t = 2.0, value_parser = common::non_negative)]
     pub min_speed: f64,
     /// Also evaluate each drive, with its own parameters, through sliding GNSS outages of this length, s.
-    #[arg(long)]
+    #[arg(long, value_parser = common::positive)]
     pub outage: Option<f64>,
     /// Step between outage windows, s (default: half the outage length).
-    #[arg(long)]
+    #[arg(long, value_parser = common::positive)]
     pub step: Option<f64>,
     /// GNSS-aided time before the first outage window, s.
-    #[arg(long, default_value_t = 5.0)]
+    #[arg(long, default_value_t = 5.0, value_parser = common::non_negative)]
     pub warmup: f64,
     /// Significance level of the history's χ² and change-point tests.
-    #[arg(long, default_value_t = 1e-3)]
+    #[arg(long, default_value_t = 1e-3, value_parser = common::probability)]
     pub alpha: f64,
     /// Drive-to-drive tolerance of a parameter, NAME=VALUE in its unit (repeatable; defaults in docs/fleet.md).
     #[arg(long, value_delimiter = ',')]
@@ -104,15 +104,15 @@ fn bar(total: usize, quiet: bool) -> Option<ProgressBar> {
 
 /// Runs `batch`.
 pub fn run(a: BatchArgs, quiet: bool, loader: &common::Loader) -> Result<()> {
-    let method: Method = a.method.parse()?;
+    let method: Method = a.method.car()?;
     let hist_opts = history_options(&a)?;
     let options = BatchOptions {
         calibration: CalibrationOptions {
             method,
-            max_iterations: a.max_iterations,
+            max_iterations: a.max_iterations as usize,
             min_speed_mps: a.min_speed,
             filter: FilterOptions {
-                timing: common::parse_timing(&a.timing)?,
+                timing: a.timing.into(),
                 ..Default::default()
             },
             ..Default::default()

@@ -27,14 +27,50 @@ pub enum OutFormat {
     Eagleye,
 }
 
+/// `calibrate --state`: what each smoothing pass carries.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum StateArg {
+    /// The car state and the six parameters.
+    Augmented,
+    /// The paper's 5-state filter, parameters fixed within a pass.
+    Paper,
+}
+
+/// `calibrate --iteration`: how the smoothing passes are chained.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum IterationArg {
+    /// Anderson-accelerated.
+    Anderson,
+    /// The paper's plain fixed-point iteration.
+    Plain,
+}
+
+impl std::fmt::Display for StateArg {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            StateArg::Augmented => "augmented",
+            StateArg::Paper => "paper",
+        })
+    }
+}
+
+impl std::fmt::Display for IterationArg {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            IterationArg::Anderson => "anderson",
+            IterationArg::Plain => "plain",
+        })
+    }
+}
+
 /// Arguments of `calibrate`.
 #[derive(Args, Debug)]
 pub struct CalibrateArgs {
     /// The drive directory or recording (a tricycle `dataset.txt` is calibrated through its own kinematics).
     pub dir: PathBuf,
     /// rts (smoothed states, needs GNSS), zupt (standstill gyro bias), truth (needs truth.csv); a tricycle: truth (its tracker); a differential drive: gnss (default: rts, truth, gnss by shape).
-    #[arg(long)]
-    pub method: Option<String>,
+    #[arg(long, value_enum)]
+    pub method: Option<common::MethodArg>,
     /// The vehicle shape: car (four wheels, the default) or diff-drive (odometry twist, calibrated against GNSS). A tricycle log is recognised by itself.
     #[arg(long, value_enum, default_value_t = ShapeArg::Car)]
     pub shape: ShapeArg,
@@ -42,28 +78,28 @@ pub struct CalibrateArgs {
     #[arg(long, value_enum, default_value_t = YawArg::Gyro)]
     pub yaw: YawArg,
     /// What each smoothing pass carries: augmented (car state + the six parameters) or paper (5-state, parameters fixed).
-    #[arg(long, default_value = "augmented")]
-    pub state: String,
+    #[arg(long, value_enum, default_value_t = StateArg::Augmented)]
+    pub state: StateArg,
     /// Chaining of the smoothing passes: anderson (accelerated) or plain (the paper's).
-    #[arg(long, default_value = "anderson")]
-    pub iteration: String,
+    #[arg(long, value_enum, default_value_t = IterationArg::Anderson)]
+    pub iteration: IterationArg,
     /// Maximum smoothing passes.
-    #[arg(long, default_value_t = 60)]
-    pub max_iterations: usize,
+    #[arg(long, default_value_t = 60, value_parser = clap::value_parser!(u32).range(1..))]
+    pub max_iterations: u32,
     /// Filter timing: wheel (the paper's, one epoch per wheel row) or each (every reading at its time).
-    #[arg(long, default_value = "wheel")]
-    pub timing: String,
+    #[arg(long, value_enum, default_value_t = common::TimingArg::Wheel)]
+    pub timing: common::TimingArg,
     /// Speed below which epochs (car) or windows (tricycle) are dropped for speed-dependent parameters, m/s (default: 2 for a car, 0.05 for a tricycle).
-    #[arg(long)]
+    #[arg(long, value_parser = common::non_negative)]
     pub min_speed: Option<f64>,
     /// Use only data from this time on, s (drive clock).
-    #[arg(long = "from")]
+    #[arg(long = "from", value_parser = common::finite, allow_hyphen_values = true)]
     pub from_s: Option<f64>,
     /// Use only data before this time, s (drive clock).
-    #[arg(long = "until")]
+    #[arg(long = "until", value_parser = common::finite, allow_hyphen_values = true)]
     pub until_s: Option<f64>,
     /// Tricycle and differential drive: length of the windows of the fit, s (default 2 for a tricycle, 60 for a differential drive).
-    #[arg(long)]
+    #[arg(long, value_parser = common::positive)]
     pub window: Option<f64>,
     /// Write the parameters here: a params.toml, or with --format autoware or
     /// eagleye a directory (created if missing).
@@ -92,14 +128,23 @@ pub struct CalibrateArgs {
 /// Runs `calibrate`.
 pub fn run(a: CalibrateArgs, load: &common::Loader) -> Result<()> {
     kinematic::check_range(a.from_s, a.until_s)?;
+    // A params.toml onto the drive's own files; the stack formats write new
+    // files into a directory, which may be the drive's.
+    if let (Some(out), OutFormat::Params) = (&a.out, a.format) {
+        common::check_output(out, &[&a.dir])?;
+    }
     if kinematic::is_tricycle_log(&a.dir) {
         return run_tricycle(&a);
     }
     if a.shape == ShapeArg::DiffDrive {
         return run_diff_drive(&a, load);
     }
-    let method_name = a.method.clone().unwrap_or_else(|| "rts".into());
-    let method: Method = method_name.parse()?;
+    let method_name = a
+        .method
+        .unwrap_or(common::MethodArg::Rts)
+        .name()
+        .to_string();
+    let method: Method = a.method.unwrap_or(common::MethodArg::Rts).car()?;
     // Only the truth calibration reads truth.csv.
     let read = deadreckon_io::ReadOptions::default();
     let read = if method == Method::Truth {
@@ -113,26 +158,24 @@ pub fn run(a: CalibrateArgs, load: &common::Loader) -> Result<()> {
     } else {
         drive
     };
-    let iteration = match a.iteration.as_str() {
-        "anderson" => Iteration::Anderson,
-        "plain" => Iteration::Plain,
-        s => anyhow::bail!("unknown iteration `{s}` (anderson, plain)"),
+    let iteration = match a.iteration {
+        IterationArg::Anderson => Iteration::Anderson,
+        IterationArg::Plain => Iteration::Plain,
     };
-    let state = match a.state.as_str() {
-        "augmented" => PassState::Augmented,
-        "paper" => PassState::Paper,
-        s => anyhow::bail!("unknown pass state `{s}` (augmented, paper)"),
+    let state = match a.state {
+        StateArg::Augmented => PassState::Augmented,
+        StateArg::Paper => PassState::Paper,
     };
     let opts = CalibrationOptions {
         method,
         state,
         iteration,
-        max_iterations: a.max_iterations,
+        max_iterations: a.max_iterations as usize,
         min_speed_mps: a
             .min_speed
             .unwrap_or(Shape::FourWheel.default_min_speed_mps()),
         filter: FilterOptions {
-            timing: common::parse_timing(&a.timing)?,
+            timing: a.timing.into(),
             wheel_monitor: common::wheel_monitor(a.no_wheel_monitor),
             ..Default::default()
         },
@@ -281,7 +324,7 @@ pub fn run(a: CalibrateArgs, load: &common::Loader) -> Result<()> {
 
 /// The tricycle: the seven kinematic parameters against the tracker.
 fn run_tricycle(a: &CalibrateArgs) -> Result<()> {
-    let method = a.method.as_deref().unwrap_or("truth");
+    let method = a.method.map_or("truth", common::MethodArg::name);
     anyhow::ensure!(
         method == "truth",
         "a tricycle log has no GNSS and no gyro: it is calibrated against its tracker with --method truth (got `{method}`)"
@@ -334,7 +377,7 @@ fn steering_toml(st: &SteeringCalibration) -> toml::Table {
 
 /// The differential drive: five parameters against the GNSS fixes.
 fn run_diff_drive(a: &CalibrateArgs, load: &common::Loader) -> Result<()> {
-    let method = a.method.as_deref().unwrap_or("gnss");
+    let method = a.method.map_or("gnss", common::MethodArg::name);
     anyhow::ensure!(
         method == "gnss",
         "a differential drive is calibrated against its GNSS fixes with --method gnss (got `{method}`)"

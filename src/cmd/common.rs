@@ -14,6 +14,26 @@ pub struct Loader {
     pub mapping: Option<std::path::PathBuf>,
     /// `--skip-checks`: read drives without the cross-stream plausibility checks.
     pub skip_checks: bool,
+    /// `--wheels`: the wheel file to read when a drive directory has both.
+    pub wheels: Option<deadreckon_io::WheelFile>,
+}
+
+/// `--wheels`: which wheel file a drive directory with both is read from.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WheelsArg {
+    /// `wheel_ticks.csv` (encoder ticks).
+    Ticks,
+    /// `wheel_speeds.csv` (wheel speeds).
+    Speeds,
+}
+
+impl From<WheelsArg> for deadreckon_io::WheelFile {
+    fn from(w: WheelsArg) -> Self {
+        match w {
+            WheelsArg::Ticks => Self::Ticks,
+            WheelsArg::Speeds => Self::Speeds,
+        }
+    }
 }
 
 impl Loader {
@@ -27,9 +47,13 @@ impl Loader {
     }
 
     /// [`Loader::drive`] with reading options for drive directories (recordings
-    /// are read whole).
+    /// are read whole); `--wheels` fills the wheel-file choice they leave open.
     pub fn drive_with(&self, path: &Path, options: &deadreckon_io::ReadOptions) -> Result<Drive> {
-        let drive = deadreckon_api::read_drive_with(path, options, self.mapping.as_deref())?;
+        let mut options = options.clone();
+        if options.prefer_wheels.is_none() {
+            options.prefer_wheels = self.wheels;
+        }
+        let drive = deadreckon_api::read_drive_with(path, &options, self.mapping.as_deref())?;
         if !self.skip_checks {
             plausible(path, &drive)?;
         }
@@ -42,6 +66,17 @@ impl Loader {
     pub fn ros_with_report(&self, path: &Path) -> Result<(Drive, deadreckon_ros::ImportReport)> {
         Ok(deadreckon_api::read_ros(path, self.mapping.as_deref())?)
     }
+}
+
+/// Refuses an output path that is one of the command's inputs (the drive, a
+/// params.toml, a model, a configuration): writing it would destroy what it
+/// was computed from. `nominal` and other non-paths among `inputs` are
+/// skipped by [`deadreckon_io::check_not_an_input`] (they do not exist).
+pub fn check_output(out: &Path, inputs: &[&Path]) -> Result<()> {
+    for input in inputs {
+        deadreckon_io::check_not_an_input(out, input)?;
+    }
+    Ok(())
 }
 
 /// The cross-stream plausibility checks: warnings on standard error, errors
@@ -86,6 +121,111 @@ pub fn load_params_corrected(spec: &str, drive: Drive) -> Result<(Params, Drive)
         return Ok((params, drive));
     }
     Ok((params, apply_stored(spec, drive)?))
+}
+
+/// `--timing`: the filter's timing scheme.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TimingArg {
+    /// One epoch per wheel row (the paper's).
+    Wheel,
+    /// One epoch per reading.
+    Each,
+}
+
+impl From<TimingArg> for Timing {
+    fn from(t: TimingArg) -> Timing {
+        match t {
+            TimingArg::Wheel => Timing::WheelEpochs,
+            TimingArg::Each => Timing::EachMeasurement,
+        }
+    }
+}
+
+/// `--method`: what a calibration is made against. Which ones a vehicle
+/// takes depends on its shape (`calibrate` says).
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MethodArg {
+    /// RTS-smoothed states of a GNSS-aided filter (a car).
+    Rts,
+    /// The gyro bias at standstill (a car).
+    Zupt,
+    /// `truth.csv` or the tracker (a car, a tricycle).
+    Truth,
+    /// The GNSS fixes (a differential drive).
+    Gnss,
+}
+
+impl MethodArg {
+    /// The name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            MethodArg::Rts => "rts",
+            MethodArg::Zupt => "zupt",
+            MethodArg::Truth => "truth",
+            MethodArg::Gnss => "gnss",
+        }
+    }
+
+    /// The four-wheel calibration method (`gnss` is the differential
+    /// drive's).
+    pub fn car(self) -> Result<deadreckon_core::calibrate::Method> {
+        use deadreckon_core::calibrate::Method;
+        Ok(match self {
+            MethodArg::Rts => Method::Rts,
+            MethodArg::Zupt => Method::Zupt,
+            MethodArg::Truth => Method::Truth,
+            MethodArg::Gnss => anyhow::bail!(
+                "--method gnss calibrates a differential drive (--shape diff-drive); a car takes rts, zupt or truth"
+            ),
+        })
+    }
+}
+
+/// clap's parser for a quantity that must be a finite number above 0 (a
+/// length, a duration, a standard deviation): `nan`, `inf`, 0 and negative
+/// values are refused before anything is read.
+pub fn positive(s: &str) -> std::result::Result<f64, String> {
+    let v = finite(s)?;
+    if v > 0.0 {
+        Ok(v)
+    } else {
+        Err(format!("must be above 0, got {v}"))
+    }
+}
+
+/// clap's parser for a finite number at least 0 (a speed threshold, a
+/// warm-up time).
+pub fn non_negative(s: &str) -> std::result::Result<f64, String> {
+    let v = finite(s)?;
+    if v >= 0.0 {
+        Ok(v)
+    } else {
+        Err(format!("must be 0 or above, got {v}"))
+    }
+}
+
+/// clap's parser for a finite number (a time on the drive clock, a bias).
+pub fn finite(s: &str) -> std::result::Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|e| format!("`{s}` is not a number ({e})"))?;
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(format!("must be a finite number, got `{s}`"))
+    }
+}
+
+/// clap's parser for a probability strictly between 0 and 1 (a
+/// significance level).
+pub fn probability(s: &str) -> std::result::Result<f64, String> {
+    let v = finite(s)?;
+    if v > 0.0 && v < 1.0 {
+        Ok(v)
+    } else {
+        Err(format!("must be between 0 and 1 (exclusive), got {v}"))
+    }
 }
 
 /// `--corrections`: which timing and mounting corrections are estimated and
@@ -193,11 +333,6 @@ pub fn quiet_on_broken_pipe(r: std::io::Result<()>) -> Result<()> {
         Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
         r => Ok(r.context("writing to standard output")?),
     }
-}
-
-/// Parses `--timing`.
-pub fn parse_timing(s: &str) -> Result<Timing> {
-    Ok(deadreckon_api::options::parse_timing(s)?)
 }
 
 /// The header of a table-III-like parameter table.

@@ -18,6 +18,41 @@ use deadreckon_core::kinematics::{self, KinematicOptions, Shape};
 use super::kinematic::{ShapeArg, YawArg};
 use super::{common, kinematic};
 
+/// `evaluate --metric`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum MetricArg {
+    /// Drift per --segment-m of path, reset to the truth at each segment.
+    Drift,
+    /// Distance travelled before the error reaches --threshold-m, then reset.
+    #[value(name = "reset-1m")]
+    Reset1m,
+    /// evo's relative pose error per --delta-m of path, translation part.
+    Rpe,
+    /// evo's absolute pose error, no alignment.
+    Ape,
+}
+
+impl MetricArg {
+    /// The name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            MetricArg::Drift => "drift",
+            MetricArg::Reset1m => "reset-1m",
+            MetricArg::Rpe => "rpe",
+            MetricArg::Ape => "ape",
+        }
+    }
+}
+
+/// `evaluate --pairs-from`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum PairsFromArg {
+    /// The estimate's travelled path chooses the pairs (evo's default).
+    Estimate,
+    /// The reference's (evo's --pairs_from_reference).
+    Reference,
+}
+
 /// Arguments of `evaluate`.
 #[derive(Args, Debug)]
 pub struct EvaluateArgs {
@@ -29,8 +64,8 @@ pub struct EvaluateArgs {
     /// drift (reset to the truth every 100 m), reset-1m (reset when the error
     /// reaches 1 m), rpe (evo's relative pose error per --delta-m of path,
     /// translation part) or ape (evo's absolute pose error, no alignment).
-    #[arg(long, default_value = "drift")]
-    pub metric: String,
+    #[arg(long, value_enum, default_value_t = MetricArg::Drift)]
+    pub metric: MetricArg,
     /// rpe/ape: the estimated track (dead-reckoned, filtered, smoothed).
     #[arg(long, default_value = "dead-reckoned")]
     pub track: String,
@@ -38,32 +73,32 @@ pub struct EvaluateArgs {
     #[arg(long, default_value = "truth")]
     pub reference: String,
     /// rpe: path length between the poses of a pair, m (evo's --delta with --delta_unit m).
-    #[arg(long, default_value_t = 100.0)]
+    #[arg(long, default_value_t = 100.0, value_parser = common::positive)]
     pub delta_m: f64,
     /// rpe: whose travelled path chooses the pairs: estimate (evo's default) or reference (evo's --pairs_from_reference).
-    #[arg(long, default_value = "estimate")]
-    pub pairs_from: String,
+    #[arg(long, value_enum, default_value_t = PairsFromArg::Estimate)]
+    pub pairs_from: PairsFromArg,
     /// rpe/ape: largest time difference of associated poses, s (evo's --t_max_diff).
-    #[arg(long, default_value_t = evo::DEFAULT_MAX_DIFF_S)]
+    #[arg(long, default_value_t = evo::DEFAULT_MAX_DIFF_S, value_parser = common::positive)]
     pub max_diff_s: f64,
     /// Segment length of the drift metric, m.
-    #[arg(long, default_value_t = 100.0)]
+    #[arg(long, default_value_t = 100.0, value_parser = common::positive)]
     pub segment_m: f64,
     /// Error threshold of the reset metric, m.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, value_parser = common::positive)]
     pub threshold_m: f64,
     /// Evaluate over sliding GNSS outages of this length, s (instead of --metric).
-    #[arg(long)]
+    #[arg(long, value_parser = common::positive)]
     pub outage: Option<f64>,
     /// Step between outage windows, s (default: half the outage length).
-    #[arg(long)]
+    #[arg(long, value_parser = common::positive)]
     pub step: Option<f64>,
     /// GNSS-aided time before the first outage window, s.
-    #[arg(long, default_value_t = 5.0)]
+    #[arg(long, default_value_t = 5.0, value_parser = common::non_negative)]
     pub warmup: f64,
     /// Filter timing: wheel or each.
-    #[arg(long, default_value = "wheel")]
-    pub timing: String,
+    #[arg(long, value_enum, default_value_t = common::TimingArg::Wheel)]
+    pub timing: common::TimingArg,
     /// Print JSON instead of text.
     #[arg(long)]
     pub json: bool,
@@ -74,7 +109,7 @@ pub struct EvaluateArgs {
     #[arg(long, value_enum)]
     pub yaw: Option<YawArg>,
     /// Differential drive: seconds of fixes before each outage the dead reckoning is aligned to.
-    #[arg(long, default_value_t = 60.0)]
+    #[arg(long, default_value_t = 60.0, value_parser = common::positive)]
     pub align: f64,
     /// Without --params: the timing and mounting corrections estimated and
     /// applied before the calibration (all: IMU tilt and every stream's
@@ -83,10 +118,10 @@ pub struct EvaluateArgs {
     #[arg(long, value_enum, default_value_t = common::CorrectionsArg::Gnss)]
     pub corrections: common::CorrectionsArg,
     /// Evaluate only data from this time on, s (drive clock).
-    #[arg(long = "from")]
+    #[arg(long = "from", value_parser = common::finite, allow_hyphen_values = true)]
     pub from_s: Option<f64>,
     /// Evaluate only data before this time, s (drive clock).
-    #[arg(long = "until")]
+    #[arg(long = "until", value_parser = common::finite, allow_hyphen_values = true)]
     pub until_s: Option<f64>,
 }
 
@@ -105,7 +140,7 @@ pub fn run(a: EvaluateArgs, load: &common::Loader) -> Result<()> {
     } else {
         drive
     };
-    let timing = common::parse_timing(&a.timing)?;
+    let timing: deadreckon_core::ekf::Timing = a.timing.into();
     if let Some(len) = a.outage {
         let (params, source, drive, corrections) = match &a.params {
             Some(p) => (
@@ -189,8 +224,8 @@ pub fn run(a: EvaluateArgs, load: &common::Loader) -> Result<()> {
     let spec = a.params.as_deref().unwrap_or("nominal");
     let params = common::load_params(spec, &drive)?;
     let drive = common::apply_stored(spec, drive)?;
-    match a.metric.as_str() {
-        "drift" => {
+    match a.metric {
+        MetricArg::Drift => {
             let r = metrics::drift(&drive, &params, a.segment_m, timing)?;
             let s = Summary::of(&r.errors_pct());
             if a.json {
@@ -201,7 +236,7 @@ pub fn run(a: EvaluateArgs, load: &common::Loader) -> Result<()> {
                 outln!("rejected by the χ² gates: {}", common::gated_text(&r.gates));
             }
         }
-        "reset-1m" => {
+        MetricArg::Reset1m => {
             let r = metrics::reset_on_error(&drive, &params, a.threshold_m, timing)?;
             let s = Summary::of(&r.distances_m);
             if a.json {
@@ -215,7 +250,7 @@ pub fn run(a: EvaluateArgs, load: &common::Loader) -> Result<()> {
                 outln!("rejected by the χ² gates: {}", common::gated_text(&r.gates));
             }
         }
-        "rpe" | "ape" => {
+        MetricArg::Rpe | MetricArg::Ape => {
             let opts = FilterOptions {
                 timing,
                 ..Default::default()
@@ -224,12 +259,12 @@ pub fn run(a: EvaluateArgs, load: &common::Loader) -> Result<()> {
             // On the values the TUM/KITTI files carry, so evo on the files agrees.
             let reference = &evo::as_written(track::find(&all, &a.reference)?);
             let estimate = &evo::as_written(track::find(&all, &a.track)?);
-            let pairs_from = match a.pairs_from.as_str() {
-                "estimate" => evo::PairsFrom::Estimate,
-                "reference" => evo::PairsFrom::Reference,
-                s => anyhow::bail!("unknown --pairs-from `{s}` (estimate, reference)"),
+            let (pairs_from, pairs_from_name) = match a.pairs_from {
+                PairsFromArg::Estimate => (evo::PairsFrom::Estimate, "estimate"),
+                PairsFromArg::Reference => (evo::PairsFrom::Reference, "reference"),
             };
-            let r = if a.metric == "rpe" {
+            let metric = a.metric.name();
+            let r = if a.metric == MetricArg::Rpe {
                 evo::rpe(
                     reference,
                     estimate,
@@ -242,23 +277,23 @@ pub fn run(a: EvaluateArgs, load: &common::Loader) -> Result<()> {
             } else {
                 evo::ape(reference, estimate, a.max_diff_s)
             }
-            .with_context(|| format!("{} of `{}` against `{}`", a.metric, a.track, a.reference))?;
+            .with_context(|| format!("{metric} of `{}` against `{}`", a.track, a.reference))?;
             if a.json {
                 let q = deadreckon_api::json::EvoQuery {
-                    metric: &a.metric,
+                    metric,
                     track: &a.track,
                     reference: &a.reference,
                     max_diff_s: a.max_diff_s,
                     delta_m: a.delta_m,
-                    pairs_from: &a.pairs_from,
+                    pairs_from: pairs_from_name,
                 };
                 let v = deadreckon_api::json::evo_json(&q, &r);
                 outln!("{}", serde_json::to_string_pretty(&v)?);
             } else {
-                let what = if a.metric == "rpe" {
+                let what = if a.metric == MetricArg::Rpe {
                     format!(
-                        "RPE per {} m (translation, pairs from the {})",
-                        a.delta_m, a.pairs_from
+                        "RPE per {} m (translation, pairs from the {pairs_from_name})",
+                        a.delta_m
                     )
                 } else {
                     "APE (translation, no alignment)".to_string()
@@ -278,7 +313,6 @@ pub fn run(a: EvaluateArgs, load: &common::Loader) -> Result<()> {
                 );
             }
         }
-        m => anyhow::bail!("unknown metric `{m}` (drift, reset-1m, rpe, ape)"),
     }
     Ok(())
 }

@@ -14,13 +14,47 @@ use deadreckon_import::comma2k19::{Comma2k19Options, GyroSource, SpeedSource};
 use deadreckon_import::tricycle::TricycleOptions;
 use deadreckon_import::TimeOrderPolicy;
 
+/// `import FORMAT`: what the source is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum FormatArg {
+    /// A comma2k19 segment directory.
+    Comma2k19,
+    /// A candump log or a comma2k19 raw_can directory, decoded with a DBC.
+    Can,
+    /// A tricycle dataset.txt.
+    Tricycle,
+    /// A ROS1 .bag.
+    Rosbag,
+    /// A ROS2 .mcap, or a rosbag2 directory holding one.
+    Mcap,
+}
+
+/// `import comma2k19 --gyro`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum GyroArg {
+    /// gyro_uncalibrated, bias kept.
+    Raw,
+    /// The phone's calibrated gyro.
+    Calibrated,
+}
+
+/// `import comma2k19 --speed-source`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum SpeedSourceArg {
+    /// The CAN SPEED message (0xB4).
+    Can,
+    /// The mean of the four wheel speeds.
+    Processed,
+}
+
 /// Import arguments.
 #[derive(Args, Debug)]
 pub struct ImportArgs {
     /// Input format: comma2k19 (segment directory), can (candump log or
     /// comma2k19 raw_can directory), tricycle (dataset.txt), rosbag (ROS1
     /// .bag), mcap (ROS2 .mcap file, or a rosbag2 directory holding one).
-    pub format: String,
+    #[arg(value_enum)]
+    pub format: FormatArg,
     /// Source file or directory.
     pub source: PathBuf,
     /// Output drive directory.
@@ -40,19 +74,19 @@ pub struct ImportArgs {
     #[arg(long)]
     pub gate: bool,
     /// comma2k19: gyro stream, `raw` (gyro_uncalibrated, bias kept) or `calibrated`.
-    #[arg(long, default_value = "raw")]
-    pub gyro: String,
+    #[arg(long, value_enum, default_value_t = GyroArg::Raw)]
+    pub gyro: GyroArg,
     /// comma2k19: speed stream, `can` (SPEED message 0xB4) or `processed` (mean of the wheel speeds).
-    #[arg(long, default_value = "can")]
-    pub speed_source: String,
+    #[arg(long, value_enum, default_value_t = SpeedSourceArg::Can)]
+    pub speed_source: SpeedSourceArg,
     /// comma2k19: forward distance from the rear axle to the device, m (default 1.5).
-    #[arg(long)]
+    #[arg(long, value_parser = super::common::finite, allow_hyphen_values = true)]
     pub device_forward_m: Option<f64>,
     /// comma2k19: u-blox fix latency subtracted from its log time, s (default 0.1).
-    #[arg(long)]
+    #[arg(long, value_parser = super::common::finite, allow_hyphen_values = true)]
     pub gnss_latency_s: Option<f64>,
     /// comma2k19: standard deviation given to each u-blox fix, m (default 1.0).
-    #[arg(long)]
+    #[arg(long, value_parser = super::common::positive)]
     pub gnss_std_m: Option<f64>,
 }
 
@@ -70,31 +104,29 @@ pub fn run(a: ImportArgs, load: &super::common::Loader) -> Result<()> {
         ),
         None => None,
     };
-    let comma_only = a.gyro != "raw"
-        || a.speed_source != "can"
+    let comma_only = a.gyro != GyroArg::Raw
+        || a.speed_source != SpeedSourceArg::Can
         || a.device_forward_m.is_some()
         || a.gnss_latency_s.is_some()
         || a.gnss_std_m.is_some();
-    if a.format != "comma2k19" && comma_only {
+    if a.format != FormatArg::Comma2k19 && comma_only {
         bail!("--gyro, --speed-source, --device-forward-m, --gnss-latency-s and --gnss-std-m apply to comma2k19 only");
     }
-    if a.format != "can" && (a.dbc.is_some() || a.map.is_some()) {
+    if a.format != FormatArg::Can && (a.dbc.is_some() || a.map.is_some()) {
         bail!("--dbc and --map apply to the can format only");
     }
-    let (drive, report) = match a.format.as_str() {
-        "comma2k19" => {
+    let (drive, report) = match a.format {
+        FormatArg::Comma2k19 => {
             let d = Comma2k19Options::default();
             let o = Comma2k19Options {
                 vehicle,
-                gyro: match a.gyro.as_str() {
-                    "raw" => GyroSource::Uncalibrated,
-                    "calibrated" => GyroSource::Calibrated,
-                    g => bail!("unknown --gyro `{g}` (raw, calibrated)"),
+                gyro: match a.gyro {
+                    GyroArg::Raw => GyroSource::Uncalibrated,
+                    GyroArg::Calibrated => GyroSource::Calibrated,
                 },
-                speed: match a.speed_source.as_str() {
-                    "can" => SpeedSource::CanSpeedMessage,
-                    "processed" => SpeedSource::Processed,
-                    s => bail!("unknown --speed-source `{s}` (can, processed)"),
+                speed: match a.speed_source {
+                    SpeedSourceArg::Can => SpeedSource::CanSpeedMessage,
+                    SpeedSourceArg::Processed => SpeedSource::Processed,
                 },
                 device_forward_m: a.device_forward_m.unwrap_or(d.device_forward_m),
                 gnss_latency_s: a.gnss_latency_s.unwrap_or(d.gnss_latency_s),
@@ -104,7 +136,7 @@ pub fn run(a: ImportArgs, load: &super::common::Loader) -> Result<()> {
             let i = deadreckon_import::read_comma2k19_with(&a.source, &o)?;
             (i.drive, i.report.to_string())
         }
-        "can" => {
+        FormatArg::Can => {
             let builtin = a.dbc.is_none() && a.map.is_none();
             let db = match &a.dbc {
                 Some(p) => Database::read(p)?,
@@ -137,7 +169,7 @@ pub fn run(a: ImportArgs, load: &super::common::Loader) -> Result<()> {
                 format!("{} frames read\n{}", frames.len(), i.report),
             )
         }
-        "tricycle" => {
+        FormatArg::Tricycle => {
             let o = TricycleOptions {
                 vehicle,
                 policy,
@@ -146,7 +178,7 @@ pub fn run(a: ImportArgs, load: &super::common::Loader) -> Result<()> {
             let i = deadreckon_import::tricycle::read_tricycle(&a.source, &o)?;
             (i.drive, i.report.to_string())
         }
-        "rosbag" | "mcap" => {
+        FormatArg::Rosbag | FormatArg::Mcap => {
             // Samples out of order, duplicated or invalid are always dropped
             // and counted by these readers (see the report); the topics and
             // the vehicle come from `--mapping` (default: the built-in Husky).
@@ -163,10 +195,9 @@ pub fn run(a: ImportArgs, load: &super::common::Loader) -> Result<()> {
             }
             (drive, format!("{report}\n"))
         }
-        other => bail!("unknown import format `{other}` (comma2k19, can, tricycle, rosbag, mcap)"),
     };
     write_new_or_update(&a.out, &drive)?;
-    print!("{report}");
+    outln!("{}", report.trim_end_matches('\n'));
     print_counts(&drive)?;
     outln!("wrote {}", a.out.display());
     Ok(())

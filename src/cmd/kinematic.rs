@@ -156,17 +156,17 @@ pub fn print_table(c: &KinematicCalibration) -> anyhow::Result<()> {
     }
     if !c.correlated.is_empty() {
         outln!("correlation:");
-        print!("{:<18}", "");
+        let mut header = format!("{:<18}", "");
         for n in &c.correlated {
-            print!(" {:>8}", abbreviate(n));
+            header.push_str(&format!(" {:>8}", abbreviate(n)));
         }
-        outln!();
+        outln!("{header}");
         for (n, row) in c.correlated.iter().zip(&c.correlation) {
-            print!("{n:<18}");
+            let mut line = format!("{n:<18}");
             for v in row {
-                print!(" {v:>8.3}");
+                line.push_str(&format!(" {v:>8.3}"));
             }
-            outln!();
+            outln!("{line}");
         }
     }
     outln!(

@@ -27,7 +27,7 @@ pub struct ReportArgs {
     #[arg(long)]
     pub model: Option<PathBuf>,
     /// Also run the sliding-window outage evaluation with windows of this length, s.
-    #[arg(long)]
+    #[arg(long, value_parser = common::positive)]
     pub outage: Option<f64>,
     /// Output HTML file.
     #[arg(long)]
@@ -36,6 +36,12 @@ pub struct ReportArgs {
 
 /// Runs `report`.
 pub fn run(a: ReportArgs, quiet: bool, load: &common::Loader) -> Result<()> {
+    let params = a.params.as_deref().map(std::path::Path::new);
+    let inputs: Vec<&std::path::Path> = [Some(a.dir.as_path()), params, a.model.as_deref()]
+        .into_iter()
+        .flatten()
+        .collect();
+    common::check_output(&a.out, &inputs)?;
     let steps = Steps::new(8, quiet);
     steps.step("reading the drive");
     let drive = load.drive(&a.dir)?;

@@ -41,11 +41,11 @@ pub struct RunArgs {
     #[arg(long, value_enum, default_value_t = McapContent::Foxglove)]
     pub mcap: McapContent,
     /// Largest time difference of associated poses for --sync-with, s (evo's --t_max_diff).
-    #[arg(long, default_value_t = evo::DEFAULT_MAX_DIFF_S)]
+    #[arg(long, default_value_t = evo::DEFAULT_MAX_DIFF_S, value_parser = common::positive)]
     pub max_diff_s: f64,
     /// Filter timing: wheel or each.
-    #[arg(long, default_value = "wheel")]
-    pub timing: String,
+    #[arg(long, value_enum, default_value_t = common::TimingArg::Wheel)]
+    pub timing: common::TimingArg,
     /// Initial pose for dead reckoning `EAST_M,NORTH_M,YAW_RAD` (default: the truth, else the smoothed GNSS track).
     #[arg(long)]
     pub init_pose: Option<String>,
@@ -128,7 +128,7 @@ pub fn write_tracks(
 
 /// Runs `run`.
 pub fn run(a: RunArgs, load: &common::Loader) -> Result<()> {
-    deadreckon_io::check_not_an_input(&a.out, &a.dir)?;
+    common::check_output(&a.out, &[&a.dir, Path::new(&a.params)])?;
     if kinematic::is_tricycle_log(&a.dir) {
         // The tricycle is dead-reckoned through its own kinematics (the car
         // filter's wheel and steering observations oscillate at its steering
@@ -169,7 +169,7 @@ pub fn run(a: RunArgs, load: &common::Loader) -> Result<()> {
         None => None,
     };
     let opts = FilterOptions {
-        timing: common::parse_timing(&a.timing)?,
+        timing: a.timing.into(),
         wheel_monitor: common::wheel_monitor(a.no_wheel_monitor),
         ..Default::default()
     };

@@ -24,26 +24,26 @@ pub struct SimulateArgs {
     #[arg(long)]
     pub vehicle: Option<PathBuf>,
     /// True gyro bias, rad/s.
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = common::finite)]
     pub gyro_bias: Option<f64>,
     /// True CAN speed scale factor.
-    #[arg(long)]
+    #[arg(long, value_parser = common::positive)]
     pub speed_scale: Option<f64>,
     /// True wheel circumferences FL,FR,RL,RR in metres.
-    #[arg(long, value_delimiter = ',')]
+    #[arg(long, value_delimiter = ',', value_parser = common::positive)]
     pub circumferences: Option<Vec<f64>>,
     /// GNSS noise standard deviation, m.
-    #[arg(long)]
+    #[arg(long, value_parser = common::positive)]
     pub gnss_std: Option<f64>,
     /// Number of laps of the route.
-    #[arg(long)]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     pub laps: Option<u32>,
     /// Drive duration, s (laps repeat until then).
-    #[arg(long)]
+    #[arg(long, value_parser = common::positive)]
     pub duration: Option<f64>,
     /// Geodetic origin LAT,LON (degrees, WGS84) written into vehicle.toml, so
     /// that tracks can be written as GeoJSON.
-    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true, value_parser = common::finite)]
     pub origin: Option<Vec<f64>>,
     /// The vehicle id written to vehicle.toml (drives with one id form a calibration history).
     #[arg(long)]

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use deadreckon_core::ekf::{FilterOptions, Timing};
+use deadreckon_core::ekf::FilterOptions;
 use deadreckon_core::online::{LearnTargets, Online, Start};
 use deadreckon_core::{Params, ParamsWithStd};
 
@@ -21,24 +21,6 @@ pub enum OnBadLine {
     Skip,
 }
 
-/// Filter timing scheme.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum TimingArg {
-    /// One epoch per wheel row (the paper's).
-    Wheel,
-    /// One epoch per reading.
-    Each,
-}
-
-impl From<TimingArg> for Timing {
-    fn from(t: TimingArg) -> Timing {
-        match t {
-            TimingArg::Wheel => Timing::WheelEpochs,
-            TimingArg::Each => Timing::EachMeasurement,
-        }
-    }
-}
-
 /// Arguments of `stream`.
 #[derive(Args, Debug)]
 pub struct StreamArgs {
@@ -50,7 +32,7 @@ pub struct StreamArgs {
     pub params: String,
     /// Filter timing.
     #[arg(long, value_enum, default_value = "wheel")]
-    pub timing: TimingArg,
+    pub timing: super::common::TimingArg,
     /// Resume from this state file if it exists, and write the state to it at the end.
     #[arg(long)]
     pub state: Option<PathBuf>,
@@ -65,7 +47,7 @@ pub struct StreamArgs {
     #[arg(long, requires = "learn")]
     pub params_out: Option<PathBuf>,
     /// With --params-out: also write them every this many seconds of stream time.
-    #[arg(long, requires = "params_out")]
+    #[arg(long, requires = "params_out", value_parser = super::common::positive)]
     pub save_every_s: Option<f64>,
 }
 
@@ -77,6 +59,12 @@ fn default_prior() -> Params {
 
 /// Runs `stream`.
 pub fn run(a: StreamArgs) -> Result<()> {
+    // The learned parameters and the state file (read, then written) are
+    // outputs: neither may be the vehicle or the parameters read.
+    let inputs = [a.vehicle.as_path(), std::path::Path::new(&a.params)];
+    for out in a.params_out.iter().chain(a.state.iter()) {
+        super::common::check_output(out, &inputs)?;
+    }
     let vehicle = deadreckon_io::read_vehicle(&a.vehicle)
         .with_context(|| format!("reading {}", a.vehicle.display()))?;
     let (params, prior) = if a.params == "nominal" {

@@ -80,11 +80,11 @@ pub enum TedrisCommand {
         #[arg(long, value_enum, default_value = "auto")]
         model: Kind,
         /// τ, samples per block.
-        #[arg(long)]
-        tau: Option<usize>,
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+        tau: Option<u32>,
         /// k of ε = k·(W_H − W_L); `inf` for one repository (the paper's robot).
-        #[arg(long)]
-        epsilon_k: Option<String>,
+        #[arg(long, value_parser = epsilon_k)]
+        epsilon_k: Option<EpsilonK>,
         /// Fit each repository separately, as in the paper (default: pooled slopes).
         #[arg(long)]
         separate_repositories: bool,
@@ -97,10 +97,10 @@ pub enum TedrisCommand {
         #[arg(long)]
         config: Option<PathBuf>,
         /// Train only on data from this time on, s (drive clock).
-        #[arg(long = "from")]
+        #[arg(long = "from", value_parser = super::common::finite, allow_hyphen_values = true)]
         from_s: Option<f64>,
         /// Train only on data before this time, s (drive clock).
-        #[arg(long = "until")]
+        #[arg(long = "until", value_parser = super::common::finite, allow_hyphen_values = true)]
         until_s: Option<f64>,
         /// Print JSON instead of tables.
         #[arg(long)]
@@ -124,12 +124,25 @@ pub enum TedrisCommand {
         #[arg(long, value_enum, default_value = "auto")]
         reference: Reference,
         /// The error threshold reported as `time_to_threshold_s`, m.
-        #[arg(long, default_value_t = 1.0)]
+        #[arg(long, default_value_t = 1.0, value_parser = super::common::positive)]
         threshold_m: f64,
         /// Print JSON.
         #[arg(long)]
         json: bool,
     },
+}
+
+/// `--epsilon-k`: a positive finite factor, or `inf` (`None`) for one
+/// repository.
+#[derive(Debug, Clone, Copy)]
+pub struct EpsilonK(Option<f64>);
+
+fn epsilon_k(s: &str) -> std::result::Result<EpsilonK, String> {
+    if s.trim() == "inf" {
+        Ok(EpsilonK(None))
+    } else {
+        super::common::positive(s).map(|k| EpsilonK(Some(k)))
+    }
 }
 
 /// Runs a TedriS subcommand.
@@ -154,6 +167,10 @@ pub fn run(c: TedrisCommand, load: &super::common::Loader) -> Result<()> {
                     bail!("--from {a} must be before --until {b}");
                 }
             }
+            let inputs: Vec<&std::path::Path> = std::iter::once(dir.as_path())
+                .chain(config.as_deref())
+                .collect();
+            super::common::check_output(&out, &inputs)?;
             let drive = load.drive(&dir)?;
             let drive = if from_s.is_some() || until_s.is_some() {
                 time_range(&drive, from_s, until_s)
@@ -189,17 +206,10 @@ pub fn run(c: TedrisCommand, load: &super::common::Loader) -> Result<()> {
                 Kind::Baseline => ModelChoice::Fixed(ModelKind::Baseline),
             };
             if let Some(t) = tau {
-                cfg.tau_samples = t;
+                cfg.tau_samples = t as usize;
             }
             if let Some(k) = epsilon_k {
-                cfg.epsilon_factor = if k == "inf" {
-                    None
-                } else {
-                    Some(
-                        k.parse()
-                            .with_context(|| format!("--epsilon-k {k} is not a number or inf"))?,
-                    )
-                };
+                cfg.epsilon_factor = k.0;
             }
             if separate_repositories {
                 cfg.repository_fit = RepositoryFit::Separate;
@@ -230,6 +240,9 @@ pub fn run(c: TedrisCommand, load: &super::common::Loader) -> Result<()> {
             threshold_m,
             json,
         } => {
+            if let Some(p) = &out {
+                super::common::check_output(p, &[&dir, &model])?;
+            }
             let text = std::fs::read_to_string(&model)
                 .with_context(|| format!("reading {}", model.display()))?;
             let m: TedrisModel = serde_json::from_str(&text)

@@ -31,7 +31,7 @@ pub enum IoError {
     },
     /// Both `wheel_ticks.csv` and `wheel_speeds.csv` exist and no option picks one.
     #[error(
-        "{}: both wheel_ticks.csv and wheel_speeds.csv exist; pick one with ReadOptions::prefer_wheels",
+        "{}: both wheel_ticks.csv and wheel_speeds.csv exist; pick one (command line: --wheels ticks|speeds; library: ReadOptions::prefer_wheels)",
         dir.display()
     )]
     AmbiguousWheels {
