@@ -111,6 +111,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         mapping: cli.mapping,
         skip_checks: cli.skip_checks,
         wheels: cli.wheels.map(Into::into),
+        checks: Default::default(),
     };
     match cli.command {
         Command::Simulate(a) => cmd::simulate::run(a),

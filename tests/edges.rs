@@ -628,3 +628,51 @@ fn nan_infinite_zero_and_negative_option_values_were_accepted() {
     assert!(!st.status.success() && err.contains("diff-drive"), "{err}");
     assert!(!std::path::Path::new(out).exists());
 }
+
+#[test]
+fn plausibility_warnings_reached_stderr_but_not_the_json() {
+    let tmp = vehicle_dir();
+    let d = tmp.path().join("d");
+    // A gyro that hardly follows the wheels (another axis?): a warning, not
+    // an error.
+    let text = std::fs::read_to_string(d.join("yaw_rate.csv")).unwrap();
+    let mut lines = text.lines();
+    let mut out = format!("{}\n", lines.next().unwrap());
+    for l in lines {
+        let (t, v) = l.split_once(',').unwrap();
+        out.push_str(&format!("{t},{}\n", 0.05 * v.parse::<f64>().unwrap()));
+    }
+    std::fs::write(d.join("yaw_rate.csv"), out).unwrap();
+    let json = |global: &[&str]| {
+        let st = bin()
+            .args(global)
+            .args(["evaluate", "--metric", "ape", "--json"])
+            .arg(&d)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&st.stderr).into_owned();
+        assert!(st.status.success(), "{err}");
+        let v: serde_json::Value = serde_json::from_slice(&st.stdout).unwrap();
+        (v["checks"].clone(), err)
+    };
+    let (checks, err) = json(&[]);
+    assert!(
+        err.contains("warning:") && err.contains("gyro_vs_wheel_yaw_rate"),
+        "{err}"
+    );
+    assert_eq!(checks["skipped"], false);
+    let w = checks["warnings"].as_array().unwrap();
+    assert_eq!(w.len(), 1, "{checks}");
+    assert_eq!(w[0]["check"], "gyro_vs_wheel_yaw_rate");
+    assert_eq!(w[0]["severity"], "warning");
+    assert!(
+        w[0]["message"]
+            .as_str()
+            .unwrap()
+            .contains("only 0.049 times"),
+        "{checks}"
+    );
+    let (checks, err) = json(&["--skip-checks"]);
+    assert!(!err.contains("warning:"), "{err}");
+    assert_eq!(checks, serde_json::json!({"skipped": true, "warnings": []}));
+}

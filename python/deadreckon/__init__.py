@@ -185,6 +185,7 @@ def calibrate(
     min_speed: float = 2.0,
     mapping: Optional[PathLike] = None,
     corrections: str = "gnss",
+    skip_checks: bool = False,
 ) -> Dict[str, Any]:
     """Calibrates the six parameters; returns ``deadreckon calibrate --json``'s object.
 
@@ -196,8 +197,14 @@ def calibrate(
     tilt and the gyro scale, apply the tilt, the GNSS delay and the scale;
     ``all``: apply every delay too; ``none``). Keys: the six parameters,
     ``std``, ``iterations``, ``converged``, ``corrections``,
-    ``method``, ``samples``, ``history`` and, when the filter ran, ``gnss``,
-    ``wheel_gaps``, ``gates``. The computation runs without the GIL.
+    ``method``, ``samples``, ``history``, ``checks`` and, when the filter
+    ran, ``gnss``, ``wheel_gaps``, ``gates``. The computation runs without
+    the GIL.
+
+    The drive is first checked across its streams, as the command does (units,
+    clocks, signs: see the README's "What the tool checks"): a drive that
+    cannot be right raises :class:`DeadreckonError` saying what disagrees; the
+    warnings are under ``checks``. ``skip_checks=True`` skips the checks.
     """
     return _native.calibrate(
         _source(drive),
@@ -209,6 +216,7 @@ def calibrate(
         min_speed,
         _opt_path(mapping),
         corrections,
+        skip_checks,
     )
 
 
@@ -261,6 +269,7 @@ def evaluate(
     timing: str = "wheel",
     mapping: Optional[PathLike] = None,
     corrections: str = "gnss",
+    skip_checks: bool = False,
 ) -> Dict[str, Any]:
     """Dead-reckoning accuracy; returns ``deadreckon evaluate --json``'s object.
 
@@ -271,7 +280,9 @@ def evaluate(
     ``params`` the drive is then calibrated with RTS first, as the command
     does, with the ``corrections`` of :func:`calibrate`. ``params`` as in
     :func:`run` (default nominal); a ``params.toml`` path applies the
-    corrections it stores, a dict carries the six parameters only.
+    corrections it stores, a dict carries the six parameters only. The drive
+    is checked across its streams first, as by :func:`calibrate`
+    (``skip_checks``); the warnings are under ``checks``.
     """
     return _native.evaluate(
         _source(drive),
@@ -290,6 +301,7 @@ def evaluate(
         timing,
         _opt_path(mapping),
         corrections,
+        skip_checks,
     )
 
 
@@ -328,13 +340,16 @@ def tedris_train(
     from_s: Optional[float] = None,
     until_s: Optional[float] = None,
     mapping: Optional[PathLike] = None,
+    skip_checks: bool = False,
 ) -> TedrisModel:
     """Trains TedriS on a drive (``deadreckon tedris train``).
 
     ``reference``: ``auto``, ``course``, ``track`` or ``gyro``; ``variant``:
     ``paper`` or ``extended``; ``model``: ``auto``, ``paper``, ``distance``,
     ``arx``, ``baseline``; ``config``: TedriS settings (docs/tedris.md);
-    ``from_s``/``until_s``: train on that part of the drive only.
+    ``from_s``/``until_s``: train on that part of the drive only. The drive
+    is checked across its streams first, as by :func:`calibrate`
+    (``skip_checks``); the summary's ``checks`` holds the warnings.
     """
     text, summary = _native.tedris_train(
         _source(drive),
@@ -345,6 +360,7 @@ def tedris_train(
         from_s,
         until_s,
         _opt_path(mapping),
+        skip_checks,
     )
     return TedrisModel(text, summary)
 
@@ -357,13 +373,20 @@ def tedris_run(
     reference: str = "auto",
     threshold_m: float = 1.0,
     mapping: Optional[PathLike] = None,
+    skip_checks: bool = False,
 ) -> Dict[str, Any]:
     """Runs TedriS with GNSS blanked in ``outages`` ((start_s, end_s), drive
     clock); returns ``tedris run --json``'s object (``outages``,
-    ``reference``, ``source``, ``model``) with ``track``: the predicted track
-    as a DataFrame (instead of the CSV's path)."""
+    ``reference``, ``source``, ``model``, ``checks``) with ``track``: the
+    predicted track as a DataFrame (instead of the CSV's path)."""
     r = _native.tedris_run(
-        _source(drive), model.json, [tuple(o) for o in outages], reference, threshold_m, _opt_path(mapping)
+        _source(drive),
+        model.json,
+        [tuple(o) for o in outages],
+        reference,
+        threshold_m,
+        _opt_path(mapping),
+        skip_checks,
     )
     r["track"] = pd.DataFrame(r["track"])
     return r

@@ -106,6 +106,7 @@ def calibrate(
     min_speed: float = 2.0,
     mapping: Optional[str] = None,
     corrections: str = "gnss",
+    skip_checks: bool = False,
 ) -> Dict[str, Any]: ...
 def run_tracks(
     source: Union[Drive, str],
@@ -131,6 +132,7 @@ def evaluate(
     timing: str = "wheel",
     mapping: Optional[str] = None,
     corrections: str = "gnss",
+    skip_checks: bool = False,
 ) -> Dict[str, Any]: ...
 def tedris_train(
     source: Union[Drive, str],
@@ -141,6 +143,7 @@ def tedris_train(
     from_s: Optional[float] = None,
     until_s: Optional[float] = None,
     mapping: Optional[str] = None,
+    skip_checks: bool = False,
 ) -> Tuple[str, Dict[str, Any]]: ...
 def tedris_run(
     source: Union[Drive, str],
@@ -149,4 +152,5 @@ def tedris_run(
     reference: str = "auto",
     threshold_m: float = 1.0,
     mapping: Optional[str] = None,
+    skip_checks: bool = False,
 ) -> Dict[str, Any]: ...

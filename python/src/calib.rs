@@ -13,7 +13,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::columns::ColumnsOut;
-use crate::drive::drive_arg;
+use crate::drive::{checked, drive_arg};
 use crate::pyjson::to_py;
 use crate::{to_py_err, with_context, DeadreckonError};
 
@@ -67,7 +67,7 @@ fn err(e: impl std::fmt::Display) -> PyErr {
 
 /// `calibrate --json` as a dict; the options are the command's.
 #[pyfunction]
-#[pyo3(signature = (source, method="rts", state="augmented", iteration="anderson", max_iterations=60, timing="wheel", min_speed=2.0, mapping=None, corrections="gnss"))]
+#[pyo3(signature = (source, method="rts", state="augmented", iteration="anderson", max_iterations=60, timing="wheel", min_speed=2.0, mapping=None, corrections="gnss", skip_checks=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn calibrate(
     py: Python<'_>,
@@ -80,6 +80,7 @@ pub fn calibrate(
     min_speed: f64,
     mapping: Option<PathBuf>,
     corrections: &str,
+    skip_checks: bool,
 ) -> PyResult<Py<PyAny>> {
     let which = corrections_which(corrections)?;
     let m: Method = method.parse().map_err(to_py_err)?;
@@ -107,6 +108,7 @@ pub fn calibrate(
         .map(|p| p.display().to_string())
         .unwrap_or_else(|_| "the drive".into());
     let drive = drive_arg(py, source, &read, mapping)?;
+    let checks = checked(source, &drive, skip_checks)?;
     let (drive, corr) = py.detach(|| prepared(&drive, &opts, which))?;
     let c = py
         .detach(|| core_calibrate::calibrate(&drive, &opts))
@@ -116,6 +118,7 @@ pub fn calibrate(
         .map_err(with_context("calibrating the steering".to_string()))?;
     let mut v = json::calibrate_json(method, &c, opts.min_speed_mps, steering.as_ref());
     v["corrections"] = deadreckon_api::corrections::corrections_json(&corr);
+    v["checks"] = checks.json();
     to_py(py, &v)
 }
 
@@ -220,7 +223,7 @@ pub fn track_columns<'py>(py: Python<'py>, t: &track::Track) -> PyResult<Bound<'
 
 /// `evaluate --json` as a dict; the options are the command's.
 #[pyfunction]
-#[pyo3(signature = (source, params=None, metric="drift", outage=None, step=None, warmup=5.0, segment_m=100.0, threshold_m=1.0, track="dead-reckoned", reference="truth", delta_m=100.0, pairs_from="estimate", max_diff_s=evo::DEFAULT_MAX_DIFF_S, timing="wheel", mapping=None, corrections="gnss"))]
+#[pyo3(signature = (source, params=None, metric="drift", outage=None, step=None, warmup=5.0, segment_m=100.0, threshold_m=1.0, track="dead-reckoned", reference="truth", delta_m=100.0, pairs_from="estimate", max_diff_s=evo::DEFAULT_MAX_DIFF_S, timing="wheel", mapping=None, corrections="gnss", skip_checks=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn evaluate(
     py: Python<'_>,
@@ -240,9 +243,11 @@ pub fn evaluate(
     timing: &str,
     mapping: Option<PathBuf>,
     corrections: &str,
+    skip_checks: bool,
 ) -> PyResult<Py<PyAny>> {
     let which = corrections_which(corrections)?;
     let drive = drive_arg(py, source, &Default::default(), mapping)?;
+    let checks = checked(source, &drive, skip_checks)?;
     let timing = parse_timing(timing).map_err(to_py_err)?;
     if let Some(len) = outage {
         let given = params.map(|p| params_arg(p, &drive.vehicle)).transpose()?;
@@ -251,7 +256,7 @@ pub fn evaluate(
             timing,
             ..Default::default()
         };
-        let v = py.detach(|| -> PyResult<serde_json::Value> {
+        let mut v = py.detach(|| -> PyResult<serde_json::Value> {
             let (params, label, drive, corr) = match given {
                 Some((p, l)) => (p, l, stored, None),
                 None => {
@@ -282,6 +287,7 @@ pub fn evaluate(
             }
             Ok(v)
         })?;
+        v["checks"] = checks.json();
         return to_py(py, &v);
     }
     let drive = with_stored(params, (*drive).clone())?;
@@ -289,7 +295,7 @@ pub fn evaluate(
         Some(p) => params_arg(p, &drive.vehicle)?.0,
         None => Params::nominal(&drive.vehicle),
     };
-    let v = py.detach(|| -> PyResult<serde_json::Value> {
+    let mut v = py.detach(|| -> PyResult<serde_json::Value> {
         match metric {
             "drift" => {
                 let r = metrics::drift(&drive, &params, segment_m, timing).map_err(to_py_err)?;
@@ -351,5 +357,6 @@ pub fn evaluate(
             ))),
         }
     })?;
+    v["checks"] = checks.json();
     to_py(py, &v)
 }

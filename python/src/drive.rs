@@ -50,6 +50,21 @@ pub fn drive_arg(
     Ok(Arc::new(d))
 }
 
+/// The cross-stream plausibility checks on a drive read by [`drive_arg`]
+/// (`skip`: none), as the command line runs them: an error raises, naming the
+/// path (or "the drive" for a `Drive`); the warnings are returned for the
+/// result's `checks`.
+pub fn checked(
+    source: &Bound<'_, PyAny>,
+    drive: &deadreckon_core::Drive,
+    skip: bool,
+) -> PyResult<deadreckon_api::checks::Checks> {
+    let what = source
+        .extract::<PathBuf>()
+        .unwrap_or_else(|_| PathBuf::from("the drive"));
+    deadreckon_api::checks::check(&what, drive, skip).map_err(to_py_err)
+}
+
 /// The vehicle from a JSON object of vehicle.toml's keys, or a vehicle.toml path.
 pub fn vehicle_arg(vehicle_json: Option<&str>, vehicle_path: Option<PathBuf>) -> PyResult<Vehicle> {
     let v = match (vehicle_json, vehicle_path) {

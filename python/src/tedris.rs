@@ -10,7 +10,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::calib::track_columns;
-use crate::drive::drive_arg;
+use crate::drive::{checked, drive_arg};
 use crate::pyjson::to_py;
 use crate::{to_py_err, DeadreckonError};
 
@@ -31,7 +31,7 @@ fn reference_source(s: &str) -> PyResult<Option<ReferenceSource>> {
 /// `tedris train`: the model as JSON text (what `--out` writes) and the
 /// summary `tedris train --json` prints.
 #[pyfunction]
-#[pyo3(signature = (source, reference="auto", variant=None, model="auto", config_json=None, from_s=None, until_s=None, mapping=None))]
+#[pyo3(signature = (source, reference="auto", variant=None, model="auto", config_json=None, from_s=None, until_s=None, mapping=None, skip_checks=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn tedris_train(
     py: Python<'_>,
@@ -43,6 +43,7 @@ pub fn tedris_train(
     from_s: Option<f64>,
     until_s: Option<f64>,
     mapping: Option<PathBuf>,
+    skip_checks: bool,
 ) -> PyResult<(String, Py<PyAny>)> {
     if let (Some(a), Some(b)) = (from_s, until_s) {
         if a.partial_cmp(&b) != Some(std::cmp::Ordering::Less) {
@@ -52,6 +53,7 @@ pub fn tedris_train(
         }
     }
     let drive = drive_arg(py, source, &Default::default(), mapping)?;
+    let checks = checked(source, &drive, skip_checks)?;
     let drive = if from_s.is_some() || until_s.is_some() {
         std::sync::Arc::new(time_range(&drive, from_s, until_s))
     } else {
@@ -98,13 +100,15 @@ pub fn tedris_train(
         .detach(|| train(&drive, cfg, source))
         .map_err(to_py_err)?;
     let text = serde_json::to_string_pretty(&m).map_err(to_py_err)?;
-    let summary = deadreckon_api::json::tedris_train_json(&m, source);
+    let mut summary = deadreckon_api::json::tedris_train_json(&m, source);
+    summary["checks"] = checks.json();
     Ok((text, to_py(py, &summary)?))
 }
 
 /// `tedris run --json` as a dict, plus `track`: the predicted track's columns.
 #[pyfunction]
-#[pyo3(signature = (source, model_json, outages, reference="auto", threshold_m=1.0, mapping=None))]
+#[pyo3(signature = (source, model_json, outages, reference="auto", threshold_m=1.0, mapping=None, skip_checks=false))]
+#[allow(clippy::too_many_arguments)]
 pub fn tedris_run<'py>(
     py: Python<'py>,
     source: &Bound<'py, PyAny>,
@@ -113,6 +117,7 @@ pub fn tedris_run<'py>(
     reference: &str,
     threshold_m: f64,
     mapping: Option<PathBuf>,
+    skip_checks: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m: TedrisModel = serde_json::from_str(model_json)
         .map_err(|e| DeadreckonError::new_err(format!("parsing the model: {e}")))?;
@@ -133,6 +138,7 @@ pub fn tedris_run<'py>(
         ));
     }
     let drive = drive_arg(py, source, &Default::default(), mapping)?;
+    let checks = checked(source, &drive, skip_checks)?;
     let opts = RunOptions {
         source: reference_source(reference)?,
         threshold_m: Some(threshold_m),
@@ -145,6 +151,7 @@ pub fn tedris_run<'py>(
         "reference": r.reference,
         "source": r.source,
         "model": m.chosen.name(),
+        "checks": checks.json(),
     });
     let out: Bound<'py, PyDict> = to_py(py, &v)?.into_bound(py).cast_into()?;
     out.set_item("track", track_columns(py, &r.track)?)?;

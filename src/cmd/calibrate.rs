@@ -255,7 +255,7 @@ pub fn run(a: CalibrateArgs, load: &common::Loader) -> Result<()> {
         );
         let mut v = v;
         v["corrections"] = deadreckon_api::corrections::corrections_json(&corrections);
-        outln!("{}", serde_json::to_string_pretty(&v)?);
+        common::print_json(load, v)?;
     } else {
         outln!("{}", common::params_header());
         outln!("{}", common::params_row(&method_name, &c.estimate));
@@ -398,7 +398,7 @@ fn run_diff_drive(a: &CalibrateArgs, load: &common::Loader) -> Result<()> {
     if a.json {
         let mut v = kinematic::calibration_json(shape, method, &c);
         v["yaw_source"] = a.yaw.name().into();
-        outln!("{}", serde_json::to_string_pretty(&v)?);
+        common::print_json(load, v)?;
     } else {
         kinematic::print_table(&c)?;
         if let Some(out) = &a.out {

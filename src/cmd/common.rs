@@ -8,7 +8,7 @@ use deadreckon_core::{Drive, Params, ParamsWithStd};
 
 /// How the commands read drives: the global options `--mapping` and
 /// `--skip-checks`, passed to each command explicitly.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Default)]
 pub struct Loader {
     /// The `--mapping` file for ROS recordings (`None`: the built-in mapping).
     pub mapping: Option<std::path::PathBuf>,
@@ -16,6 +16,9 @@ pub struct Loader {
     pub skip_checks: bool,
     /// `--wheels`: the wheel file to read when a drive directory has both.
     pub wheels: Option<deadreckon_io::WheelFile>,
+    /// What the plausibility checks said of the last drive read, for
+    /// `"checks"` in `--json`.
+    pub checks: std::sync::Mutex<deadreckon_api::checks::Checks>,
 }
 
 /// `--wheels`: which wheel file a drive directory with both is read from.
@@ -54,10 +57,19 @@ impl Loader {
             options.prefer_wheels = self.wheels;
         }
         let drive = deadreckon_api::read_drive_with(path, &options, self.mapping.as_deref())?;
-        if !self.skip_checks {
-            plausible(path, &drive)?;
+        let checks = deadreckon_api::checks::check(path, &drive, self.skip_checks)?;
+        for f in &checks.warnings {
+            eprintln!("warning: {}: {} ({})", path.display(), f.message, f.check);
         }
+        // A poisoned lock holds a whole `Checks` still: take it.
+        *self.checks.lock().unwrap_or_else(|p| p.into_inner()) = checks;
         Ok(drive)
+    }
+
+    /// `"checks"` of `--json`: the plausibility checks' verdict on the last
+    /// drive read.
+    pub fn checks_json(&self) -> serde_json::Value {
+        self.checks.lock().unwrap_or_else(|p| p.into_inner()).json()
     }
 
     /// Reads a ROS1 bag or ROS2 MCAP recording with the `--mapping` file, or the
@@ -79,27 +91,13 @@ pub fn check_output(out: &Path, inputs: &[&Path]) -> Result<()> {
     Ok(())
 }
 
-/// The cross-stream plausibility checks: warnings on standard error, errors
-/// refuse the drive (all of them listed).
-pub fn plausible(path: &Path, drive: &Drive) -> Result<()> {
-    use deadreckon_core::plausibility::{check, Severity};
-    let findings = check(drive);
-    let mut errors = Vec::new();
-    for f in findings {
-        match f.severity {
-            Severity::Warning => {
-                eprintln!("warning: {}: {} ({})", path.display(), f.message, f.check)
-            }
-            Severity::Error => errors.push(format!("  {} ({})", f.message, f.check)),
-        }
+/// Prints a `--json` object with `"checks"`: what the plausibility checks
+/// said of the drive `load` read last.
+pub fn print_json(load: &Loader, mut v: serde_json::Value) -> Result<()> {
+    if let Some(o) = v.as_object_mut() {
+        o.insert("checks".into(), load.checks_json());
     }
-    anyhow::ensure!(
-        errors.is_empty(),
-        "{}: the streams disagree (a mistake of units, clocks or signs?):\n{}\n\
-         (--skip-checks reads the drive anyway)",
-        path.display(),
-        errors.join("\n")
-    );
+    outln!("{}", serde_json::to_string_pretty(&v)?);
     Ok(())
 }
 

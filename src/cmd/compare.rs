@@ -62,7 +62,11 @@ pub fn run(a: CompareArgs, load: &common::Loader) -> Result<()> {
     if a.json {
         outln!(
             "{}",
-            serde_json::to_string_pretty(&deadreckon_api::json::comparison_json(&c))?
+            serde_json::to_string_pretty(&{
+                let mut v = deadreckon_api::json::comparison_json(&c);
+                v["checks"] = load.checks_json();
+                v
+            })?
         );
     } else {
         common::print_comparison(&c, 0.0)?;

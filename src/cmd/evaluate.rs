@@ -180,7 +180,7 @@ pub fn run(a: EvaluateArgs, load: &common::Loader) -> Result<()> {
             if let Some(c) = &corrections {
                 v["corrections"] = deadreckon_api::corrections::corrections_json(c);
             }
-            outln!("{}", serde_json::to_string_pretty(&v)?);
+            common::print_json(load, v)?;
         } else {
             outln!(
                 "{} outage windows of {len} s against the {} (parameters: {source})",
@@ -230,7 +230,7 @@ pub fn run(a: EvaluateArgs, load: &common::Loader) -> Result<()> {
             let s = Summary::of(&r.errors_pct());
             if a.json {
                 let v = deadreckon_api::json::drift_json(&r, a.segment_m);
-                outln!("{}", serde_json::to_string_pretty(&v)?);
+                common::print_json(load, v)?;
             } else {
                 outln!("drift per {} m over {} segments: mean {:.3}%, std {:.3}%, median {:.3}%, max {:.3}%", a.segment_m, s.n, s.mean, s.std, s.median, s.max);
                 outln!("rejected by the χ² gates: {}", common::gated_text(&r.gates));
@@ -241,7 +241,7 @@ pub fn run(a: EvaluateArgs, load: &common::Loader) -> Result<()> {
             let s = Summary::of(&r.distances_m);
             if a.json {
                 let v = deadreckon_api::json::reset_json(&r, a.threshold_m);
-                outln!("{}", serde_json::to_string_pretty(&v)?);
+                common::print_json(load, v)?;
             } else {
                 outln!(
                     "distance before {} m of error over {} resets: mean {:.1} m, median {:.1} m, min {:.1} m, max {:.1} m",
@@ -288,7 +288,7 @@ pub fn run(a: EvaluateArgs, load: &common::Loader) -> Result<()> {
                     pairs_from: pairs_from_name,
                 };
                 let v = deadreckon_api::json::evo_json(&q, &r);
-                outln!("{}", serde_json::to_string_pretty(&v)?);
+                common::print_json(load, v)?;
             } else {
                 let what = if a.metric == MetricArg::Rpe {
                     format!(
@@ -391,7 +391,7 @@ fn run_diff_drive(a: &EvaluateArgs, load: &common::Loader) -> Result<()> {
         let mut v = kinematic::outages_json(Shape::DiffDrive, &ev, &source);
         v["reference"] = "gnss (hidden fixes; start aligned to the preceding fixes)".into();
         v["align_s"] = a.align.into();
-        outln!("{}", serde_json::to_string_pretty(&v)?);
+        common::print_json(load, v)?;
     } else {
         let s = ev.final_error();
         outln!(

@@ -191,7 +191,7 @@ pub fn run(a: RunArgs, load: &common::Loader) -> Result<()> {
             "tracks": t.iter().map(|tr| serde_json::json!({"name": tr.name, "poses": tr.points.len()})).collect::<Vec<_>>(),
             "wheel_health": health.as_ref().ok().map(deadreckon_api::json::wheel_health_json),
         });
-        outln!("{}", serde_json::to_string_pretty(&v)?);
+        common::print_json(load, v)?;
         return Ok(());
     }
     for tr in &t {

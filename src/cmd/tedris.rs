@@ -217,14 +217,15 @@ pub fn run(c: TedrisCommand, load: &super::common::Loader) -> Result<()> {
             cfg.validate()?;
             let (m, source) = train(&drive, cfg, source)?;
             let text = serde_json::to_string_pretty(&m)?;
-            std::fs::write(&out, text).with_context(|| format!("writing {}", out.display()))?;
+            // Whole or not at all (a temporary beside it, renamed), with
+            // the permissions of a model it replaces.
+            deadreckon_io::atomic_write(&out, |w| w.write_all(text.as_bytes()))
+                .with_context(|| format!("writing {}", out.display()))?;
             if json {
-                outln!(
-                    "{}",
-                    serde_json::to_string_pretty(&deadreckon_api::json::tedris_train_json(
-                        &m, source
-                    ))?
-                );
+                super::common::print_json(
+                    load,
+                    deadreckon_api::json::tedris_train_json(&m, source),
+                )?;
             } else {
                 print_train(&m, source)?;
                 outln!("model written to {}", out.display());
@@ -273,7 +274,7 @@ pub fn run(c: TedrisCommand, load: &super::common::Loader) -> Result<()> {
                     "model": m.chosen.name(),
                     "track": out.as_ref().map(|p| p.display().to_string()),
                 });
-                outln!("{}", serde_json::to_string_pretty(&v)?);
+                super::common::print_json(load, v)?;
             } else {
                 outln!(
                     "reference heading: {:?}; errors against {}",

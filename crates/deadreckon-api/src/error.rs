@@ -67,6 +67,18 @@ pub enum Error {
         /// The path.
         path: PathBuf,
     },
+    /// The cross-stream plausibility checks found data that cannot be right
+    /// (a mistake of units, clocks or signs).
+    #[error(
+        "{}: the streams disagree (a mistake of units, clocks or signs?):\n{findings}\n(--skip-checks reads the drive anyway)",
+        path.display()
+    )]
+    Implausible {
+        /// The drive.
+        path: PathBuf,
+        /// Each error finding on a line: what disagrees, by how much, and the check's name.
+        findings: String,
+    },
     /// An option word is not one of those allowed.
     #[error("unknown {what} `{value}` ({allowed})")]
     UnknownOption {

@@ -8,6 +8,8 @@
 //!   (`deadreckon-io`), a comma2k19 segment, a ROS1 bag or ROS2 MCAP (with a
 //!   topic mapping) or a tricycle log, chosen by what the path holds; errors
 //!   name the file and, through their sources, the line and column.
+//! - [`checks`]: the cross-stream plausibility checks applied to a drive
+//!   read (errors refuse it, warnings go to `"checks"` in `--json`).
 //! - [`json`]: the objects `calibrate --json`, `evaluate --json` and
 //!   `tedris train --json` print, built from the library results.
 //! - [`options`]: the option words of the commands (`--timing wheel|each`,
@@ -19,6 +21,7 @@
 //! exception's text read the same.
 #![deny(missing_docs)]
 
+pub mod checks;
 pub mod corrections;
 pub mod json;
 pub mod options;
