@@ -41,8 +41,9 @@ pub struct SimulateArgs {
     /// Drive duration, s (laps repeat until then).
     #[arg(long, value_parser = common::positive)]
     pub duration: Option<f64>,
-    /// Geodetic origin LAT,LON (degrees, WGS84) written into vehicle.toml, so
-    /// that tracks can be written as GeoJSON.
+    /// Geodetic origin LAT,LON[,HEIGHT] (degrees, WGS84; height above the
+    /// ellipsoid in metres, default 0) written into vehicle.toml, so that
+    /// tracks can be written as GeoJSON.
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true, value_parser = common::finite)]
     pub origin: Option<Vec<f64>>,
     /// The vehicle id written to vehicle.toml (drives with one id form a calibration history).
@@ -91,10 +92,19 @@ fn with_overrides(mut sc: Scenario, a: &SimulateArgs) -> Result<Scenario> {
         sc = sc.with_duration_s(d);
     }
     if let Some(o) = &a.origin {
-        let &[lat_deg, lon_deg] = o.as_slice() else {
-            anyhow::bail!("--origin takes LAT,LON in degrees, got {} values", o.len());
+        let (lat_deg, lon_deg, height_m) = match *o.as_slice() {
+            [lat, lon] => (lat, lon, 0.0),
+            [lat, lon, h] => (lat, lon, h),
+            _ => anyhow::bail!(
+                "--origin takes LAT,LON[,HEIGHT] (degrees, metres above the WGS84 ellipsoid), got {} values",
+                o.len()
+            ),
         };
-        sc.vehicle.origin = Some(deadreckon_core::vehicle::Origin { lat_deg, lon_deg });
+        sc.vehicle.origin = Some(deadreckon_core::vehicle::Origin {
+            lat_deg,
+            lon_deg,
+            height_m,
+        });
         sc.vehicle.validate().context("--origin")?;
     }
     sc.validate()?;

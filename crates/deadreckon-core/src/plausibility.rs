@@ -12,6 +12,7 @@
 //! | `wheel_speed_range` | the speed the wheel rows imply with 90 m/s | cumulative counters, wrong `ticks_per_rev` |
 //! | `can_vs_wheel_speed` | CAN speed with the wheel speed | km/h, mph |
 //! | `gnss_vs_wheel_distance` | GNSS displacement with the wheels' distance | wrong circumference or ticks, km/h wheel speeds, swapped lat/lon |
+//! | `gnss_turns_vs_wheel_turns` | the GNSS track's turns with the wheels' | latitude and longitude swapped, east and north swapped |
 //! | `gyro_vs_wheel_yaw_rate` | gyro with the rear wheels' yaw rate | a flipped sign, deg/s (skid steering turns less than the wheels say: only a gyro below 0.1 times them is suspicious) |
 //! | `course_vs_track` | GNSS course with the direction of the GNSS track | radians, counter-clockwise from east |
 //! | `stuck_gnss` | GNSS position with wheel motion | a receiver repeating its last fix |
@@ -65,6 +66,7 @@ pub fn check(drive: &Drive) -> Vec<Finding> {
         can_vs_wheel_speed(drive, &speed, &mut out);
         gnss_vs_wheel_distance(drive, &speed, &mut out);
         gyro_vs_wheel_yaw_rate(drive, &rows, &mut out);
+        gnss_turns_vs_wheel_turns(drive, &rows, &speed, &mut out);
     }
     course_vs_track(drive, &mut out);
     stuck_gnss(drive, &speed, &mut out);
@@ -357,21 +359,111 @@ fn gnss_vs_wheel_distance(d: &Drive, speed: &[(f64, f64)], out: &mut Vec<Finding
     ));
 }
 
-fn gyro_vs_wheel_yaw_rate(d: &Drive, rows: &[(f64, [f64; 4])], out: &mut Vec<Finding>) {
+/// The yaw rate of an axle whose two wheels carry sensors, `(t, rad/s)`:
+/// (right − left) / track (rear axle first).
+fn wheel_yaw_rate(d: &Drive, rows: &[(f64, [f64; 4])]) -> Option<Vec<(f64, f64)>> {
     let v = &d.vehicle;
-    // The yaw rate of an axle whose two wheels carry sensors: (right − left) / track.
-    let pair = if v.wheels_present[2] && v.wheels_present[3] {
-        Some((2, 3, v.track_rear_m))
+    let (l, r, track) = if v.wheels_present[2] && v.wheels_present[3] {
+        (2, 3, v.track_rear_m)
     } else if v.wheels_present[0] && v.wheels_present[1] {
-        Some((0, 1, v.track_front_m))
+        (0, 1, v.track_front_m)
     } else {
-        None
+        return None;
     };
-    let Some((l, r, track)) = pair else { return };
-    let rate: Vec<(f64, f64)> = rows
-        .iter()
-        .map(|(t, w)| (*t, (w[r] - w[l]) / track))
-        .collect();
+    Some(
+        rows.iter()
+            .map(|(t, w)| (*t, (w[r] - w[l]) / track))
+            .collect(),
+    )
+}
+
+/// Turns the GNSS track makes against those of the wheels: a mirrored track
+/// (latitude and longitude swapped, or east and north) turns the other way,
+/// while its distances may stay within the distance check's tolerance.
+fn gnss_turns_vs_wheel_turns(
+    d: &Drive,
+    rows: &[(f64, [f64; 4])],
+    speed: &[(f64, f64)],
+    out: &mut Vec<Finding>,
+) {
+    let Some(rate) = wheel_yaw_rate(d, rows) else {
+        return;
+    };
+    // The wheels' heading, integrated (trapezoids).
+    let mut heading = Vec::with_capacity(rate.len());
+    let mut h = 0.0;
+    for (i, &(t, w)) in rate.iter().enumerate() {
+        if i > 0 {
+            let (t0, w0) = rate[i - 1];
+            h += 0.5 * (w + w0) * (t - t0);
+        }
+        heading.push((t, h));
+    }
+    let moving = |a: f64, b: f64| {
+        let i = speed.partition_point(|p| p.0 < a);
+        let j = speed.partition_point(|p| p.0 <= b);
+        i > 0 && j < speed.len() && speed[i..j].iter().all(|p| p.1 > MIN_SPEED_MPS)
+    };
+    // Chords of the GNSS track long against the fixes' noise (ten standard
+    // deviations: direction to about 0.1 rad) and at most 5 s long, one
+    // after the other, while moving forward: (middle time, direction).
+    let mut chords: Vec<(f64, f64, f64)> = Vec::new();
+    let mut k = 0;
+    while k < d.gnss.len() {
+        let a = &d.gnss[k];
+        let mut next = k + 1;
+        for j in k + 1..d.gnss.len() {
+            let b = &d.gnss[j];
+            if b.t_s - a.t_s > 5.0 {
+                break;
+            }
+            let (de, dn) = (b.east_m - a.east_m, b.north_m - a.north_m);
+            if de.hypot(dn) >= 10.0 * a.std_m.max(b.std_m) {
+                if moving(a.t_s, b.t_s) {
+                    chords.push((a.t_s, b.t_s, dn.atan2(de)));
+                }
+                next = j;
+                break;
+            }
+        }
+        k = next;
+    }
+    // Turns of more than 0.3 rad between neighbouring chords.
+    let (mut turns, mut against) = (0usize, 0usize);
+    for w in chords.windows(2) {
+        let ((a0, b0, d0), (a1, b1, d1)) = (w[0], w[1]);
+        if a1 - b0 > 5.0 {
+            continue;
+        }
+        let (m0, m1) = (0.5 * (a0 + b0), 0.5 * (a1 + b1));
+        let (Some(h0), Some(h1)) = (interpolate(&heading, m0), interpolate(&heading, m1)) else {
+            continue;
+        };
+        let wheels = h1 - h0;
+        let gnss = (d1 - d0 + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
+            - std::f64::consts::PI;
+        if wheels.abs() > 0.3 {
+            turns += 1;
+            if gnss * wheels < 0.0 {
+                against += 1;
+            }
+        }
+    }
+    if turns >= 5 && against as f64 > 0.8 * turns as f64 {
+        out.push(error(
+            "gnss_turns_vs_wheel_turns",
+            format!(
+                "the GNSS track turns the other way from the wheels in {against} of {turns} \
+                 turns: latitude and longitude swapped (or east and north)?"
+            ),
+        ));
+    }
+}
+
+fn gyro_vs_wheel_yaw_rate(d: &Drive, rows: &[(f64, [f64; 4])], out: &mut Vec<Finding>) {
+    let Some(rate) = wheel_yaw_rate(d, rows) else {
+        return;
+    };
     // Smooth the wheel rate over about 0.5 s (ticks are coarse), then regress
     // the gyro on it through the origin after removing both means (the bias).
     let smooth: Vec<(f64, f64)> = rate

@@ -5,7 +5,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::Error;
 
-/// A geodetic origin for drives recorded in latitude/longitude.
+/// A geodetic origin for drives recorded in latitude/longitude: the point
+/// whose tangent plane is the drive's east/north frame.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Origin {
@@ -13,6 +14,25 @@ pub struct Origin {
     pub lat_deg: f64,
     /// Longitude, degrees east (WGS84).
     pub lon_deg: f64,
+    /// Height above the WGS84 ellipsoid, m (default 0; not written when 0).
+    /// Positions without a height of their own are taken at this height.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub height_m: f64,
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
+}
+
+impl Origin {
+    /// An origin on the ellipsoid (height 0).
+    pub fn new(lat_deg: f64, lon_deg: f64) -> Self {
+        Origin {
+            lat_deg,
+            lon_deg,
+            height_m: 0.0,
+        }
+    }
 }
 
 /// Noise standard deviations: the paper's tables I (evolution, per 20 ms step) and
@@ -184,6 +204,12 @@ impl Vehicle {
                 return Err(Error::InvalidVehicle(format!(
                     "origin longitude must be within ±180°, got {}",
                     o.lon_deg
+                )));
+            }
+            if !(o.height_m.is_finite() && (-1000.0..=10_000.0).contains(&o.height_m)) {
+                return Err(Error::InvalidVehicle(format!(
+                    "origin height must be metres above the WGS84 ellipsoid, -1000 to 10000, got {}",
+                    o.height_m
                 )));
             }
         }

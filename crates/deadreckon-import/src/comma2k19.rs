@@ -307,12 +307,19 @@ pub fn read_comma2k19_with(dir: &Path, o: &Comma2k19Options) -> Result<Import, I
     let first_fix = fixes
         .iter()
         .find(|f| f[0].is_finite() && f[1].is_finite() && f[4].is_finite());
-    let alt0 = first_fix.map_or(0.0, |f| f[4]);
+    let first_alt = first_fix.map_or(0.0, |f| f[4]);
+    // The frame is the tangent plane at the origin at its height: a given
+    // origin's, or (given without one, or taken from it) the first fix's.
     let origin = match (vehicle.origin, first_fix) {
-        (Some(o), _) => o,
+        (Some(o), _) if o.height_m != 0.0 => o,
+        (Some(o), _) => Origin {
+            height_m: first_alt,
+            ..o
+        },
         (None, Some(f)) => Origin {
             lat_deg: f[0],
             lon_deg: f[1],
+            height_m: f[4],
         },
         (None, None) => {
             return Err(ImportError::Stream {
@@ -325,9 +332,10 @@ pub fn read_comma2k19_with(dir: &Path, o: &Comma2k19Options) -> Result<Import, I
         }
     };
     vehicle.origin = Some(origin);
+    let alt0 = origin.height_m;
     let (lat0, lon0) = (origin.lat_deg.to_radians(), origin.lon_deg.to_radians());
     report.notes.push(format!(
-        "origin: lat {:.8} lon {:.8} (altitude {alt0:.2} m, from the first u-blox fix)",
+        "origin: lat {:.8} lon {:.8} (altitude {alt0:.2} m above the WGS84 ellipsoid)",
         origin.lat_deg, origin.lon_deg
     ));
     let mut b = StreamBuilder::new("gnss", &gn.dir, o.policy);

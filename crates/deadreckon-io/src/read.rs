@@ -141,9 +141,9 @@ pub fn read_drive_with(dir: &Path, options: &ReadOptions) -> Result<Drive, IoErr
     let steering = scalar(files::STEERING, "steering_wheel_rad", Limit::SteeringWheel)?;
 
     let gnss_path = dir.join(files::GNSS);
-    let (mut gnss, gnss_geo) = match read_optional(&gnss_path)? {
+    let (mut gnss, gnss_heights) = match read_optional(&gnss_path)? {
         Some(b) => parse_gnss(&gnss_path, &b)?,
-        None => (Vec::new(), false),
+        None => (Vec::new(), None),
     };
     let truth_path = dir.join(files::TRUTH);
     let truth_bytes = if options.skip_truth {
@@ -151,14 +151,14 @@ pub fn read_drive_with(dir: &Path, options: &ReadOptions) -> Result<Drive, IoErr
     } else {
         read_optional(&truth_path)?
     };
-    let (mut truth, truth_geo) = match truth_bytes {
+    let (mut truth, truth_heights) = match truth_bytes {
         Some(b) => parse_truth(&truth_path, &b)?,
-        None => (Vec::new(), false),
+        None => (Vec::new(), None),
     };
 
     // Geodetic files: pick the origin, then convert.
-    let gnss_geo = gnss_geo && !gnss.is_empty();
-    let truth_geo = truth_geo && !truth.is_empty();
+    let gnss_geo = gnss_heights.is_some() && !gnss.is_empty();
+    let truth_geo = truth_heights.is_some() && !truth.is_empty();
     if gnss_geo || truth_geo {
         let origin = match vehicle.origin {
             Some(o) => o,
@@ -183,23 +183,41 @@ pub fn read_drive_with(dir: &Path, options: &ReadOptions) -> Result<Drive, IoErr
                 } else {
                     truth.first().map(|t| (t.east_m, t.north_m))
                 };
+                let first_height = if gnss_geo {
+                    gnss_heights
+                        .as_ref()
+                        .and_then(|h| h.first().copied().flatten())
+                } else {
+                    truth_heights
+                        .as_ref()
+                        .and_then(|h| h.first().copied().flatten())
+                };
                 let Some((lat_deg, lon_deg)) = first else {
                     return Err(IoError::NeedsOrigin {
                         file: dir.to_path_buf(),
                         message: "no fix to take as the origin".into(),
                     });
                 };
-                Origin { lat_deg, lon_deg }
+                Origin {
+                    lat_deg,
+                    lon_deg,
+                    height_m: first_height.unwrap_or(0.0),
+                }
             }
         };
-        if gnss_geo {
-            for g in &mut gnss {
-                (g.east_m, g.north_m) = geo::geodetic_to_en(&origin, g.east_m, g.north_m);
+        // Each position at its own height where the file gives one, else at
+        // the origin's.
+        let to_en = |lat: f64, lon: f64, h: Option<f64>| {
+            geo::geodetic_height_to_en(&origin, lat, lon, h.unwrap_or(origin.height_m))
+        };
+        if let (true, Some(h)) = (gnss_geo, &gnss_heights) {
+            for (g, &h) in gnss.iter_mut().zip(h) {
+                (g.east_m, g.north_m) = to_en(g.east_m, g.north_m, h);
             }
         }
-        if truth_geo {
-            for t in &mut truth {
-                (t.east_m, t.north_m) = geo::geodetic_to_en(&origin, t.east_m, t.north_m);
+        if let (true, Some(h)) = (truth_geo, &truth_heights) {
+            for (t, &h) in truth.iter_mut().zip(h) {
+                (t.east_m, t.north_m) = to_en(t.east_m, t.north_m, h);
             }
         }
         vehicle.origin = Some(origin);
@@ -365,46 +383,69 @@ fn position_indices(
     })
 }
 
-/// Parses `gnss.csv`; with latitude/longitude (flag `true`) the fixes carry
-/// latitude in `east_m` and longitude in `north_m` until converted.
-pub(crate) fn parse_gnss(file: &Path, bytes: &[u8]) -> Result<(Vec<GnssFix>, bool), IoError> {
+/// Per-row ellipsoidal heights of a file in latitude/longitude (`None`
+/// where it gives none), or `None` for a file in east/north.
+pub(crate) type Heights = Option<Vec<Option<f64>>>;
+
+/// The rows' heights as [`Heights`].
+fn heights(geodetic: bool, h: Vec<Option<f64>>) -> Heights {
+    geodetic.then_some(h)
+}
+
+/// Parses `gnss.csv`; with latitude/longitude (heights `Some`) the fixes
+/// carry latitude in `east_m` and longitude in `north_m` until converted.
+pub(crate) fn parse_gnss(file: &Path, bytes: &[u8]) -> Result<(Vec<GnssFix>, Heights), IoError> {
     let t = Table::new(file, bytes)?;
     let geodetic = position_columns(&t)?;
     let ts = t.col("t_s")?;
     let std = t.col("std_m")?;
     let (a, b, la, lb) = position_indices(&t, geodetic)?;
     let (course, speed) = (t.opt_col("course_deg"), t.opt_col("speed_mps"));
-    let fixes = t.rows(|r| {
-        Ok(GnssFix {
+    let height = if geodetic {
+        t.opt_col("height_m")
+    } else {
+        None
+    };
+    let rows = t.rows(|r| {
+        let fix = GnssFix {
             t_s: r.f64(ts)?,
             east_m: position(r, a, la)?,
             north_m: position(r, b, lb)?,
             std_m: r.checked(std, Limit::Std)?,
             course_deg: r.opt_checked(course, Limit::Course)?,
             speed_mps: r.opt_checked(speed, Limit::Speed)?,
-        })
+        };
+        Ok((fix, r.opt_checked(height, Limit::Height)?))
     })?;
-    Ok((fixes, geodetic))
+    let (fixes, h): (Vec<_>, Vec<_>) = rows.into_iter().unzip();
+    Ok((fixes, heights(geodetic, h)))
 }
 
 /// Parses `truth.csv`, like [`parse_gnss`].
-pub(crate) fn parse_truth(file: &Path, bytes: &[u8]) -> Result<(Vec<TruthPose>, bool), IoError> {
+pub(crate) fn parse_truth(file: &Path, bytes: &[u8]) -> Result<(Vec<TruthPose>, Heights), IoError> {
     let t = Table::new(file, bytes)?;
     let geodetic = position_columns(&t)?;
     let ts = t.col("t_s")?;
     let yaw = t.col("yaw_rad")?;
     let (a, b, la, lb) = position_indices(&t, geodetic)?;
     let speed = t.opt_col("speed_mps");
-    let poses = t.rows(|r| {
-        Ok(TruthPose {
+    let height = if geodetic {
+        t.opt_col("height_m")
+    } else {
+        None
+    };
+    let rows = t.rows(|r| {
+        let pose = TruthPose {
             t_s: r.f64(ts)?,
             east_m: position(r, a, la)?,
             north_m: position(r, b, lb)?,
             yaw_rad: r.checked(yaw, Limit::Yaw)?,
             speed_mps: r.opt_checked(speed, Limit::Speed)?,
-        })
+        };
+        Ok((pose, r.opt_checked(height, Limit::Height)?))
     })?;
-    Ok((poses, geodetic))
+    let (poses, h): (Vec<_>, Vec<_>) = rows.into_iter().unzip();
+    Ok((poses, heights(geodetic, h)))
 }
 
 fn position(

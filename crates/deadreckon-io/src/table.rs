@@ -29,7 +29,15 @@ pub(crate) enum Limit {
     Lon,
     /// Specific force, m/s²: |v| ≤ 200.
     Accel,
+    /// Ellipsoidal height, m: -1000 ≤ v ≤ 10000.
+    Height,
 }
+
+/// Lowest accepted ellipsoidal height, m (the Dead Sea shore is about -400 m
+/// above the geoid, the geoid within ±110 m of the ellipsoid).
+pub(crate) const MIN_HEIGHT_M: f64 = -1000.0;
+/// Highest accepted ellipsoidal height, m (above every road).
+pub(crate) const MAX_HEIGHT_M: f64 = 10_000.0;
 
 /// Largest accepted |specific force|, m/s² (about 20 g).
 pub(crate) const MAX_ACCEL_MPS2: f64 = 200.0;
@@ -58,6 +66,7 @@ impl Limit {
             Limit::Lat => v.abs() <= 90.0,
             Limit::Lon => v.abs() <= 180.0,
             Limit::Accel => v.abs() <= MAX_ACCEL_MPS2,
+            Limit::Height => (MIN_HEIGHT_M..=MAX_HEIGHT_M).contains(&v),
         };
         if ok {
             return None;
@@ -78,6 +87,9 @@ impl Limit {
                 Limit::Speed => "|speed| > 100 m/s looks like km/h or mph; expected m/s",
                 Limit::Lat => "not a latitude in degrees (expected -90 to 90)",
                 Limit::Lon => "not a longitude in degrees (expected -180 to 180)",
+                Limit::Height => {
+                    "not a height above the WGS84 ellipsoid in metres (expected -1000 to 10000; millimetres or feet?)"
+                }
                 Limit::Accel => {
                     "|specific force| > 200 m/s² looks like mm/s² or cm/s²; expected m/s²"
                 }

@@ -86,6 +86,7 @@ fn lat_lon_files_match_east_north_within_a_millimetre() {
     let origin = Origin {
         lat_deg: 49.4,
         lon_deg: 2.8,
+        height_m: 0.0,
     };
     // Spread the positions over about a kilometre.
     let mut drive = drive;
@@ -609,4 +610,98 @@ fn preferring_a_missing_wheel_file_uses_the_other() {
         read_drive_with(dir.path(), &opts).expect("ticks used"),
         drive
     );
+}
+
+#[test]
+fn heights_were_taken_as_0_by_the_csv_reader_and_the_track_writers() {
+    // A drive 2,000 m above the ellipsoid, positions out to 100 km.
+    let origin = Origin {
+        lat_deg: 46.0,
+        lon_deg: 8.0,
+        height_m: 2_000.0,
+    };
+    let mut drive = small_drive();
+    let far = [(0.0, 100e3), (100e3, 0.0), (-70e3, -70e3)];
+    for (i, g) in drive.gnss.iter_mut().enumerate() {
+        (g.east_m, g.north_m) = far[i % far.len()];
+    }
+    let dir = written(&drive);
+    let mut with_origin = drive.clone();
+    with_origin.vehicle.origin = Some(origin);
+    deadreckon_io::write_vehicle(&dir.path().join(files::VEHICLE), &with_origin.vehicle)
+        .expect("vehicle");
+    let lat_lon = |height: &dyn Fn(usize) -> String| {
+        let mut gnss = String::from("t_s,lat_deg,lon_deg,height_m,std_m\n");
+        for (i, g) in drive.gnss.iter().enumerate() {
+            let (lat, lon) = geo::en_to_geodetic(&origin, g.east_m, g.north_m);
+            gnss += &format!("{},{lat},{lon},{},{}\n", g.t_s, height(i), g.std_m);
+        }
+        gnss
+    };
+    // Heights given (one left empty: the origin's), and no height column.
+    for gnss in [
+        lat_lon(&|i| if i == 1 { String::new() } else { "2000".into() }),
+        lat_lon(&|_| "2000".into()).replace(",height_m", ",h"),
+    ] {
+        put(dir.path(), files::GNSS, &gnss);
+        let back = read_drive(dir.path()).expect("lat/lon drive");
+        assert_eq!(back.vehicle.origin, Some(origin));
+        for (a, b) in back.gnss.iter().zip(&drive.gnss) {
+            assert!(
+                (a.east_m - b.east_m).abs() < 1e-6 && (a.north_m - b.north_m).abs() < 1e-6,
+                "({}, {}) vs ({}, {})",
+                a.east_m,
+                a.north_m,
+                b.east_m,
+                b.north_m
+            );
+        }
+    }
+    // Read as if at height 0 (what the reader did): 31 m off at 100 km.
+    put(dir.path(), files::GNSS, &lat_lon(&|_| "0".into()));
+    let low = read_drive(dir.path()).expect("lat/lon drive");
+    let off = (low.gnss[0].north_m - 100e3).abs();
+    assert!((25.0..40.0).contains(&off), "{off} m");
+    // A height in millimetres is refused with its line.
+    put(dir.path(), files::GNSS, &lat_lon(&|_| "2000000".into()));
+    let (_, msg) = read_err(dir.path());
+    assert_mentions(&msg, &["gnss.csv", "line 2", "height_m", "ellipsoid"]);
+
+    // Written back: the GeoJSON of the positions read gives the same
+    // latitude/longitude to its 1e-8° rounding.
+    let track = deadreckon_core::Track {
+        name: "fixes".into(),
+        points: drive
+            .gnss
+            .iter()
+            .map(|g| deadreckon_core::TrackPoint {
+                t_s: g.t_s,
+                east_m: g.east_m,
+                north_m: g.north_m,
+                yaw_rad: 0.0,
+                speed_mps: 0.0,
+                yaw_rate_rps: 0.0,
+                cov_pose: [0.0; 9],
+            })
+            .collect(),
+        origin: Some(origin),
+    };
+    let out = dir.path().join("t.geojson");
+    deadreckon_io::write_track_geojson(&out, &[track]).expect("geojson");
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    let coords = v["features"][0]["geometry"]["coordinates"]
+        .as_array()
+        .unwrap();
+    for (c, g) in coords.iter().zip(&drive.gnss) {
+        let (lat, lon) = geo::en_to_geodetic(&origin, g.east_m, g.north_m);
+        assert!(
+            (c[0].as_f64().unwrap() - lon).abs() < 1e-8,
+            "{c} vs {lat}, {lon}"
+        );
+        assert!(
+            (c[1].as_f64().unwrap() - lat).abs() < 1e-8,
+            "{c} vs {lat}, {lon}"
+        );
+    }
 }

@@ -48,6 +48,7 @@ fn vehicle_round_trip_with_origin_and_noise() {
     v.origin = Some(Origin {
         lat_deg: 49.123456789012,
         lon_deg: -2.5,
+        height_m: 0.0,
     });
     v.noise.steering = 1.0 / 3.0;
     write_vehicle(&path, &v).expect("written");
@@ -279,6 +280,7 @@ fn track_geojson_line_strings_and_points() {
     let origin = Origin {
         lat_deg: 49.4,
         lon_deg: 2.8,
+        height_m: 0.0,
     };
     let tracks = [
         track("smoothed", Some(origin), 5),
@@ -395,6 +397,7 @@ fn geodetic_conversion_matches_wgs84_closed_forms() {
         let origin = Origin {
             lat_deg: lat0,
             lon_deg: lon0,
+            height_m: 0.0,
         };
         let phi = lat0.to_radians();
         let w = (1.0 - e2 * phi.sin().powi(2)).sqrt();
@@ -423,6 +426,7 @@ fn geodetic_conversion_matches_wgs84_closed_forms() {
         &Origin {
             lat_deg: 0.0,
             lon_deg: 0.0,
+            height_m: 0.0,
         },
         0.0,
         1.0,

@@ -136,8 +136,9 @@ fn stamp(t_s: f64, file: &str) -> Result<(u64, Value), RosError> {
 }
 
 fn geodetic(origin: Origin, east_m: f64, north_m: f64) -> (f64, f64, f64) {
+    // Planar tracks lie at the origin's height.
     let (lat, lon) = deadreckon_core::geo::en_to_geodetic(&origin, east_m, north_m);
-    (lat, lon, 0.0)
+    (lat, lon, origin.height_m)
 }
 
 /// `foxglove.PositionCovarianceType` DIAGONAL_KNOWN: per-axis variances (a

@@ -101,7 +101,11 @@ impl std::fmt::Display for ImportReport {
             writeln!(f, "not read: {}", self.unmapped_topics.join(", "))?;
         }
         if let Some(o) = self.origin {
-            writeln!(f, "origin: {:.7} N, {:.7} E", o.lat_deg, o.lon_deg)?;
+            writeln!(
+                f,
+                "origin: {:.7} N, {:.7} E, {:.2} m above the WGS84 ellipsoid",
+                o.lat_deg, o.lon_deg, o.height_m
+            )?;
         }
         Ok(())
     }
@@ -150,7 +154,14 @@ impl<'m> Ingest<'m> {
                 origin: mapping.vehicle.origin,
             },
             last_t: vec![f64::NEG_INFINITY; mapping.streams.len()],
-            origin: mapping.vehicle.origin.map(|o| (o.lat_deg, o.lon_deg, None)),
+            // An origin without a height (0) takes the first fix's.
+            origin: mapping.vehicle.origin.map(|o| {
+                (
+                    o.lat_deg,
+                    o.lon_deg,
+                    (o.height_m != 0.0).then_some(o.height_m),
+                )
+            }),
         }
     }
 
@@ -323,11 +334,17 @@ impl<'m> Ingest<'m> {
                         }
                         None => {
                             self.origin = Some((lat_deg, lon_deg, Some(alt_m)));
-                            let o = Origin { lat_deg, lon_deg };
-                            self.drive.vehicle.origin = Some(o);
                             (lat_deg, lon_deg, alt_m)
                         }
                     };
+                    // The drive's origin with the height its frame is about,
+                    // so writers convert back at the same height.
+                    let o = Origin {
+                        lat_deg: lat0,
+                        lon_deg: lon0,
+                        height_m: alt0,
+                    };
+                    self.drive.vehicle.origin = Some(o);
                     let (e, n, _) = map_3d::geodetic2enu(
                         lat_deg.to_radians(),
                         lon_deg.to_radians(),

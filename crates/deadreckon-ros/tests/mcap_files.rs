@@ -115,6 +115,7 @@ fn vehicle_origin_is_used_when_given() {
     mapping.vehicle.origin = Some(Origin {
         lat_deg: LAT0 - 0.001,
         lon_deg: LON0,
+        height_m: 0.0,
     });
     let (drive, _) = read_mcap_bytes(&ros2_mcap(true, &CLEAN), "fixture.mcap", &mapping).unwrap();
     // 0.001° of latitude is about 111 m.
@@ -154,6 +155,7 @@ fn foxglove_writer_round_trip() {
     let origin = Origin {
         lat_deg: LAT0,
         lon_deg: LON0,
+        height_m: 0.0,
     };
     let tracks = [
         track("smoothed", Some(origin), 150),

@@ -167,3 +167,47 @@ fn a_stuck_gnss_fix_for_200_s() {
     let m = only(&check(&d), "stuck_gnss");
     assert!(m.contains("repeating"), "{m}");
 }
+
+#[test]
+fn latitude_and_longitude_swapped() {
+    use deadreckon_core::geo::{en_to_geodetic, geodetic_to_en};
+    use deadreckon_core::vehicle::Origin;
+    // gnss.csv written in latitude/longitude with the two columns swapped,
+    // read as the reader does without [origin]: about the first fix.
+    // Longitudes within ±90° (others cannot be read as latitudes: the
+    // reader refuses them on their line), with and without the course.
+    for ((lat0, lon0), course) in [(48.1, 11.6), (52.5, 13.4), (-33.9, 18.4), (35.7, 51.4)]
+        .into_iter()
+        .flat_map(|o| [(o, true), (o, false)])
+    {
+        let mut d = ticks_drive();
+        if !course {
+            for g in &mut d.gnss {
+                g.course_deg = None;
+            }
+        }
+        let origin = Origin::new(lat0, lon0);
+        let swapped: Vec<(f64, f64)> = d
+            .gnss
+            .iter()
+            .map(|g| {
+                let (lat, lon) = en_to_geodetic(&origin, g.east_m, g.north_m);
+                (lon, lat)
+            })
+            .collect();
+        let (a, b) = swapped[0];
+        let first = Origin::new(a, b);
+        let mut bad = d.clone();
+        for (g, &(lat, lon)) in bad.gnss.iter_mut().zip(&swapped) {
+            (g.east_m, g.north_m) = geodetic_to_en(&first, lat, lon);
+        }
+        // The track is mirrored: it turns the other way from the wheels
+        // (33–39 of 36–41 turns measured), whether or not the distances
+        // (1.0–1.3× the wheels') or a course give it away too.
+        let m = only(&check(&bad), "gnss_turns_vs_wheel_turns");
+        assert!(
+            m.contains("latitude and longitude swapped"),
+            "({lat0}, {lon0}): {m}"
+        );
+    }
+}
