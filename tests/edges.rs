@@ -676,3 +676,44 @@ fn plausibility_warnings_reached_stderr_but_not_the_json() {
     assert!(!err.contains("warning:"), "{err}");
     assert_eq!(checks, serde_json::json!({"skipped": true, "warnings": []}));
 }
+
+#[test]
+fn evaluate_used_nominal_for_metrics_but_rts_for_outages() {
+    let tmp = vehicle_dir();
+    let d = tmp.path().join("d");
+    let eval = |args: &[&str]| -> (serde_json::Value, String) {
+        let st = bin().arg("evaluate").arg(&d).args(args).output().unwrap();
+        let err = String::from_utf8_lossy(&st.stderr).into_owned();
+        assert!(st.status.success(), "{args:?}: {err}");
+        let out = String::from_utf8_lossy(&st.stdout).into_owned();
+        let v = serde_json::from_str(&out).unwrap_or(serde_json::Value::Null);
+        (v, out)
+    };
+    // One rule, whatever the metric: the RTS calibration on the drive.
+    let (ape, _) = eval(&["--metric", "ape", "--json"]);
+    let (outage, _) = eval(&["--outage", "10", "--step", "10", "--json"]);
+    let label = ape["params"].as_str().unwrap().to_string();
+    assert!(label.starts_with("rts ("), "{ape}");
+    assert_eq!(outage["params"], label.as_str());
+    assert!(ape["corrections"].is_object(), "{ape}");
+    // Printed with the rule.
+    let (_, text) = eval(&["--metric", "ape"]);
+    assert!(
+        text.starts_with(&format!(
+            "parameters: {label} (without parameters, evaluate calibrates with RTS"
+        )),
+        "{text}"
+    );
+    // Given parameters are named as given.
+    let (nominal, _) = eval(&["--params", "nominal", "--metric", "ape", "--json"]);
+    assert_eq!(nominal["params"], "nominal");
+    assert!(
+        nominal["stats_m"]["rmse"].as_f64() > ape["stats_m"]["rmse"].as_f64(),
+        "{nominal} {ape}"
+    );
+    // Without a GNSS fix there is nothing to calibrate on: nominal, said so.
+    std::fs::remove_file(d.join("gnss.csv")).unwrap();
+    let (v, _) = eval(&["--metric", "ape", "--json"]);
+    assert_eq!(v["params"], "nominal (no GNSS fix to calibrate on)");
+    assert_eq!(v["stats_m"], nominal["stats_m"]);
+}

@@ -102,7 +102,14 @@ fn evo(tool: &str, args: &[&str], work: &Path) -> (Value, Vec<f64>) {
 
 /// Our metric, from `evaluate --json`.
 fn ours(drive: &Path, extra: &[&str]) -> (Value, Vec<f64>) {
-    let mut args = vec!["evaluate", drive.to_str().unwrap(), "--json"];
+    // The parameters `run` wrote the files with.
+    let mut args = vec![
+        "evaluate",
+        drive.to_str().unwrap(),
+        "--params",
+        "nominal",
+        "--json",
+    ];
     args.extend_from_slice(extra);
     let v: Value = serde_json::from_str(&deadreckon(&args)).unwrap();
     let errors = v["errors_m"]
@@ -282,6 +289,8 @@ fn rpe_ours_matched(drive: &Path) -> usize {
     let v: Value = serde_json::from_str(&deadreckon(&[
         "evaluate",
         drive.to_str().unwrap(),
+        "--params",
+        "nominal",
         "--metric",
         "ape",
         "--json",

@@ -141,8 +141,10 @@ fn evaluate_rpe_and_ape_json_and_errors() {
     let drive = tmp.path().join("eval");
     simulate(&drive, "evaluation", "12");
     let d = drive.to_str().unwrap();
-    let v: serde_json::Value =
-        serde_json::from_str(&run_ok(&["evaluate", d, "--metric", "rpe", "--json"])).unwrap();
+    let v: serde_json::Value = serde_json::from_str(&run_ok(&[
+        "evaluate", d, "--params", "nominal", "--metric", "rpe", "--json",
+    ]))
+    .unwrap();
     assert_eq!(v["n"], 50);
     assert_eq!(v["matched"], 33647);
     assert_eq!(v["delta_m"], 100.0);
@@ -154,14 +156,23 @@ fn evaluate_rpe_and_ape_json_and_errors() {
     // over the drive; the smoothed GNSS-aided track stays within metres.
     let ape = |track: &str| -> f64 {
         let v: serde_json::Value = serde_json::from_str(&run_ok(&[
-            "evaluate", d, "--metric", "ape", "--track", track, "--json",
+            "evaluate", d, "--params", "nominal", "--metric", "ape", "--track", track, "--json",
         ]))
         .unwrap();
         v["stats_m"]["rmse"].as_f64().unwrap()
     };
     let (dr, sm) = (ape("dead-reckoned"), ape("smoothed"));
     assert!(dr > 100.0 && sm < 5.0, "{dr} {sm}");
-    let e = run_err(&["evaluate", d, "--metric", "rpe", "--delta-m", "1e6"]);
+    let e = run_err(&[
+        "evaluate",
+        d,
+        "--params",
+        "nominal",
+        "--metric",
+        "rpe",
+        "--delta-m",
+        "1e6",
+    ]);
     assert!(
         e.contains("shorter than the RPE's delta of 1000000 m"),
         "{e}"
@@ -175,7 +186,7 @@ fn evaluate_rpe_and_ape_json_and_errors() {
 
     // Without truth.csv there is no `truth` track to compare with.
     std::fs::remove_file(drive.join("truth.csv")).unwrap();
-    let e = run_err(&["evaluate", d, "--metric", "ape"]);
+    let e = run_err(&["evaluate", d, "--params", "nominal", "--metric", "ape"]);
     assert!(
         e.contains("no track named `truth`") && e.contains("smoothed"),
         "{e}"

@@ -276,11 +276,13 @@ def evaluate(
     ``metric``: ``drift`` (per ``segment_m``), ``reset-1m`` (at
     ``threshold_m``), ``rpe`` (evo's relative pose error per ``delta_m`` of
     path) or ``ape``. With ``outage`` (s), sliding GNSS outages every
-    ``step`` s (default half the outage) after ``warmup`` s instead; without
-    ``params`` the drive is then calibrated with RTS first, as the command
-    does, with the ``corrections`` of :func:`calibrate`. ``params`` as in
-    :func:`run` (default nominal); a ``params.toml`` path applies the
-    corrections it stores, a dict carries the six parameters only. The drive
+    ``step`` s (default half the outage) after ``warmup`` s instead. Without
+    ``params``, for every metric, the drive is calibrated with RTS first, as
+    the command does (in-sample), with the ``corrections`` of
+    :func:`calibrate`, or the nominal parameters are taken when it has no
+    GNSS fix; the result's ``params`` says which. ``params`` as in
+    :func:`run`; a ``params.toml`` path applies the corrections it stores, a
+    dict carries the six parameters only. The drive
     is checked across its streams first, as by :func:`calibrate`
     (``skip_checks``); the warnings are under ``checks``.
     """

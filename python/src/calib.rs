@@ -249,29 +249,31 @@ pub fn evaluate(
     let drive = drive_arg(py, source, &Default::default(), mapping)?;
     let checks = checked(source, &drive, skip_checks)?;
     let timing = parse_timing(timing).map_err(to_py_err)?;
+    if outage.is_none() && !["drift", "reset-1m", "rpe", "ape"].contains(&metric) {
+        return Err(err(format!(
+            "unknown metric `{metric}` (drift, reset-1m, rpe, ape)"
+        )));
+    }
+    // One rule for every metric (deadreckon_api::evaluate::RULE), as the
+    // command applies it.
+    let given = params.map(|p| params_arg(p, &drive.vehicle)).transpose()?;
+    let stored = with_stored(params, (*drive).clone())?;
+    let (params, label, drive, corr) = py.detach(|| -> PyResult<_> {
+        Ok(match given {
+            Some((p, l)) => (p, l, stored, None),
+            None => {
+                let (c, d) = deadreckon_api::evaluate::default_parameters(&drive, which)
+                    .map_err(to_py_err)?;
+                (c.params, c.label, d, c.corrections)
+            }
+        })
+    })?;
     if let Some(len) = outage {
-        let given = params.map(|p| params_arg(p, &drive.vehicle)).transpose()?;
-        let stored = with_stored(params, (*drive).clone())?;
         let base = FilterOptions {
             timing,
             ..Default::default()
         };
         let mut v = py.detach(|| -> PyResult<serde_json::Value> {
-            let (params, label, drive, corr) = match given {
-                Some((p, l)) => (p, l, stored, None),
-                None => {
-                    let copts = CalibrationOptions::default();
-                    let (drive, corr) = prepared(&drive, &copts, which)?;
-                    let c = core_calibrate::calibrate(&drive, &copts)
-                        .map_err(with_context("RTS calibration with GNSS"))?;
-                    (
-                        c.estimate.params,
-                        format!("rts ({} passes)", c.iterations),
-                        drive,
-                        Some(corr),
-                    )
-                }
-            };
             let ev = outage::evaluate(
                 &drive,
                 &params,
@@ -290,11 +292,6 @@ pub fn evaluate(
         v["checks"] = checks.json();
         return to_py(py, &v);
     }
-    let drive = with_stored(params, (*drive).clone())?;
-    let params = match params {
-        Some(p) => params_arg(p, &drive.vehicle)?.0,
-        None => Params::nominal(&drive.vehicle),
-    };
     let mut v = py.detach(|| -> PyResult<serde_json::Value> {
         match metric {
             "drift" => {
@@ -357,6 +354,10 @@ pub fn evaluate(
             ))),
         }
     })?;
+    v["params"] = label.into();
+    if let Some(c) = &corr {
+        v["corrections"] = deadreckon_api::corrections::corrections_json(c);
+    }
     v["checks"] = checks.json();
     to_py(py, &v)
 }

@@ -238,19 +238,25 @@ pub enum CorrectionsArg {
     None,
 }
 
+impl From<CorrectionsArg> for deadreckon_core::timing::Which {
+    fn from(c: CorrectionsArg) -> Self {
+        use deadreckon_core::timing::Which;
+        match c {
+            CorrectionsArg::All => Which::All,
+            CorrectionsArg::Gnss => Which::Gnss,
+            CorrectionsArg::None => Which::None,
+        }
+    }
+}
+
 /// Estimates and applies the corrections `which` asks for.
 pub fn prepare(
     drive: &Drive,
     which: CorrectionsArg,
     copts: &deadreckon_core::calibrate::CalibrationOptions,
 ) -> Result<(Drive, deadreckon_core::timing::Corrections)> {
-    use deadreckon_core::timing::{self, DelayOptions, Which};
-    let w = match which {
-        CorrectionsArg::All => Which::All,
-        CorrectionsArg::Gnss => Which::Gnss,
-        CorrectionsArg::None => Which::None,
-    };
-    timing::prepare_with(drive, copts, &DelayOptions::default(), w)
+    use deadreckon_core::timing::{self, DelayOptions};
+    timing::prepare_with(drive, copts, &DelayOptions::default(), which.into())
         .context("estimating the streams' delays and the IMU tilt")
 }
 

@@ -6,7 +6,6 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use clap::Args;
-use deadreckon_core::calibrate::{self, CalibrationOptions};
 use deadreckon_core::ekf::FilterOptions;
 use deadreckon_core::metrics::{self, Summary};
 use deadreckon_core::outage;
@@ -141,27 +140,25 @@ pub fn run(a: EvaluateArgs, load: &common::Loader) -> Result<()> {
         drive
     };
     let timing: deadreckon_core::ekf::Timing = a.timing.into();
+    // One rule for every metric (deadreckon_api::evaluate::RULE).
+    let (chosen, drive) = match &a.params {
+        Some(p) => (
+            deadreckon_api::evaluate::Parameters {
+                params: common::load_params(p, &drive)?,
+                label: p.clone(),
+                corrections: None,
+            },
+            common::apply_stored(p, drive)?,
+        ),
+        None => deadreckon_api::evaluate::default_parameters(&drive, a.corrections.into())?,
+    };
+    let params = chosen.params;
+    let source = chosen.label;
+    let corrections = chosen.corrections;
+    if a.params.is_none() && !a.json {
+        outln!("parameters: {source} ({})", deadreckon_api::evaluate::RULE);
+    }
     if let Some(len) = a.outage {
-        let (params, source, drive, corrections) = match &a.params {
-            Some(p) => (
-                common::load_params(p, &drive)?,
-                p.clone(),
-                common::apply_stored(p, drive)?,
-                None,
-            ),
-            None => {
-                let copts = CalibrationOptions::default();
-                let (drive, corr) = common::prepare(&drive, a.corrections, &copts)?;
-                let c =
-                    calibrate::calibrate(&drive, &copts).context("RTS calibration with GNSS")?;
-                (
-                    c.estimate.params,
-                    format!("rts ({} passes)", c.iterations),
-                    drive,
-                    Some(corr),
-                )
-            }
-        };
         let base = FilterOptions {
             timing,
             ..Default::default()
@@ -221,16 +218,20 @@ pub fn run(a: EvaluateArgs, load: &common::Loader) -> Result<()> {
         }
         return Ok(());
     }
-    let spec = a.params.as_deref().unwrap_or("nominal");
-    let params = common::load_params(spec, &drive)?;
-    let drive = common::apply_stored(spec, drive)?;
+    let with_source = |mut v: serde_json::Value| {
+        v["params"] = source.clone().into();
+        if let Some(c) = &corrections {
+            v["corrections"] = deadreckon_api::corrections::corrections_json(c);
+        }
+        v
+    };
     match a.metric {
         MetricArg::Drift => {
             let r = metrics::drift(&drive, &params, a.segment_m, timing)?;
             let s = Summary::of(&r.errors_pct());
             if a.json {
                 let v = deadreckon_api::json::drift_json(&r, a.segment_m);
-                common::print_json(load, v)?;
+                common::print_json(load, with_source(v))?;
             } else {
                 outln!("drift per {} m over {} segments: mean {:.3}%, std {:.3}%, median {:.3}%, max {:.3}%", a.segment_m, s.n, s.mean, s.std, s.median, s.max);
                 outln!("rejected by the χ² gates: {}", common::gated_text(&r.gates));
@@ -241,7 +242,7 @@ pub fn run(a: EvaluateArgs, load: &common::Loader) -> Result<()> {
             let s = Summary::of(&r.distances_m);
             if a.json {
                 let v = deadreckon_api::json::reset_json(&r, a.threshold_m);
-                common::print_json(load, v)?;
+                common::print_json(load, with_source(v))?;
             } else {
                 outln!(
                     "distance before {} m of error over {} resets: mean {:.1} m, median {:.1} m, min {:.1} m, max {:.1} m",
@@ -288,7 +289,7 @@ pub fn run(a: EvaluateArgs, load: &common::Loader) -> Result<()> {
                     pairs_from: pairs_from_name,
                 };
                 let v = deadreckon_api::json::evo_json(&q, &r);
-                common::print_json(load, v)?;
+                common::print_json(load, with_source(v))?;
             } else {
                 let what = if a.metric == MetricArg::Rpe {
                     format!(

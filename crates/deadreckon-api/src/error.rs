@@ -79,6 +79,15 @@ pub enum Error {
         /// Each error finding on a line: what disagrees, by how much, and the check's name.
         findings: String,
     },
+    /// A calibration (or the estimation before it) failed.
+    #[error("{what}")]
+    Calibration {
+        /// What was being done.
+        what: &'static str,
+        /// The library's error.
+        #[source]
+        source: deadreckon_core::Error,
+    },
     /// An option word is not one of those allowed.
     #[error("unknown {what} `{value}` ({allowed})")]
     UnknownOption {

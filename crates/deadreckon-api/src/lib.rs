@@ -10,6 +10,8 @@
 //!   name the file and, through their sources, the line and column.
 //! - [`checks`]: the cross-stream plausibility checks applied to a drive
 //!   read (errors refuse it, warnings go to `"checks"` in `--json`).
+//! - [`evaluate`]: the parameters `evaluate` measures when none are given
+//!   (one rule for every metric).
 //! - [`json`]: the objects `calibrate --json`, `evaluate --json` and
 //!   `tedris train --json` print, built from the library results.
 //! - [`options`]: the option words of the commands (`--timing wheel|each`,
@@ -23,6 +25,7 @@
 
 pub mod checks;
 pub mod corrections;
+pub mod evaluate;
 pub mod json;
 pub mod options;
 pub mod source;
