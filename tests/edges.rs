@@ -696,14 +696,28 @@ fn evaluate_used_nominal_for_metrics_but_rts_for_outages() {
     assert!(label.starts_with("rts ("), "{ape}");
     assert_eq!(outage["params"], label.as_str());
     assert!(ape["corrections"].is_object(), "{ape}");
-    // Printed with the rule.
-    let (_, text) = eval(&["--metric", "ape"]);
+    // Printed with the rule, after the drive's time span (the 30 s
+    // simulated drive's first and last samples; the JSON carries it too).
+    let span = ape["time_span_s"].as_array().unwrap();
+    let (t0, t1) = (span[0].as_f64().unwrap(), span[1].as_f64().unwrap());
     assert!(
-        text.starts_with(&format!(
+        t0 >= 0.0 && t0 < 0.05 && t1 > 29.95 && t1 <= 30.0,
+        "{t0} {t1}"
+    );
+    let (_, text) = eval(&["--metric", "ape"]);
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        format!("drive: drive clock {t0:.3} to {t1:.3} s ({:.1} s)", t1 - t0),
+        "{text}"
+    );
+    assert!(
+        lines.next().unwrap().starts_with(&format!(
             "parameters: {label} (without parameters, evaluate calibrates with RTS"
         )),
         "{text}"
     );
+
     // Given parameters are named as given.
     let (nominal, _) = eval(&["--params", "nominal", "--metric", "ape", "--json"]);
     assert_eq!(nominal["params"], "nominal");

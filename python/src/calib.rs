@@ -118,7 +118,7 @@ pub fn calibrate(
         .map_err(with_context("calibrating the steering".to_string()))?;
     let mut v = json::calibrate_json(method, &c, opts.min_speed_mps, steering.as_ref());
     v["corrections"] = deadreckon_api::corrections::corrections_json(&corr);
-    v["checks"] = checks.json();
+    checks.annotate(&mut v);
     to_py(py, &v)
 }
 
@@ -289,7 +289,7 @@ pub fn evaluate(
             }
             Ok(v)
         })?;
-        v["checks"] = checks.json();
+        checks.annotate(&mut v);
         return to_py(py, &v);
     }
     let mut v = py.detach(|| -> PyResult<serde_json::Value> {
@@ -358,6 +358,6 @@ pub fn evaluate(
     if let Some(c) = &corr {
         v["corrections"] = deadreckon_api::corrections::corrections_json(c);
     }
-    v["checks"] = checks.json();
+    checks.annotate(&mut v);
     to_py(py, &v)
 }

@@ -101,7 +101,7 @@ pub fn tedris_train(
         .map_err(to_py_err)?;
     let text = serde_json::to_string_pretty(&m).map_err(to_py_err)?;
     let mut summary = deadreckon_api::json::tedris_train_json(&m, source);
-    summary["checks"] = checks.json();
+    checks.annotate(&mut summary);
     Ok((text, to_py(py, &summary)?))
 }
 
@@ -146,13 +146,13 @@ pub fn tedris_run<'py>(
     let r = py
         .detach(|| run_outages_with(&drive, &m, &outages, &opts))
         .map_err(to_py_err)?;
-    let v = serde_json::json!({
+    let mut v = serde_json::json!({
         "outages": r.outages,
         "reference": r.reference,
         "source": r.source,
         "model": m.chosen.name(),
-        "checks": checks.json(),
     });
+    checks.annotate(&mut v);
     let out: Bound<'py, PyDict> = to_py(py, &v)?.into_bound(py).cast_into()?;
     out.set_item("track", track_columns(py, &r.track)?)?;
     Ok(out)

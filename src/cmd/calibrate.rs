@@ -257,6 +257,7 @@ pub fn run(a: CalibrateArgs, load: &common::Loader) -> Result<()> {
         v["corrections"] = deadreckon_api::corrections::corrections_json(&corrections);
         common::print_json(load, v)?;
     } else {
+        outln!("drive: {}", load.checks().span_text());
         outln!("{}", common::params_header());
         outln!("{}", common::params_row(&method_name, &c.estimate));
         for (k, why) in &not_estimated {

@@ -66,10 +66,13 @@ impl Loader {
         Ok(drive)
     }
 
-    /// `"checks"` of `--json`: the plausibility checks' verdict on the last
-    /// drive read.
-    pub fn checks_json(&self) -> serde_json::Value {
-        self.checks.lock().unwrap_or_else(|p| p.into_inner()).json()
+    /// The plausibility checks' verdict on the last drive read, and its time
+    /// span.
+    pub fn checks(&self) -> deadreckon_api::checks::Checks {
+        self.checks
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .clone()
     }
 
     /// Reads a ROS1 bag or ROS2 MCAP recording with the `--mapping` file, or the
@@ -91,12 +94,10 @@ pub fn check_output(out: &Path, inputs: &[&Path]) -> Result<()> {
     Ok(())
 }
 
-/// Prints a `--json` object with `"checks"`: what the plausibility checks
-/// said of the drive `load` read last.
+/// Prints a `--json` object with `"checks"` (what the plausibility checks
+/// said of the drive `load` read last) and `"time_span_s"`.
 pub fn print_json(load: &Loader, mut v: serde_json::Value) -> Result<()> {
-    if let Some(o) = v.as_object_mut() {
-        o.insert("checks".into(), load.checks_json());
-    }
+    load.checks().annotate(&mut v);
     outln!("{}", serde_json::to_string_pretty(&v)?);
     Ok(())
 }

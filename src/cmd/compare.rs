@@ -64,11 +64,12 @@ pub fn run(a: CompareArgs, load: &common::Loader) -> Result<()> {
             "{}",
             serde_json::to_string_pretty(&{
                 let mut v = deadreckon_api::json::comparison_json(&c);
-                v["checks"] = load.checks_json();
+                load.checks().annotate(&mut v);
                 v
             })?
         );
     } else {
+        outln!("drive: {}", load.checks().span_text());
         common::print_comparison(&c, 0.0)?;
     }
     Ok(())

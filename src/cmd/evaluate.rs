@@ -155,6 +155,9 @@ pub fn run(a: EvaluateArgs, load: &common::Loader) -> Result<()> {
     let params = chosen.params;
     let source = chosen.label;
     let corrections = chosen.corrections;
+    if !a.json {
+        outln!("drive: {}", load.checks().span_text());
+    }
     if a.params.is_none() && !a.json {
         outln!("parameters: {source} ({})", deadreckon_api::evaluate::RULE);
     }

@@ -19,9 +19,32 @@ pub struct Checks {
     pub skipped: bool,
     /// The warnings (suspicious, not refused).
     pub warnings: Vec<Finding>,
+    /// The drive's time span on its own clock, s (`None`: no sample).
+    pub time_span_s: Option<(f64, f64)>,
 }
 
 impl Checks {
+    /// Adds `"checks"` ([`Checks::json`]) and `"time_span_s"` (`[start,
+    /// end]` on the drive's clock, or null) to a `--json` object.
+    pub fn annotate(&self, v: &mut Value) {
+        if let Some(o) = v.as_object_mut() {
+            o.insert("checks".into(), self.json());
+            o.insert(
+                "time_span_s".into(),
+                self.time_span_s.map_or(Value::Null, |(a, b)| json!([a, b])),
+            );
+        }
+    }
+
+    /// The time span as a summary line: `drive clock 46408.580 to
+    /// 46468.580 s (60.0 s)` (bag clocks are UNIX time).
+    pub fn span_text(&self) -> String {
+        match self.time_span_s {
+            Some((a, b)) => format!("drive clock {a:.3} to {b:.3} s ({:.1} s)", b - a),
+            None => "no samples".into(),
+        }
+    }
+
     /// The checks as the `"checks"` object of `--json`:
     /// `{"skipped": bool, "warnings": [{"check", "severity", "message"}]}`.
     pub fn json(&self) -> Value {
@@ -35,10 +58,12 @@ impl Checks {
 /// Runs the checks on the drive read from `path` (`skip`: not at all).
 /// Errors refuse it; warnings are returned.
 pub fn check(path: &Path, drive: &Drive, skip: bool) -> Result<Checks, Error> {
+    let time_span_s = drive.time_span();
     if skip {
         return Ok(Checks {
             skipped: true,
             warnings: Vec::new(),
+            time_span_s,
         });
     }
     let (errors, warnings): (Vec<Finding>, Vec<Finding>) = plausibility::check(drive)
@@ -57,6 +82,7 @@ pub fn check(path: &Path, drive: &Drive, skip: bool) -> Result<Checks, Error> {
     Ok(Checks {
         skipped: false,
         warnings,
+        time_span_s,
     })
 }
 
@@ -68,8 +94,15 @@ mod tests {
     fn a_drive_that_never_moves_passes_with_no_warning() {
         let drive = parked();
         let c = check(Path::new("d"), &drive, false).unwrap();
-        assert_eq!(c, Checks::default());
         assert_eq!(c.json(), json!({"skipped": false, "warnings": []}));
+        assert_eq!(c.time_span_s, Some((0.0, 0.01)));
+        let mut v = json!({"x": 1});
+        c.annotate(&mut v);
+        assert_eq!(
+            v,
+            json!({"x": 1, "checks": {"skipped": false, "warnings": []}, "time_span_s": [0.0, 0.01]})
+        );
+        assert_eq!(c.span_text(), "drive clock 0.000 to 0.010 s (0.0 s)");
         let s = check(Path::new("d"), &drive, true).unwrap();
         assert_eq!(s.json(), json!({"skipped": true, "warnings": []}));
     }
