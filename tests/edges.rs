@@ -731,3 +731,48 @@ fn evaluate_used_nominal_for_metrics_but_rts_for_outages() {
     assert_eq!(v["params"], "nominal (no GNSS fix to calibrate on)");
     assert_eq!(v["stats_m"], nominal["stats_m"]);
 }
+
+#[test]
+fn an_origin_at_95_degrees_wrote_geojson_at_85_north() {
+    let tmp = vehicle_dir();
+    let d = tmp.path().join("d");
+    let vehicle = std::fs::read_to_string(d.join("vehicle.toml")).unwrap();
+    std::fs::write(
+        d.join("vehicle.toml"),
+        format!("{vehicle}\n[origin]\nlat_deg = 95.0\nlon_deg = 8.0\n"),
+    )
+    .unwrap();
+    let out = tmp.path().join("t.geojson");
+    let st = bin()
+        .arg("run")
+        .arg(&d)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&st.stderr);
+    assert!(!st.status.success());
+    assert!(
+        err.contains("vehicle.toml") && err.contains("origin latitude must be within ±90°, got 95"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    // The same for a height that is not metres above the ellipsoid.
+    std::fs::write(
+        d.join("vehicle.toml"),
+        format!("{vehicle}\n[origin]\nlat_deg = 45.0\nlon_deg = 8.0\nheight_m = 250000.0\n"),
+    )
+    .unwrap();
+    let st = bin()
+        .arg("run")
+        .arg(&d)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&st.stderr);
+    assert!(
+        !st.status.success() && err.contains("origin height"),
+        "{err}"
+    );
+}
