@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use deadreckon_tedris::{
-    run_outages_with, time_range, train, ModelChoice, ModelKind, Outage, ReferenceSource,
+    run_outages_with, train, ModelChoice, ModelKind, Outage, ReferenceSource,
     RunOptions, TedrisConfig, TedrisModel, Variant,
 };
 use pyo3::prelude::*;
@@ -55,7 +55,7 @@ pub fn tedris_train(
     let drive = drive_arg(py, source, &Default::default(), mapping)?;
     let checks = checked(source, &drive, skip_checks)?;
     let drive = if from_s.is_some() || until_s.is_some() {
-        std::sync::Arc::new(time_range(&drive, from_s, until_s))
+        std::sync::Arc::new(drive.time_range(from_s, until_s))
     } else {
         drive
     };

@@ -6,8 +6,8 @@ use std::path::PathBuf;
 use anyhow::{bail, Context, Result};
 use clap::{Subcommand, ValueEnum};
 use deadreckon_tedris::{
-    run_outages_with, time_range, train, ModelChoice, ModelKind, Outage, ReferenceSource,
-    RepositoryFit, RunOptions, TedrisConfig, TedrisModel, Variant,
+    run_outages_with, train, ModelChoice, ModelKind, Outage, ReferenceSource, RepositoryFit,
+    RunOptions, TedrisConfig, TedrisModel, Variant,
 };
 
 /// The reference heading the model learns from.
@@ -173,7 +173,7 @@ pub fn run(c: TedrisCommand, load: &super::common::Loader) -> Result<()> {
             super::common::check_output(&out, &inputs)?;
             let drive = load.drive(&dir)?;
             let drive = if from_s.is_some() || until_s.is_some() {
-                time_range(&drive, from_s, until_s)
+                drive.time_range(from_s, until_s)
             } else {
                 drive
             };

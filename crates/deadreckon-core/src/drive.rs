@@ -184,7 +184,23 @@ pub struct Drive {
     pub imu: Imu,
 }
 
+/// Whether `t` falls in one of `windows`, each `[start, end)` on the drive
+/// clock: the one rule by which GNSS is hidden, whether fixes are removed
+/// ([`Drive::without_gnss_in`]) or skipped by a filter
+/// (`FilterOptions::gnss_outages`) or by TedriS.
+pub fn in_windows(t: f64, windows: &[(f64, f64)]) -> bool {
+    windows.iter().any(|&(a, b)| t >= a && t < b)
+}
+
 impl Drive {
+    /// The drive without the GNSS fixes inside `windows` ([`in_windows`]);
+    /// every other stream kept.
+    pub fn without_gnss_in(&self, windows: &[(f64, f64)]) -> Drive {
+        let mut d = self.clone();
+        d.gnss.retain(|g| !in_windows(g.t_s, windows));
+        d
+    }
+
     /// The part of the drive with `from_s ≤ t < until_s` (drive clock;
     /// `None`: open), every stream cut alike (wheel ticks are per-epoch
     /// increments, so the cut is exact).

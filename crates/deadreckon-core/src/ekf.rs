@@ -500,7 +500,7 @@ impl Feeder {
     }
 
     fn hidden(&self, t: f64) -> bool {
-        self.outages.iter().any(|&(a, b)| t >= a && t < b)
+        crate::drive::in_windows(t, &self.outages)
     }
 
     fn process_batch<L: Layout<N>, const N: usize>(

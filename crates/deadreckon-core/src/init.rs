@@ -17,7 +17,7 @@ pub fn truth_state(drive: &Drive, t: f64) -> Option<State> {
 
 /// The filter's start: time, car state and covariance, as `opts.init` says.
 pub fn initial_state(drive: &Drive, opts: &FilterOptions) -> Result<(f64, State, Mat), Error> {
-    let hidden = |t: f64| opts.gnss_outages.iter().any(|&(a, b)| t >= a && t < b);
+    let hidden = |t: f64| crate::drive::in_windows(t, &opts.gnss_outages);
     match opts.init {
         Init::Given { t_s, x, p } => Ok((t_s, x, p)),
         Init::Truth => {

@@ -199,7 +199,7 @@ impl Online {
     pub fn push(&mut self, ev: Event, out: &mut dyn FnMut(TrackPoint)) -> Result<(), Error> {
         match &mut self.stage {
             Stage::Waiting { init, buffer } => {
-                let hidden = |t: f64| self.opts.gnss_outages.iter().any(|&(a, b)| t >= a && t < b);
+                let hidden = |t: f64| crate::drive::in_windows(t, &self.opts.gnss_outages);
                 let mut start = None;
                 if let Some(fix) = ev.gnss_fix().filter(|g| !hidden(g.t_s)) {
                     if !init.has_first() {

@@ -42,14 +42,6 @@ pub struct Comparison {
     pub tedris_checks: (u64, u64, u32, u64),
 }
 
-/// The drive without GNSS inside the windows.
-pub fn hide(drive: &Drive, windows: &[(f64, f64)]) -> Drive {
-    let mut d = drive.clone();
-    d.gnss
-        .retain(|g| !windows.iter().any(|&(a, b)| g.t_s >= a && g.t_s < b));
-    d
-}
-
 /// Runs both methods through `outages`. Without `params`, the four-wheel
 /// parameters are calibrated (RTS) on the drive with the outages hidden; without
 /// `model`, TedriS is trained on the drive with the outages hidden.
@@ -60,7 +52,7 @@ pub fn compare(
     model: Option<(TedrisModel, String)>,
 ) -> Result<Comparison, Error> {
     let windows: Vec<(f64, f64)> = outages.iter().map(|o| (o.start_s, o.end_s)).collect();
-    let hidden = hide(drive, &windows);
+    let hidden = drive.without_gnss_in(&windows);
     let (params, params_source) = match params {
         Some(p) => p,
         None => {

@@ -474,7 +474,7 @@ pub fn tedris_from_model(
     }
     // Error through each outage for TedriS and the four-wheel EKF (calibrated with the outages hidden).
     let windows: Vec<(f64, f64)> = outages.iter().map(|o| (o.start_s, o.end_s)).collect();
-    let hidden = crate::compare::hide(drive, &windows);
+    let hidden = drive.without_gnss_in(&windows);
     let fw = calibrate::calibrate(&hidden, &CalibrationOptions::default())
         .ok()
         .and_then(|c| {

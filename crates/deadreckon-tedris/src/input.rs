@@ -88,10 +88,6 @@ pub struct DriveInput {
     pub initial_pose: Option<(f64, f64, f64)>,
 }
 
-fn blanked(t: f64, windows: &[(f64, f64)]) -> bool {
-    windows.iter().any(|&(a, b)| t >= a && t < b)
-}
-
 /// Builds the event stream, dropping the reference and the fixes inside `blank` windows `[start, end)`.
 pub fn drive_input(
     drive: &Drive,
@@ -146,7 +142,7 @@ pub fn drive_input_with(
     let fixes: Vec<_> = drive
         .gnss
         .iter()
-        .filter(|g| !blanked(g.t_s, blank))
+        .filter(|g| !deadreckon_core::drive::in_windows(g.t_s, blank))
         .collect();
     // The robot variant (gyro reference) dead-reckons between its own odometry, as
     // in the paper: GNSS positions, if any, are not used, when the truth defines
@@ -205,7 +201,7 @@ pub fn drive_input_with(
                 None => chord_offset(&chords(&fixes), &series),
             };
             for (s, (t, y)) in drive.yaw_rate.iter().zip(series) {
-                if !blanked(s.t_s, blank) {
+                if !deadreckon_core::drive::in_windows(s.t_s, blank) {
                     events.push(Event::Heading(HeadingSample {
                         t_s: t,
                         yaw_rad: yaw0 + y,

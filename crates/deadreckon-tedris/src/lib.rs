@@ -219,7 +219,7 @@ pub use input::ReferenceSource;
 pub use machine::{Estimate, Geometry, HeadingSample, Phase, PositionFix, Tedris, WheelSample};
 pub use model::TedrisModel;
 pub use outage::{
-    run_outages, run_outages_with, time_range, train, Outage, OutageError, OutageReport, RunOptions,
+    run_outages, run_outages_with, train, Outage, OutageError, OutageReport, RunOptions,
 };
 
 /// Errors of TedriS.

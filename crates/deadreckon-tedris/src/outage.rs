@@ -120,12 +120,6 @@ fn feed(machine: &mut Tedris, events: &[Event]) -> Vec<Estimate> {
     out
 }
 
-/// The part of a drive with `from_s ≤ t < until_s` (drive clock; `None`: open),
-/// every stream cut alike (wheel ticks are per-epoch increments, so the cut is exact).
-pub fn time_range(drive: &Drive, from_s: Option<f64>, until_s: Option<f64>) -> Drive {
-    drive.time_range(from_s, until_s)
-}
-
 /// Trains a model over a whole drive (GNSS or gyro good throughout).
 pub fn train(
     drive: &Drive,

@@ -8,8 +8,7 @@
 //! `cargo test --release -p deadreckon-tedris --test husky_bag -- --nocapture`
 
 use deadreckon_tedris::{
-    run_outages_with, time_range, train, Outage, OutageError, ReferenceSource, RunOptions,
-    TedrisConfig,
+    run_outages_with, train, Outage, OutageError, ReferenceSource, RunOptions, TedrisConfig,
 };
 
 const BAG: &str = concat!(
@@ -25,7 +24,7 @@ fn run(source: ReferenceSource, cfg: TedrisConfig, rel_outages: &[(f64, f64)]) -
     let (drive, _) = deadreckon_ros::read_log(BAG, &deadreckon_ros::Mapping::husky()).unwrap();
     let (t0, t1) = drive.time_span().unwrap();
     let half = 0.5 * (t0 + t1);
-    let (model, _) = train(&time_range(&drive, None, Some(half)), cfg, Some(source)).unwrap();
+    let (model, _) = train(&drive.time_range(None, Some(half)), cfg, Some(source)).unwrap();
     let outages: Vec<Outage> = rel_outages
         .iter()
         .map(|&(a, b)| Outage {
