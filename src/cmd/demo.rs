@@ -35,6 +35,8 @@ pub struct DemoArgs {
 pub struct MethodResult {
     /// Method name.
     pub name: &'static str,
+    /// Where the parameters come from.
+    pub source: report::Source,
     /// Calibration (None for nominal).
     pub calibration: Option<Calibration>,
     /// Parameters used.
@@ -52,12 +54,13 @@ pub fn calibrate_and_evaluate(
 ) -> Result<Vec<MethodResult>> {
     let nominal = Params::nominal(&cal.vehicle);
     let mut out = Vec::new();
-    for (name, method) in [
-        ("nominal", None),
-        ("ZUPT", Some(Method::Zupt)),
-        ("RTS", Some(Method::Rts)),
-        ("truth", Some(Method::Truth)),
+    for (source, method) in [
+        (report::Source::Nominal, None),
+        (report::Source::Zupt, Some(Method::Zupt)),
+        (report::Source::Rts, Some(Method::Rts)),
+        (report::Source::Truth, Some(Method::Truth)),
     ] {
+        let name = source.name();
         let calibration = match method {
             None => None,
             Some(m) => Some(
@@ -82,6 +85,7 @@ pub fn calibrate_and_evaluate(
         let reset = metrics::reset_on_error(eval, &params.params, 1.0, Timing::WheelEpochs)?;
         out.push(MethodResult {
             name,
+            source,
             calibration,
             params,
             drift,
@@ -113,14 +117,18 @@ pub fn run(a: DemoArgs, quiet: bool, load: &common::Loader) -> Result<()> {
         }
     }
     // The report of the evaluation drive with the calibrations made on the calibration drive.
-    let methods: Vec<report::NamedParams> = results
-        .iter()
-        .map(|r| report::NamedParams {
-            name: r.name.into(),
-            params: r.params,
-            calibration: r.calibration.clone(),
-        })
-        .collect();
+    let methods = report::Calibrations {
+        sets: results
+            .iter()
+            .map(|r| report::NamedParams {
+                name: r.name.into(),
+                source: r.source,
+                params: r.params,
+                calibration: r.calibration.clone(),
+            })
+            .collect(),
+        skipped: Vec::new(),
+    };
     let mut input = report::four_wheel_input(&eval, &methods, Some(20.0), &steps)?;
     input.header = report::header(
         &eval,

@@ -48,8 +48,9 @@ pub fn run(a: ReportArgs, quiet: bool, load: &common::Loader) -> Result<()> {
     let mut methods = calibrations(&drive, &steps);
     if let Some(p) = &a.params {
         let params = common::load_params(p, &drive)?;
-        methods.push(NamedParams {
+        methods.sets.push(NamedParams {
             name: "given".into(),
+            source: deadreckon_eval::report::Source::Given,
             params: ParamsWithStd {
                 params,
                 std: Params::from_array([0.0; 6]),

@@ -12,14 +12,54 @@ use deadreckon_report as rp;
 
 use crate::{Error, Progress};
 
+/// Where a parameter set comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Source {
+    /// The vehicle's nominal values.
+    Nominal,
+    /// The ZUPT calibration (gyro bias at standstill).
+    Zupt,
+    /// The RTS calibration against GNSS (the paper's method; the report's
+    /// filter health and iterations are drawn with it).
+    Rts,
+    /// The calibration against the truth.
+    Truth,
+    /// Given by the user (a params.toml).
+    Given,
+}
+
+impl Source {
+    /// The name the report shows.
+    pub fn name(self) -> &'static str {
+        match self {
+            Source::Nominal => "nominal",
+            Source::Zupt => "ZUPT",
+            Source::Rts => "RTS",
+            Source::Truth => "truth",
+            Source::Given => "given",
+        }
+    }
+}
+
 /// A named parameter set for the report.
 pub struct NamedParams {
     /// Display name.
     pub name: String,
+    /// Where it comes from.
+    pub source: Source,
     /// Parameters.
     pub params: ParamsWithStd,
     /// The calibration that produced them, if any.
     pub calibration: Option<Calibration>,
+}
+
+/// The parameter sets a report shows, and the calibrations it could not
+/// make with why (shown in the report, not dropped).
+pub struct Calibrations {
+    /// The sets, nominal first.
+    pub sets: Vec<NamedParams>,
+    /// Calibrations the drive did not support, or that failed.
+    pub skipped: Vec<rp::NotComputed>,
 }
 
 fn param_set(p: &Params) -> rp::ParamSet {
@@ -102,39 +142,63 @@ pub fn header(drive: &Drive, name: &str, inputs: Vec<(String, String)>) -> rp::H
     }
 }
 
-/// The calibrations a drive supports: nominal always, ZUPT with a standstill,
-/// RTS with GNSS, truth with a reference.
-pub fn calibrations(drive: &Drive, steps: &dyn Progress) -> Vec<NamedParams> {
+/// The calibrations of a drive: nominal always, then ZUPT, RTS and truth,
+/// each kept when the drive supports it (a standstill, GNSS, a reference)
+/// and otherwise listed in `skipped` with the calibration's error.
+pub fn calibrations(drive: &Drive, steps: &dyn Progress) -> Calibrations {
     let nominal = Params::nominal(&drive.vehicle);
-    let mut out = vec![NamedParams {
-        name: "nominal".into(),
-        params: ParamsWithStd {
-            params: nominal,
-            std: Params::from_array([0.0; 6]),
-        },
-        calibration: None,
-    }];
-    for (name, method) in [
-        ("ZUPT", Method::Zupt),
-        ("RTS", Method::Rts),
-        ("truth", Method::Truth),
+    let mut out = Calibrations {
+        sets: vec![NamedParams {
+            name: Source::Nominal.name().into(),
+            source: Source::Nominal,
+            params: ParamsWithStd {
+                params: nominal,
+                std: Params::from_array([0.0; 6]),
+            },
+            calibration: None,
+        }],
+        skipped: Vec::new(),
+    };
+    for (source, method) in [
+        (Source::Zupt, Method::Zupt),
+        (Source::Rts, Method::Rts),
+        (Source::Truth, Method::Truth),
     ] {
-        steps.step(&format!("{name} calibration"));
-        if let Ok(c) = calibrate::calibrate(
+        steps.step(&format!("{} calibration", source.name()));
+        match calibrate::calibrate(
             drive,
             &CalibrationOptions {
                 method,
                 ..Default::default()
             },
         ) {
-            out.push(NamedParams {
-                name: name.into(),
+            Ok(c) => out.sets.push(NamedParams {
+                name: source.name().into(),
+                source,
                 params: c.estimate,
                 calibration: Some(c),
-            });
+            }),
+            Err(e) => out
+                .skipped
+                .push(not_computed(format!("{} calibration", source.name()), &e)),
         }
     }
     out
+}
+
+/// A [`rp::NotComputed`] from an error and its causes.
+fn not_computed(what: String, e: &dyn std::error::Error) -> rp::NotComputed {
+    let mut reason = e.to_string();
+    let mut cause = e.source();
+    while let Some(c) = cause {
+        let text = c.to_string();
+        if !reason.contains(&text) {
+            reason.push_str(": ");
+            reason.push_str(&text);
+        }
+        cause = c.source();
+    }
+    rp::NotComputed { what, reason }
 }
 
 fn sensor_unit(k: SensorKind, ticks: bool) -> &'static str {
@@ -241,14 +305,20 @@ fn consistency(drive: &Drive, params: &Params) -> Option<rp::NeesConsistency> {
     })
 }
 
-/// Builds the four-wheel part of a report for `drive` with the given parameter sets.
+/// Builds the four-wheel part of a report for `drive` with the given
+/// parameter sets. What cannot be computed (a skipped calibration, a failed
+/// step) is listed in the report's `not_computed`, never dropped silently.
 pub fn four_wheel_input(
     drive: &Drive,
-    methods: &[NamedParams],
+    calibrations: &Calibrations,
     outage_s: Option<f64>,
     steps: &dyn Progress,
 ) -> Result<rp::ReportInput, Error> {
-    let mut input = rp::ReportInput::default();
+    let methods = &calibrations.sets;
+    let mut input = rp::ReportInput {
+        not_computed: calibrations.skipped.clone(),
+        ..Default::default()
+    };
     let mut traj = rp::Trajectories::default();
     if let Some(r) = deadreckon_core::reference::Reference::from_truth(&drive.truth) {
         traj.truth = Some(rp::EnPath {
@@ -259,12 +329,18 @@ pub fn four_wheel_input(
     // Filter health and the aided tracks with the best parameters available.
     let best = methods
         .iter()
-        .find(|m| m.name == "RTS")
+        .find(|m| m.source == Source::Rts)
         .or_else(|| methods.last())
         .map(|m| m.params.params);
     if let (Some(best), true) = (best, drive.gnss.len() >= 2) {
         steps.step("filter health");
-        if let Ok((h, st, tracks)) = health(drive, &best) {
+        let health = health(drive, &best);
+        if let Err(e) = &health {
+            input
+                .not_computed
+                .push(not_computed("filter health".into(), e));
+        }
+        if let Ok((h, st, tracks)) = health {
             let gated: Vec<f64> = h
                 .innovations
                 .iter()
@@ -306,11 +382,14 @@ pub fn four_wheel_input(
             tracks::dead_reckoning_init(drive, None, None)
                 .and_then(|i| tracks::dead_reckoned(drive, &m.params.params, &opts, i))
         };
-        if let Ok(dr) = dr {
-            traj.dead_reckoned.push(rp::MethodPath {
+        match dr {
+            Ok(dr) => traj.dead_reckoned.push(rp::MethodPath {
                 method: m.name.clone(),
                 path: path_of(&dr),
-            });
+            }),
+            Err(e) => input
+                .not_computed
+                .push(not_computed(format!("dead reckoning with {}", m.name), &e)),
         }
     }
     input.trajectories = Some(traj);
@@ -326,10 +405,10 @@ pub fn four_wheel_input(
     }
     if let Some(c) = methods
         .iter()
-        .find(|m| m.name == "RTS")
+        .find(|m| m.source == Source::Rts)
         .and_then(|m| m.calibration.as_ref())
     {
-        cal.iterated_method = "RTS".into();
+        cal.iterated_method = Source::Rts.name().into();
         cal.iterations = std::iter::once(Params::nominal(&drive.vehicle))
             .chain(c.history.iter().copied())
             .map(|p| param_set(&p))
@@ -342,11 +421,17 @@ pub fn four_wheel_input(
         for m in methods {
             steps.step(&format!("drift with {}", m.name));
             let p = &m.params.params;
-            let (Ok(dr), Ok(rs)) = (
+            let (dr, rs) = match (
                 metrics::drift(drive, p, 100.0, opts.timing),
                 metrics::reset_on_error(drive, p, 1.0, opts.timing),
-            ) else {
-                continue;
+            ) {
+                (Ok(dr), Ok(rs)) => (dr, rs),
+                (Err(e), _) | (_, Err(e)) => {
+                    input
+                        .not_computed
+                        .push(not_computed(format!("drift with {}", m.name), &e));
+                    continue;
+                }
             };
             d.methods.push(rp::DriftMethod {
                 method: m.name.clone(),
@@ -364,11 +449,14 @@ pub fn four_wheel_input(
         };
         for m in methods {
             steps.step(&format!("{len} s outages with {}", m.name));
-            if let Ok(o) = outage::evaluate(drive, &m.params.params, len, len / 2.0, 5.0, &opts) {
-                ev.methods.push(rp::MethodSample {
+            match outage::evaluate(drive, &m.params.params, len, len / 2.0, 5.0, &opts) {
+                Ok(o) => ev.methods.push(rp::MethodSample {
                     method: m.name.clone(),
                     final_error_m: o.windows.iter().map(|w| w.final_error_m).collect(),
-                });
+                }),
+                Err(e) => input
+                    .not_computed
+                    .push(not_computed(format!("{len} s outages with {}", m.name), &e)),
             }
         }
         if !ev.methods.is_empty() {

@@ -32,6 +32,19 @@ pub struct ReportInput {
     pub tedris: Option<Tedris>,
     /// Final errors of sliding simulated GNSS outages.
     pub outages: Option<OutageEvaluation>,
+    /// What the report could not compute, and why (a calibration a drive
+    /// does not support, a failed step): shown first, never dropped.
+    pub not_computed: Vec<NotComputed>,
+}
+
+/// Something the report does not show, with the reason.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct NotComputed {
+    /// What (`ZUPT calibration`, `filter health`, `drift with RTS`).
+    pub what: String,
+    /// Why (the error or the missing stream).
+    pub reason: String,
 }
 
 /// The report header: what was driven and which sensor streams the drive has.

@@ -18,6 +18,19 @@ pub(crate) fn render_all(input: &ReportInput) -> Result<Vec<SectionView>, Report
     let mut palette = Palette::default();
     register_methods(input, &mut palette);
     let mut out = Vec::new();
+    if !input.not_computed.is_empty() {
+        out.push(SectionView {
+            id: "not-computed",
+            title: "Not computed",
+            blocks: input
+                .not_computed
+                .iter()
+                .map(|n| crate::page::Block::Note {
+                    text: format!("{}: {}", n.what, n.reason),
+                })
+                .collect(),
+        });
+    }
     let mut push = |s: Option<SectionView>| {
         if let Some(mut s) = s {
             s.drop_empty_figures();
