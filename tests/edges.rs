@@ -701,7 +701,7 @@ fn evaluate_used_nominal_for_metrics_but_rts_for_outages() {
     let span = ape["time_span_s"].as_array().unwrap();
     let (t0, t1) = (span[0].as_f64().unwrap(), span[1].as_f64().unwrap());
     assert!(
-        t0 >= 0.0 && t0 < 0.05 && t1 > 29.95 && t1 <= 30.0,
+        (0.0..0.05).contains(&t0) && t1 > 29.95 && t1 <= 30.0,
         "{t0} {t1}"
     );
     let (_, text) = eval(&["--metric", "ape"]);
