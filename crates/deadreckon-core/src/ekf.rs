@@ -246,6 +246,8 @@ pub struct FilterOutput<const N: usize = 5> {
     pub stats: FilterStats,
     /// What the wheel-health monitor saw (`None` without one).
     pub wheel_health: Option<WheelHealth>,
+    /// Indices in `drive.gnss` of the fixes the χ² gate rejected, in order.
+    pub gnss_gated: Vec<usize>,
 }
 
 impl<const N: usize> Default for FilterOutput<N> {
@@ -255,6 +257,7 @@ impl<const N: usize> Default for FilterOutput<N> {
             innovations: Vec::new(),
             stats: FilterStats::default(),
             wheel_health: None,
+            gnss_gated: Vec::new(),
         }
     }
 }
@@ -313,6 +316,9 @@ pub struct Feeder {
     stats: FilterStats,
     #[serde(skip)]
     updates: Vec<Update>,
+    /// The time of the GNSS fix the gate rejected at this event, if any.
+    #[serde(skip)]
+    gated_fix_t_s: Option<f64>,
     /// Whether epochs carry their prediction (a copy of the predicted state and
     /// covariance, which a run that records no epochs does without).
     #[serde(default = "yes")]
@@ -333,6 +339,9 @@ pub struct EpochOut<'a, const N: usize> {
     pub prediction: Option<&'a Prediction<N>>,
     /// The updates applied (or rejected) at the epoch.
     pub updates: &'a [Update],
+    /// The time of the GNSS fix the χ² gate rejected at this epoch (its own
+    /// time, which identifies it in the drive; the epoch may be later).
+    pub gated_fix_t_s: Option<f64>,
 }
 
 impl Feeder {
@@ -356,6 +365,7 @@ impl Feeder {
             pending_gnss: None,
             stats: FilterStats::default(),
             updates: Vec::new(),
+            gated_fix_t_s: None,
             predictions: opts.record_epochs,
             monitor: opts.wheel_monitor.map(WheelMonitor::new),
         }
@@ -580,6 +590,9 @@ impl Feeder {
     ) -> Result<(), Error> {
         let u = f.update_gnss(fix)?;
         self.updates.push(u);
+        if !u.accepted {
+            self.gated_fix_t_s = Some(fix.t_s);
+        }
         if u.accepted && self.sensors.gnss_course {
             if let Some(course) = fix.course_yaw_rad() {
                 if let Some(u) = f.update_course(course, fix.speed_mps)? {
@@ -602,6 +615,7 @@ impl Feeder {
         }
         let use_ = self.sensors;
         self.updates.clear();
+        self.gated_fix_t_s = None;
         let supersede = |slot: &mut Option<f64>, v: f64, n: &mut usize| {
             if slot.replace(v).is_some() {
                 *n += 1;
@@ -664,6 +678,7 @@ impl Feeder {
                         EpochOut {
                             prediction: prediction.as_ref(),
                             updates: &self.updates,
+                            gated_fix_t_s: self.gated_fix_t_s,
                         },
                     );
                 }
@@ -729,6 +744,7 @@ impl Feeder {
                     EpochOut {
                         prediction: prediction.as_ref(),
                         updates: &self.updates,
+                        gated_fix_t_s: self.gated_fix_t_s,
                     },
                 );
             }
@@ -851,6 +867,14 @@ pub fn run_filter<L: Layout<N>, const N: usize>(
             let (mut x, mut p) = (*f.state(), *f.covariance());
             hook.after_epoch(f.time_s(), &mut x, &mut p);
             f.set_state(x, p);
+        }
+        if let Some(t) = e.gated_fix_t_s {
+            // Fix times are strictly increasing in a valid drive: the time
+            // is the fix's key.
+            let i = drive.gnss.partition_point(|g| g.t_s < t);
+            if drive.gnss.get(i).is_some_and(|g| g.t_s == t) {
+                out.gnss_gated.push(i);
+            }
         }
         if opts.record_innovations {
             out.innovations

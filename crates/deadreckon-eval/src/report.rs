@@ -212,11 +212,13 @@ fn sensor_unit(k: SensorKind, ticks: bool) -> &'static str {
     }
 }
 
+/// What [`health`] returns: the report's section, the run's counters, the
+/// filtered and smoothed tracks, and the indices in `drive.gnss` of the
+/// fixes the gate rejected.
+pub type Health = (rp::FilterHealth, FilterStats, Vec<Track>, Vec<usize>);
+
 /// Filter health from a GNSS-aided run with innovations recorded.
-pub fn health(
-    drive: &Drive,
-    params: &Params,
-) -> Result<(rp::FilterHealth, FilterStats, Vec<Track>), Error> {
+pub fn health(drive: &Drive, params: &Params) -> Result<Health, Error> {
     let opts = FilterOptions {
         record_innovations: true,
         record_epochs: true,
@@ -274,7 +276,7 @@ pub fn health(
             }));
         }
     }
-    Ok((h, out.stats, tracks))
+    Ok((h, out.stats, tracks, out.gnss_gated))
 }
 
 /// NEES through 30 s dead-reckoning windows every 60 s against the truth
@@ -340,26 +342,15 @@ pub fn four_wheel_input(
                 .not_computed
                 .push(not_computed("filter health".into(), e));
         }
-        if let Ok((h, st, tracks)) = health {
-            let gated: Vec<f64> = h
-                .innovations
-                .iter()
-                .filter(|s| s.sensor == "gnss")
-                .flat_map(|s| {
-                    s.t_s
-                        .iter()
-                        .zip(&s.gated)
-                        .filter(|(_, g)| **g)
-                        .map(|(t, _)| *t)
-                })
-                .collect();
-            let is_gated = |t: f64| gated.iter().any(|g| (g - t).abs() < 0.011);
+        if let Ok((h, st, tracks, gated)) = health {
             traj.gnss = Some(rp::EnPath {
                 east_m: drive.gnss.iter().map(|g| g.east_m).collect(),
                 north_m: drive.gnss.iter().map(|g| g.north_m).collect(),
             });
             if st.gnss_rejected > 0 {
-                let gg: Vec<_> = drive.gnss.iter().filter(|g| is_gated(g.t_s)).collect();
+                // The fixes the filter says it gated (they were matched by
+                // time within 0.011 s of the wheel epoch that used them).
+                let gg: Vec<_> = gated.iter().filter_map(|&i| drive.gnss.get(i)).collect();
                 traj.gnss_gated = Some(rp::EnPath {
                     east_m: gg.iter().map(|g| g.east_m).collect(),
                     north_m: gg.iter().map(|g| g.north_m).collect(),

@@ -59,3 +59,45 @@ proptest! {
         }
     }
 }
+
+/// The report found the fixes the gate rejected by matching innovation
+/// times within 0.011 s (a fix is used at the next wheel epoch): the filter
+/// now says which fixes it gated, by their index in the drive.
+#[test]
+fn gated_fixes_were_found_by_matching_times_within_11_ms() {
+    use deadreckon_core::ekf::{run, FilterOptions, Timing};
+    let sim = simulate(&Scenario::builtin("evaluation").unwrap(), 5).unwrap();
+    let mut drive = sim.drive;
+    // The true parameters (with the nominal ones the gate rejects hundreds
+    // of this drive's fixes).
+    let params = sim.truth_params;
+    let clean_drive = drive.clone();
+    // Two outliers 150 m east, well apart.
+    let outliers = [400, 900];
+    for &i in &outliers {
+        drive.gnss[i].east_m += 150.0;
+    }
+    for timing in [Timing::WheelEpochs, Timing::EachMeasurement] {
+        let opts = FilterOptions {
+            timing,
+            ..Default::default()
+        };
+        // The gate's own rejections on the clean drive (2 with wheel epochs),
+        // plus the outliers: a rejected fix leaves the state unchanged.
+        let clean = run(&clean_drive, &params, &opts, &mut ()).unwrap();
+        assert!(
+            clean.gnss_gated.len() <= 3,
+            "{timing:?}: {:?}",
+            clean.gnss_gated
+        );
+        let mut expected = clean.gnss_gated.clone();
+        expected.extend(outliers);
+        expected.sort_unstable();
+        let out = run(&drive, &params, &opts, &mut ()).unwrap();
+        assert_eq!(out.gnss_gated, expected, "{timing:?}");
+        assert_eq!(out.stats.gnss_rejected, expected.len(), "{timing:?}");
+        for &i in &out.gnss_gated {
+            assert!(i < drive.gnss.len());
+        }
+    }
+}
