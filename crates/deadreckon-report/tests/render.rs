@@ -80,6 +80,7 @@ fn every_section_and_figure_of_a_full_report_draws_data() {
     assert_eq!(
         section_ids(&html),
         [
+            "not-computed",
             "trajectories",
             "calibration",
             "drift",

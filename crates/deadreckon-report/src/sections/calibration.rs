@@ -34,11 +34,11 @@ pub(crate) fn section(
     )?;
     let mut blocks = Vec::new();
     if !c.rows.is_empty() {
+        // One cell per parameter, "value ± std": with a column for each
+        // standard error the table was wider than the page (its last
+        // columns and caption were cut off at 1,120 px).
         let mut headers = vec!["method".to_string()];
-        for l in SHORT_LABELS {
-            headers.push(l.to_string());
-            headers.push("±".to_string());
-        }
+        headers.extend(SHORT_LABELS.iter().map(|l| l.to_string()));
         let rows = c
             .rows
             .iter()
@@ -46,14 +46,14 @@ pub(crate) fn section(
                 let mut cells = vec![r.method.clone()];
                 let std = r.std.map(|s| s.to_array());
                 for (i, v) in r.values.to_array().into_iter().enumerate() {
-                    cells.push(fmt_sig(v, if i == 0 { 3 } else { 5 }));
+                    let value = fmt_sig(v, if i == 0 { 3 } else { 5 });
                     // A standard error of exactly 0 is a parameter the method
                     // held fixed (the data could not determine it): "± 0"
                     // read as perfectly known.
                     cells.push(match std.map(|s| s[i]) {
-                        None => "–".into(),
-                        Some(0.0) => "not estimated".into(),
-                        Some(s) => fmt_sig(s, 2),
+                        None => value,
+                        Some(0.0) => format!("{value} n.e."),
+                        Some(s) => format!("{value} ± {}", fmt_sig(s, 2)),
                     });
                 }
                 RowView {
@@ -64,9 +64,9 @@ pub(crate) fn section(
             .collect();
         blocks.push(Block::Tables {
             tables: vec![TableView {
-                caption: "Calibrated parameters (table III); ± is one standard error; \
-                          \"not estimated\": held at its starting value because the drive \
-                          cannot determine it."
+                caption: "Calibrated parameters (table III); ± one standard error; \
+                          n.e.: not estimated, held at its starting value (the drive \
+                          cannot determine it)."
                     .into(),
                 headers,
                 rows,

@@ -317,9 +317,14 @@ fn nis_figure(
         data_end(chart)
     })?;
     let mut caption = format!(
-        "NIS of {} ({dof} degrees of freedom): {n} observations; of the {} accepted, {inside} ({:.1}%) inside the \
+        "NIS of {} ({dof} {}): {n} observations; of the {} accepted, {inside} ({:.1}%) inside the \
          two-sided {pc}% chi-square bounds [{}, {}]; mean {} (expected {dof})",
         s.sensor,
+        if dof == 1 {
+            "degree of freedom"
+        } else {
+            "degrees of freedom"
+        },
         acc_sorted.len(),
         100.0 * inside as f64 / acc_sorted.len().max(1) as f64,
         fmt_sig(lo, 3),
