@@ -147,6 +147,15 @@ fn cross_correlation(cc: &CrossCorrelation) -> Result<Option<FigureView>, Report
     }))
 }
 
+/// A p value, with everything below 1e-4 as "< 0.0001".
+fn p_value(p: f64) -> String {
+    if p < 1e-4 {
+        "< 0.0001".into()
+    } else {
+        format!("{p:.4}")
+    }
+}
+
 fn model_table(m: &crate::model::RegressionModel) -> TableView {
     let mut rows: Vec<RowView> = m
         .coefficients
@@ -158,11 +167,7 @@ fn model_table(m: &crate::model::RegressionModel) -> TableView {
                 fmt_trim(c.estimate, 6),
                 fmt_trim(c.std_error, 4),
                 format!("{:.2}", c.t_value),
-                if c.p_value < 1e-4 {
-                    "< 0.0001".into()
-                } else {
-                    format!("{:.4}", c.p_value)
-                },
+                p_value(c.p_value),
             ],
         })
         .collect();
@@ -170,7 +175,12 @@ fn model_table(m: &crate::model::RegressionModel) -> TableView {
         swatch: None,
         cells: vec![
             s.name.clone(),
-            fmt_trim(s.value, 4),
+            // The tests' p values as the coefficients' ("0" read as exact).
+            if s.name.ends_with(" p") {
+                p_value(s.value)
+            } else {
+                fmt_trim(s.value, 4)
+            },
             String::new(),
             String::new(),
             String::new(),
