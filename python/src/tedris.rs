@@ -119,9 +119,8 @@ pub fn tedris_run<'py>(
     mapping: Option<PathBuf>,
     skip_checks: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let m: TedrisModel = serde_json::from_str(model_json)
-        .map_err(|e| DeadreckonError::new_err(format!("parsing the model: {e}")))?;
-    m.validate().map_err(to_py_err)?;
+    let m = TedrisModel::from_json(model_json)
+        .map_err(|e| DeadreckonError::new_err(format!("the model: {e}")))?;
     let outages: Vec<Outage> = outages
         .iter()
         .map(|(a, b)| format!("{a}:{b}").parse())

@@ -4,10 +4,10 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
 use deadreckon_eval::compare::compare;
-use deadreckon_tedris::{Outage, TedrisModel};
+use deadreckon_tedris::Outage;
 
 use super::common;
 
@@ -47,15 +47,10 @@ pub fn run(a: CompareArgs, load: &common::Loader) -> Result<()> {
         None => (None, drive),
     };
     let model = match &a.model {
-        Some(m) => {
-            let text =
-                std::fs::read_to_string(m).with_context(|| format!("reading {}", m.display()))?;
-            Some((
-                serde_json::from_str::<TedrisModel>(&text)
-                    .with_context(|| format!("parsing {}", m.display()))?,
-                m.display().to_string(),
-            ))
-        }
+        Some(m) => Some((
+            deadreckon_api::tedris::read_model(m)?,
+            m.display().to_string(),
+        )),
         None => None,
     };
     let c = compare(&drive, &outages, params, model)?;

@@ -90,9 +90,6 @@ pub fn tedris_section(
     model_path: &std::path::Path,
     outage_s: Option<f64>,
 ) -> Result<rp::Tedris> {
-    let text = std::fs::read_to_string(model_path)
-        .with_context(|| format!("reading {}", model_path.display()))?;
-    let m: deadreckon_tedris::TedrisModel =
-        serde_json::from_str(&text).with_context(|| format!("parsing {}", model_path.display()))?;
+    let m = deadreckon_api::tedris::read_model(model_path)?;
     Ok(tedris_from_model(drive, &m, outage_s)?)
 }

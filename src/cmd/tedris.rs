@@ -244,11 +244,7 @@ pub fn run(c: TedrisCommand, load: &super::common::Loader) -> Result<()> {
             if let Some(p) = &out {
                 super::common::check_output(p, &[&dir, &model])?;
             }
-            let text = std::fs::read_to_string(&model)
-                .with_context(|| format!("reading {}", model.display()))?;
-            let m: TedrisModel = serde_json::from_str(&text)
-                .with_context(|| format!("parsing the model {}", model.display()))?;
-            m.validate()?;
+            let m = deadreckon_api::tedris::read_model(&model)?;
             let outages: Vec<Outage> = outages
                 .iter()
                 .map(|s| s.parse())

@@ -79,6 +79,24 @@ pub enum Error {
         /// Each error finding on a line: what disagrees, by how much, and the check's name.
         findings: String,
     },
+    /// A TedriS model file could not be read.
+    #[error("reading the TedriS model {}", path.display())]
+    ModelFile {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// A TedriS model file is not a usable model.
+    #[error("the TedriS model {}", path.display())]
+    Model {
+        /// The file.
+        path: PathBuf,
+        /// Why (JSON, or the checks of `TedrisModel::validate`).
+        #[source]
+        source: deadreckon_tedris::Error,
+    },
     /// A calibration (or the estimation before it) failed.
     #[error("{what}")]
     Calibration {

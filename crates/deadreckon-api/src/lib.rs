@@ -14,6 +14,7 @@
 //!   (one rule for every metric).
 //! - [`json`]: the objects `calibrate --json`, `evaluate --json` and
 //!   `tedris train --json` print, built from the library results.
+//! - [`tedris`]: a TedriS model read from its file and checked.
 //! - [`options`]: the option words of the commands (`--timing wheel|each`,
 //!   `--state`, `--iteration`) parsed into the library's enums.
 //!
@@ -29,6 +30,7 @@ pub mod evaluate;
 pub mod json;
 pub mod options;
 pub mod source;
+pub mod tedris;
 
 mod error;
 pub use error::{chain_text, Error};

@@ -451,6 +451,15 @@ impl TedrisModel {
         &self.repositories.straight
     }
 
+    /// A model from its JSON (what `tedris train --out` writes), checked
+    /// ([`TedrisModel::validate`]): the one way every command and the Python
+    /// bindings load a model (the report and `compare` did not check it).
+    pub fn from_json(text: &str) -> Result<TedrisModel, Error> {
+        let m: TedrisModel = serde_json::from_str(text).map_err(|e| Error::Json(e.to_string()))?;
+        m.validate()?;
+        Ok(m)
+    }
+
     /// Checks a loaded model is usable (non-empty fits, finite numbers).
     pub fn validate(&self) -> Result<(), Error> {
         self.config.validate()?;
