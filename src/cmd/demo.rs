@@ -302,7 +302,8 @@ fn tedris_part(
     steps.step("TedriS report");
     let methods = report::calibrations(&drive, steps);
     let mut input = report::four_wheel_input(&drive, &methods, None, steps)?;
-    input.tedris = Some(report::tedris_from_model(&drive, &c.model, Some(80.0))?);
+    // The report's outage curves are the comparison printed above.
+    input.tedris = Some(report::tedris_from_model(&drive, &c.model, &c)?);
     input.header = report::header(
         &drive,
         "demo: TedriS campus drive",

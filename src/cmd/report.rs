@@ -83,13 +83,21 @@ pub fn run(a: ReportArgs, quiet: bool, load: &common::Loader) -> Result<()> {
 
 /// The TedriS sections for a drive and a trained model: the cross-correlation,
 /// the regression tables of every model kind, the repositories, the training
-/// heading against the reference, and the error through outages of `outage_s`
-/// (default 80 s) at a quarter, half and three quarters of the drive.
+/// heading against the reference, and the errors through outages of
+/// `outage_s` (default 80 s) at a quarter, half and three quarters of the
+/// drive, as `compare --model` gives them for those windows.
 pub fn tedris_section(
     drive: &Drive,
     model_path: &std::path::Path,
     outage_s: Option<f64>,
 ) -> Result<rp::Tedris> {
     let m = deadreckon_api::tedris::read_model(model_path)?;
-    Ok(tedris_from_model(drive, &m, outage_s)?)
+    let windows = deadreckon_eval::compare::default_windows(drive, outage_s.unwrap_or(80.0))?;
+    let c = deadreckon_eval::compare::compare(
+        drive,
+        &windows,
+        None,
+        Some((m.clone(), model_path.display().to_string())),
+    )?;
+    Ok(tedris_from_model(drive, &m, &c)?)
 }

@@ -19,6 +19,8 @@ pub struct Row {
     pub fin: f64,
     /// Time until the error first reaches 1 m, s.
     pub to_1m: Option<f64>,
+    /// The errors summarised: (time since the outage start, s; error, m).
+    pub errors: Vec<(f64, f64)>,
 }
 
 /// The comparison through a set of outages.
@@ -35,11 +37,31 @@ pub struct Comparison {
     pub rows: Vec<(Outage, Option<Row>, Option<Row>)>,
     /// The TedriS model used.
     pub model: TedrisModel,
+    /// TedriS's track through the drive, GNSS hidden in the outages.
+    pub tedris_track: deadreckon_core::Track,
     /// The four-wheel filter's χ² gate counters over the run.
     pub four_wheel_gates: deadreckon_core::filter::GateCounts,
     /// TedriS's checks over the run: (headings refused as inconsistent with
     /// the wheels, calibrations refused, heading segments, watchdog alarms).
     pub tedris_checks: (u64, u64, u32, u64),
+}
+
+/// The outages a report and the demo compare through when none are given:
+/// `len` s (at most a fifth of the drive) centred at a quarter, half and
+/// three quarters of the drive.
+pub fn default_windows(drive: &Drive, len: f64) -> Result<Vec<Outage>, Error> {
+    let (t0, t1) = drive.time_span().ok_or(Error::EmptyDrive)?;
+    let len = len.min(0.2 * (t1 - t0));
+    Ok([0.25, 0.5, 0.75]
+        .iter()
+        .map(|f| {
+            let a = t0 + f * (t1 - t0) - 0.5 * len;
+            Outage {
+                start_s: a,
+                end_s: a + len,
+            }
+        })
+        .collect())
 }
 
 /// Runs both methods through `outages`. Without `params`, the four-wheel
@@ -85,6 +107,7 @@ pub fn compare(
                 max: w.max_error_m,
                 fin: w.final_error_m,
                 to_1m: w.errors.iter().find(|e| e.1 >= 1.0).map(|e| e.0),
+                errors: w.errors.clone(),
             });
         let t = td
             .outages
@@ -95,6 +118,7 @@ pub fn compare(
                 max: e.max_error_m,
                 fin: e.final_error_m,
                 to_1m: e.time_to_1m_s,
+                errors: e.errors.clone(),
             });
         rows.push((*o, f, t));
     }
@@ -105,6 +129,7 @@ pub fn compare(
         tedris_reference: td.reference.clone(),
         rows,
         model,
+        tedris_track: td.track.clone(),
         four_wheel_gates: fw.gates,
         tedris_checks: (
             td.machine.inconsistent_headings(),

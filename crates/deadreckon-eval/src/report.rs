@@ -457,11 +457,15 @@ pub fn four_wheel_input(
     Ok(input)
 }
 
-/// [`tedris_section`] for a model in memory.
+/// The TedriS sections of a report for a trained model `m`: the
+/// cross-correlation, the regression tables, the repositories, and from the
+/// comparison `c` (made with `m`) the training heading and the error curves
+/// through its outages, so the report shows the numbers the comparison
+/// table prints (they used to come from other windows).
 pub fn tedris_from_model(
     drive: &Drive,
     m: &deadreckon_tedris::TedrisModel,
-    outage_s: Option<f64>,
+    c: &crate::compare::Comparison,
 ) -> Result<rp::Tedris, Error> {
     let mut t = rp::Tedris {
         cross_correlation: Some(rp::CrossCorrelation {
@@ -514,20 +518,7 @@ pub fn tedris_from_model(
         min_fill: Some(m.config.min_fill as u64),
         max_fill: Some(m.config.max_fill as u64),
     });
-    // Outages spread over the drive.
-    let (t0, t1) = drive.time_span().ok_or(Error::EmptyDrive)?;
-    let len = outage_s.unwrap_or(80.0).min(0.2 * (t1 - t0));
-    let outages: Vec<deadreckon_tedris::Outage> = [0.25, 0.5, 0.75]
-        .iter()
-        .map(|f| {
-            let a = t0 + f * (t1 - t0) - 0.5 * len;
-            deadreckon_tedris::Outage {
-                start_s: a,
-                end_s: a + len,
-            }
-        })
-        .collect();
-    let run = deadreckon_tedris::run_outages(drive, m, &outages)?;
+    let (t0, _) = drive.time_span().ok_or(Error::EmptyDrive)?;
     // Training heading (TedriS's own estimate outside outages) against the reference course.
     let course: Vec<(f64, f64)> = drive
         .gnss
@@ -544,70 +535,24 @@ pub fn tedris_from_model(
         };
         t.gnss_heading_rad = Some(unwrap(course));
         t.training_heading_rad = Some(unwrap(
-            run.track
+            c.tedris_track
                 .points
                 .iter()
                 .map(|p| (p.t_s, p.yaw_rad))
                 .collect(),
         ));
     }
-    // Error through each outage for TedriS and the four-wheel EKF (calibrated with the outages hidden).
-    let windows: Vec<(f64, f64)> = outages.iter().map(|o| (o.start_s, o.end_s)).collect();
-    let hidden = drive.without_gnss_in(&windows);
-    let fw = calibrate::calibrate(&hidden, &CalibrationOptions::default())
-        .ok()
-        .and_then(|c| {
-            outage::through_windows(
-                drive,
-                &c.estimate.params,
-                &windows,
-                &FilterOptions::default(),
-            )
-            .ok()
-        });
-    let truth = deadreckon_core::reference::Reference::from_truth(&drive.truth);
-    for o in &outages {
+    // Each outage's errors as the comparison measured and printed them.
+    for (o, four_wheel, tedris) in &c.rows {
         let mut series = Vec::new();
-        if let Some(tr) = &truth {
-            let pts: Vec<(f64, f64)> = run
-                .track
-                .points
-                .iter()
-                .filter(|p| p.t_s >= o.start_s && p.t_s <= o.end_s)
-                .filter_map(|p| {
-                    tr.state_at(p.t_s)
-                        .map(|x| (p.t_s - o.start_s, (p.east_m - x[0]).hypot(p.north_m - x[1])))
-                })
-                .collect();
-            series.push(rp::MethodSeries {
-                method: "TedriS".into(),
-                t_s: pts.iter().map(|p| p.0).collect(),
-                error_m: pts.iter().map(|p| p.1).collect(),
-            });
-        } else {
-            // Without truth, against the hidden GNSS fixes, as the four-wheel
-            // errors are (the TedriS curve was missing on the Husky).
-            let pts = deadreckon_tedris::outage::gnss_error_points(
-                drive,
-                &run.track.points,
-                o.start_s,
-                o.end_s,
-            );
-            series.push(rp::MethodSeries {
-                method: "TedriS".into(),
-                t_s: pts.iter().map(|p| p.0 - o.start_s).collect(),
-                error_m: pts.iter().map(|p| p.2).collect(),
-            });
-        }
-        if let Some(w) = fw
-            .as_ref()
-            .and_then(|f| f.windows.iter().find(|w| w.start_s == o.start_s))
-        {
-            series.push(rp::MethodSeries {
-                method: "RTS".into(),
-                t_s: w.errors.iter().map(|e| e.0).collect(),
-                error_m: w.errors.iter().map(|e| e.1).collect(),
-            });
+        for (name, row) in [("TedriS", tedris), ("four-wheel", four_wheel)] {
+            if let Some(r) = row {
+                series.push(rp::MethodSeries {
+                    method: name.into(),
+                    t_s: r.errors.iter().map(|e| e.0).collect(),
+                    error_m: r.errors.iter().map(|e| e.1).collect(),
+                });
+            }
         }
         if !series.is_empty() {
             t.outages.push(rp::OutageRun {

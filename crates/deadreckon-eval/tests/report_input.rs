@@ -35,3 +35,54 @@ fn a_failed_calibration_silently_vanished_from_the_report() {
     assert!(page.contains("Not computed"), "no section");
     assert!(page.contains("truth calibration: "), "no reason given");
 }
+
+/// `demo` printed one TedriS-vs-four-wheel table and its report showed other
+/// windows and other numbers (e.g. 151.6:231.6 printed, 120–200 s reported).
+/// The report's outage curves are now the comparison's own errors.
+#[test]
+fn the_demo_printed_one_comparison_and_reported_another() {
+    use deadreckon_eval::compare::{compare, default_windows};
+    use deadreckon_eval::report::tedris_from_model;
+    let drive = simulate(&Scenario::builtin("tedris-car").unwrap(), 7)
+        .unwrap()
+        .drive;
+    let windows = default_windows(&drive, 80.0).unwrap();
+    assert_eq!(windows.len(), 3);
+    let c = compare(&drive, &windows, None, None).unwrap();
+    let t = tedris_from_model(&drive, &c.model, &c).unwrap();
+    assert_eq!(t.outages.len(), c.rows.len());
+    let (t0, _) = drive.time_span().unwrap();
+    for ((o, four_wheel, tedris), run) in c.rows.iter().zip(&t.outages) {
+        assert_eq!(
+            run.name,
+            format!("outage {:.0}–{:.0} s", o.start_s - t0, o.end_s - t0)
+        );
+        for (name, row) in [("TedriS", tedris), ("four-wheel", four_wheel)] {
+            let row = row.as_ref().expect("both methods ran");
+            let s = run
+                .series
+                .iter()
+                .find(|s| s.method == name)
+                .unwrap_or_else(|| panic!("no {name} curve in {}", run.name));
+            // The printed final, largest and mean errors are the curve's.
+            assert_eq!(
+                s.error_m.last().copied(),
+                Some(row.fin),
+                "{name} {}",
+                run.name
+            );
+            let max = s.error_m.iter().copied().fold(f64::NAN, f64::max);
+            assert_eq!(max, row.max, "{name} {}", run.name);
+            let mean = s.error_m.iter().sum::<f64>() / s.error_m.len() as f64;
+            assert!((mean - row.mean).abs() < 1e-12, "{name} {}", run.name);
+            // The four-wheel filter's last epoch may fall 0.04 s after the end.
+            let len = o.end_s - o.start_s + 0.05;
+            assert!(
+                s.t_s.iter().all(|&dt| (0.0..=len).contains(&dt)),
+                "{name}: {:?} .. {:?}",
+                s.t_s.first(),
+                s.t_s.last()
+            );
+        }
+    }
+}

@@ -71,6 +71,10 @@ pub struct OutageError {
     pub points: usize,
     /// Estimates of the outage made while the machine was predicting with a model.
     pub predicted_fraction: f64,
+    /// The errors the figures above summarise: (time since the outage
+    /// start, s; horizontal error, m), for plots (not in the JSON).
+    #[serde(skip)]
+    pub errors: Vec<(f64, f64)>,
 }
 
 /// The result of [`run_outages`].
@@ -291,6 +295,7 @@ pub(crate) fn summarise_errors(
         } else {
             0.0
         },
+        errors: errs.iter().map(|e| (e.0 - o.start_s, e.1)).collect(),
     }
 }
 
