@@ -65,6 +65,19 @@ impl Summary {
     }
 }
 
+/// Arithmetic mean (NaN for an empty slice).
+pub fn mean(v: &[f64]) -> f64 {
+    v.iter().sum::<f64>() / v.len() as f64
+}
+
+/// Median (NaN for an empty slice); the mean of the two middle values for
+/// even lengths.
+pub fn median(v: &[f64]) -> f64 {
+    let mut s = v.to_vec();
+    s.sort_by(f64::total_cmp);
+    quantile(&s, 0.5)
+}
+
 /// Quantile `q` of sorted values, with linear interpolation.
 pub fn quantile(sorted: &[f64], q: f64) -> f64 {
     if sorted.is_empty() {

@@ -1,18 +1,9 @@
 //! Small statistics the report needs: summaries, quantiles, histogram bins, the
 //! chi-square quantile for the NIS bounds, and decimation of long series.
 
-/// Summary of a sample, finite values only.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Summary {
-    pub n: usize,
-    pub mean: f64,
-    /// Sample standard deviation (n − 1); 0 for a single value.
-    pub std: f64,
-    pub median: f64,
-    pub p95: f64,
-    pub min: f64,
-    pub max: f64,
-}
+/// Summaries and quantiles are `deadreckon_core::metrics`' (one place for
+/// the whole workspace); the report takes the finite values only.
+pub(crate) use deadreckon_core::metrics::{quantile as quantile_sorted, Summary};
 
 /// The finite values of `v`, sorted.
 pub(crate) fn sorted_finite(v: &[f64]) -> Vec<f64> {
@@ -21,42 +12,10 @@ pub(crate) fn sorted_finite(v: &[f64]) -> Vec<f64> {
     s
 }
 
-/// Quantile `q` in [0, 1] of sorted data, linear interpolation between order statistics.
-pub(crate) fn quantile_sorted(s: &[f64], q: f64) -> f64 {
-    match s.len() {
-        0 => f64::NAN,
-        1 => s[0],
-        n => {
-            let h = q.clamp(0.0, 1.0) * (n - 1) as f64;
-            let i = h.floor() as usize;
-            let j = (i + 1).min(n - 1);
-            s[i] + (h - i as f64) * (s[j] - s[i])
-        }
-    }
-}
-
 /// Summary of the finite values of `v`; `None` when there are none.
 pub(crate) fn summary(v: &[f64]) -> Option<Summary> {
     let s = sorted_finite(v);
-    let n = s.len();
-    if n == 0 {
-        return None;
-    }
-    let mean = s.iter().sum::<f64>() / n as f64;
-    let std = if n > 1 {
-        (s.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1) as f64).sqrt()
-    } else {
-        0.0
-    };
-    Some(Summary {
-        n,
-        mean,
-        std,
-        median: quantile_sorted(&s, 0.5),
-        p95: quantile_sorted(&s, 0.95),
-        min: s[0],
-        max: s[n - 1],
-    })
+    (!s.is_empty()).then(|| Summary::of(&s))
 }
 
 /// Histogram bin edges shared by several samples: about `target` bins over the

@@ -212,25 +212,8 @@ pub fn invert(a: &[Vec<f64>]) -> Option<Vec<Vec<f64>>> {
     Some(inv)
 }
 
-/// Arithmetic mean (NaN for an empty slice).
-pub fn mean(v: &[f64]) -> f64 {
-    v.iter().sum::<f64>() / v.len() as f64
-}
-
-/// Median (NaN for an empty slice); the mean of the two middle values for even lengths.
-pub fn median(v: &[f64]) -> f64 {
-    if v.is_empty() {
-        return f64::NAN;
-    }
-    let mut s = v.to_vec();
-    s.sort_by(f64::total_cmp);
-    let m = s.len() / 2;
-    if s.len() % 2 == 1 {
-        s[m]
-    } else {
-        0.5 * (s[m - 1] + s[m])
-    }
-}
+/// The summary statistics live in one place, `deadreckon_core::metrics`.
+pub use deadreckon_core::metrics::{mean, median};
 
 #[cfg(test)]
 mod tests {
