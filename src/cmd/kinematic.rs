@@ -60,9 +60,9 @@ pub fn diff_drive(
 }
 
 /// Whether `path` is a recording read through a kinematic shape (a
-/// tricycle `dataset.txt`).
+/// tricycle `dataset.txt`), as the library's format detection says.
 pub fn is_tricycle_log(path: &Path) -> bool {
-    path.is_file() && path.extension().and_then(|e| e.to_str()) == Some("txt")
+    deadreckon_api::source::detect(path) == deadreckon_api::source::SourceKind::TricycleLog
 }
 
 /// Reads a tricycle log as a kinematic drive cut to `[from, until)`.

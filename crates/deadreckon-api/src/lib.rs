@@ -34,4 +34,4 @@ pub mod tedris;
 
 mod error;
 pub use error::{chain_text, Error};
-pub use source::{read_drive, read_drive_with, read_ros};
+pub use source::{detect, read_drive, read_drive_with, read_ros, SourceKind};

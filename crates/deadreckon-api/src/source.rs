@@ -6,6 +6,50 @@ use deadreckon_core::Drive;
 
 use crate::Error;
 
+/// What a path holds, as the tool tells recordings apart: by what a
+/// directory contains and a file's extension (the one place that decides;
+/// the command line asks it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SourceKind {
+    /// A drive directory (`vehicle.toml` and the CSV streams; also a
+    /// directory that is none of the others: reading it says what is missing).
+    DriveDirectory,
+    /// A comma2k19 segment directory (`processed_log/`, no `vehicle.toml`).
+    Comma2k19,
+    /// A rosbag2 directory (`metadata.yaml`) holding one `.mcap`.
+    Rosbag2Directory,
+    /// A ROS1 `.bag` or ROS2 `.mcap` file.
+    RosFile,
+    /// A tricycle log (`.txt`), read as a drive or through the tricycle's
+    /// own kinematics.
+    TricycleLog,
+    /// A file of no format the tool reads.
+    Unknown,
+}
+
+/// What `path` holds ([`SourceKind`]).
+pub fn detect(path: &Path) -> SourceKind {
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+    if path.is_dir() {
+        if !path.join("vehicle.toml").exists() && path.join("processed_log").is_dir() {
+            SourceKind::Comma2k19
+        } else if path.join("metadata.yaml").is_file() {
+            SourceKind::Rosbag2Directory
+        } else {
+            SourceKind::DriveDirectory
+        }
+    } else if path.is_file() {
+        match ext {
+            "bag" | "mcap" => SourceKind::RosFile,
+            "txt" => SourceKind::TricycleLog,
+            _ => SourceKind::Unknown,
+        }
+    } else {
+        // Missing: the drive reader names it.
+        SourceKind::DriveDirectory
+    }
+}
+
 /// Reads a drive from a drive directory or, directly, from a recording that a
 /// reader understands: a comma2k19 segment directory, a ROS1 `.bag`, a ROS2
 /// `.mcap` (with `mapping`, a topic-mapping TOML file, or the built-in Husky
@@ -21,38 +65,34 @@ pub fn read_drive_with(
     options: &deadreckon_io::ReadOptions,
     mapping: Option<&Path>,
 ) -> Result<Drive, Error> {
-    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
-    if path.is_dir() && !path.join("vehicle.toml").exists() && path.join("processed_log").is_dir() {
-        return deadreckon_import::read_comma2k19(path, None).map_err(|source| Error::Comma2k19 {
-            path: path.to_path_buf(),
-            source,
-        });
-    }
-    // A rosbag2 directory: read through its one .mcap file.
-    if path.is_dir() && path.join("metadata.yaml").is_file() {
-        return Ok(read_ros(path, mapping)?.0);
-    }
-    if path.is_file() {
-        return match ext {
-            "bag" | "mcap" => Ok(read_ros(path, mapping)?.0),
-            "txt" => {
-                let o = deadreckon_import::tricycle::TricycleOptions::default();
-                Ok(deadreckon_import::tricycle::read_tricycle(path, &o)
-                    .map_err(|source| Error::Tricycle {
-                        path: path.to_path_buf(),
-                        source,
-                    })?
-                    .drive)
-            }
-            _ => Err(Error::Unrecognised {
+    match detect(path) {
+        SourceKind::Comma2k19 => {
+            deadreckon_import::read_comma2k19(path, None).map_err(|source| Error::Comma2k19 {
                 path: path.to_path_buf(),
-            }),
-        };
+                source,
+            })
+        }
+        // A rosbag2 directory: read through its one .mcap file.
+        SourceKind::Rosbag2Directory | SourceKind::RosFile => Ok(read_ros(path, mapping)?.0),
+        SourceKind::TricycleLog => {
+            let o = deadreckon_import::tricycle::TricycleOptions::default();
+            Ok(deadreckon_import::tricycle::read_tricycle(path, &o)
+                .map_err(|source| Error::Tricycle {
+                    path: path.to_path_buf(),
+                    source,
+                })?
+                .drive)
+        }
+        SourceKind::Unknown => Err(Error::Unrecognised {
+            path: path.to_path_buf(),
+        }),
+        SourceKind::DriveDirectory => {
+            deadreckon_io::read_drive_with(path, options).map_err(|source| Error::Drive {
+                path: path.to_path_buf(),
+                source,
+            })
+        }
     }
-    deadreckon_io::read_drive_with(path, options).map_err(|source| Error::Drive {
-        path: path.to_path_buf(),
-        source,
-    })
 }
 
 /// Reads a ROS1 bag or ROS2 MCAP recording with the `mapping` file, or the
@@ -90,6 +130,32 @@ pub fn read_ros(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_command_line_told_tricycle_logs_apart_by_itself() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        let file = |name: &str| {
+            let p = d.join(name);
+            std::fs::write(&p, "x").unwrap();
+            p
+        };
+        assert_eq!(detect(&file("dataset.txt")), SourceKind::TricycleLog);
+        assert_eq!(detect(&file("h.bag")), SourceKind::RosFile);
+        assert_eq!(detect(&file("h.mcap")), SourceKind::RosFile);
+        assert_eq!(detect(&file("h.csv")), SourceKind::Unknown);
+        let seg = d.join("seg");
+        std::fs::create_dir_all(seg.join("processed_log")).unwrap();
+        assert_eq!(detect(&seg), SourceKind::Comma2k19);
+        // With a vehicle.toml it is a drive directory (an imported segment).
+        std::fs::write(seg.join("vehicle.toml"), "").unwrap();
+        assert_eq!(detect(&seg), SourceKind::DriveDirectory);
+        let bag2 = d.join("bag2");
+        std::fs::create_dir_all(&bag2).unwrap();
+        std::fs::write(bag2.join("metadata.yaml"), "").unwrap();
+        assert_eq!(detect(&bag2), SourceKind::Rosbag2Directory);
+        assert_eq!(detect(&d.join("missing")), SourceKind::DriveDirectory);
+    }
 
     #[test]
     fn an_unknown_file_is_refused_naming_it() {
