@@ -7,11 +7,8 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use clap::Args;
-use deadreckon_core::calibrate::{
-    self, Calibration, CalibrationOptions, Iteration, Method, PassState,
-};
-use deadreckon_core::ekf::Timing;
-use deadreckon_core::metrics::{self, Summary};
+use deadreckon_core::calibrate::{self, CalibrationOptions, Iteration, PassState};
+use deadreckon_core::metrics::Summary;
 use deadreckon_core::{Params, ParamsWithStd};
 
 use super::common;
@@ -31,70 +28,6 @@ pub struct DemoArgs {
     pub json: bool,
 }
 
-/// One calibration method's results.
-pub struct MethodResult {
-    /// Method name.
-    pub name: &'static str,
-    /// Where the parameters come from.
-    pub source: report::Source,
-    /// Calibration (None for nominal).
-    pub calibration: Option<Calibration>,
-    /// Parameters used.
-    pub params: ParamsWithStd,
-    /// Drift evaluation.
-    pub drift: metrics::DriftResult,
-    /// Reset-on-1 m evaluation.
-    pub reset: metrics::ResetResult,
-}
-
-/// Calibrates with every method on `cal` and evaluates on `eval`.
-pub fn calibrate_and_evaluate(
-    cal: &deadreckon_core::Drive,
-    eval: &deadreckon_core::Drive,
-) -> Result<Vec<MethodResult>> {
-    let nominal = Params::nominal(&cal.vehicle);
-    let mut out = Vec::new();
-    for (source, method) in [
-        (report::Source::Nominal, None),
-        (report::Source::Zupt, Some(Method::Zupt)),
-        (report::Source::Rts, Some(Method::Rts)),
-        (report::Source::Truth, Some(Method::Truth)),
-    ] {
-        let name = source.name();
-        let calibration = match method {
-            None => None,
-            Some(m) => Some(
-                calibrate::calibrate(
-                    cal,
-                    &CalibrationOptions {
-                        method: m,
-                        ..Default::default()
-                    },
-                )
-                .with_context(|| format!("{name} calibration"))?,
-            ),
-        };
-        let params = calibration
-            .as_ref()
-            .map(|c| c.estimate)
-            .unwrap_or(ParamsWithStd {
-                params: nominal,
-                std: Params::from_array([0.0; 6]),
-            });
-        let drift = metrics::drift(eval, &params.params, 100.0, Timing::WheelEpochs)?;
-        let reset = metrics::reset_on_error(eval, &params.params, 1.0, Timing::WheelEpochs)?;
-        out.push(MethodResult {
-            name,
-            source,
-            calibration,
-            params,
-            drift,
-            reset,
-        });
-    }
-    Ok(out)
-}
-
 /// Runs `demo`.
 pub fn run(a: DemoArgs, quiet: bool, load: &common::Loader) -> Result<()> {
     let steps = super::progress::Steps::new(16, quiet);
@@ -107,7 +40,7 @@ pub fn run(a: DemoArgs, quiet: bool, load: &common::Loader) -> Result<()> {
     let cal = load.drive(&cal_dir)?;
     let eval = load.drive(&eval_dir)?;
     steps.step("calibrating and evaluating");
-    let results = calibrate_and_evaluate(&cal, &eval)?;
+    let results = deadreckon_eval::crossval::calibrate_and_evaluate(&cal, &eval)?;
     for r in &results {
         if let Some(c) = &r.calibration {
             let file = a.out.join(format!("params_{}.toml", r.name.to_lowercase()));

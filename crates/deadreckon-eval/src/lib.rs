@@ -8,6 +8,8 @@
 //! - [`compare`]: TedriS and the calibrated four-wheel EKF through the same GNSS
 //!   outages, neither seeing GNSS inside them, not even for calibration or
 //!   training ([`compare::compare`], [`compare::Comparison`]);
+//! - [`crossval`]: calibrate with every method on one drive and evaluate on
+//!   another (`demo`'s tables III and IV);
 //! - [`report`]: estimator results as the HTML report's data model
 //!   (`deadreckon_report::ReportInput`): calibrations, filter health, dead
 //!   reckoning, drift, outages, the TedriS sections.
@@ -17,6 +19,7 @@
 #![deny(missing_docs)]
 
 pub mod compare;
+pub mod crossval;
 pub mod report;
 
 /// Where a long evaluation reports its steps (the command line's progress bar).
@@ -41,6 +44,15 @@ pub enum Error {
     /// TedriS could not be trained on the drive with the outages hidden.
     #[error("TedriS training with the outages hidden")]
     HiddenTraining(#[source] deadreckon_tedris::Error),
+    /// A calibration of [`crossval::calibrate_and_evaluate`] failed.
+    #[error("{method} calibration")]
+    Calibration {
+        /// The method.
+        method: &'static str,
+        /// Why.
+        #[source]
+        source: deadreckon_core::Error,
+    },
     /// The drive holds no samples.
     #[error("empty drive")]
     EmptyDrive,
