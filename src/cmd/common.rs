@@ -74,13 +74,6 @@ impl Loader {
             .unwrap_or_else(|p| p.into_inner())
             .clone()
     }
-
-    /// Reads a ROS1 bag or ROS2 MCAP recording with the `--mapping` file, or the
-    /// built-in mapping (Husky, or Jackal when the file name says so), with the
-    /// reader's report of what was used, dropped and counted.
-    pub fn ros_with_report(&self, path: &Path) -> Result<(Drive, deadreckon_ros::ImportReport)> {
-        Ok(deadreckon_api::read_ros(path, self.mapping.as_deref())?)
-    }
 }
 
 /// Refuses an output path that is one of the command's inputs (the drive, a

@@ -1,6 +1,7 @@
 //! `deadreckon import FORMAT SOURCE --out DIR`: read a log into a drive
-//! directory. Each format is one arm of the `match` in [`run`], returning the
-//! drive and a printable report; the drive is written atomically (into a
+//! directory. The options become a `deadreckon_api::import::ImportOptions`,
+//! `deadreckon_api::import::import` returns the drive and a printable report;
+//! the drive is written atomically (into a
 //! temporary sibling directory renamed into place when `--out` is new; file by
 //! file when it exists).
 
@@ -8,10 +9,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
+use deadreckon_api::import::{import, ImportFormat, ImportOptions, Imported};
 use deadreckon_core::Drive;
-use deadreckon_import::can::{self, Database, Mapping};
 use deadreckon_import::comma2k19::{Comma2k19Options, GyroSource, SpeedSource};
-use deadreckon_import::tricycle::TricycleOptions;
 use deadreckon_import::TimeOrderPolicy;
 
 /// `import FORMAT`: what the source is.
@@ -115,87 +115,42 @@ pub fn run(a: ImportArgs, load: &super::common::Loader) -> Result<()> {
     if a.format != FormatArg::Can && (a.dbc.is_some() || a.map.is_some()) {
         bail!("--dbc and --map apply to the can format only");
     }
-    let (drive, report) = match a.format {
-        FormatArg::Comma2k19 => {
-            let d = Comma2k19Options::default();
-            let o = Comma2k19Options {
-                vehicle,
-                gyro: match a.gyro {
-                    GyroArg::Raw => GyroSource::Uncalibrated,
-                    GyroArg::Calibrated => GyroSource::Calibrated,
-                },
-                speed: match a.speed_source {
-                    SpeedSourceArg::Can => SpeedSource::CanSpeedMessage,
-                    SpeedSourceArg::Processed => SpeedSource::Processed,
-                },
-                device_forward_m: a.device_forward_m.unwrap_or(d.device_forward_m),
-                gnss_latency_s: a.gnss_latency_s.unwrap_or(d.gnss_latency_s),
-                gnss_std_m: a.gnss_std_m.unwrap_or(d.gnss_std_m),
-                policy,
-            };
-            let i = deadreckon_import::read_comma2k19_with(&a.source, &o)?;
-            (i.drive, i.report.to_string())
-        }
-        FormatArg::Can => {
-            let builtin = a.dbc.is_none() && a.map.is_none();
-            let db = match &a.dbc {
-                Some(p) => Database::read(p)?,
-                None => Database::parse(
-                    can::TOYOTA_RAV4_DBC,
-                    Path::new("<built-in toyota_rav4_subset.dbc>"),
-                )?,
-            };
-            let map = match &a.map {
-                Some(p) => Mapping::read(p, &db)?,
-                None => Mapping::parse(
-                    can::TOYOTA_RAV4_MAP,
-                    &db,
-                    Path::new("<built-in toyota_rav4_comma2k19.toml>"),
-                )?,
-            };
-            let vehicle = match vehicle {
-                Some(v) => v,
-                None if builtin => deadreckon_import::profiles::toyota_rav4(),
-                None => bail!("--vehicle is required with your own --dbc/--map"),
-            };
-            let frames = if a.source.is_dir() {
-                can::read_raw_can(&a.source)?
-            } else {
-                can::read_candump(&a.source)?
-            };
-            let i = can::decode_frames(&frames, &map, vehicle, policy, &a.source)?;
-            (
-                i.drive,
-                format!("{} frames read\n{}", frames.len(), i.report),
-            )
-        }
-        FormatArg::Tricycle => {
-            let o = TricycleOptions {
-                vehicle,
-                policy,
-                ..Default::default()
-            };
-            let i = deadreckon_import::tricycle::read_tricycle(&a.source, &o)?;
-            (i.drive, i.report.to_string())
-        }
-        FormatArg::Rosbag | FormatArg::Mcap => {
-            // Samples out of order, duplicated or invalid are always dropped
-            // and counted by these readers (see the report); the topics and
-            // the vehicle come from `--mapping` (default: the built-in Husky).
-            if a.gate {
-                bail!("--gate does not apply to rosbag/mcap: their readers always drop and count bad samples");
-            }
-            let (mut drive, report) = load.ros_with_report(&a.source)?;
-            if let Some(v) = vehicle {
-                let origin = drive.vehicle.origin;
-                drive.vehicle = deadreckon_core::Vehicle {
-                    origin: v.origin.or(origin),
-                    ..v
-                };
-            }
-            (drive, format!("{report}\n"))
-        }
+    if a.gate && matches!(a.format, FormatArg::Rosbag | FormatArg::Mcap) {
+        // Their readers always drop and count (see the report); the topics
+        // and the vehicle come from `--mapping` (default: the built-in Husky).
+        bail!(
+            "--gate does not apply to rosbag/mcap: their readers always drop and count bad samples"
+        );
+    }
+    let d = Comma2k19Options::default();
+    let options = ImportOptions {
+        vehicle,
+        dbc: a.dbc.clone(),
+        can_map: a.map.clone(),
+        ros_mapping: load.mapping.clone(),
+        policy,
+        comma2k19: Comma2k19Options {
+            gyro: match a.gyro {
+                GyroArg::Raw => GyroSource::Uncalibrated,
+                GyroArg::Calibrated => GyroSource::Calibrated,
+            },
+            speed: match a.speed_source {
+                SpeedSourceArg::Can => SpeedSource::CanSpeedMessage,
+                SpeedSourceArg::Processed => SpeedSource::Processed,
+            },
+            device_forward_m: a.device_forward_m.unwrap_or(d.device_forward_m),
+            gnss_latency_s: a.gnss_latency_s.unwrap_or(d.gnss_latency_s),
+            gnss_std_m: a.gnss_std_m.unwrap_or(d.gnss_std_m),
+            ..d
+        },
     };
+    let format = match a.format {
+        FormatArg::Comma2k19 => ImportFormat::Comma2k19,
+        FormatArg::Can => ImportFormat::Can,
+        FormatArg::Tricycle => ImportFormat::Tricycle,
+        FormatArg::Rosbag | FormatArg::Mcap => ImportFormat::Ros,
+    };
+    let Imported { drive, report } = import(format, &a.source, &options)?;
     write_new_or_update(&a.out, &drive)?;
     outln!("{}", report.trim_end_matches('\n'));
     print_counts(&drive)?;

@@ -79,6 +79,18 @@ pub enum Error {
         /// Each error finding on a line: what disagrees, by how much, and the check's name.
         findings: String,
     },
+    /// A log could not be imported.
+    #[error("importing {}", path.display())]
+    Import {
+        /// The log.
+        path: PathBuf,
+        /// The importer's error (file, stream, line).
+        #[source]
+        source: deadreckon_import::ImportError,
+    },
+    /// A CAN import with its own DBC or mapping has no vehicle description.
+    #[error("a vehicle description (--vehicle) is required with your own DBC or CAN mapping")]
+    NeedsVehicle,
     /// A TedriS model file could not be read.
     #[error("reading the TedriS model {}", path.display())]
     ModelFile {

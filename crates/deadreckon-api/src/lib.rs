@@ -12,6 +12,8 @@
 //!   read (errors refuse it, warnings go to `"checks"` in `--json`).
 //! - [`evaluate`]: the parameters `evaluate` measures when none are given
 //!   (one rule for every metric).
+//! - [`import`]: a log (comma2k19, CAN with a DBC, tricycle, ROS) read into
+//!   a drive with the importer's report, as `deadreckon import` writes it.
 //! - [`json`]: the objects `calibrate --json`, `evaluate --json` and
 //!   `tedris train --json` print, built from the library results.
 //! - [`tedris`]: a TedriS model read from its file and checked.
@@ -27,6 +29,7 @@
 pub mod checks;
 pub mod corrections;
 pub mod evaluate;
+pub mod import;
 pub mod json;
 pub mod options;
 pub mod source;
