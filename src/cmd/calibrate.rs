@@ -345,7 +345,9 @@ fn run_tricycle(a: &CalibrateArgs) -> Result<()> {
     if a.json {
         outln!(
             "{}",
-            serde_json::to_string_pretty(&kinematic::calibration_json(shape, method, &c))?
+            serde_json::to_string_pretty(&deadreckon_api::json::kinematic_calibration_json(
+                shape, method, &c
+            ))?
         );
     } else {
         kinematic::print_table(&c)?;
@@ -397,7 +399,7 @@ fn run_diff_drive(a: &CalibrateArgs, load: &common::Loader) -> Result<()> {
         kinematic::write_params(out, shape, method, Some(a.yaw.name()), &c)?;
     }
     if a.json {
-        let mut v = kinematic::calibration_json(shape, method, &c);
+        let mut v = deadreckon_api::json::kinematic_calibration_json(shape, method, &c);
         v["yaw_source"] = a.yaw.name().into();
         common::print_json(load, v)?;
     } else {

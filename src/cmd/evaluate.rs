@@ -349,7 +349,9 @@ fn run_tricycle(a: &EvaluateArgs) -> Result<()> {
     if a.json {
         outln!(
             "{}",
-            serde_json::to_string_pretty(&kinematic::outages_json(shape, &ev, &source))?
+            serde_json::to_string_pretty(&deadreckon_api::json::kinematic_outages_json(
+                shape, &ev, &source
+            ))?
         );
     } else {
         let s = ev.final_error();
@@ -392,7 +394,7 @@ fn run_diff_drive(a: &EvaluateArgs, load: &common::Loader) -> Result<()> {
     let ev = evaluate_diff_drive(&dd, &params, len, a.step.unwrap_or(len / 2.0), a.align)?;
     let source = format!("{source}, yaw {}", yaw.name());
     if a.json {
-        let mut v = kinematic::outages_json(Shape::DiffDrive, &ev, &source);
+        let mut v = deadreckon_api::json::kinematic_outages_json(Shape::DiffDrive, &ev, &source);
         v["reference"] = "gnss (hidden fixes; start aligned to the preceding fixes)".into();
         v["align_s"] = a.align.into();
         common::print_json(load, v)?;

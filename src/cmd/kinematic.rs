@@ -6,9 +6,8 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use deadreckon_core::kinematics::diff_drive::{DiffDriveDrive, YawSource};
 use deadreckon_core::kinematics::tricycle::TricycleDrive;
-use deadreckon_core::kinematics::{KinematicCalibration, KinematicModel, KinematicOutages, Shape};
+use deadreckon_core::kinematics::{KinematicCalibration, KinematicModel, Shape};
 use deadreckon_io::kinematic_toml::{is_kinematic_params, KinematicParamsFile};
-use serde_json::json;
 
 /// `--shape`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -190,34 +189,6 @@ fn abbreviate(name: &str) -> String {
     name.chars().take(8).collect()
 }
 
-/// The `calibrate --json` object of a kinematic shape.
-pub fn calibration_json(shape: Shape, method: &str, c: &KinematicCalibration) -> serde_json::Value {
-    let params: serde_json::Map<String, serde_json::Value> = c
-        .params
-        .iter()
-        .map(|p| {
-            (
-                p.name.clone(),
-                json!({"value": p.value, "std": p.std, "estimated": p.estimated, "reason": p.reason}),
-            )
-        })
-        .collect();
-    json!({
-        "shape": shape.name(),
-        "method": method,
-        "params": params,
-        "correlation": {"names": c.correlated, "matrix": c.correlation},
-        "converged": c.converged,
-        "termination": c.termination,
-        "evaluations": c.evaluations,
-        "windows_used": c.windows_used,
-        "windows_total": c.windows_total,
-        "min_speed_mps": c.min_speed_mps,
-        "rms_position_m": c.rms_position_m,
-        "rms_heading_rad": c.rms_heading_rad,
-    })
-}
-
 /// Writes the parameters file.
 pub fn write_params(
     path: &Path,
@@ -230,19 +201,4 @@ pub fn write_params(
     f.yaw_source = yaw_source.map(str::to_string);
     deadreckon_io::write_kinematic_params(path, &f)
         .with_context(|| format!("writing {}", path.display()))
-}
-
-/// The `evaluate --outage --json` object (the shape of the car's: `windows`,
-/// `final_error_m` with `mean`, `median`, `p95`, `max`).
-pub fn outages_json(shape: Shape, ev: &KinematicOutages, source: &str) -> serde_json::Value {
-    let s = ev.final_error();
-    json!({
-        "outage_s": ev.outage_s,
-        "step_s": ev.step_s,
-        "windows": ev.windows.len(),
-        "reference": "reference pose (start) and measured point (error)",
-        "shape": shape.name(),
-        "params": source,
-        "final_error_m": {"mean": s.mean, "median": s.median, "p95": s.p95, "min": s.min, "max": s.max, "std": s.std, "n": s.n},
-    })
 }

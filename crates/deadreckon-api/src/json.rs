@@ -289,3 +289,54 @@ pub fn comparison_json(c: &deadreckon_eval::compare::Comparison) -> Value {
         })).collect::<Vec<_>>(),
     })
 }
+
+/// The `calibrate --json` object of a kinematic shape.
+pub fn kinematic_calibration_json(
+    shape: deadreckon_core::kinematics::Shape,
+    method: &str,
+    c: &deadreckon_core::kinematics::KinematicCalibration,
+) -> Value {
+    let params: serde_json::Map<String, Value> = c
+        .params
+        .iter()
+        .map(|p| {
+            (
+                p.name.clone(),
+                json!({"value": p.value, "std": p.std, "estimated": p.estimated, "reason": p.reason}),
+            )
+        })
+        .collect();
+    json!({
+        "shape": shape.name(),
+        "method": method,
+        "params": params,
+        "correlation": {"names": c.correlated, "matrix": c.correlation},
+        "converged": c.converged,
+        "termination": c.termination,
+        "evaluations": c.evaluations,
+        "windows_used": c.windows_used,
+        "windows_total": c.windows_total,
+        "min_speed_mps": c.min_speed_mps,
+        "rms_position_m": c.rms_position_m,
+        "rms_heading_rad": c.rms_heading_rad,
+    })
+}
+
+/// The `evaluate --outage --json` object (the shape of the car's: `windows`,
+/// `final_error_m` with `mean`, `median`, `p95`, `max`).
+pub fn kinematic_outages_json(
+    shape: deadreckon_core::kinematics::Shape,
+    ev: &deadreckon_core::kinematics::KinematicOutages,
+    source: &str,
+) -> Value {
+    let s = ev.final_error();
+    json!({
+        "outage_s": ev.outage_s,
+        "step_s": ev.step_s,
+        "windows": ev.windows.len(),
+        "reference": "reference pose (start) and measured point (error)",
+        "shape": shape.name(),
+        "params": source,
+        "final_error_m": {"mean": s.mean, "median": s.median, "p95": s.p95, "min": s.min, "max": s.max, "std": s.std, "n": s.n},
+    })
+}
