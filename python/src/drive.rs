@@ -247,7 +247,11 @@ impl Drive {
                     } else {
                         (truth[0].east_m, truth[0].north_m)
                     };
-                    Origin { lat_deg, lon_deg, height_m: 0.0 }
+                    Origin {
+                        lat_deg,
+                        lon_deg,
+                        height_m: 0.0,
+                    }
                 }
             };
             if gnss_geo {

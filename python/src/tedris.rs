@@ -3,8 +3,8 @@
 use std::path::PathBuf;
 
 use deadreckon_tedris::{
-    run_outages_with, train, ModelChoice, ModelKind, Outage, ReferenceSource,
-    RunOptions, TedrisConfig, TedrisModel, Variant,
+    run_outages_with, ModelKind, Outage, ReferenceSource, RunOptions, TedrisConfig, TedrisModel,
+    Variant,
 };
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -59,10 +59,6 @@ pub fn tedris_train(
     } else {
         drive
     };
-    let source = match reference_source(reference)? {
-        Some(s) => Some(s),
-        None => ReferenceSource::auto(&drive).ok(),
-    };
     let variant = match variant {
         None => None,
         Some("paper") => Some(Variant::Paper),
@@ -73,31 +69,34 @@ pub fn tedris_train(
             )))
         }
     };
-    let mut cfg = match config_json {
-        Some(text) => serde_json::from_str::<TedrisConfig>(text)
-            .map_err(|e| DeadreckonError::new_err(format!("TedriS configuration: {e}")))?,
-        None if variant == Some(Variant::Paper) => TedrisConfig::paper(),
-        None if source == Some(ReferenceSource::Gyro) => TedrisConfig::robot(),
-        None => TedrisConfig::default(),
+    let config = match config_json {
+        Some(text) => Some(
+            serde_json::from_str::<TedrisConfig>(text)
+                .map_err(|e| DeadreckonError::new_err(format!("TedriS configuration: {e}")))?,
+        ),
+        None => None,
     };
-    if let Some(v) = variant {
-        cfg.variant = v;
-    }
-    cfg.model = match model {
-        "auto" => cfg.model,
-        "paper" => ModelChoice::Fixed(ModelKind::Paper),
-        "distance" => ModelChoice::Fixed(ModelKind::Distance),
-        "arx" => ModelChoice::Fixed(ModelKind::Arx),
-        "baseline" => ModelChoice::Fixed(ModelKind::Baseline),
+    let model = match model {
+        "auto" => None,
+        "paper" => Some(ModelKind::Paper),
+        "distance" => Some(ModelKind::Distance),
+        "arx" => Some(ModelKind::Arx),
+        "baseline" => Some(ModelKind::Baseline),
         m => {
             return Err(DeadreckonError::new_err(format!(
                 "unknown model `{m}` (auto, paper, distance, arx, baseline)"
             )))
         }
     };
-    cfg.validate().map_err(to_py_err)?;
+    let options = deadreckon_api::tedris::TrainOptions {
+        reference: reference_source(reference)?,
+        config,
+        variant,
+        model,
+        ..Default::default()
+    };
     let (m, source) = py
-        .detach(|| train(&drive, cfg, source))
+        .detach(|| deadreckon_api::tedris::train(&drive, &options))
         .map_err(to_py_err)?;
     let text = serde_json::to_string_pretty(&m).map_err(to_py_err)?;
     let mut summary = deadreckon_api::json::tedris_train_json(&m, source);

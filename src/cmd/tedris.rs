@@ -6,8 +6,8 @@ use std::path::PathBuf;
 use anyhow::{bail, Context, Result};
 use clap::{Subcommand, ValueEnum};
 use deadreckon_tedris::{
-    run_outages_with, train, ModelChoice, ModelKind, Outage, ReferenceSource, RepositoryFit,
-    RunOptions, TedrisConfig, TedrisModel, Variant,
+    run_outages_with, ModelKind, Outage, ReferenceSource, RunOptions, TedrisConfig, TedrisModel,
+    Variant,
 };
 
 /// The reference heading the model learns from.
@@ -177,45 +177,36 @@ pub fn run(c: TedrisCommand, load: &super::common::Loader) -> Result<()> {
             } else {
                 drive
             };
-            let source = match reference.source() {
-                Some(s) => Some(s),
-                None => ReferenceSource::auto(&drive).ok(),
-            };
-            let mut cfg = match &config {
+            let config = match &config {
                 Some(p) => {
                     let text = std::fs::read_to_string(p)
                         .with_context(|| format!("reading {}", p.display()))?;
-                    serde_json::from_str::<TedrisConfig>(&text)
-                        .with_context(|| format!("parsing {}", p.display()))?
+                    Some(
+                        serde_json::from_str::<TedrisConfig>(&text)
+                            .with_context(|| format!("parsing {}", p.display()))?,
+                    )
                 }
-                None if variant == Some(VariantArg::Paper) => TedrisConfig::paper(),
-                None if source == Some(ReferenceSource::Gyro) => TedrisConfig::robot(),
-                None => TedrisConfig::default(),
+                None => None,
             };
-            if let Some(v) = variant {
-                cfg.variant = match v {
+            let options = deadreckon_api::tedris::TrainOptions {
+                reference: reference.source(),
+                config,
+                variant: variant.map(|v| match v {
                     VariantArg::Paper => Variant::Paper,
                     VariantArg::Extended => Variant::Extended,
-                };
-            }
-            cfg.model = match model {
-                Kind::Auto => cfg.model,
-                Kind::Paper => ModelChoice::Fixed(ModelKind::Paper),
-                Kind::Distance => ModelChoice::Fixed(ModelKind::Distance),
-                Kind::Arx => ModelChoice::Fixed(ModelKind::Arx),
-                Kind::Baseline => ModelChoice::Fixed(ModelKind::Baseline),
+                }),
+                model: match model {
+                    Kind::Auto => None,
+                    Kind::Paper => Some(ModelKind::Paper),
+                    Kind::Distance => Some(ModelKind::Distance),
+                    Kind::Arx => Some(ModelKind::Arx),
+                    Kind::Baseline => Some(ModelKind::Baseline),
+                },
+                tau_samples: tau.map(|t| t as usize),
+                epsilon_factor: epsilon_k.map(|k| k.0),
+                separate_repositories,
             };
-            if let Some(t) = tau {
-                cfg.tau_samples = t as usize;
-            }
-            if let Some(k) = epsilon_k {
-                cfg.epsilon_factor = k.0;
-            }
-            if separate_repositories {
-                cfg.repository_fit = RepositoryFit::Separate;
-            }
-            cfg.validate()?;
-            let (m, source) = train(&drive, cfg, source)?;
+            let (m, source) = deadreckon_api::tedris::train(&drive, &options)?;
             let text = serde_json::to_string_pretty(&m)?;
             // Whole or not at all (a temporary beside it, renamed), with
             // the permissions of a model it replaces.

@@ -91,6 +91,9 @@ pub enum Error {
     /// A CAN import with its own DBC or mapping has no vehicle description.
     #[error("a vehicle description (--vehicle) is required with your own DBC or CAN mapping")]
     NeedsVehicle,
+    /// TedriS failed (its configuration, training).
+    #[error("TedriS")]
+    Tedris(#[source] deadreckon_tedris::Error),
     /// A TedriS model file could not be read.
     #[error("reading the TedriS model {}", path.display())]
     ModelFile {

@@ -3,9 +3,72 @@
 
 use std::path::Path;
 
-use deadreckon_tedris::TedrisModel;
+use deadreckon_core::Drive;
+use deadreckon_tedris::{
+    ModelChoice, ModelKind, ReferenceSource, RepositoryFit, TedrisConfig, TedrisModel, Variant,
+};
 
 use crate::Error;
+
+/// How `tedris train` is configured (the command's options, Python's
+/// arguments); `None` leaves the configuration's value.
+#[derive(Debug, Clone, Default)]
+pub struct TrainOptions {
+    /// The reference heading (`None`: the course if the fixes have one,
+    /// else the gyro).
+    pub reference: Option<ReferenceSource>,
+    /// A whole configuration (`--config`); without it the variant's preset,
+    /// or the robot preset with the gyro reference, or the default.
+    pub config: Option<TedrisConfig>,
+    /// The method variant.
+    pub variant: Option<Variant>,
+    /// The regression kind (`None`: the automatic choice).
+    pub model: Option<ModelKind>,
+    /// τ, samples per block.
+    pub tau_samples: Option<usize>,
+    /// k of ε = k·(W_H − W_L) (`Some(None)`: one repository).
+    pub epsilon_factor: Option<Option<f64>>,
+    /// Fit each repository separately, as in the paper.
+    pub separate_repositories: bool,
+}
+
+/// The reference heading and the configuration `o` asks for on `drive`,
+/// checked: one rule for the command line and Python (each built its own).
+pub fn train_config(
+    drive: &Drive,
+    o: &TrainOptions,
+) -> Result<(Option<ReferenceSource>, TedrisConfig), Error> {
+    let source = o.reference.or_else(|| ReferenceSource::auto(drive).ok());
+    let mut cfg = match &o.config {
+        Some(c) => c.clone(),
+        None if o.variant == Some(Variant::Paper) => TedrisConfig::paper(),
+        None if source == Some(ReferenceSource::Gyro) => TedrisConfig::robot(),
+        None => TedrisConfig::default(),
+    };
+    if let Some(v) = o.variant {
+        cfg.variant = v;
+    }
+    if let Some(k) = o.model {
+        cfg.model = ModelChoice::Fixed(k);
+    }
+    if let Some(t) = o.tau_samples {
+        cfg.tau_samples = t;
+    }
+    if let Some(k) = o.epsilon_factor {
+        cfg.epsilon_factor = k;
+    }
+    if o.separate_repositories {
+        cfg.repository_fit = RepositoryFit::Separate;
+    }
+    cfg.validate().map_err(Error::Tedris)?;
+    Ok((source, cfg))
+}
+
+/// Trains a model on `drive` as `o` asks ([`train_config`]).
+pub fn train(drive: &Drive, o: &TrainOptions) -> Result<(TedrisModel, ReferenceSource), Error> {
+    let (source, cfg) = train_config(drive, o)?;
+    deadreckon_tedris::train(drive, cfg, source).map_err(Error::Tedris)
+}
 
 /// The model in the JSON file `path` (`tedris train --out`), checked:
 /// errors name the file.
