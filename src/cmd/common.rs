@@ -4,7 +4,7 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 use deadreckon_core::ekf::Timing;
-use deadreckon_core::{Drive, Params, ParamsWithStd};
+use deadreckon_core::{Drive, Params};
 
 /// How the commands read drives: the global options `--mapping` and
 /// `--skip-checks`, passed to each command explicitly.
@@ -262,58 +262,6 @@ pub fn apply_stored(spec: &str, drive: Drive) -> Result<Drive> {
     Ok(stored.apply(&drive))
 }
 
-/// The corrections as text lines (one per stream, and the tilt).
-pub fn corrections_lines(c: &deadreckon_core::timing::Corrections) -> Vec<String> {
-    use deadreckon_core::timing::Stream;
-    let mut out = vec![format!(
-        "{:<10} {:>10} {:>9}  status",
-        "delay of", "s", "std s"
-    )];
-    for s in Stream::ALL {
-        let d = c.delays.get(s);
-        out.push(match d.status.reason() {
-            None => format!(
-                "{:<10} {:>+10.4} {:>9.4}  estimated, applied",
-                s.name(),
-                d.delay_s,
-                d.std_s
-            ),
-            Some(r) => format!(
-                "{:<10} {:>10} {:>9}  not estimated: {r}",
-                s.name(),
-                "-",
-                "-"
-            ),
-        });
-    }
-    match &c.tilt {
-        None => out.push("imu tilt: no three-axis IMU in the drive".into()),
-        Some(t) => out.push(match t.status.reason() {
-            None => format!(
-                "imu tilt: {:.2}° ± {:.2}° (pitch {:+.2}°, roll {:+.2}°, from gravity while {}), yaw rate projected on the vertical",
-                t.tilt_rad.to_degrees(),
-                t.std_rad.to_degrees(),
-                t.pitch_rad.to_degrees(),
-                t.roll_rad.to_degrees(),
-                t.source.name()
-            ),
-            Some(r) => format!("imu tilt: not estimated: {r}"),
-        }),
-    }
-    if let Some(g) = &c.gyro_scale {
-        out.push(match g.status.reason() {
-            None => format!(
-                "gyro scale error: {:+.3}% ± {:.3}% ({} turns), applied",
-                100.0 * g.scale_error,
-                100.0 * g.std,
-                g.turns
-            ),
-            Some(r) => format!("gyro scale error: not estimated: {r}"),
-        });
-    }
-    out
-}
-
 /// Reads a params.toml with its standard errors, validated.
 pub fn read_params_file(spec: &str) -> Result<deadreckon_core::ParamsWithStd> {
     let p = deadreckon_io::read_params(Path::new(spec))
@@ -333,67 +281,6 @@ pub fn quiet_on_broken_pipe(r: std::io::Result<()>) -> Result<()> {
     }
 }
 
-/// The header of a table-III-like parameter table.
-pub fn params_header() -> String {
-    format!(
-        "{:<8} {:>22} {:>18} {:>20} {:>20} {:>20} {:>20}",
-        "method", "b_gyro (rad/s)", "a_v", "rho_FL (m)", "rho_FR (m)", "rho_RL (m)", "rho_RR (m)"
-    )
-}
-
-/// One row of a parameter table, with standard errors where they are non-zero.
-pub fn params_row(name: &str, p: &ParamsWithStd) -> String {
-    let a = p.params.to_array();
-    let s = p.std.to_array();
-    let cell = |v: f64, e: f64, prec: usize| -> String {
-        if e > 0.0 {
-            format!("{v:.prec$} ± {e:.prec$}")
-        } else {
-            format!("{v:.prec$}")
-        }
-    };
-    format!(
-        "{:<8} {:>22} {:>18} {:>20} {:>20} {:>20} {:>20}",
-        name,
-        cell(a[0], s[0], 6),
-        cell(a[1], s[1], 5),
-        cell(a[2], s[2], 5),
-        cell(a[3], s[3], 5),
-        cell(a[4], s[4], 5),
-        cell(a[5], s[5], 5)
-    )
-}
-
-/// A one-line account of what the filter used and gated.
-pub fn stats_line(st: &deadreckon_core::ekf::FilterStats) -> String {
-    format!(
-        "filter: {} epochs, GNSS {} used / {} rejected by the gate ({} recoveries) / {} hidden, {} wheel gaps skipped; rejected by the χ² gates: {}",
-        st.epochs,
-        st.gnss_updates,
-        st.gnss_rejected,
-        st.gnss_recoveries,
-        st.gnss_hidden,
-        st.wheel_gaps,
-        gated_text(&st.gates)
-    )
-}
-
-/// The sensors the χ² gates rejected something of, as `name rejected/total`,
-/// or `none`.
-pub fn gated_text(g: &deadreckon_core::filter::GateCounts) -> String {
-    let gated: Vec<String> = g
-        .rows()
-        .into_iter()
-        .filter(|r| r.2 > 0)
-        .map(|(name, a, r, _)| format!("{name} {r}/{}", a + r))
-        .collect();
-    if gated.is_empty() {
-        "none".to_string()
-    } else {
-        gated.join(", ")
-    }
-}
-
 /// Every track of a drive: the estimated ones
 /// ([`deadreckon_core::track::drive_tracks`]) and, with truth, `truth`.
 pub fn all_tracks(
@@ -405,47 +292,6 @@ pub fn all_tracks(
     let mut t = deadreckon_core::track::drive_tracks(drive, params, opts, init_pose)?;
     t.extend(deadreckon_core::Track::from_truth(drive));
     Ok(t)
-}
-
-/// Prints the comparison table of `compare` and `demo`; `t0` is subtracted from the outage times.
-pub fn print_comparison(c: &deadreckon_eval::compare::Comparison, t0: f64) -> anyhow::Result<()> {
-    outln!(
-        "four-wheel EKF: {}; errors against the {}",
-        c.params_source,
-        c.four_wheel_reference
-    );
-    outln!(
-        "TedriS: {}; errors against the {}",
-        c.model_source,
-        c.tedris_reference
-    );
-    outln!(
-        "{:<20} {:<12} {:>10} {:>10} {:>10} {:>16}",
-        "outage (s)",
-        "method",
-        "mean (m)",
-        "max (m)",
-        "final (m)",
-        "time to 1 m (s)"
-    );
-    let fmt = |r: &Option<deadreckon_eval::compare::Row>| match r {
-        Some(r) => format!(
-            "{:>10.2} {:>10.2} {:>10.2} {:>16}",
-            r.mean,
-            r.max,
-            r.fin,
-            r.to_1m
-                .map(|t| format!("{t:.1}"))
-                .unwrap_or_else(|| "never".into())
-        ),
-        None => format!("{:>10} {:>10} {:>10} {:>16}", "-", "-", "-", "-"),
-    };
-    for (o, f, t) in &c.rows {
-        let w = format!("{:.1}:{:.1}", o.start_s - t0, o.end_s - t0);
-        outln!("{:<20} {:<12} {}", w, "four-wheel", fmt(f));
-        outln!("{:<20} {:<12} {}", "", "TedriS", fmt(t));
-    }
-    Ok(())
 }
 
 /// The footer: version and command line.
@@ -495,25 +341,20 @@ pub fn wheel_monitor(off: bool) -> Option<deadreckon_core::wheel_health::WheelMo
 
 /// The wheel-health lines of `run` and `calibrate`.
 pub fn print_wheel_health(h: &deadreckon_core::wheel_health::WheelHealth) -> Result<()> {
-    if h.all_good() {
-        outln!("wheel health: no wheel slipped or read wrong");
-    }
-    for l in h.lines() {
+    for l in deadreckon_api::text::wheel_health_lines(h) {
         outln!("{l}");
-    }
-    for (name, w) in deadreckon_core::wheel_health::WHEEL_NAMES
-        .iter()
-        .zip(&h.wheels)
-    {
-        for i in &w.intervals {
-            outln!(
-                "  wheel {name} out {:.2}..{:.2} s ({}, peak |T| {:.1})",
-                i.start_s,
-                i.end_s,
-                i.reason.name(),
-                i.peak_sigma
-            );
-        }
     }
     Ok(())
 }
+
+/// Prints the comparison table of `compare` and `demo`; `t0` is subtracted from the outage times.
+pub fn print_comparison(c: &deadreckon_eval::compare::Comparison, t0: f64) -> Result<()> {
+    for l in deadreckon_api::text::comparison_lines(c, t0) {
+        outln!("{l}");
+    }
+    Ok(())
+}
+
+pub use deadreckon_api::text::{
+    corrections_lines, gated_text, params_header, params_row, stats_line,
+};

@@ -17,6 +17,7 @@
 //! - [`json`]: the objects `calibrate --json`, `evaluate --json` and
 //!   `tedris train --json` print, built from the library results.
 //! - [`tedris`]: a TedriS model read from its file and checked.
+//! - [`text`]: the commands' text tables and summary lines.
 //! - [`options`]: the option words of the commands (`--timing wheel|each`,
 //!   `--state`, `--iteration`) parsed into the library's enums.
 //!
@@ -34,6 +35,7 @@ pub mod json;
 pub mod options;
 pub mod source;
 pub mod tedris;
+pub mod text;
 
 mod error;
 pub use error::{chain_text, Error};
