@@ -1,23 +1,12 @@
 //! The corrections a params.toml stores (issue 13: delays, IMU tilt, gyro
 //! scale) are applied wherever `--params` reads it, not only by `evaluate`.
 
+mod common;
+use common::run_ok;
+
 use std::path::Path;
-use std::process::Command;
 
 use deadreckon_sim::family::CarFamily;
-
-fn deadreckon(args: &[&str]) -> String {
-    let out = Command::new(env!("CARGO_BIN_EXE_deadreckon"))
-        .args(args)
-        .output()
-        .expect("binary runs");
-    assert!(
-        out.status.success(),
-        "deadreckon {args:?} failed:\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout).expect("utf-8")
-}
 
 /// Mean horizontal distance between the dead-reckoned track and the truth
 /// in a track CSV (truth interpolated at the dead-reckoned times).
@@ -68,7 +57,7 @@ fn run_applied_the_parameters_without_the_corrections_they_were_calibrated_with(
     let d = dir.to_str().unwrap();
 
     let p = tmp.path().join("params.toml");
-    deadreckon(&["calibrate", d, "--out", p.to_str().unwrap()]);
+    run_ok(&["calibrate", d, "--out", p.to_str().unwrap()]);
     let text = std::fs::read_to_string(&p).unwrap();
     assert!(text.contains("[imu]"), "{text}");
     // The same parameters without the stored corrections.
@@ -79,7 +68,7 @@ fn run_applied_the_parameters_without_the_corrections_they_were_calibrated_with(
 
     let err = |params: &Path| {
         let out = tmp.path().join("track.csv");
-        deadreckon(&[
+        run_ok(&[
             "run",
             d,
             "--params",

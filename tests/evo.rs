@@ -9,6 +9,9 @@
 //! `DEADRECKON_EVO_BIN` set to the environment's `bin` directory. Run them
 //! the same way by hand; without the variable they fail, saying so.
 
+mod common;
+use common::run_ok;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -37,19 +40,6 @@ fn evo_bin() -> PathBuf {
              (.ci/run does this)"
         ),
     }
-}
-
-fn deadreckon(args: &[&str]) -> String {
-    let out = Command::new(env!("CARGO_BIN_EXE_deadreckon"))
-        .args(args)
-        .output()
-        .expect("deadreckon runs");
-    assert!(
-        out.status.success(),
-        "deadreckon {args:?} failed:\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout).expect("utf-8")
 }
 
 /// Runs an evo tool with `--save_results`, and returns the saved statistics
@@ -111,7 +101,7 @@ fn ours(drive: &Path, extra: &[&str]) -> (Value, Vec<f64>) {
         "--json",
     ];
     args.extend_from_slice(extra);
-    let v: Value = serde_json::from_str(&deadreckon(&args)).unwrap();
+    let v: Value = serde_json::from_str(&run_ok(&args)).unwrap();
     let errors = v["errors_m"]
         .as_array()
         .unwrap()
@@ -153,7 +143,7 @@ fn write(drive: &Path, out: &Path, track: &str, sync_with: Option<&str>) {
     if let Some(w) = sync_with {
         args.extend(["--sync-with", w]);
     }
-    deadreckon(&args);
+    run_ok(&args);
 }
 
 fn lines(path: &Path) -> usize {
@@ -256,7 +246,7 @@ fn compare(drive: &Path, work: &Path, label: &str) -> (f64, f64) {
     // ROS 2 nav_msgs/Odometry in MCAP, read by evo through rosbags: positions
     // in full precision there (ours are rounded to the micrometre as in the
     // text files, hence the looser bound).
-    deadreckon(&[
+    run_ok(&[
         "run",
         drive.to_str().unwrap(),
         "--out",
@@ -286,7 +276,7 @@ fn compare(drive: &Path, work: &Path, label: &str) -> (f64, f64) {
 }
 
 fn rpe_ours_matched(drive: &Path) -> usize {
-    let v: Value = serde_json::from_str(&deadreckon(&[
+    let v: Value = serde_json::from_str(&run_ok(&[
         "evaluate",
         drive.to_str().unwrap(),
         "--params",
@@ -305,7 +295,7 @@ fn evo_agrees_on_a_simulated_drive() {
     evo_bin();
     let tmp = tempfile::tempdir().unwrap();
     let drive = tmp.path().join("eval");
-    deadreckon(&[
+    run_ok(&[
         "simulate",
         "--scenario",
         "evaluation",
@@ -327,7 +317,7 @@ fn evo_agrees_on_the_comma2k19_segment() {
     let comma = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/comma2k19-rav4");
     let tmp = tempfile::tempdir().unwrap();
     let drive = tmp.path().join("rav4");
-    deadreckon(&[
+    run_ok(&[
         "import",
         "comma2k19",
         comma,

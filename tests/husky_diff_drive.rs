@@ -13,22 +13,12 @@
 //! (an antenna 0.6–1 m behind the axle). The bounds pin these numbers with
 //! a margin of about 10% so that a degradation shows.
 
+mod common;
+use common::run_ok;
+
 use std::process::Command;
 
 const HUSKY: &str = "../shared/data/husky-gps-bag/husky_gps.bag";
-
-fn run_ok(args: &[&str]) -> String {
-    let out = Command::new(env!("CARGO_BIN_EXE_deadreckon"))
-        .args(args)
-        .output()
-        .expect("binary runs");
-    assert!(
-        out.status.success(),
-        "deadreckon {args:?} failed:\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout).expect("utf-8 output")
-}
 
 fn outage_mean(params: &str, extra: &[&str]) -> (f64, serde_json::Value) {
     let mut args = vec![
