@@ -390,8 +390,7 @@ pub fn read_comma2k19_with(dir: &Path, o: &Comma2k19Options) -> Result<Import, I
             accel: imu_accel,
         },
     };
-    drive.validate().map_err(|e| invalid(dir, e))?;
-    Ok(Import { drive, report })
+    Import::checked(drive, report, dir)
 }
 
 /// A three-axis stream in `[forward, right, down]` axes as `[forward, left, up]`.

@@ -70,3 +70,20 @@ pub struct Import {
     /// Counts per stream, gated samples and the decisions taken.
     pub report: ImportReport,
 }
+
+impl Import {
+    /// The importers' common end: the drive checked against its invariants
+    /// ([`deadreckon_core::Drive::validate`]), an error naming the log
+    /// `path` if it breaks one.
+    pub fn checked(
+        drive: deadreckon_core::Drive,
+        report: ImportReport,
+        path: &std::path::Path,
+    ) -> Result<Import, ImportError> {
+        drive.validate().map_err(|source| ImportError::Invalid {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Ok(Import { drive, report })
+    }
+}

@@ -577,11 +577,7 @@ pub fn tricycle_drive(
         truth,
         imu: Default::default(),
     };
-    drive.validate().map_err(|source| ImportError::Invalid {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    Ok(Import { drive, report })
+    Import::checked(drive, report, path)
 }
 
 /// Reads the log at `path` as a tricycle drive for the kinematic model

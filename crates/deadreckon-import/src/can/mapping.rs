@@ -457,11 +457,7 @@ pub fn decode_frames(
         truth: Vec::new(),
         imu: Default::default(),
     };
-    drive.validate().map_err(|source| ImportError::Invalid {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    Ok(Import { drive, report })
+    Import::checked(drive, report, path)
 }
 
 #[cfg(test)]
