@@ -176,3 +176,140 @@ pub fn wheel_health_lines(h: &deadreckon_core::wheel_health::WheelHealth) -> Vec
     }
     out
 }
+
+/// The summary `tedris train` prints: the reference, τ and the lag, the
+/// straight line, the drift corrections, the course convention, every
+/// model kind with its coefficients and residual tests, the repositories.
+pub fn tedris_train_lines(
+    m: &deadreckon_tedris::TedrisModel,
+    source: deadreckon_tedris::ReferenceSource,
+) -> Vec<String> {
+    use deadreckon_tedris::ReferenceSource;
+    let mut out = Vec::new();
+    let s = m.straight();
+    out.push(format!("reference heading: {source:?}"));
+    out.push(format!(
+        "tau = {} samples, sample period {:.4} s, lag h = {} samples (peak corr {:.3})",
+        m.config.tau_samples,
+        m.sample_period_s,
+        m.lag_samples,
+        m.ccf
+            .values
+            .iter()
+            .copied()
+            .fold(f64::NEG_INFINITY, f64::max)
+    ));
+    let eps = s.epsilon_m.map_or("inf".to_string(), |e| format!("{e:.6}"));
+    out.push(format!(
+        "straight line ({} blocks{}): mu = {:.6} m, W_L = {:.6} m, W_H = {:.6} m, epsilon = {} m (per wheel sample)",
+        s.blocks,
+        if s.fallback { ", quietest blocks" } else { "" },
+        s.mu_m,
+        s.w_low_m,
+        s.w_high_m,
+        eps
+    ));
+    if m.per_metre_straight {
+        // Heading per metre as the rear radius mismatch it is.
+        out.push(format!(
+            "straight-line heading {:.3e} rad/m (per metre only: none at rest), turn gain = {:.4}",
+            m.dcf_distance_rad_per_m, m.turn_gain
+        ));
+    } else if m.config.joint_calibration() {
+        out.push(format!(
+            "DCF0 = {:.3e} rad/sample, DCF = {:.3e} rad/sample + {:.3e} rad/m, turn gain = {:.4}",
+            m.dcf0_rad, m.dcf_rad, m.dcf_distance_rad_per_m, m.turn_gain
+        ));
+    } else {
+        // The paper's method: eq. (6) only; no distance term, no turn gain.
+        out.push(format!(
+            "DCF0 = {:.3e} rad/sample, DCF = {:.3e} rad/sample (eq. 6; heading per metre and turn gain not estimated)",
+            m.dcf0_rad, m.dcf_rad
+        ));
+    }
+    match &m.course_convention {
+        Some(c) => out.push(format!(
+            "course convention found on the data: {:?} (residual as body yaw / as antenna course = {:.3})",
+            c.convention, c.rss_ratio
+        )),
+        None if source == ReferenceSource::GnssCourse => {
+            out.push("course convention: not decided on the data (taken as the antenna's velocity)".to_string())
+        }
+        None => {}
+    }
+    for f in &m.fits {
+        let mark = if f.kind == m.chosen {
+            "  <- chosen"
+        } else {
+            ""
+        };
+        out.push(String::new());
+        out.push(format!(
+            "model {} (n = {}, R² = {:.4}, sigma = {:.3e}, AIC = {:.1}, BIC = {:.1}){mark}",
+            f.kind.name(),
+            f.global.n,
+            f.global.r_squared,
+            f.global.sigma2.sqrt(),
+            f.global.aic,
+            f.global.bic
+        ));
+        out.extend(coefficient_lines(&f.global.coefficients));
+        out.push(format!(
+            "  Box-Pierce Q = {:.2} (L = {}, p = {:.4}); Ljung-Box Q* = {:.2} (p = {:.4})",
+            f.box_pierce.statistic,
+            f.box_pierce.lags,
+            f.box_pierce.p_value,
+            f.ljung_box.statistic,
+            f.ljung_box.p_value
+        ));
+        match (&f.correction, &f.corrected) {
+            (Some(c), Some(t)) => {
+                out.push(format!(
+                    "  residuals not white: {} correction (innovations Ljung-Box p = {:.4}); joint refit:",
+                    c.correction.label(),
+                    c.ljung_box.p_value
+                ));
+                out.extend(coefficient_lines(&t.coefficients));
+            }
+            (Some(c), None) => out.push(format!(
+                "  residuals not white: {} correction",
+                c.correction.label()
+            )),
+            _ => out.push("  residuals white: no correction".to_string()),
+        }
+    }
+    out.push(String::new());
+    out.push("repositories (omega interval per wheel sample, m):".to_string());
+    for r in m.repositories.fill(m.config.required_bins) {
+        out.push(format!(
+            "  R{:<4} [{:>10.5}, {:>10.5}]  {:>6} tuples{}",
+            r.index,
+            r.low_m,
+            r.high_m,
+            r.tuples,
+            if r.filled {
+                ""
+            } else {
+                "  (below minimum fill)"
+            }
+        ));
+    }
+    out.push(format!("training complete: {}", m.complete));
+    out
+}
+
+/// A coefficient table of a TedriS regression.
+fn coefficient_lines(c: &[deadreckon_tedris::stats::Coefficient]) -> Vec<String> {
+    let mut out = Vec::new();
+    out.push(format!(
+        "  {:<12} {:>14} {:>14} {:>10} {:>10}",
+        "", "Estimate", "Std. Error", "t value", "p value"
+    ));
+    for r in c {
+        out.push(format!(
+            "  {:<12} {:>14.6e} {:>14.6e} {:>10.2} {:>10.4}",
+            r.name, r.estimate, r.std_error, r.t_value, r.p_value
+        ));
+    }
+    out
+}
