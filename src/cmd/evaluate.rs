@@ -187,27 +187,12 @@ pub fn run(a: EvaluateArgs, load: &common::Loader) -> Result<()> {
                 ev.windows.len(),
                 ev.reference.name()
             );
-            outln!(
-                "{:<28} {:>9} {:>9} {:>9} {:>9}",
-                "",
-                "mean",
-                "median",
-                "p95",
-                "max"
-            );
-            for (name, s) in [
+            for l in deadreckon_api::text::summary_table(&[
                 ("final error (m)", fe),
                 ("drift per 100 m (%)", dr),
                 ("distance before 1 m (m)", d1),
-            ] {
-                outln!(
-                    "{:<28} {:>9.3} {:>9.3} {:>9.3} {:>9.3}",
-                    name,
-                    s.mean,
-                    s.median,
-                    s.p95,
-                    s.max
-                );
+            ]) {
+                outln!("{l}");
             }
             outln!(
                 "rejected by the χ² gates: {}",
@@ -412,21 +397,8 @@ fn run_diff_drive(a: &EvaluateArgs, load: &common::Loader) -> Result<()> {
 
 /// The final-error line of the kinematic shapes' outage evaluations.
 fn final_error_table(s: &deadreckon_core::metrics::Summary) -> Result<()> {
-    outln!(
-        "{:<28} {:>9} {:>9} {:>9} {:>9}",
-        "",
-        "mean",
-        "median",
-        "p95",
-        "max"
-    );
-    outln!(
-        "{:<28} {:>9.3} {:>9.3} {:>9.3} {:>9.3}",
-        "final error (m)",
-        s.mean,
-        s.median,
-        s.p95,
-        s.max
-    );
+    for l in deadreckon_api::text::summary_table(&[("final error (m)", *s)]) {
+        outln!("{l}");
+    }
     Ok(())
 }

@@ -313,3 +313,18 @@ fn coefficient_lines(c: &[deadreckon_tedris::stats::Coefficient]) -> Vec<String>
     }
     out
 }
+
+/// Summaries as a table: a header (mean, median, p95, max) and a row each.
+pub fn summary_table(rows: &[(&str, deadreckon_core::metrics::Summary)]) -> Vec<String> {
+    let mut out = vec![format!(
+        "{:<28} {:>9} {:>9} {:>9} {:>9}",
+        "", "mean", "median", "p95", "max"
+    )];
+    for (name, s) in rows {
+        out.push(format!(
+            "{:<28} {:>9.3} {:>9.3} {:>9.3} {:>9.3}",
+            name, s.mean, s.median, s.p95, s.max
+        ));
+    }
+    out
+}
