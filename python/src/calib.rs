@@ -37,15 +37,7 @@ fn prepared(
     opts: &CalibrationOptions,
     which: deadreckon_core::timing::Which,
 ) -> PyResult<(deadreckon_core::Drive, deadreckon_core::timing::Corrections)> {
-    deadreckon_core::timing::prepare_with(
-        drive,
-        opts,
-        &deadreckon_core::timing::DelayOptions::default(),
-        which,
-    )
-    .map_err(with_context(
-        "estimating the streams' delays and the IMU tilt".to_string(),
-    ))
+    deadreckon_api::corrections::estimate_and_apply(drive, opts, which).map_err(to_py_err)
 }
 
 /// The drive with the corrections a params.toml `p` stores applied (none for

@@ -249,9 +249,11 @@ pub fn prepare(
     which: CorrectionsArg,
     copts: &deadreckon_core::calibrate::CalibrationOptions,
 ) -> Result<(Drive, deadreckon_core::timing::Corrections)> {
-    use deadreckon_core::timing::{self, DelayOptions};
-    timing::prepare_with(drive, copts, &DelayOptions::default(), which.into())
-        .context("estimating the streams' delays and the IMU tilt")
+    Ok(deadreckon_api::corrections::estimate_and_apply(
+        drive,
+        copts,
+        which.into(),
+    )?)
 }
 
 /// The drive with the corrections stored in the params.toml `spec` applied

@@ -55,14 +55,7 @@ pub fn run(a: CompareArgs, load: &common::Loader) -> Result<()> {
     };
     let c = compare(&drive, &outages, params, model)?;
     if a.json {
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&{
-                let mut v = deadreckon_api::json::comparison_json(&c);
-                load.checks().annotate(&mut v);
-                v
-            })?
-        );
+        common::print_json(load, deadreckon_api::json::comparison_json(&c))?;
     } else {
         outln!("drive: {}", load.checks().span_text());
         common::print_comparison(&c, 0.0)?;

@@ -43,7 +43,9 @@ pub fn run(a: DemoArgs, quiet: bool, load: &common::Loader) -> Result<()> {
     let results = deadreckon_eval::crossval::calibrate_and_evaluate(&cal, &eval)?;
     for r in &results {
         if let Some(c) = &r.calibration {
-            let file = a.out.join(format!("params_{}.toml", r.name.to_lowercase()));
+            let file = a
+                .out
+                .join(format!("params_{}.toml", r.source.name().to_lowercase()));
             let mut extra = toml::Table::new();
             extra.insert("iterations".into(), (c.iterations as i64).into());
             deadreckon_io::write_params(&file, &c.estimate, Some(&extra))?;
@@ -54,7 +56,7 @@ pub fn run(a: DemoArgs, quiet: bool, load: &common::Loader) -> Result<()> {
         sets: results
             .iter()
             .map(|r| report::NamedParams {
-                name: r.name.into(),
+                name: r.source.name().into(),
                 source: r.source,
                 params: r.params,
                 calibration: r.calibration.clone(),
@@ -95,7 +97,7 @@ pub fn run(a: DemoArgs, quiet: bool, load: &common::Loader) -> Result<()> {
                 let d = Summary::of(&r.drift.errors_pct());
                 let s = Summary::of(&r.reset.distances_m);
                 serde_json::json!({
-                    "method": r.name,
+                    "method": r.source.name(),
                     "params": r.params.params.to_array(),
                     "std": r.params.std.to_array(),
                     "iterations": r.calibration.as_ref().map(|c| c.iterations),
@@ -135,11 +137,11 @@ pub fn run(a: DemoArgs, quiet: bool, load: &common::Loader) -> Result<()> {
         )
     );
     for r in &results {
-        outln!("{}", common::params_row(r.name, &r.params));
+        outln!("{}", common::params_row(r.source.name(), &r.params));
     }
     if let Some(rts) = results
         .iter()
-        .find(|r| r.name == "RTS")
+        .find(|r| r.source == report::Source::Rts)
         .and_then(|r| r.calibration.as_ref())
     {
         let e = rts.estimate.params.to_array();
@@ -186,7 +188,7 @@ pub fn run(a: DemoArgs, quiet: bool, load: &common::Loader) -> Result<()> {
         let s = Summary::of(&r.reset.distances_m);
         outln!(
             "{:<8} {:>11.3}% {:>11.3}% {:>6}   mean {:>6.1} m, median {:>6.1} m",
-            r.name,
+            r.source.name(),
             d.mean,
             d.std,
             d.n,

@@ -97,7 +97,7 @@ pub fn tedris_section(
         drive,
         &windows,
         None,
-        Some((m.clone(), model_path.display().to_string())),
+        Some((m, model_path.display().to_string())),
     )?;
-    Ok(tedris_from_model(drive, &m, &c)?)
+    Ok(tedris_from_model(drive, &c.model, &c)?)
 }

@@ -192,3 +192,19 @@ pub fn stored_corrections(extra: &toml::Table) -> Result<Stored, String> {
     }
     Ok(s)
 }
+
+/// Estimates the corrections `which` asks for (IMU tilt, delays, gyro scale)
+/// and applies them: the drive a calibration runs on, and what was found.
+/// The one call `calibrate`, `evaluate` and Python make.
+pub fn estimate_and_apply(
+    drive: &Drive,
+    copts: &deadreckon_core::calibrate::CalibrationOptions,
+    which: timing::Which,
+) -> Result<(Drive, Corrections), crate::Error> {
+    timing::prepare_with(drive, copts, &timing::DelayOptions::default(), which).map_err(|source| {
+        crate::Error::Calibration {
+            what: "estimating the streams' delays and the IMU tilt",
+            source,
+        }
+    })
+}

@@ -3,7 +3,7 @@
 //! line and the Python bindings alike.
 
 use deadreckon_core::calibrate::{self, CalibrationOptions};
-use deadreckon_core::timing::{self, Corrections, DelayOptions, Which};
+use deadreckon_core::timing::{Corrections, Which};
 use deadreckon_core::{Drive, Params};
 
 use crate::Error;
@@ -40,11 +40,7 @@ pub fn default_parameters(drive: &Drive, which: Which) -> Result<(Parameters, Dr
         ));
     }
     let copts = CalibrationOptions::default();
-    let (drive, corrections) = timing::prepare_with(drive, &copts, &DelayOptions::default(), which)
-        .map_err(|source| Error::Calibration {
-            what: "estimating the streams' delays and the IMU tilt",
-            source,
-        })?;
+    let (drive, corrections) = crate::corrections::estimate_and_apply(drive, &copts, which)?;
     let c = calibrate::calibrate(&drive, &copts).map_err(|source| Error::Calibration {
         what: "RTS calibration with GNSS",
         source,

@@ -129,7 +129,7 @@ pub fn compare(
         tedris_reference: td.reference.clone(),
         rows,
         model,
-        tedris_track: td.track.clone(),
+        tedris_track: td.track,
         four_wheel_gates: fw.gates,
         tedris_checks: (
             td.machine.inconsistent_headings(),

@@ -11,9 +11,7 @@ use crate::Error;
 
 /// One calibration method's results.
 pub struct MethodResult {
-    /// Method name.
-    pub name: &'static str,
-    /// Where the parameters come from.
+    /// Where the parameters come from (its `name()` is the method's).
     pub source: Source,
     /// Calibration (None for nominal).
     pub calibration: Option<Calibration>,
@@ -63,7 +61,6 @@ pub fn calibrate_and_evaluate(cal: &Drive, eval: &Drive) -> Result<Vec<MethodRes
         let drift = metrics::drift(eval, &params.params, 100.0, Timing::WheelEpochs)?;
         let reset = metrics::reset_on_error(eval, &params.params, 1.0, Timing::WheelEpochs)?;
         out.push(MethodResult {
-            name,
             source,
             calibration,
             params,
