@@ -256,6 +256,9 @@ pub fn tedris_train_json(m: &TedrisModel, source: ReferenceSource) -> Value {
         "dcf_distance_rad_per_m": m.config.joint_calibration().then_some(m.dcf_distance_rad_per_m),
         "gyro_bias": m.gyro_bias,
         "turn_gain": m.config.turn_gain().then_some(m.turn_gain),
+        // From GNSS chords; null while not estimated.
+        "distance_scale": m.distance_scale.estimated(),
+        "distance_scale_chords": m.distance_scale.chords,
         "per_metre_straight": m.per_metre_straight,
         "course_convention": m.course_convention,
         "complete": m.complete,

@@ -227,6 +227,18 @@ pub fn tedris_train_lines(
             m.dcf0_rad, m.dcf_rad
         ));
     }
+    if m.config.distance_scale() {
+        out.push(match m.distance_scale.estimated() {
+            Some(k) => format!(
+                "rear wheels' distance scale = {k:.4} (from {} GNSS chords)",
+                m.distance_scale.chords
+            ),
+            None => format!(
+                "rear wheels' distance scale: not estimated (too few GNSS chords of {} s; 1 kept)",
+                deadreckon_tedris::tuning::CHORD_S
+            ),
+        });
+    }
     match &m.course_convention {
         Some(c) => out.push(format!(
             "course convention found on the data: {:?} (residual as body yaw / as antenna course = {:.3})",

@@ -176,6 +176,11 @@ pub struct TedrisConfig {
     pub max_radius_mismatch: f64,
     /// Largest turn gain error, relative (default 0.05); a fit beyond it is refused.
     pub max_gain_error: f64,
+    /// Largest error of the rear wheels' distance scale (their mean
+    /// circumference against the nominal one), relative (default 0.05: worn,
+    /// soft or oversized tyres); a fit beyond it is refused.
+    #[serde(default = "default_max_distance_scale_error")]
+    pub max_distance_scale_error: f64,
     /// Window over which the straight-line detector measures the heading change, s (default 3).
     pub slt_window_s: f64,
     /// Largest reference heading change over `slt_window_s` on a straight line, degrees (default 1).
@@ -220,6 +225,7 @@ impl Default for TedrisConfig {
             min_calibration_span_s: 120.0,
             max_radius_mismatch: 0.01,
             max_gain_error: 0.05,
+            max_distance_scale_error: default_max_distance_scale_error(),
             slt_window_s: 3.0,
             slt_max_change_deg: 1.0,
             portmanteau_lags: 10,
@@ -278,6 +284,12 @@ impl TedrisConfig {
         self.variant == Variant::Extended
     }
 
+    /// The rear wheels' distance scale is estimated from GNSS chords (the
+    /// extended variant).
+    pub fn distance_scale(&self) -> bool {
+        self.variant == Variant::Extended
+    }
+
     /// The turn gain is estimated (by the joint calibration: the extended variant).
     pub fn turn_gain(&self) -> bool {
         self.variant == Variant::Extended
@@ -329,6 +341,7 @@ impl TedrisConfig {
             ("min_calibration_span_s", self.min_calibration_span_s),
             ("max_radius_mismatch", self.max_radius_mismatch),
             ("max_gain_error", self.max_gain_error),
+            ("max_distance_scale_error", self.max_distance_scale_error),
         ] {
             if !(v.is_finite() && v > 0.0) {
                 return bad(k, v.to_string());
@@ -354,4 +367,8 @@ impl TedrisConfig {
         }
         Ok(())
     }
+}
+
+fn default_max_distance_scale_error() -> f64 {
+    0.05
 }

@@ -305,6 +305,38 @@ pub struct TedrisModel {
     /// paper variant, where it is not estimated).
     #[serde(default = "one")]
     pub turn_gain: f64,
+    /// The rear wheels' distance scale (see [`DistanceScale`]).
+    #[serde(default)]
+    pub distance_scale: DistanceScale,
+}
+
+/// The rear wheels' distance scale: metres travelled per metre the rear
+/// wheels report (their mean circumference against the nominal one),
+/// estimated from GNSS chords (the extended variant). It scales the position
+/// only: the heading model is fitted on the wheels' own distances.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct DistanceScale {
+    /// The scale (1 until estimated).
+    pub value: f64,
+    /// Chords of the fit that set it; 0: not estimated (the paper variant,
+    /// or too few chords yet), and `value` is then the nominal 1.
+    pub chords: usize,
+}
+
+impl Default for DistanceScale {
+    fn default() -> Self {
+        DistanceScale {
+            value: 1.0,
+            chords: 0,
+        }
+    }
+}
+
+impl DistanceScale {
+    /// The scale when estimated, `None` when not.
+    pub fn estimated(&self) -> Option<f64> {
+        (self.chords > 0).then_some(self.value)
+    }
 }
 
 fn one() -> f64 {
@@ -371,6 +403,7 @@ impl TedrisModel {
             straight_omega,
             straight_sigma_m,
             turn_gain: 1.0,
+            distance_scale: DistanceScale::default(),
         };
         m.set_dcf0();
         Ok(m)
@@ -493,7 +526,9 @@ impl TedrisModel {
             && self.sample_period_s.is_finite()
             && self.sample_period_s > 0.0
             && self.turn_gain.is_finite()
-            && self.turn_gain > 0.0;
+            && self.turn_gain > 0.0
+            && self.distance_scale.value.is_finite()
+            && self.distance_scale.value > 0.0;
         if !ok {
             return Err(Error::Model(
                 "the model holds non-finite or inconsistent values".into(),

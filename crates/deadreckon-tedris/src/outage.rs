@@ -158,6 +158,7 @@ pub fn train(
         f.dcf_rad = model.dcf_rad;
         f.dcf_distance_rad_per_m = model.dcf_distance_rad_per_m;
         f.turn_gain = model.turn_gain;
+        f.distance_scale = model.distance_scale;
         f.per_metre_straight = model.per_metre_straight;
         f.course_convention = model.course_convention;
         f.settle_kind();

@@ -63,6 +63,15 @@ pub const MIN_TURNING_RAD: f64 = 1.0;
 /// the rest is held back to accept or refuse it.
 pub const FIT_SHARE: f64 = 0.75;
 
+/// The scale calibration's chords: fixes this far apart, s ...
+pub const CHORD_S: f64 = 10.0;
+/// ... at least this long (dead-reckoned), m ...
+pub const MIN_CHORD_M: f64 = 20.0;
+/// ... within runs of fixes no more than this apart, s.
+pub const CHORD_GAP_S: f64 = 2.0;
+/// Chords the scale is fitted on, at least (and a third as many held back).
+pub const MIN_SCALE_CHORDS: usize = 12;
+
 /// Recent training blocks kept for the error correction at an outage start.
 pub const RECENT_BLOCKS: usize = 32;
 

@@ -11,6 +11,7 @@ impl Tedris {
     /// DR heading over the last `update_window_s` (the constant offset removed).
     pub(super) fn update_dcf(&mut self, t: f64) {
         self.last_update_t = t;
+        self.calibrate_scale();
         if self
             .model
             .as_ref()

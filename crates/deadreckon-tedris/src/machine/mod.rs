@@ -33,6 +33,7 @@ use crate::Error;
 use deadreckon_core::angle::wrap;
 
 mod calibration;
+mod scale;
 mod sync;
 mod training;
 
@@ -148,6 +149,13 @@ pub struct Tedris {
     position_offset: (f64, f64),
     theta_dr: f64,
     pos_dr: (f64, f64),
+    /// The dead-reckoned rear-axle position with the wheels' distances
+    /// unscaled (see [`scale`]).
+    #[serde(default)]
+    pos_raw: (f64, f64),
+    /// Fixes beside `pos_raw`, for the distance scale (see [`scale`]).
+    #[serde(default)]
+    chord_points: VecDeque<scale::ChordPoint>,
     speed_mps: f64,
     good_since: Option<f64>,
     last_update_t: f64,
@@ -218,6 +226,8 @@ impl Tedris {
             position_offset: (0.0, 0.0),
             theta_dr: 0.0,
             pos_dr: (0.0, 0.0),
+            pos_raw: (0.0, 0.0),
+            chord_points: VecDeque::new(),
             speed_mps: 0.0,
             good_since: None,
             last_update_t: f64::MIN,
@@ -342,6 +352,11 @@ impl Tedris {
         Ok(m)
     }
 
+    /// The model's distance scale (1 without a model).
+    fn distance_scale(&self) -> f64 {
+        self.model.as_ref().map_or(1.0, |m| m.distance_scale.value)
+    }
+
     fn heading_out(&self) -> f64 {
         self.theta_dr + self.heading_offset
     }
@@ -383,9 +398,13 @@ impl Tedris {
         let before = self.heading_out();
         self.theta_dr += rate;
         let mid = before + 0.5 * rate;
-        self.pos_dr.0 += dist * mid.cos();
-        self.pos_dr.1 += dist * mid.sin();
-        self.speed_mps = if dt > 0.0 { dist / dt } else { 0.0 };
+        let (c, s) = (mid.cos(), mid.sin());
+        self.pos_raw.0 += dist * c;
+        self.pos_raw.1 += dist * s;
+        let travelled = dist * self.distance_scale();
+        self.pos_dr.0 += travelled * c;
+        self.pos_dr.1 += travelled * s;
+        self.speed_mps = if dt > 0.0 { travelled / dt } else { 0.0 };
         let idx = self.next_idx;
         self.next_idx += 1;
         self.history.push(Sample {
@@ -500,12 +519,16 @@ impl Tedris {
         };
         let yaw = self.heading_out();
         let ahead = (f.t_s - t_last).clamp(-1.0, 1.0) * self.speed_mps;
-        let (pe, pn) = (
-            self.pos_dr.0 + ahead * yaw.cos(),
-            self.pos_dr.1 + ahead * yaw.sin(),
-        );
+        let (c, s) = (yaw.cos(), yaw.sin());
+        let (pe, pn) = (self.pos_dr.0 + ahead * c, self.pos_dr.1 + ahead * s);
         let l = self.geometry.lever_arm_m;
-        let (me, mn) = (f.east_m - l * yaw.cos(), f.north_m - l * yaw.sin());
+        let (me, mn) = (f.east_m - l * c, f.north_m - l * s);
+        let raw_ahead = ahead / self.distance_scale();
+        let raw = (
+            self.pos_raw.0 + raw_ahead * c,
+            self.pos_raw.1 + raw_ahead * s,
+        );
+        self.keep_chord_point(f.t_s, (me, mn), raw);
         self.position_pairs.push_back((f.t_s, me - pe, mn - pn));
         let win = self.config.position_anchor_window_s;
         while self

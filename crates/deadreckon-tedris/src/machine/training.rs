@@ -158,6 +158,10 @@ impl Tedris {
         match TedrisModel::fit(c.clone(), period, lag, ccf, repos) {
             Ok(mut model) => {
                 model.per_metre_straight = per_metre;
+                // A rebuilt model keeps the scale (the tyres did not change).
+                if let Some(old) = &self.model {
+                    model.distance_scale = old.distance_scale;
+                }
                 model.course_convention = self
                     .model
                     .as_ref()
@@ -224,6 +228,7 @@ impl Tedris {
         }
         let Some(old) = &self.model else { return };
         let convention = old.course_convention;
+        let scale = old.distance_scale;
         let (gain, per_metre, dist, dcf, joint) = (
             old.turn_gain,
             old.per_metre_straight,
@@ -239,6 +244,7 @@ impl Tedris {
             old.repositories.clone(),
         ) {
             m.turn_gain = gain;
+            m.distance_scale = scale;
             m.per_metre_straight = per_metre;
             m.course_convention = convention;
             m.settle_kind();
