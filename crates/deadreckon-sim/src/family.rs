@@ -19,8 +19,12 @@
 //! # Ok::<(), deadreckon_sim::SimError>(())
 //! ```
 //!
-//! What the family does not cover: reversing (the route model drives forward
-//! only), wheel ticks (wheel speeds only), slopes and slip.
+//! Reversing: at a share of the stops ([`SHUNT_SHARE`]) the car backs up
+//! 3–15 m along the path it just drove and drives forward again (signed
+//! wheel speeds; an antenna-velocity course turns round, a body-yaw course
+//! does not). What the family does not cover: other reversing manoeuvres
+//! (three-point turns, parking), unsigned wheel speeds, wheel ticks (wheel
+//! speeds only), slopes and slip.
 
 use deadreckon_core::{Params, Vehicle};
 use rand::{RngExt, SeedableRng};
@@ -75,6 +79,10 @@ fn rng(seed: u64, purpose: u64) -> Pcg64 {
         seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ purpose.wrapping_mul(0xD1B5_4A32_D192_ED03),
     )
 }
+
+/// The share of a drive's stops at which the car shunts (backs up and
+/// drives forward again).
+pub const SHUNT_SHARE: f64 = 0.4;
 
 fn between(r: &mut Pcg64, lo: f64, hi: f64) -> f64 {
     lo + (hi - lo) * r.random::<f64>()
@@ -145,9 +153,23 @@ impl CarFamily {
 
     /// A drive of this car drawn from `seed`, at least `min_duration_s` long
     /// (stops included): a random open route of straights, turns,
-    /// roundabouts and stops.
+    /// roundabouts and stops, with shunts (backing up) at a share
+    /// [`SHUNT_SHARE`] of the stops.
     pub fn drive(&self, seed: u64, min_duration_s: f64) -> Scenario {
+        self.drive_with(seed, min_duration_s, SHUNT_SHARE)
+    }
+
+    /// [`CarFamily::drive`] without shunts: the car only drives forward (the
+    /// same route and stops).
+    pub fn drive_forward(&self, seed: u64, min_duration_s: f64) -> Scenario {
+        self.drive_with(seed, min_duration_s, 0.0)
+    }
+
+    fn drive_with(&self, seed: u64, min_duration_s: f64, shunt_share: f64) -> Scenario {
         let r = &mut rng(seed, 2 + self.seed.wrapping_mul(31));
+        // The shunts from their own generator: the routes are those drawn
+        // before reversing was added.
+        let shunts = &mut rng(seed, 3 + self.seed.wrapping_mul(31));
         let mut segments = vec![Segment::Straight {
             length_m: between(r, 80.0, 200.0),
             speed_limit_kmh: Some(between(r, 30.0, 50.0)),
@@ -169,7 +191,7 @@ impl CarFamily {
         // Segments are drawn in batches until the planned drive is long enough.
         loop {
             for _ in 0..8 {
-                segments.push(random_segment(r));
+                segments.push(random_segment(r, shunts, shunt_share));
             }
             let spec = route_of(&segments);
             let planned = crate::route::Route::build(&spec, 1)
@@ -230,8 +252,9 @@ impl CarFamily {
     }
 }
 
-/// One random segment: a straight, a turn, a roundabout or a stop.
-fn random_segment(r: &mut Pcg64) -> Segment {
+/// One random segment: a straight, a turn, a roundabout or a stop (with a
+/// shunt drawn from `shunts`).
+fn random_segment(r: &mut Pcg64, shunts: &mut Pcg64, shunt_share: f64) -> Segment {
     let pick = r.random::<f64>();
     if pick < 0.42 {
         Segment::Straight {
@@ -257,6 +280,7 @@ fn random_segment(r: &mut Pcg64) -> Segment {
     } else {
         Segment::Stop {
             duration_s: between(r, 5.0, 40.0),
+            reverse_m: (shunts.random::<f64>() < shunt_share).then(|| between(shunts, 3.0, 15.0)),
         }
     }
 }
@@ -312,6 +336,71 @@ mod tests {
             assert!(out.stats.duration_s >= 400.0, "{}", out.stats.duration_s);
             assert!(out.drive.validate().is_ok());
             assert!(!out.stats.stops.is_empty());
+        }
+    }
+
+    /// The bug: a wheel at rest read its edge jitter and white noise as
+    /// speeds of up to 0.3 m/s (no edge passes a sensor at rest: it reads 0),
+    /// which turned a parked car's dead-reckoned heading.
+    #[test]
+    fn wheel_speeds_at_rest_carried_jitter_and_noise() {
+        for seed in [2, 3] {
+            let car = CarFamily::draw(seed);
+            let out = simulate(&car.drive_forward(7, 300.0), 7).expect("simulated");
+            let deadreckon_core::drive::Wheels::Speeds(ws) = &out.drive.wheels else {
+                panic!("speeds");
+            };
+            let mut at_rest = 0;
+            for &(t, d) in &out.stats.stops {
+                for w in ws.iter().filter(|w| w.t_s > t + 0.5 && w.t_s < t + d - 0.5) {
+                    assert_eq!([w.fl_mps, w.fr_mps, w.rl_mps, w.rr_mps], [0.0; 4], "{w:?}");
+                    at_rest += 1;
+                }
+            }
+            assert!(at_rest > 100, "{at_rest} samples at rest");
+        }
+    }
+
+    /// Shunts: the rear wheels read negative speeds while the car backs up;
+    /// an antenna-velocity course turns round with the motion, a body-yaw
+    /// course does not.
+    #[test]
+    fn shunts_reverse_the_wheels_and_only_the_antenna_course() {
+        let mut car = CarFamily::draw(2);
+        car.min_course_speed_mps = 0.3;
+        car.gnss_markov = (0.0, 60.0);
+        for convention in [CourseConvention::AntennaVelocity, CourseConvention::BodyYaw] {
+            car.course_convention = convention;
+            let out = simulate(&car.drive(5, 600.0), 5).expect("simulated");
+            let d = &out.drive;
+            let deadreckon_core::drive::Wheels::Speeds(ws) = &d.wheels else {
+                panic!("speeds");
+            };
+            assert!(ws.iter().any(|w| w.rl_mps < -0.5 && w.rr_mps < -0.5));
+            // Courses while backing up faster than 1 m/s, against the yaw.
+            let yaw_at = |t: f64| {
+                let i = d
+                    .truth
+                    .partition_point(|p| p.t_s < t)
+                    .min(d.truth.len() - 1);
+                (d.truth[i].yaw_rad, d.truth[i].speed_mps.unwrap_or(0.0))
+            };
+            let mut n = 0;
+            for g in &d.gnss {
+                let (yaw, v) = yaw_at(g.t_s - car.gnss_latency_s);
+                let Some(c) = g.course_yaw_rad() else {
+                    continue;
+                };
+                if v < -1.0 {
+                    let off = deadreckon_core::angle::wrap(c - yaw).abs();
+                    match convention {
+                        CourseConvention::AntennaVelocity => assert!(off > 2.0, "{off}"),
+                        CourseConvention::BodyYaw => assert!(off < 1.0, "{off}"),
+                    }
+                    n += 1;
+                }
+            }
+            assert!(n > 5, "{n} courses while backing up");
         }
     }
 }

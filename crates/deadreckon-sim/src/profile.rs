@@ -84,6 +84,10 @@ enum Kind {
     Cruise(f64),
     /// Half-cosine transition from the first speed to the second.
     Ramp(f64, f64),
+    /// A shunt during a stop: this distance (negative: backwards) from rest
+    /// to rest, s(τ) = s₀ + Δ·(τ/T − sin(2πτ/T)/(2π)): speed and
+    /// acceleration are zero at both ends.
+    Shunt(f64),
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -113,6 +117,17 @@ pub(crate) struct SpeedProfile {
     end_s: f64,
 }
 
+/// Peak speed of a shunt, m/s.
+const SHUNT_SPEED_MPS: f64 = 1.5;
+/// Shortest rest before, between and after the moves of a shunt, s.
+const SHUNT_REST_S: f64 = 1.0;
+
+/// Duration of a shunt of `d` metres: peak speed 2d/T at most
+/// [`SHUNT_SPEED_MPS`], peak acceleration 2πd/T² at most `a`.
+fn shunt_time(d: f64, a: f64) -> f64 {
+    (2.0 * d / SHUNT_SPEED_MPS).max((2.0 * std::f64::consts::PI * d / a).sqrt())
+}
+
 /// Duration of a transition between `v0` and `v1` with peak acceleration `a`
 /// and peak jerk `j`: a = πΔ/(2T), j = π²Δ/(2T²).
 fn ramp_time(v0: f64, v1: f64, a: f64, j: f64) -> f64 {
@@ -123,10 +138,14 @@ fn ramp_time(v0: f64, v1: f64, a: f64, j: f64) -> f64 {
 impl SpeedProfile {
     /// Plans the profile over all laps of `route`.
     pub fn plan(route: &Route, spec: &SpeedSpec) -> Result<SpeedProfile, String> {
-        // Zones: (length, cruise speed, stop duration).
+        // Zones: (length, cruise speed, stop duration); shunts by zone index.
         let mut zones: Vec<(f64, f64, Option<f64>)> = vec![(0.0, 0.0, Some(spec.start_stop_s))];
+        let mut shunts = std::collections::HashMap::new();
         for z in &route.zones {
             if let Some(d) = z.stop_s {
+                if z.reverse_m > 0.0 {
+                    shunts.insert(zones.len(), z.reverse_m);
+                }
                 zones.push((0.0, 0.0, Some(d)));
             } else if z.len > 1e-9 {
                 let mut v = z.limit_mps.unwrap_or(spec.default_limit_kmh / 3.6);
@@ -187,7 +206,19 @@ impl SpeedProfile {
         for i in 0..n {
             let (len, v, stop) = zones[i];
             if let Some(d) = stop {
-                push(d, 0.0, Kind::Hold, &mut t, &mut s);
+                match shunts.get(&i) {
+                    Some(&back) => {
+                        // Rest, back up, rest, drive forward again, rest.
+                        let move_t = shunt_time(back, spec.max_accel_mps2);
+                        let rest = ((d - 2.0 * move_t) / 3.0).max(SHUNT_REST_S);
+                        push(rest, 0.0, Kind::Hold, &mut t, &mut s);
+                        push(move_t, -back, Kind::Shunt(-back), &mut t, &mut s);
+                        push(rest, 0.0, Kind::Hold, &mut t, &mut s);
+                        push(move_t, back, Kind::Shunt(back), &mut t, &mut s);
+                        push(rest, 0.0, Kind::Hold, &mut t, &mut s);
+                    }
+                    None => push(d, 0.0, Kind::Hold, &mut t, &mut s),
+                }
                 continue;
             }
             let (vp, vn) = (zones[i - 1].1, zones[i + 1].1);
@@ -257,6 +288,15 @@ impl SpeedProfile {
                 v,
                 a: 0.0,
             },
+            Kind::Shunt(d) => {
+                let w = 2.0 * std::f64::consts::PI / p.dur;
+                let (sin, cos) = (w * tau).sin_cos();
+                Motion {
+                    s: p.s0 + d * (tau / p.dur - sin / (w * p.dur)),
+                    v: d / p.dur * (1.0 - cos),
+                    a: d / p.dur * w * sin,
+                }
+            }
             Kind::Ramp(v0, v1) => {
                 let dv = v1 - v0;
                 let w = std::f64::consts::PI / p.dur;
@@ -324,7 +364,10 @@ mod tests {
                     length_m: 5.0,
                     speed_limit_kmh: Some(70.0),
                 },
-                Segment::Stop { duration_s: 3.0 },
+                Segment::Stop {
+                    duration_s: 3.0,
+                    reverse_m: None,
+                },
                 Segment::Straight {
                     length_m: 300.0,
                     speed_limit_kmh: Some(30.0),
@@ -359,5 +402,71 @@ mod tests {
         }
         assert!((prev.s - r.length_m()).abs() < 1e-6);
         assert_eq!(p.stops_until(p.duration_s()).len(), 3);
+    }
+
+    #[test]
+    fn a_shunt_backs_up_along_the_path_and_returns() {
+        let spec = RouteSpec {
+            closed: false,
+            start_yaw_deg: 0.0,
+            transition_m: 10.0,
+            segments: vec![
+                Segment::Straight {
+                    length_m: 100.0,
+                    speed_limit_kmh: None,
+                },
+                Segment::Stop {
+                    duration_s: 10.0,
+                    reverse_m: Some(8.0),
+                },
+                Segment::Straight {
+                    length_m: 100.0,
+                    speed_limit_kmh: None,
+                },
+            ],
+        };
+        let r = Route::build(&spec, 1).unwrap();
+        let sp = SpeedSpec::default();
+        let p = SpeedProfile::plan(&r, &sp).unwrap();
+        let dt = 1e-3;
+        let (mut prev, mut t) = (p.eval(0.0), dt);
+        let (mut s_min, mut v_min) = (f64::MAX, 0.0f64);
+        let (mut after_stop, mut reached) = (None, false);
+        while t < p.duration_s() {
+            let m = p.eval(t);
+            assert!(
+                ((m.s - prev.s) - 0.5 * (m.v + prev.v) * dt).abs() < 1e-6,
+                "at {t}"
+            );
+            assert!(
+                m.a <= sp.max_accel_mps2 + 1e-9 && m.a >= -sp.max_decel_mps2 - 1e-9,
+                "at {t}"
+            );
+            if reached || m.s > 100.0 - 1e-9 {
+                reached = true;
+                s_min = s_min.min(m.s);
+            }
+            v_min = v_min.min(m.v);
+            if prev.v < 0.0 && m.v >= 0.0 {
+                after_stop = Some(m.s);
+            }
+            prev = m;
+            t += dt;
+        }
+        // Backed up 8 m from the stop at 100 m, at up to 1.5 m/s.
+        assert!((s_min - 92.0).abs() < 1e-6, "{s_min}");
+        assert!((-SHUNT_SPEED_MPS - 1e-9..-1.0).contains(&v_min), "{v_min}");
+        assert!(after_stop.is_some_and(|s| (s - 92.0).abs() < 1e-6));
+        assert!((prev.s - r.length_m()).abs() < 1e-3);
+        // Three rests: the stop is three stops.
+        assert_eq!(p.stops_until(p.duration_s()).len(), 5);
+        // Backing up further than the path driven is refused.
+        let mut bad = spec.clone();
+        bad.segments[1] = Segment::Stop {
+            duration_s: 10.0,
+            reverse_m: Some(150.0),
+        };
+        let e = Route::build(&bad, 1).unwrap_err();
+        assert!(e.1.contains("longer than the path"), "{e:?}");
     }
 }

@@ -61,10 +61,16 @@ pub enum Segment {
         #[serde(default, skip_serializing_if = "Option::is_none")]
         speed_limit_kmh: Option<f64>,
     },
-    /// A standstill (traffic light, stop sign) of the given duration.
+    /// A standstill (traffic light, stop sign) of the given duration; with
+    /// `reverse_m`, a shunt within it: the car backs up that far along the
+    /// path it just drove and drives forward to where it stopped (the stop
+    /// is lengthened to fit both moves).
     Stop {
         /// Standstill duration, s.
         duration_s: f64,
+        /// Distance backed up during the stop, m (default: none).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        reverse_m: Option<f64>,
     },
 }
 
@@ -141,6 +147,8 @@ pub(crate) struct Zone {
     pub max_abs_kappa: f64,
     /// Standstill duration, s, for a stop.
     pub stop_s: Option<f64>,
+    /// Distance backed up and driven again during the stop, m (0: none).
+    pub reverse_m: f64,
 }
 
 /// A route expanded into pieces, repeated over laps.
@@ -306,6 +314,7 @@ fn expand(spec: &RouteSpec) -> Result<Expanded, RouteError> {
         limit_mps,
         max_abs_kappa,
         stop_s,
+        reverse_m: 0.0,
     };
     for (i, seg) in spec.segments.iter().enumerate() {
         let start = pieces.len();
@@ -375,11 +384,32 @@ fn expand(spec: &RouteSpec) -> Result<Expanded, RouteError> {
                     }
                 }
             }
-            Segment::Stop { duration_s } => {
+            Segment::Stop {
+                duration_s,
+                reverse_m,
+            } => {
                 if !(duration_s.is_finite() && duration_s >= 0.0) {
                     return Err(bad(i, "duration_s", "must be a non-negative number"));
                 }
-                zones.push((start..start, zone(None, 0.0, Some(duration_s))));
+                let reverse_m = reverse_m.unwrap_or(0.0);
+                if !(reverse_m.is_finite() && reverse_m >= 0.0) {
+                    return Err(bad(i, "reverse_m", "must be a non-negative number"));
+                }
+                let back: f64 = pieces.iter().map(|p| p.len).sum();
+                if reverse_m > back {
+                    return Err(bad(
+                        i,
+                        "reverse_m",
+                        "is longer than the path driven before the stop",
+                    ));
+                }
+                zones.push((
+                    start..start,
+                    Zone {
+                        reverse_m,
+                        ..zone(None, 0.0, Some(duration_s))
+                    },
+                ));
             }
         }
     }

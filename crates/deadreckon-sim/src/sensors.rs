@@ -638,6 +638,11 @@ impl Suite {
                         + (e - last_jitter[i]) / dt
                         + self.noise[WHEELS].gauss(std);
                     last_jitter[i] = e;
+                    // A wheel at rest passes no edge: its speed reads 0, with
+                    // neither jitter nor noise (the draws above are made all
+                    // the same, so the noise of the moving samples does not
+                    // depend on the stops).
+                    let raw = if rot[i] == last_rot[i] { 0.0 } else { raw };
                     v[i] = if q > 0.0 { (raw / q).round() * q } else { raw };
                 }
                 *last_rot = rot;
@@ -681,12 +686,14 @@ impl Suite {
         let (mut course_deg, mut speed_mps) = (None, None);
         if let Some(vstd) = spec.velocity_std_mps {
             // Antenna velocity: v·(cos ψ, sin ψ) + l·ψ̇·(−sin ψ, cos ψ).
-            let lat = match spec.course_convention {
-                CourseConvention::AntennaVelocity => l * st.yaw_rate,
-                CourseConvention::BodyYaw => 0.0,
+            // A body-yaw course is the direction the car faces: it does not
+            // turn round when the car reverses.
+            let (lat, fwd) = match spec.course_convention {
+                CourseConvention::AntennaVelocity => (l * st.yaw_rate, st.v),
+                CourseConvention::BodyYaw => (0.0, st.v.abs()),
             };
-            let ve = st.v * cos - lat * sin + n.gauss(vstd);
-            let vn = st.v * sin + lat * cos + n.gauss(vstd);
+            let ve = fwd * cos - lat * sin + n.gauss(vstd);
+            let vn = fwd * sin + lat * cos + n.gauss(vstd);
             let sp = ve.hypot(vn);
             speed_mps = Some(sp);
             if sp >= spec.min_course_speed_mps {

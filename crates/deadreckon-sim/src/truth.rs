@@ -88,12 +88,15 @@ impl<'a> Kinematics<'a> {
         }
     }
 
-    /// Ground speeds of the wheels FL, FR, RL, RR for speed `v` and yaw rate `w`.
+    /// Ground speeds of the wheels FL, FR, RL, RR for speed `v` and yaw rate
+    /// `w`, negative when reversing (the front wheels' speed takes the sign
+    /// of `v`).
     pub fn wheel_speeds(&self, v: f64, w: f64) -> [f64; 4] {
         let lat = self.wheelbase * w;
+        let sign = if v < 0.0 { -1.0 } else { 1.0 };
         [
-            (lat * lat + (v - self.half_front * w).powi(2)).sqrt(),
-            (lat * lat + (v + self.half_front * w).powi(2)).sqrt(),
+            sign * (lat * lat + (v - self.half_front * w).powi(2)).sqrt(),
+            sign * (lat * lat + (v + self.half_front * w).powi(2)).sqrt(),
             v - self.half_rear * w,
             v + self.half_rear * w,
         ]

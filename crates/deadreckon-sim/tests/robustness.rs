@@ -25,7 +25,10 @@ fn segment() -> impl Strategy<Value = Segment> {
                 speed_limit_kmh: None,
                 transition_m
             }),
-        (-1.0..10.0f64).prop_map(|duration_s| Segment::Stop { duration_s }),
+        (-1.0..10.0f64).prop_map(|duration_s| Segment::Stop {
+            duration_s,
+            reverse_m: None
+        }),
     ]
 }
 

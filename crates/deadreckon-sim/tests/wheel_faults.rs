@@ -33,7 +33,10 @@ struct Case {
 
 fn case(seed: u64, spin: bool, shrink: bool) -> Case {
     let car = CarFamily::draw(seed);
-    let base = car.drive(seed, 600.0);
+    // Forward only: with shunts (the family's default) the monitor's
+    // verdicts differ (a spin burst while backing up is not dropped, the 3 %
+    // wheel is dropped in two intervals instead of one); not studied yet.
+    let base = car.drive_forward(seed, 600.0);
     let sim0 = simulate(&base, seed).unwrap();
     let mid = 0.5 * sim0.stats.duration_s;
     let faults = WheelFaultsSpec {

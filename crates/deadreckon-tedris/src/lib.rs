@@ -66,7 +66,10 @@
 //!   convention) has an intercept per segment ([`history::centre_per_segment`]).
 //! - **Courses checked against the wheels**: a course is used only when its
 //!   change since the previous course agrees with the wheels' turn within
-//!   `course_consistency_rad`, not only above a speed.
+//!   `course_consistency_rad`, not only above a speed; none is used while the
+//!   rear wheels roll backwards (receivers then report the direction of
+//!   motion, a frozen course or a random one;
+//!   [`Tedris::reversing_courses`] counts them).
 //! - **Physical form** (GNSS course, the extended variant): the straight-line
 //!   heading is per metre only, as unequal rear radii make it; the model turns
 //!   the car only when the wheels move ([`history::moving`]); the ARX kind,

@@ -23,7 +23,8 @@ struct PairResult {
     outage: Outage,
     tedris_m: f64,
     tedris_max_m: f64,
-    paper_m: f64,
+    /// `None`: the paper's method could not train on the training drive.
+    paper_m: Option<f64>,
     baseline_m: f64,
     after_stop: bool,
 }
@@ -72,7 +73,15 @@ fn run_car(car_seed: u64) -> (Vec<PairResult>, ConventionCheck) {
         .drive;
     let test_out = simulate(&car.drive(2000 + car_seed, 500.0), 2000 + car_seed).expect("test");
     let (model, _) = train(&train_drive, TedrisConfig::default(), None).expect("trained");
-    let (paper, _) = train(&train_drive, TedrisConfig::paper(), None).expect("paper trained");
+    // The paper's method may fail to train (its cross-correlation peak
+    // requirement): reported, not hidden.
+    let paper = match train(&train_drive, TedrisConfig::paper(), None) {
+        Ok((m, _)) => Some(m),
+        Err(e) => {
+            eprintln!("  the paper's method did not train: {e}");
+            None
+        }
+    };
     let base = Baseline::fit(&train_drive).expect("baseline");
     eprintln!(
         "  course convention found: {:?}",
@@ -89,14 +98,16 @@ fn run_car(car_seed: u64) -> (Vec<PairResult>, ConventionCheck) {
     let mut out = Vec::new();
     for (o, after_stop) in outages(&test_out.stats.stops, test_out.stats.duration_s) {
         let r = run_outages(&test_out.drive, &model, &[o]).expect("run");
-        let p = run_outages(&test_out.drive, &paper, &[o]).expect("paper run");
+        let p = paper
+            .as_ref()
+            .map(|m| run_outages(&test_out.drive, m, &[o]).expect("paper run"));
         let b = base.run_outage(&test_out.drive, &o).expect("baseline run");
         out.push(PairResult {
             alarms: r.machine.model_alarms(),
             outage: o,
             tedris_m: r.outages[0].mean_error_m,
             tedris_max_m: r.outages[0].max_error_m,
-            paper_m: p.outages[0].mean_error_m,
+            paper_m: p.map(|p| p.outages[0].mean_error_m),
             baseline_m: b.mean_error_m,
             after_stop,
         });
@@ -136,13 +147,13 @@ fn family_train_test_80s_outages() {
         conventions.push(check);
         for r in results {
             eprintln!(
-                "  [{:.0}, {:.0}) {}: tedris mean {:.2} m (max {:.2}), paper {:.2} m, baseline {:.2} m",
+                "  [{:.0}, {:.0}) {}: tedris mean {:.2} m (max {:.2}), paper {} m, baseline {:.2} m",
                 r.outage.start_s,
                 r.outage.end_s,
                 if r.after_stop { "after a stop" } else { "mid-drive   " },
                 r.tedris_m,
                 r.tedris_max_m,
-                r.paper_m,
+                r.paper_m.map_or("not trained".into(), |p| format!("{p:.2}")),
                 r.baseline_m
             );
             all.push(r);
@@ -150,32 +161,38 @@ fn family_train_test_80s_outages() {
     }
     let mean = |f: fn(&PairResult) -> f64| all.iter().map(f).sum::<f64>() / all.len() as f64;
     let worst = all.iter().map(|r| r.tedris_m).fold(0.0, f64::max);
+    // The paper's method over the pairs it trained on, and TedriS over the same.
+    let paper_pairs: Vec<&PairResult> = all.iter().filter(|r| r.paper_m.is_some()).collect();
+    let over_paper = |f: fn(&PairResult) -> f64| {
+        paper_pairs.iter().map(|r| f(r)).sum::<f64>() / paper_pairs.len() as f64
+    };
+    let p = over_paper(|r| r.paper_m.unwrap_or(f64::NAN));
+    let t_paper_pairs = over_paper(|r| r.tedris_m);
     eprintln!(
-        "{} pairs: tedris mean {:.2} m (worst {:.2}), paper {:.2} m, baseline {:.2} m (worst {:.2})",
+        "{} pairs: tedris mean {:.2} m (worst {:.2}), paper {:.2} m over the {} pairs it trained for (tedris {:.2} m there), baseline {:.2} m (worst {:.2})",
         all.len(),
         mean(|r| r.tedris_m),
         worst,
-        mean(|r| r.paper_m),
+        p,
+        paper_pairs.len(),
+        t_paper_pairs,
         mean(|r| r.baseline_m),
         all.iter().map(|r| r.baseline_m).fold(0.0, f64::max)
     );
     assert!(all.len() >= 20, "{} pairs", all.len());
-    // Measured (cars 1–12, 24 pairs, GNSS latencies 0–0.15 s): TedriS 2.70 m
-    // mean, worst 8.61 m; the paper's method alone 72.1 m; the baseline
-    // 8.12 m (worst 25.6 m). Cars 101–112 (28 pairs, not looked at while
-    // developing): 1.92 m, worst 5.68 m; paper 49.8 m; baseline 5.16 m
-    // (worst 14.0 m). Without the distance scale from GNSS chords: 3.17 m
-    // (worst 8.04 m) and 2.22 m (worst 5.67 m). Before the heading segments,
-    // the consistency check and the per-metre form (and without latencies):
-    // 82.3 m mean, worst 390 m. The issue's targets: mean under 3 m, no
-    // outage above 10 m.
-    let (t, b, p) = (
-        mean(|r| r.tedris_m),
-        mean(|r| r.baseline_m),
-        mean(|r| r.paper_m),
-    );
-    assert!(t < 2.9, "TedriS mean {t} m");
-    assert!(worst < 9.0, "TedriS worst outage {worst} m");
+    // Measured (cars 1–12, 26 pairs, reversing at 40 % of the stops):
+    // TedriS 2.46 m mean, worst 6.07 m; the paper's method alone 36.2 m over
+    // the 23 pairs it trained for (not on car 11: cross-correlation peak
+    // 0.265); the baseline 6.00 m (worst 18.1 m). Cars 101–112 (29 pairs, not
+    // looked at while developing): 1.43 m, worst 3.65 m; paper 20.8 m;
+    // baseline 5.23 m. Before reversing was added to the family (24 and 28
+    // pairs): 2.70 m (worst 8.61) and 1.92 m (worst 5.68) with the distance
+    // scale, 3.17 m and 2.22 m without it. Before the heading segments, the
+    // consistency check and the per-metre form: 82.3 m mean, worst 390 m.
+    // The issue's targets: mean under 3 m, no outage above 10 m.
+    let (t, b) = (mean(|r| r.tedris_m), mean(|r| r.baseline_m));
+    assert!(t < 2.7, "TedriS mean {t} m");
+    assert!(worst < 7.0, "TedriS worst outage {worst} m");
     // The course convention: measured 9 right, 3 undecided (cars 101–112: 9
     // right, 3 undecided), none wrong.
     let count = |c| conventions.iter().filter(|x| **x == c).count();
@@ -186,16 +203,19 @@ fn family_train_test_80s_outages() {
         count(ConventionCheck::Undecided)
     );
     assert_eq!(count(ConventionCheck::Wrong), 0);
-    // The watchdog is a noisy signal: measured 6 alarms on trained models over
-    // the 24 test runs of cars 1–12 (0 over the 28 of cars 101–112). An alarm
+    // The watchdog is a noisy signal: measured 3 alarms on trained models over
+    // the 26 test runs of cars 1–12 (0 over the 29 of cars 101–112). An alarm
     // only brings a calibration forward, which the held-back check guards, so
     // the errors above are the same with and without it.
     let alarms: u64 = all.iter().map(|r| r.alarms).sum();
     eprintln!("watchdog alarms over the test drives: {alarms}");
-    assert!(alarms <= 8, "{alarms} watchdog alarms on trained models");
+    assert!(alarms <= 5, "{alarms} watchdog alarms on trained models");
     assert!(count(ConventionCheck::Right) >= 8);
     assert!(t < 0.6 * b, "TedriS {t} m against the baseline's {b} m");
-    assert!(t < 0.1 * p, "TedriS {t} m against the paper method's {p} m");
+    assert!(
+        t_paper_pairs < 0.1 * p,
+        "TedriS {t_paper_pairs} m against the paper method's {p} m"
+    );
 }
 
 /// The bug of issue 8: a receiver reporting random courses while the car
@@ -445,4 +465,45 @@ fn a_distance_scale_beyond_its_bound_is_refused_not_clamped() {
     assert_eq!(model.distance_scale.estimated(), None);
     assert_eq!(model.distance_scale.value, 1.0);
     assert!(r.machine.refused_calibrations() > 0);
+}
+
+/// Found while adding reversing to the family: courses taken while the car
+/// backed up (a receiver frozen on the last forward course, or the direction
+/// of motion, π from the heading) were anchored as the heading; an outage
+/// starting after a shunt then ran 80 m off (car 8). Courses while the rear
+/// wheels roll backwards are now not used, and counted.
+#[test]
+fn courses_while_reversing_turned_the_anchored_heading() {
+    let car = CarFamily::draw(8);
+    let train_drive = simulate(&car.drive(1008, 900.0), 1008)
+        .expect("train")
+        .drive;
+    let test = simulate(&car.drive(2008, 500.0), 2008).expect("test");
+    let (model, _) = train(&train_drive, TedrisConfig::default(), None).expect("trained");
+    let o = Outage {
+        start_s: 316.0,
+        end_s: 396.0,
+    };
+    // The outage follows a shunt: the car backed up just before it.
+    let reversed = test.drive.truth.iter().any(|p| {
+        p.t_s > o.start_s - 20.0 && p.t_s < o.start_s && p.speed_mps.unwrap_or(0.0) < -0.5
+    });
+    assert!(reversed, "the drive no longer backs up before the outage");
+    let r = run_outages(&test.drive, &model, &[o]).expect("run");
+    let e = &r.outages[0];
+    eprintln!(
+        "courses while reversing: {}; outage mean {:.2} m, max {:.2} m",
+        r.machine.reversing_courses(),
+        e.mean_error_m,
+        e.max_error_m
+    );
+    assert!(r.machine.reversing_courses() > 0);
+    // Measured: 2.29 m (80.4 m when the reversing courses were anchored,
+    // measured before wheels at rest read exactly 0 in the simulator).
+    assert!(
+        e.mean_error_m < 3.0,
+        "mean {:.2} m, max {:.2} m",
+        e.mean_error_m,
+        e.max_error_m
+    );
 }

@@ -168,6 +168,9 @@ pub struct Tedris {
     /// Reference headings refused as inconsistent with the wheels' turn.
     #[serde(default)]
     inconsistent_headings: u64,
+    /// GNSS courses not used because the car was reversing.
+    #[serde(default)]
+    reversing_courses: u64,
     /// Calibrations refused: worse out of sample than the model they would
     /// replace, or at a physical bound.
     #[serde(default)]
@@ -236,6 +239,7 @@ impl Tedris {
             rejected: 0,
             segment: 0,
             inconsistent_headings: 0,
+            reversing_courses: 0,
             refused_calibrations: 0,
             untrained_because: None,
             model_alarms: 0,
@@ -305,6 +309,13 @@ impl Tedris {
     /// could confirm them (the first course after a gap).
     pub fn inconsistent_headings(&self) -> u64 {
         self.inconsistent_headings
+    }
+
+    /// GNSS courses not used because the rear wheels rolled backwards
+    /// (reversing): a receiver then reports the direction of motion, a frozen
+    /// course or a random one.
+    pub fn reversing_courses(&self) -> u64 {
+        self.reversing_courses
     }
 
     /// Calibrations refused (worse on held-back data than the current model,

@@ -106,7 +106,14 @@ impl Tedris {
                 }
             }
             let v = if st > 0.0 { sd / st } else { 0.0 };
-            if v.abs() < self.config.min_course_speed_mps.max(1e-3) {
+            // Reversing (the rear wheels roll backwards), receivers differ: the
+            // direction of motion (π from the heading), the last course at
+            // speed frozen, or a random one. None is used; the consistency
+            // check confirms the first course after.
+            if v < 0.0 {
+                usable = false;
+                self.reversing_courses += 1;
+            } else if v < self.config.min_course_speed_mps.max(1e-3) {
                 usable = false;
             } else {
                 let yaw_rate = sw / self.geometry.track_rear_m / st;
