@@ -259,6 +259,7 @@ pub fn run(c: TedrisCommand, load: &super::common::Loader) -> Result<()> {
                     "reference": r.reference,
                     "source": r.source,
                     "model": m.chosen.name(),
+                    "checks": r.machine.checks(),
                     "track": out.as_ref().map(|p| p.display().to_string()),
                 });
                 super::common::print_json(load, v)?;
@@ -298,6 +299,7 @@ pub fn run(c: TedrisCommand, load: &super::common::Loader) -> Result<()> {
                         ))
                     );
                 }
+                outln!("{}", r.machine.checks().line());
                 if let Some(p) = &out {
                     outln!("track written to {}", p.display());
                 }

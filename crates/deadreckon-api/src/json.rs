@@ -280,12 +280,7 @@ pub fn comparison_json(c: &deadreckon_eval::compare::Comparison) -> Value {
         "four_wheel_params": c.params_source,
         "tedris_model": c.model_source,
         "four_wheel_gates": gates_json(&c.four_wheel_gates),
-        "tedris_checks": {
-            "inconsistent_headings": c.tedris_checks.0,
-            "refused_calibrations": c.tedris_checks.1,
-            "heading_segments": c.tedris_checks.2,
-            "model_alarms": c.tedris_checks.3,
-        },
+        "tedris_checks": c.tedris_checks,
         "outages": c.rows.iter().map(|(o, f, t)| json!({
             "start_s": o.start_s, "end_s": o.end_s,
             "four_wheel": row_json(f), "tedris": row_json(t),

@@ -149,6 +149,7 @@ pub fn comparison_lines(c: &deadreckon_eval::compare::Comparison, t0: f64) -> Ve
         out.push(format!("{:<20} {:<12} {}", w, "four-wheel", fmt(f)));
         out.push(format!("{:<20} {:<12} {}", "", "TedriS", fmt(t)));
     }
+    out.push(c.tedris_checks.line());
     out
 }
 

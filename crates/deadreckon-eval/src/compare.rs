@@ -41,9 +41,8 @@ pub struct Comparison {
     pub tedris_track: deadreckon_core::Track,
     /// The four-wheel filter's χ² gate counters over the run.
     pub four_wheel_gates: deadreckon_core::filter::GateCounts,
-    /// TedriS's checks over the run: (headings refused as inconsistent with
-    /// the wheels, calibrations refused, heading segments, watchdog alarms).
-    pub tedris_checks: (u64, u64, u32, u64),
+    /// What TedriS refused or found over the run.
+    pub tedris_checks: deadreckon_tedris::machine::MachineChecks,
 }
 
 /// The outages a report and the demo compare through when none are given:
@@ -131,11 +130,6 @@ pub fn compare(
         model,
         tedris_track: td.track,
         four_wheel_gates: fw.gates,
-        tedris_checks: (
-            td.machine.inconsistent_headings(),
-            td.machine.refused_calibrations(),
-            td.machine.segments(),
-            td.machine.model_alarms(),
-        ),
+        tedris_checks: td.machine.checks(),
     })
 }

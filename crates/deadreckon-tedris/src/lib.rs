@@ -226,7 +226,9 @@ pub mod tuning;
 
 pub use config::{ModelChoice, ModelKind, RepositoryFit, TedrisConfig, Variant};
 pub use input::ReferenceSource;
-pub use machine::{Estimate, Geometry, HeadingSample, Phase, PositionFix, Tedris, WheelSample};
+pub use machine::{
+    Estimate, Geometry, HeadingSample, MachineChecks, Phase, PositionFix, Tedris, WheelSample,
+};
 pub use model::{DistanceScale, TedrisModel};
 pub use outage::{
     run_outages, run_outages_with, train, Outage, OutageError, OutageReport, RunOptions,

@@ -117,6 +117,38 @@ pub struct Estimate {
     pub phase: Phase,
 }
 
+/// What a machine refused or found while it ran ([`Tedris::checks`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct MachineChecks {
+    /// Courses refused as inconsistent with the wheels' turn.
+    pub inconsistent_headings: u64,
+    /// Courses not used while the car reversed.
+    pub reversing_courses: u64,
+    /// Calibrations refused (worse out of sample, or at a physical bound).
+    pub refused_calibrations: u64,
+    /// Heading segments started.
+    pub heading_segments: u32,
+    /// Times the watchdog found the model off.
+    pub model_alarms: u64,
+    /// Samples rejected as invalid (not finite, time going backwards).
+    pub rejected_samples: u64,
+}
+
+impl MachineChecks {
+    /// One line for a table: what was refused, and how often.
+    pub fn line(&self) -> String {
+        format!(
+            "TedriS checks: {} courses inconsistent with the wheels, {} while reversing, {} calibrations refused, {} heading segments, {} watchdog alarms, {} samples rejected",
+            self.inconsistent_headings,
+            self.reversing_courses,
+            self.refused_calibrations,
+            self.heading_segments,
+            self.model_alarms,
+            self.rejected_samples
+        )
+    }
+}
+
 /// The streaming TedriS estimator. Serialises to JSON with its model and buffers.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Tedris {
@@ -309,6 +341,19 @@ impl Tedris {
     /// could confirm them (the first course after a gap).
     pub fn inconsistent_headings(&self) -> u64 {
         self.inconsistent_headings
+    }
+
+    /// What the machine refused or found so far, in one value (for tables
+    /// and `--json`).
+    pub fn checks(&self) -> MachineChecks {
+        MachineChecks {
+            inconsistent_headings: self.inconsistent_headings,
+            reversing_courses: self.reversing_courses,
+            refused_calibrations: self.refused_calibrations,
+            heading_segments: self.segment,
+            model_alarms: self.model_alarms,
+            rejected_samples: self.rejected,
+        }
     }
 
     /// GNSS courses not used because the rear wheels rolled backwards
