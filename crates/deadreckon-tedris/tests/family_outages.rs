@@ -382,6 +382,21 @@ fn watchdog_finds_a_model_that_is_off_and_recalibrates() {
     );
 }
 
+/// Family car `seed` with every tyre's true circumference times `factor`.
+fn car_with_tyres_scaled(seed: u64, factor: f64) -> CarFamily {
+    let mut car = CarFamily::draw(seed);
+    let e = &mut car.errors;
+    for c in [
+        &mut e.circumference_fl_m,
+        &mut e.circumference_fr_m,
+        &mut e.circumference_rl_m,
+        &mut e.circumference_rr_m,
+    ] {
+        *c *= factor;
+    }
+    car
+}
+
 /// The bug: TedriS took the rear wheels' reported distance as the distance
 /// travelled, so a car whose tyres are larger than nominal fell short of
 /// the truth in every outage (1 % is 8 m after 800 m). The distance scale
@@ -390,17 +405,9 @@ fn watchdog_finds_a_model_that_is_off_and_recalibrates() {
 /// a car with nominal tyres.
 #[test]
 fn tedris_position_ignored_the_tyres_distance_scale() {
-    let mut car = CarFamily::draw(3);
+    let car = car_with_tyres_scaled(3, 1.02);
     let nominal = car.vehicle.wheel_circumference_m;
-    let e = &mut car.errors;
-    for c in [
-        &mut e.circumference_fl_m,
-        &mut e.circumference_fr_m,
-        &mut e.circumference_rl_m,
-        &mut e.circumference_rr_m,
-    ] {
-        *c *= 1.02;
-    }
+    let e = &car.errors;
     let truth = 0.5 * (e.circumference_rl_m + e.circumference_rr_m) / nominal;
     let train_drive = simulate(&car.drive(51, 900.0), 51).expect("train").drive;
     let test = simulate(&car.drive(52, 500.0), 52).expect("test");
@@ -444,16 +451,7 @@ fn tedris_position_ignored_the_tyres_distance_scale() {
 /// (5 %) allows: the fit is refused, not clamped to the bound.
 #[test]
 fn a_distance_scale_beyond_its_bound_is_refused_not_clamped() {
-    let mut car = CarFamily::draw(3);
-    let e = &mut car.errors;
-    for c in [
-        &mut e.circumference_fl_m,
-        &mut e.circumference_fr_m,
-        &mut e.circumference_rl_m,
-        &mut e.circumference_rr_m,
-    ] {
-        *c *= 1.08;
-    }
+    let car = car_with_tyres_scaled(3, 1.08);
     let d = simulate(&car.drive(53, 900.0), 53).expect("drive").drive;
     let (model, _) = train(&d, TedrisConfig::default(), None).expect("trained");
     let r = run_outages(&d, &model, &[]).expect("run");
