@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use deadreckon_api::json;
 use deadreckon_api::options::{parse_iteration, parse_pass_state, parse_timing};
-use deadreckon_core::calibrate::{self as core_calibrate, CalibrationOptions, Method};
+use deadreckon_core::calibrate::{CalibrationOptions, Method};
 use deadreckon_core::ekf::FilterOptions;
 use deadreckon_core::metrics;
 use deadreckon_core::{evo, outage, track, Params};
@@ -28,16 +28,6 @@ fn corrections_which(s: &str) -> PyResult<deadreckon_core::timing::Which> {
             "unknown corrections `{other}` (gnss, all, none)"
         ))),
     }
-}
-
-/// The drive with the timing and mounting corrections estimated and applied
-/// (as the CLI's `--corrections`), and the corrections.
-fn prepared(
-    drive: &deadreckon_core::Drive,
-    opts: &CalibrationOptions,
-    which: deadreckon_core::timing::Which,
-) -> PyResult<(deadreckon_core::Drive, deadreckon_core::timing::Corrections)> {
-    deadreckon_api::corrections::estimate_and_apply(drive, opts, which).map_err(to_py_err)
 }
 
 /// The drive with the corrections a params.toml `p` stores applied (none for
@@ -101,15 +91,10 @@ pub fn calibrate(
         .unwrap_or_else(|_| "the drive".into());
     let drive = drive_arg(py, source, &read, mapping)?;
     let checks = checked(source, &drive, skip_checks)?;
-    let (drive, corr) = py.detach(|| prepared(&drive, &opts, which))?;
-    let c = py
-        .detach(|| core_calibrate::calibrate(&drive, &opts))
-        .map_err(with_context(format!("calibrating {what}")))?;
-    let steering = py
-        .detach(|| json::car_steering(&drive, m, opts.min_speed_mps))
-        .map_err(with_context("calibrating the steering".to_string()))?;
-    let mut v = json::calibrate_json(method, &c, opts.min_speed_mps, steering.as_ref());
-    v["corrections"] = deadreckon_api::corrections::corrections_json(&corr);
+    let cc = py
+        .detach(|| deadreckon_api::calibrate::calibrate_car(&drive, method, opts, which, &what))
+        .map_err(to_py_err)?;
+    let mut v = cc.json();
     checks.annotate(&mut v);
     to_py(py, &v)
 }

@@ -6,9 +6,8 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use clap::Args;
-use deadreckon_core::calibrate::{self, CalibrationOptions, Iteration, Method, PassState};
+use deadreckon_core::calibrate::{CalibrationOptions, Iteration, Method, PassState};
 use deadreckon_core::ekf::FilterOptions;
-use deadreckon_core::kinematics::steering::SteeringCalibration;
 
 use deadreckon_core::kinematics::diff_drive::{calibrate_diff_drive, DiffDriveOptions};
 use deadreckon_core::kinematics::{self, KinematicOptions, Shape};
@@ -181,55 +180,30 @@ pub fn run(a: CalibrateArgs, load: &common::Loader) -> Result<()> {
         },
         ..Default::default()
     };
-    let (drive, corrections) = common::prepare(&drive, a.corrections, &opts)?;
-    let c = calibrate::calibrate(&drive, &opts)
-        .with_context(|| format!("calibrating {}", a.dir.display()))?;
-    // Parameters no sample above the threshold informed keep their nominal
-    // value: say so instead of reporting them as calibrated.
-    let not_estimated = deadreckon_api::json::not_estimated(&c, opts.min_speed_mps);
-    // With the truth, the steering ratio and offset too.
-    let steering = deadreckon_api::json::car_steering(&drive, method, opts.min_speed_mps)
-        .context("calibrating the steering")?;
+    let cc = deadreckon_api::calibrate::calibrate_car(
+        &drive,
+        &method_name,
+        opts,
+        a.corrections.into(),
+        &a.dir.display().to_string(),
+    )?;
     let mut written = Vec::new();
     if let Some(out) = &a.out {
         let export = || deadreckon_io::stack_params::StackExport {
-            estimate: &c.estimate,
-            samples: c.samples,
+            estimate: &cc.calibration.estimate,
+            samples: cc.calibration.samples,
             noise: &drive.vehicle.noise,
-            provenance: format!(
-                "Calibrated on {} with --method {} ({} passes, {}).",
-                a.dir.display(),
-                method_name,
-                c.iterations,
-                if c.converged {
-                    "converged"
-                } else {
-                    "NOT converged"
-                }
-            ),
+            provenance: cc.provenance(&a.dir.display().to_string()),
         };
         let context = || format!("writing {}", out.display());
         match a.format {
             OutFormat::Params => {
-                let mut extra = toml::Table::new();
-                extra.insert("method".into(), method_name.clone().into());
-                extra.insert("iterations".into(), (c.iterations as i64).into());
-                extra.insert("converged".into(), c.converged.into());
-                if !not_estimated.is_empty() {
-                    let t: toml::Table = not_estimated
-                        .iter()
-                        .map(|(k, why)| (k.to_string(), why.clone().into()))
-                        .collect();
-                    extra.insert("not_estimated".into(), t.into());
-                }
-                if let Some(st) = &steering {
-                    extra.insert("steering".into(), steering_toml(st).into());
-                }
-                if a.corrections != common::CorrectionsArg::None {
-                    extra.extend(deadreckon_api::corrections::corrections_toml(&corrections));
-                }
-                deadreckon_io::write_params(out, &c.estimate, Some(&extra))
-                    .with_context(context)?;
+                deadreckon_io::write_params(
+                    out,
+                    &cc.calibration.estimate,
+                    Some(&cc.params_extra()),
+                )
+                .with_context(context)?;
                 written.push(out.clone());
             }
             OutFormat::Autoware => written.extend(
@@ -247,74 +221,11 @@ pub fn run(a: CalibrateArgs, load: &common::Loader) -> Result<()> {
         );
     }
     if a.json {
-        let v = deadreckon_api::json::calibrate_json(
-            &method_name,
-            &c,
-            opts.min_speed_mps,
-            steering.as_ref(),
-        );
-        let mut v = v;
-        v["corrections"] = deadreckon_api::corrections::corrections_json(&corrections);
-        common::print_json(load, v)?;
+        common::print_json(load, cc.json())?;
     } else {
         outln!("drive: {}", load.checks().span_text());
-        outln!("{}", common::params_header());
-        outln!("{}", common::params_row(&method_name, &c.estimate));
-        for (k, why) in &not_estimated {
-            outln!("{k}: NOT ESTIMATED ({why})");
-        }
-        if let Some(st) = &steering {
-            for p in [&st.ratio, &st.offset] {
-                match (&p.reason, p.std) {
-                    (None, Some(s)) => outln!("{}: {:.5} ± {s:.5}", p.name, p.value),
-                    (Some(r), _) => outln!("{}: NOT ESTIMATED ({r}), {} kept", p.name, p.value),
-                    (None, None) => outln!("{}: {:.5}", p.name, p.value),
-                }
-            }
-        }
-        if method == Method::Rts {
-            outln!(
-                "{} smoothing passes ({} state, {} iteration), {}",
-                c.iterations,
-                a.state,
-                a.iteration,
-                if c.converged {
-                    "converged"
-                } else {
-                    "NOT converged: raise --max-iterations"
-                }
-            );
-        }
-        if let Some(st) = &c.filter_stats {
-            outln!("{}", common::stats_line(st));
-        }
-        if a.corrections != common::CorrectionsArg::None {
-            for line in common::corrections_lines(&corrections) {
-                outln!("{line}");
-            }
-        }
-        if let Some(h) = &c.wheel_health {
-            common::print_wheel_health(h)?;
-        }
-        if let Some(mv) = &c.manoeuvres {
-            outln!(
-                "drive: {:.0} s, {:.0} s above {} m/s ({:.0} s left turns, {:.0} s right turns, {:.0} s straight), {} stops ({:.0} s)",
-                mv.duration_s,
-                mv.above_threshold_s,
-                opts.min_speed_mps,
-                mv.left_turn_s,
-                mv.right_turn_s,
-                mv.straight_s,
-                mv.stops,
-                mv.stopped_s
-            );
-            let lacks = mv.lacking();
-            if !lacks.is_empty() {
-                outln!("the drive lacked (drive more before trusting these):");
-            }
-            for l in lacks {
-                outln!("  {}: weakens {} ({})", l.what, l.weakens.join(", "), l.why);
-            }
+        for l in cc.lines(&a.state.to_string(), &a.iteration.to_string()) {
+            outln!("{l}");
         }
         for w in &written {
             outln!("wrote {}", w.display());
@@ -356,26 +267,6 @@ fn run_tricycle(a: &CalibrateArgs) -> Result<()> {
         }
     }
     Ok(())
-}
-
-/// The steering calibration as a params.toml table: value, std (when
-/// estimated) and the reason when not.
-fn steering_toml(st: &SteeringCalibration) -> toml::Table {
-    let mut t = toml::Table::new();
-    for p in [&st.ratio, &st.offset] {
-        let mut e = toml::Table::new();
-        e.insert("value".into(), p.value.into());
-        e.insert("estimated".into(), p.estimated.into());
-        if let Some(s) = p.std {
-            e.insert("std".into(), s.into());
-        }
-        if let Some(r) = &p.reason {
-            e.insert("reason".into(), r.clone().into());
-        }
-        t.insert(p.name.clone(), e.into());
-    }
-    t.insert("samples".into(), (st.samples as i64).into());
-    t
 }
 
 /// The differential drive: five parameters against the GNSS fixes.

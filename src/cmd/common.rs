@@ -243,19 +243,6 @@ impl From<CorrectionsArg> for deadreckon_core::timing::Which {
     }
 }
 
-/// Estimates and applies the corrections `which` asks for.
-pub fn prepare(
-    drive: &Drive,
-    which: CorrectionsArg,
-    copts: &deadreckon_core::calibrate::CalibrationOptions,
-) -> Result<(Drive, deadreckon_core::timing::Corrections)> {
-    Ok(deadreckon_api::corrections::estimate_and_apply(
-        drive,
-        copts,
-        which.into(),
-    )?)
-}
-
 /// The drive with the corrections stored in the params.toml `spec` applied
 /// (none for `nominal` or a file without them).
 pub fn apply_stored(spec: &str, drive: Drive) -> Result<Drive> {

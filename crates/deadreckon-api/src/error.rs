@@ -112,6 +112,16 @@ pub enum Error {
         #[source]
         source: deadreckon_tedris::Error,
     },
+    /// One step of a calibration failed ("calibrating DIR", "calibrating the
+    /// steering").
+    #[error("{step}")]
+    Step {
+        /// What was being done, and on what.
+        step: String,
+        /// The library's error.
+        #[source]
+        source: deadreckon_core::Error,
+    },
     /// A calibration (or the estimation before it) failed.
     #[error("{what}")]
     Calibration {

@@ -8,6 +8,9 @@
 //!   (`deadreckon-io`), a comma2k19 segment, a ROS1 bag or ROS2 MCAP (with a
 //!   topic mapping) or a tricycle log, chosen by what the path holds; errors
 //!   name the file and, through their sources, the line and column.
+//! - [`calibrate`]: the car's calibration as `calibrate` and Python run it
+//!   (corrections, the six parameters, the steering) with its `--json`
+//!   object, params.toml keys and text.
 //! - [`checks`]: the cross-stream plausibility checks applied to a drive
 //!   read (errors refuse it, warnings go to `"checks"` in `--json`).
 //! - [`evaluate`]: the parameters `evaluate` measures when none are given
@@ -27,6 +30,7 @@
 //! exception's text read the same.
 #![deny(missing_docs)]
 
+pub mod calibrate;
 pub mod checks;
 pub mod corrections;
 pub mod evaluate;

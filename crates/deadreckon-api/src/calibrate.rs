@@ -1,0 +1,211 @@
+//! The car's calibration as `deadreckon calibrate` and Python's `calibrate`
+//! run it: the timing and mounting corrections estimated and applied, the
+//! six parameters calibrated, the steering ratio and offset with the truth;
+//! and what both show of it (the `--json` object, the params.toml keys, the
+//! text table). The command line and the bindings each wrote this sequence
+//! out.
+
+use deadreckon_core::calibrate::{self, Calibration, CalibrationOptions, Method};
+use deadreckon_core::kinematics::steering::SteeringCalibration;
+use deadreckon_core::timing::{Corrections, Which};
+use deadreckon_core::Drive;
+use serde_json::Value;
+
+use crate::Error;
+
+/// A car calibration with everything the commands show of it.
+#[derive(Debug, Clone)]
+pub struct CarCalibration {
+    /// The method, as the user named it (`rts`, `zupt`, `truth`).
+    pub method_name: String,
+    /// The options it ran with.
+    pub options: CalibrationOptions,
+    /// The calibration.
+    pub calibration: Calibration,
+    /// The corrections estimated (and applied as `which` asked).
+    pub corrections: Corrections,
+    /// Which corrections were applied.
+    pub which: Which,
+    /// The steering ratio and offset (with the truth method).
+    pub steering: Option<SteeringCalibration>,
+}
+
+/// Estimates and applies the corrections `which` asks for, then calibrates
+/// `drive` with `options`; `name` (the drive's path) goes into the error.
+pub fn calibrate_car(
+    drive: &Drive,
+    method_name: &str,
+    options: CalibrationOptions,
+    which: Which,
+    name: &str,
+) -> Result<CarCalibration, Error> {
+    let (drive, corrections) = crate::corrections::estimate_and_apply(drive, &options, which)?;
+    let calibration = calibrate::calibrate(&drive, &options).map_err(|source| Error::Step {
+        step: format!("calibrating {name}"),
+        source,
+    })?;
+    let steering = crate::json::car_steering(&drive, options.method, options.min_speed_mps)
+        .map_err(|source| Error::Step {
+            step: "calibrating the steering".into(),
+            source,
+        })?;
+    Ok(CarCalibration {
+        method_name: method_name.to_string(),
+        options,
+        calibration,
+        corrections,
+        which,
+        steering,
+    })
+}
+
+impl CarCalibration {
+    /// The parameters no sample above the speed threshold informed, with why
+    /// (they keep their nominal value and are reported as not estimated).
+    pub fn not_estimated(&self) -> Vec<(&'static str, String)> {
+        crate::json::not_estimated(&self.calibration, self.options.min_speed_mps)
+    }
+
+    /// The `--json` object of `calibrate` (without `"checks"`).
+    pub fn json(&self) -> Value {
+        let mut v = crate::json::calibrate_json(
+            &self.method_name,
+            &self.calibration,
+            self.options.min_speed_mps,
+            self.steering.as_ref(),
+        );
+        v["corrections"] = crate::corrections::corrections_json(&self.corrections);
+        v
+    }
+
+    /// The keys params.toml holds beside the parameters: method, passes,
+    /// convergence, the parameters not estimated, the steering and the
+    /// corrections (when any were asked for).
+    pub fn params_extra(&self) -> toml::Table {
+        let c = &self.calibration;
+        let mut extra = toml::Table::new();
+        extra.insert("method".into(), self.method_name.clone().into());
+        extra.insert("iterations".into(), (c.iterations as i64).into());
+        extra.insert("converged".into(), c.converged.into());
+        let not_estimated = self.not_estimated();
+        if !not_estimated.is_empty() {
+            let t: toml::Table = not_estimated
+                .iter()
+                .map(|(k, why)| (k.to_string(), why.clone().into()))
+                .collect();
+            extra.insert("not_estimated".into(), t.into());
+        }
+        if let Some(st) = &self.steering {
+            extra.insert("steering".into(), steering_toml(st).into());
+        }
+        if self.which != Which::None {
+            extra.extend(crate::corrections::corrections_toml(&self.corrections));
+        }
+        extra
+    }
+
+    /// The provenance line of the stack parameter files.
+    pub fn provenance(&self, source: &str) -> String {
+        let c = &self.calibration;
+        format!(
+            "Calibrated on {source} with --method {} ({} passes, {}).",
+            self.method_name,
+            c.iterations,
+            if c.converged {
+                "converged"
+            } else {
+                "NOT converged"
+            }
+        )
+    }
+
+    /// The text of `calibrate`: the parameters, what was not estimated, the
+    /// steering, the passes (RTS, with the `state` and `iteration` words),
+    /// the filter's counts, the corrections, wheel health and what the drive
+    /// lacked.
+    pub fn lines(&self, state: &str, iteration: &str) -> Vec<String> {
+        let c = &self.calibration;
+        let mut out = vec![
+            crate::text::params_header(),
+            crate::text::params_row(&self.method_name, &c.estimate),
+        ];
+        for (k, why) in self.not_estimated() {
+            out.push(format!("{k}: NOT ESTIMATED ({why})"));
+        }
+        if let Some(st) = &self.steering {
+            for p in [&st.ratio, &st.offset] {
+                out.push(match (&p.reason, p.std) {
+                    (None, Some(s)) => format!("{}: {:.5} ± {s:.5}", p.name, p.value),
+                    (Some(r), _) => format!("{}: NOT ESTIMATED ({r}), {} kept", p.name, p.value),
+                    (None, None) => format!("{}: {:.5}", p.name, p.value),
+                });
+            }
+        }
+        if self.options.method == Method::Rts {
+            out.push(format!(
+                "{} smoothing passes ({state} state, {iteration} iteration), {}",
+                c.iterations,
+                if c.converged {
+                    "converged"
+                } else {
+                    "NOT converged: raise --max-iterations"
+                }
+            ));
+        }
+        if let Some(st) = &c.filter_stats {
+            out.push(crate::text::stats_line(st));
+        }
+        if self.which != Which::None {
+            out.extend(crate::text::corrections_lines(&self.corrections));
+        }
+        if let Some(h) = &c.wheel_health {
+            out.extend(crate::text::wheel_health_lines(h));
+        }
+        if let Some(mv) = &c.manoeuvres {
+            out.push(format!(
+                "drive: {:.0} s, {:.0} s above {} m/s ({:.0} s left turns, {:.0} s right turns, {:.0} s straight), {} stops ({:.0} s)",
+                mv.duration_s,
+                mv.above_threshold_s,
+                self.options.min_speed_mps,
+                mv.left_turn_s,
+                mv.right_turn_s,
+                mv.straight_s,
+                mv.stops,
+                mv.stopped_s
+            ));
+            let lacks = mv.lacking();
+            if !lacks.is_empty() {
+                out.push("the drive lacked (drive more before trusting these):".into());
+            }
+            for l in lacks {
+                out.push(format!(
+                    "  {}: weakens {} ({})",
+                    l.what,
+                    l.weakens.join(", "),
+                    l.why
+                ));
+            }
+        }
+        out
+    }
+}
+
+/// The steering calibration as a params.toml table: value, std (when
+/// estimated) and the reason when not.
+fn steering_toml(st: &SteeringCalibration) -> toml::Table {
+    let mut t = toml::Table::new();
+    for p in [&st.ratio, &st.offset] {
+        let mut e = toml::Table::new();
+        e.insert("value".into(), p.value.into());
+        e.insert("estimated".into(), p.estimated.into());
+        if let Some(s) = p.std {
+            e.insert("std".into(), s.into());
+        }
+        if let Some(r) = &p.reason {
+            e.insert("reason".into(), r.clone().into());
+        }
+        t.insert(p.name.clone(), e.into());
+    }
+    t.insert("samples".into(), (st.samples as i64).into());
+    t
+}
