@@ -15,7 +15,7 @@ use pyo3::types::PyDict;
 use crate::columns::ColumnsOut;
 use crate::drive::{checked, drive_arg};
 use crate::pyjson::to_py;
-use crate::{to_py_err, with_context, DeadreckonError};
+use crate::{to_py_err, DeadreckonError};
 
 /// The `--corrections` word of `calibrate` and `evaluate`.
 fn corrections_which(s: &str) -> PyResult<deadreckon_core::timing::Which> {
@@ -281,41 +281,6 @@ pub fn evaluate(
                 Ok(json::reset_json(&r, threshold_m))
             }
             "rpe" | "ape" => {
-                let opts = FilterOptions {
-                    timing,
-                    ..Default::default()
-                };
-                let mut all =
-                    track::drive_tracks(&drive, &params, &opts, None).map_err(to_py_err)?;
-                all.extend(track::Track::from_truth(&drive));
-                let reference_t =
-                    &evo::as_written(track::find(&all, reference).map_err(to_py_err)?);
-                let estimate = &evo::as_written(track::find(&all, track).map_err(to_py_err)?);
-                let pairs = match pairs_from {
-                    "estimate" => evo::PairsFrom::Estimate,
-                    "reference" => evo::PairsFrom::Reference,
-                    s => {
-                        return Err(err(format!(
-                            "unknown pairs_from `{s}` (estimate, reference)"
-                        )))
-                    }
-                };
-                let r = if metric == "rpe" {
-                    evo::rpe(
-                        reference_t,
-                        estimate,
-                        &evo::RpeOptions {
-                            delta_m,
-                            max_diff_s,
-                            pairs_from: pairs,
-                        },
-                    )
-                } else {
-                    evo::ape(reference_t, estimate, max_diff_s)
-                }
-                .map_err(with_context(format!(
-                    "{metric} of `{track}` against `{reference}`"
-                )))?;
                 let q = json::EvoQuery {
                     metric,
                     track,
@@ -324,6 +289,8 @@ pub fn evaluate(
                     delta_m,
                     pairs_from,
                 };
+                let r = deadreckon_api::evaluate::evo_metric(&drive, &params, timing, &q)
+                    .map_err(to_py_err)?;
                 Ok(json::evo_json(&q, &r))
             }
             m => Err(err(format!(

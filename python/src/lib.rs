@@ -34,13 +34,6 @@ pub(crate) fn to_py_err(e: impl std::error::Error + 'static) -> PyErr {
     DeadreckonError::new_err(deadreckon_api::chain_text(&e))
 }
 
-/// A `DeadreckonError` with `context: ` before the error's chain.
-pub(crate) fn with_context(
-    context: impl std::fmt::Display,
-) -> impl FnOnce(deadreckon_core::Error) -> PyErr {
-    move |e| DeadreckonError::new_err(format!("{context}: {}", deadreckon_api::chain_text(&e)))
-}
-
 /// The native module.
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {

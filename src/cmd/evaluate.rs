@@ -7,9 +7,9 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use clap::Args;
 use deadreckon_core::ekf::FilterOptions;
+use deadreckon_core::evo;
 use deadreckon_core::metrics::{self, Summary};
 use deadreckon_core::outage;
-use deadreckon_core::{evo, track};
 
 use deadreckon_core::kinematics::diff_drive::{self, evaluate_diff_drive, DiffDriveDrive};
 use deadreckon_core::kinematics::{self, KinematicOptions, Shape};
@@ -240,66 +240,25 @@ pub fn run(a: EvaluateArgs, load: &common::Loader) -> Result<()> {
             }
         }
         MetricArg::Rpe | MetricArg::Ape => {
-            let opts = FilterOptions {
-                timing,
-                ..Default::default()
+            let q = deadreckon_api::json::EvoQuery {
+                metric: a.metric.name(),
+                track: &a.track,
+                reference: &a.reference,
+                max_diff_s: a.max_diff_s,
+                delta_m: a.delta_m,
+                pairs_from: match a.pairs_from {
+                    PairsFromArg::Estimate => "estimate",
+                    PairsFromArg::Reference => "reference",
+                },
             };
-            let all = common::all_tracks(&drive, &params, &opts, None)?;
-            // On the values the TUM/KITTI files carry, so evo on the files agrees.
-            let reference = &evo::as_written(track::find(&all, &a.reference)?);
-            let estimate = &evo::as_written(track::find(&all, &a.track)?);
-            let (pairs_from, pairs_from_name) = match a.pairs_from {
-                PairsFromArg::Estimate => (evo::PairsFrom::Estimate, "estimate"),
-                PairsFromArg::Reference => (evo::PairsFrom::Reference, "reference"),
-            };
-            let metric = a.metric.name();
-            let r = if a.metric == MetricArg::Rpe {
-                evo::rpe(
-                    reference,
-                    estimate,
-                    &evo::RpeOptions {
-                        delta_m: a.delta_m,
-                        max_diff_s: a.max_diff_s,
-                        pairs_from,
-                    },
-                )
-            } else {
-                evo::ape(reference, estimate, a.max_diff_s)
-            }
-            .with_context(|| format!("{metric} of `{}` against `{}`", a.track, a.reference))?;
+            let r = deadreckon_api::evaluate::evo_metric(&drive, &params, timing, &q)?;
             if a.json {
-                let q = deadreckon_api::json::EvoQuery {
-                    metric,
-                    track: &a.track,
-                    reference: &a.reference,
-                    max_diff_s: a.max_diff_s,
-                    delta_m: a.delta_m,
-                    pairs_from: pairs_from_name,
-                };
                 let v = deadreckon_api::json::evo_json(&q, &r);
                 common::print_json(load, with_source(v))?;
             } else {
-                let what = if a.metric == MetricArg::Rpe {
-                    format!(
-                        "RPE per {} m (translation, pairs from the {pairs_from_name})",
-                        a.delta_m
-                    )
-                } else {
-                    "APE (translation, no alignment)".to_string()
-                };
-                let s = r.stats;
-                outln!(
-                    "{what} of `{}` against `{}`: {} errors over {} associated poses (as evo {})",
-                    a.track,
-                    a.reference,
-                    r.errors_m.len(),
-                    r.matched,
-                    evo::EVO_VERSION
-                );
-                outln!(
-                    "rmse {:.4} m, mean {:.4} m, median {:.4} m, std {:.4} m, min {:.4} m, max {:.4} m",
-                    s.rmse, s.mean, s.median, s.std, s.min, s.max
-                );
+                for l in deadreckon_api::text::evo_lines(&q, &r) {
+                    outln!("{l}");
+                }
             }
         }
     }

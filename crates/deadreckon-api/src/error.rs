@@ -112,6 +112,10 @@ pub enum Error {
         #[source]
         source: deadreckon_tedris::Error,
     },
+    /// A library error with no more context to add (its own message names
+    /// what is wrong: an unknown track name, too few poses).
+    #[error(transparent)]
+    Core(#[from] deadreckon_core::Error),
     /// One step of a calibration failed ("calibrating DIR", "calibrating the
     /// steering").
     #[error("{step}")]

@@ -153,6 +153,37 @@ pub fn comparison_lines(c: &deadreckon_eval::compare::Comparison, t0: f64) -> Ve
     out
 }
 
+/// `evaluate --metric rpe|ape`'s two lines: what was measured, and the
+/// statistics.
+pub fn evo_lines(
+    q: &crate::json::EvoQuery<'_>,
+    r: &deadreckon_core::evo::TrajectoryError,
+) -> Vec<String> {
+    let what = if q.metric == "rpe" {
+        format!(
+            "RPE per {} m (translation, pairs from the {})",
+            q.delta_m, q.pairs_from
+        )
+    } else {
+        "APE (translation, no alignment)".to_string()
+    };
+    let s = &r.stats;
+    vec![
+        format!(
+            "{what} of `{}` against `{}`: {} errors over {} associated poses (as evo {})",
+            q.track,
+            q.reference,
+            r.errors_m.len(),
+            r.matched,
+            deadreckon_core::evo::EVO_VERSION
+        ),
+        format!(
+            "rmse {:.4} m, mean {:.4} m, median {:.4} m, std {:.4} m, min {:.4} m, max {:.4} m",
+            s.rmse, s.mean, s.median, s.std, s.min, s.max
+        ),
+    ]
+}
+
 /// The wheel-health lines of `run` and `calibrate`: a summary, a line per
 /// wheel, and each stretch a wheel was out of the fusion.
 pub fn wheel_health_lines(h: &deadreckon_core::wheel_health::WheelHealth) -> Vec<String> {
