@@ -344,6 +344,4 @@ pub fn print_comparison(c: &deadreckon_eval::compare::Comparison, t0: f64) -> Re
     Ok(())
 }
 
-pub use deadreckon_api::text::{
-    corrections_lines, gated_text, params_header, params_row, stats_line,
-};
+pub use deadreckon_api::text::{gated_text, params_header, params_row, stats_line};

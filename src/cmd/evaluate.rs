@@ -174,7 +174,6 @@ pub fn run(a: EvaluateArgs, load: &common::Loader) -> Result<()> {
             a.warmup,
             &base,
         )?;
-        let (fe, dr, d1) = (ev.final_error(), ev.drift_pct(), ev.distance_to_1m());
         if a.json {
             let mut v = deadreckon_api::json::outage_json(len, &source, &ev);
             if let Some(c) = &corrections {
@@ -182,26 +181,8 @@ pub fn run(a: EvaluateArgs, load: &common::Loader) -> Result<()> {
             }
             common::print_json(load, v)?;
         } else {
-            outln!(
-                "{} outage windows of {len} s against the {} (parameters: {source})",
-                ev.windows.len(),
-                ev.reference.name()
-            );
-            for l in deadreckon_api::text::summary_table(&[
-                ("final error (m)", fe),
-                ("drift per 100 m (%)", dr),
-                ("distance before 1 m (m)", d1),
-            ]) {
+            for l in deadreckon_api::text::outage_lines(&ev, &source, corrections.as_ref()) {
                 outln!("{l}");
-            }
-            outln!(
-                "rejected by the χ² gates: {}",
-                common::gated_text(&ev.gates)
-            );
-            if let Some(c) = &corrections {
-                for line in common::corrections_lines(c) {
-                    outln!("{line}");
-                }
             }
         }
         return Ok(());

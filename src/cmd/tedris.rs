@@ -264,42 +264,9 @@ pub fn run(c: TedrisCommand, load: &super::common::Loader) -> Result<()> {
                 });
                 super::common::print_json(load, v)?;
             } else {
-                outln!(
-                    "reference heading: {:?}; errors against {}",
-                    r.source,
-                    r.reference
-                );
-                // The threshold column only when it is not the 1 m one.
-                let extra = (threshold_m != 1.0).then(|| format!("to_{threshold_m}m_s"));
-                outln!(
-                    "{:>9} {:>9} {:>10} {:>9} {:>10} {:>12}{}",
-                    "start_s",
-                    "end_s",
-                    "mean_m",
-                    "max_m",
-                    "final_m",
-                    "to_1m_s",
-                    extra
-                        .as_ref()
-                        .map_or(String::new(), |h| format!(" {h:>12}"))
-                );
-                let opt = |v: Option<f64>| v.map_or("never".to_string(), |x| format!("{x:.1}"));
-                for o in &r.outages {
-                    outln!(
-                        "{:>9.1} {:>9.1} {:>10.2} {:>9.2} {:>10.2} {:>12}{}",
-                        o.start_s,
-                        o.end_s,
-                        o.mean_error_m,
-                        o.max_error_m,
-                        o.final_error_m,
-                        opt(o.time_to_1m_s),
-                        extra.as_ref().map_or(String::new(), |_| format!(
-                            " {:>12}",
-                            opt(o.time_to_threshold_s)
-                        ))
-                    );
+                for l in deadreckon_api::text::tedris_outage_lines(&r, threshold_m) {
+                    outln!("{l}");
                 }
-                outln!("{}", r.machine.checks().line());
                 if let Some(p) = &out {
                     outln!("track written to {}", p.display());
                 }

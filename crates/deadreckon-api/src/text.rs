@@ -153,6 +153,74 @@ pub fn comparison_lines(c: &deadreckon_eval::compare::Comparison, t0: f64) -> Ve
     out
 }
 
+/// `tedris run`'s table: the reference, one row per outage (the threshold
+/// column only when it is not the 1 m one), and the machine's checks.
+pub fn tedris_outage_lines(r: &deadreckon_tedris::OutageReport, threshold_m: f64) -> Vec<String> {
+    let mut out = vec![format!(
+        "reference heading: {:?}; errors against {}",
+        r.source, r.reference
+    )];
+    let extra = (threshold_m != 1.0).then(|| format!("to_{threshold_m}m_s"));
+    out.push(format!(
+        "{:>9} {:>9} {:>10} {:>9} {:>10} {:>12}{}",
+        "start_s",
+        "end_s",
+        "mean_m",
+        "max_m",
+        "final_m",
+        "to_1m_s",
+        extra
+            .as_ref()
+            .map_or(String::new(), |h| format!(" {h:>12}"))
+    ));
+    let opt = |v: Option<f64>| v.map_or("never".to_string(), |x| format!("{x:.1}"));
+    for o in &r.outages {
+        out.push(format!(
+            "{:>9.1} {:>9.1} {:>10.2} {:>9.2} {:>10.2} {:>12}{}",
+            o.start_s,
+            o.end_s,
+            o.mean_error_m,
+            o.max_error_m,
+            o.final_error_m,
+            opt(o.time_to_1m_s),
+            extra.as_ref().map_or(String::new(), |_| format!(
+                " {:>12}",
+                opt(o.time_to_threshold_s)
+            ))
+        ));
+    }
+    out.push(r.machine.checks().line());
+    out
+}
+
+/// `evaluate --outage`'s text: the windows, the summary table, the gates
+/// and the corrections estimated (when any).
+pub fn outage_lines(
+    ev: &deadreckon_core::outage::OutageEvaluation,
+    source: &str,
+    corrections: Option<&deadreckon_core::timing::Corrections>,
+) -> Vec<String> {
+    let mut out = vec![format!(
+        "{} outage windows of {} s against the {} (parameters: {source})",
+        ev.windows.len(),
+        ev.outage_s,
+        ev.reference.name()
+    )];
+    out.extend(summary_table(&[
+        ("final error (m)", ev.final_error()),
+        ("drift per 100 m (%)", ev.drift_pct()),
+        ("distance before 1 m (m)", ev.distance_to_1m()),
+    ]));
+    out.push(format!(
+        "rejected by the χ² gates: {}",
+        gated_text(&ev.gates)
+    ));
+    if let Some(c) = corrections {
+        out.extend(corrections_lines(c));
+    }
+    out
+}
+
 /// `evaluate --metric rpe|ape`'s two lines: what was measured, and the
 /// statistics.
 pub fn evo_lines(
