@@ -1,6 +1,7 @@
 //! `deadreckon`: the command-line tool. Parses arguments, calls the library
 //! crates, prints tables or JSON. All logic lives in the crates under `crates/`.
 
+mod args;
 mod cmd;
 
 use clap::{Parser, Subcommand};
@@ -23,7 +24,7 @@ struct Cli {
     /// `wheel_ticks.csv` and `wheel_speeds.csv` (having both is otherwise an
     /// error; with only one, that one is read).
     #[arg(long, global = true, value_enum)]
-    wheels: Option<cmd::common::WheelsArg>,
+    wheels: Option<args::WheelsArg>,
     #[command(subcommand)]
     command: Command,
 }
@@ -31,30 +32,30 @@ struct Cli {
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Simulate a drive with known truth into a drive directory.
-    Simulate(cmd::simulate::SimulateArgs),
+    Simulate(args::simulate::SimulateArgs),
     /// Calibrate gyro bias, speed scale and wheel circumferences (rts, zupt, truth).
-    Calibrate(cmd::calibrate::CalibrateArgs),
+    Calibrate(args::calibrate::CalibrateArgs),
     /// Evaluate dead reckoning: drift per 100 m, distance before 1 m, sliding GNSS outages.
-    Evaluate(cmd::evaluate::EvaluateArgs),
+    Evaluate(args::evaluate::EvaluateArgs),
     /// Write the dead-reckoned (and filtered, smoothed) track with covariances.
-    Run(cmd::run::RunArgs),
+    Run(args::run::RunArgs),
     /// Simulate, calibrate with every method, evaluate, print tables III and IV, write the report.
-    Demo(cmd::demo::DemoArgs),
+    Demo(args::demo::DemoArgs),
     /// TedriS and the calibrated four-wheel EKF through the same GNSS outages, in one table.
-    Compare(cmd::compare::CompareArgs),
+    Compare(args::compare::CompareArgs),
     /// Write one self-contained HTML report with the papers' tables and figures for a drive.
-    Report(cmd::report::ReportArgs),
+    Report(args::report::ReportArgs),
     /// TedriS time-series dead reckoning: train a model, predict through outages.
     #[command(subcommand)]
-    Tedris(cmd::tedris::TedrisCommand),
+    Tedris(args::tedris::TedrisCommand),
     /// Print a drive as time-ordered JSON lines, one measurement a line (docs/events.md).
-    Events(cmd::events::EventsArgs),
+    Events(args::events::EventsArgs),
     /// Run the four-wheel filter on JSON-line events from standard input, one JSON line per epoch out.
-    Stream(cmd::stream::StreamArgs),
+    Stream(args::stream::StreamArgs),
     /// Convert a log (comma2k19, ROS bag, MCAP, CAN + DBC, tricycle) into a drive directory.
-    Import(cmd::import::ImportArgs),
+    Import(args::import::ImportArgs),
     /// Calibrate many drives in parallel, one CSV row each, and each vehicle's calibration history.
-    Batch(cmd::batch::BatchArgs),
+    Batch(args::batch::BatchArgs),
 }
 
 fn main() {

@@ -3,11 +3,9 @@
 //! `deadreckon_fleet`'s; this parses, reports progress and prints.
 
 use std::io::{IsTerminal, Write};
-use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use clap::Args;
 use deadreckon_core::calibrate::{CalibrationOptions, Method};
 use deadreckon_core::ekf::FilterOptions;
 use deadreckon_core::Params;
@@ -18,49 +16,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 
 use super::common;
 
-/// Arguments of `batch`.
-#[derive(Args, Debug)]
-pub struct BatchArgs {
-    /// Drives: drive directories, directories of drive directories, recordings, or glob patterns.
-    #[arg(required = true)]
-    pub inputs: Vec<String>,
-    /// The results CSV, one row per drive (written atomically; must not be an input).
-    #[arg(long)]
-    pub out: PathBuf,
-    /// The calibration history CSV, one row per vehicle and parameter and one per change.
-    #[arg(long)]
-    pub history: Option<PathBuf>,
-    /// Worker threads (0: one per core).
-    #[arg(long, default_value_t = 0)]
-    pub threads: usize,
-    /// rts, zupt or truth (needs truth.csv).
-    #[arg(long, value_enum, default_value_t = common::MethodArg::Rts)]
-    pub method: common::MethodArg,
-    /// Maximum smoothing passes per drive.
-    #[arg(long, default_value_t = 60, value_parser = clap::value_parser!(u32).range(1..))]
-    pub max_iterations: u32,
-    /// Filter timing: wheel or each.
-    #[arg(long, value_enum, default_value_t = common::TimingArg::Wheel)]
-    pub timing: common::TimingArg,
-    /// Speed below which epochs are dropped for speed-dependent parameters, m/s.
-    #[arg(long, default_value_t = 2.0, value_parser = common::non_negative)]
-    pub min_speed: f64,
-    /// Also evaluate each drive, with its own parameters, through sliding GNSS outages of this length, s.
-    #[arg(long, value_parser = common::positive)]
-    pub outage: Option<f64>,
-    /// Step between outage windows, s (default: half the outage length).
-    #[arg(long, value_parser = common::positive)]
-    pub step: Option<f64>,
-    /// GNSS-aided time before the first outage window, s.
-    #[arg(long, default_value_t = 5.0, value_parser = common::non_negative)]
-    pub warmup: f64,
-    /// Significance level of the history's χ² and change-point tests.
-    #[arg(long, default_value_t = 1e-3, value_parser = common::probability)]
-    pub alpha: f64,
-    /// Drive-to-drive tolerance of a parameter, NAME=VALUE in its unit (repeatable; defaults in docs/fleet.md).
-    #[arg(long, value_delimiter = ',')]
-    pub tolerance: Vec<String>,
-}
+use crate::args::batch::*;
 
 fn history_options(a: &BatchArgs) -> Result<HistoryOptions> {
     let mut o = HistoryOptions {

@@ -2,127 +2,17 @@
 //! parameters of the four-wheel car; for a tricycle log, the kinematic
 //! calibration of its seven parameters against the tracker.
 
-use std::path::PathBuf;
-
 use anyhow::{Context, Result};
-use clap::Args;
 use deadreckon_core::calibrate::{CalibrationOptions, Iteration, Method, PassState};
 use deadreckon_core::ekf::FilterOptions;
 
 use deadreckon_core::kinematics::diff_drive::{calibrate_diff_drive, DiffDriveOptions};
 use deadreckon_core::kinematics::{self, KinematicOptions, Shape};
 
-use super::kinematic::{ShapeArg, YawArg};
 use super::{common, kinematic};
+use crate::args::kinematic::ShapeArg;
 
-/// What `calibrate --out` writes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum OutFormat {
-    /// deadreckon's params.toml.
-    Params,
-    /// Autoware's imu_corrector.param.yaml and vehicle_velocity_converter.param.yaml.
-    Autoware,
-    /// Eagleye's eagleye_config.yaml keys and velocity_scale_factor.txt.
-    Eagleye,
-}
-
-/// `calibrate --state`: what each smoothing pass carries.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum StateArg {
-    /// The car state and the six parameters.
-    Augmented,
-    /// The paper's 5-state filter, parameters fixed within a pass.
-    Paper,
-}
-
-/// `calibrate --iteration`: how the smoothing passes are chained.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum IterationArg {
-    /// Anderson-accelerated.
-    Anderson,
-    /// The paper's plain fixed-point iteration.
-    Plain,
-}
-
-impl std::fmt::Display for StateArg {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
-            StateArg::Augmented => "augmented",
-            StateArg::Paper => "paper",
-        })
-    }
-}
-
-impl std::fmt::Display for IterationArg {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
-            IterationArg::Anderson => "anderson",
-            IterationArg::Plain => "plain",
-        })
-    }
-}
-
-/// Arguments of `calibrate`.
-#[derive(Args, Debug)]
-pub struct CalibrateArgs {
-    /// The drive directory or recording (a tricycle `dataset.txt` is calibrated through its own kinematics).
-    pub dir: PathBuf,
-    /// rts (smoothed states, needs GNSS), zupt (standstill gyro bias), truth (needs truth.csv); a tricycle: truth (its tracker); a differential drive: gnss (default: rts, truth, gnss by shape).
-    #[arg(long, value_enum)]
-    pub method: Option<common::MethodArg>,
-    /// The vehicle shape: car (four wheels, the default) or diff-drive (odometry twist, calibrated against GNSS). A tricycle log is recognised by itself.
-    #[arg(long, value_enum, default_value_t = ShapeArg::Car)]
-    pub shape: ShapeArg,
-    /// Differential drive: the yaw rate integrated, gyro or odometry.
-    #[arg(long, value_enum, default_value_t = YawArg::Gyro)]
-    pub yaw: YawArg,
-    /// What each smoothing pass carries: augmented (car state + the six parameters) or paper (5-state, parameters fixed).
-    #[arg(long, value_enum, default_value_t = StateArg::Augmented)]
-    pub state: StateArg,
-    /// Chaining of the smoothing passes: anderson (accelerated) or plain (the paper's).
-    #[arg(long, value_enum, default_value_t = IterationArg::Anderson)]
-    pub iteration: IterationArg,
-    /// Maximum smoothing passes.
-    #[arg(long, default_value_t = 60, value_parser = clap::value_parser!(u32).range(1..))]
-    pub max_iterations: u32,
-    /// Filter timing: wheel (the paper's, one epoch per wheel row) or each (every reading at its time).
-    #[arg(long, value_enum, default_value_t = common::TimingArg::Wheel)]
-    pub timing: common::TimingArg,
-    /// Speed below which epochs (car) or windows (tricycle) are dropped for speed-dependent parameters, m/s (default: 2 for a car, 0.05 for a tricycle).
-    #[arg(long, value_parser = common::non_negative)]
-    pub min_speed: Option<f64>,
-    /// Use only data from this time on, s (drive clock).
-    #[arg(long = "from", value_parser = common::finite, allow_hyphen_values = true)]
-    pub from_s: Option<f64>,
-    /// Use only data before this time, s (drive clock).
-    #[arg(long = "until", value_parser = common::finite, allow_hyphen_values = true)]
-    pub until_s: Option<f64>,
-    /// Tricycle and differential drive: length of the windows of the fit, s (default 2 for a tricycle, 60 for a differential drive).
-    #[arg(long, value_parser = common::positive)]
-    pub window: Option<f64>,
-    /// Write the parameters here: a params.toml, or with --format autoware or
-    /// eagleye a directory (created if missing).
-    #[arg(long)]
-    pub out: Option<PathBuf>,
-    /// What --out holds: params (params.toml), autoware (imu_corrector and
-    /// vehicle_velocity_converter parameter files) or eagleye (configuration
-    /// keys and the saved velocity scale factor); see docs/stack-params.md.
-    #[arg(long, value_enum, default_value_t = OutFormat::Params)]
-    pub format: OutFormat,
-    /// Print JSON instead of a table.
-    #[arg(long)]
-    pub json: bool,
-    /// The timing and mounting corrections estimated and applied before
-    /// calibrating, and written to params.toml: all (IMU tilt and every
-    /// stream's delay), gnss (tilt and GNSS delay; the others reported, not
-    /// applied) or none.
-    #[arg(long, value_enum, default_value_t = common::CorrectionsArg::Gnss)]
-    pub corrections: common::CorrectionsArg,
-    /// Fuse every wheel reading: no wheel-health monitor (slipping and bad
-    /// wheels are then neither dropped nor reported).
-    #[arg(long)]
-    pub no_wheel_monitor: bool,
-}
+use crate::args::calibrate::*;
 
 /// Runs `calibrate`.
 pub fn run(a: CalibrateArgs, load: &common::Loader) -> Result<()> {

@@ -3,8 +3,9 @@
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use deadreckon_core::ekf::Timing;
 use deadreckon_core::{Drive, Params};
+
+pub use crate::args::*;
 
 /// How the commands read drives: the global options `--mapping` and
 /// `--skip-checks`, passed to each command explicitly.
@@ -19,24 +20,6 @@ pub struct Loader {
     /// What the plausibility checks said of the last drive read, for
     /// `"checks"` in `--json`.
     pub checks: std::sync::Mutex<deadreckon_api::checks::Checks>,
-}
-
-/// `--wheels`: which wheel file a drive directory with both is read from.
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum WheelsArg {
-    /// `wheel_ticks.csv` (encoder ticks).
-    Ticks,
-    /// `wheel_speeds.csv` (wheel speeds).
-    Speeds,
-}
-
-impl From<WheelsArg> for deadreckon_io::WheelFile {
-    fn from(w: WheelsArg) -> Self {
-        match w {
-            WheelsArg::Ticks => Self::Ticks,
-            WheelsArg::Speeds => Self::Speeds,
-        }
-    }
 }
 
 impl Loader {
@@ -113,134 +96,6 @@ pub fn load_params_corrected(spec: &str, drive: Drive) -> Result<(Params, Drive)
         return Ok((params, drive));
     }
     Ok((params, apply_stored(spec, drive)?))
-}
-
-/// `--timing`: the filter's timing scheme.
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum TimingArg {
-    /// One epoch per wheel row (the paper's).
-    Wheel,
-    /// One epoch per reading.
-    Each,
-}
-
-impl From<TimingArg> for Timing {
-    fn from(t: TimingArg) -> Timing {
-        match t {
-            TimingArg::Wheel => Timing::WheelEpochs,
-            TimingArg::Each => Timing::EachMeasurement,
-        }
-    }
-}
-
-/// `--method`: what a calibration is made against. Which ones a vehicle
-/// takes depends on its shape (`calibrate` says).
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum MethodArg {
-    /// RTS-smoothed states of a GNSS-aided filter (a car).
-    Rts,
-    /// The gyro bias at standstill (a car).
-    Zupt,
-    /// `truth.csv` or the tracker (a car, a tricycle).
-    Truth,
-    /// The GNSS fixes (a differential drive).
-    Gnss,
-}
-
-impl MethodArg {
-    /// The name on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            MethodArg::Rts => "rts",
-            MethodArg::Zupt => "zupt",
-            MethodArg::Truth => "truth",
-            MethodArg::Gnss => "gnss",
-        }
-    }
-
-    /// The four-wheel calibration method (`gnss` is the differential
-    /// drive's).
-    pub fn car(self) -> Result<deadreckon_core::calibrate::Method> {
-        use deadreckon_core::calibrate::Method;
-        Ok(match self {
-            MethodArg::Rts => Method::Rts,
-            MethodArg::Zupt => Method::Zupt,
-            MethodArg::Truth => Method::Truth,
-            MethodArg::Gnss => anyhow::bail!(
-                "--method gnss calibrates a differential drive (--shape diff-drive); a car takes rts, zupt or truth"
-            ),
-        })
-    }
-}
-
-/// clap's parser for a quantity that must be a finite number above 0 (a
-/// length, a duration, a standard deviation): `nan`, `inf`, 0 and negative
-/// values are refused before anything is read.
-pub fn positive(s: &str) -> std::result::Result<f64, String> {
-    let v = finite(s)?;
-    if v > 0.0 {
-        Ok(v)
-    } else {
-        Err(format!("must be above 0, got {v}"))
-    }
-}
-
-/// clap's parser for a finite number at least 0 (a speed threshold, a
-/// warm-up time).
-pub fn non_negative(s: &str) -> std::result::Result<f64, String> {
-    let v = finite(s)?;
-    if v >= 0.0 {
-        Ok(v)
-    } else {
-        Err(format!("must be 0 or above, got {v}"))
-    }
-}
-
-/// clap's parser for a finite number (a time on the drive clock, a bias).
-pub fn finite(s: &str) -> std::result::Result<f64, String> {
-    let v: f64 = s
-        .trim()
-        .parse()
-        .map_err(|e| format!("`{s}` is not a number ({e})"))?;
-    if v.is_finite() {
-        Ok(v)
-    } else {
-        Err(format!("must be a finite number, got `{s}`"))
-    }
-}
-
-/// clap's parser for a probability strictly between 0 and 1 (a
-/// significance level).
-pub fn probability(s: &str) -> std::result::Result<f64, String> {
-    let v = finite(s)?;
-    if v > 0.0 && v < 1.0 {
-        Ok(v)
-    } else {
-        Err(format!("must be between 0 and 1 (exclusive), got {v}"))
-    }
-}
-
-/// `--corrections`: which timing and mounting corrections are estimated and
-/// applied before calibrating (see `deadreckon_core::timing`).
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum CorrectionsArg {
-    /// IMU tilt, every stream's delay and the gyro scale.
-    All,
-    /// IMU tilt, GNSS delay and gyro scale (the other delays reported, not applied).
-    Gnss,
-    /// None.
-    None,
-}
-
-impl From<CorrectionsArg> for deadreckon_core::timing::Which {
-    fn from(c: CorrectionsArg) -> Self {
-        use deadreckon_core::timing::Which;
-        match c {
-            CorrectionsArg::All => Which::All,
-            CorrectionsArg::Gnss => Which::Gnss,
-            CorrectionsArg::None => Which::None,
-        }
-    }
 }
 
 /// The drive with the corrections stored in the params.toml `spec` applied
@@ -323,6 +178,7 @@ pub fn write_scenario(
     .with_context(|| format!("writing {}", dir.display()))?;
     Ok(out)
 }
+
 /// The wheel-health monitor's settings: the defaults, or none with `--no-wheel-monitor`.
 pub fn wheel_monitor(off: bool) -> Option<deadreckon_core::wheel_health::WheelMonitorConfig> {
     (!off).then(Default::default)

@@ -2,33 +2,13 @@
 //! same GNSS outages, in one table. Neither method sees GNSS inside the
 //! outages, not even for calibration or training.
 
-use std::path::PathBuf;
-
 use anyhow::Result;
-use clap::Args;
 use deadreckon_eval::compare::compare;
 use deadreckon_tedris::Outage;
 
 use super::common;
 
-/// Arguments of `compare`.
-#[derive(Args, Debug)]
-pub struct CompareArgs {
-    /// The drive directory (or a recording read directly).
-    pub dir: PathBuf,
-    /// A GNSS outage `START_S:END_S` on the drive clock (repeatable).
-    #[arg(long, required = true)]
-    pub outage: Vec<String>,
-    /// Four-wheel parameters (params.toml); default: RTS calibration on the drive with the outages hidden.
-    #[arg(long)]
-    pub params: Option<String>,
-    /// TedriS model (model.json); default: trained on the drive with the outages hidden.
-    #[arg(long)]
-    pub model: Option<PathBuf>,
-    /// Print JSON instead of a table.
-    #[arg(long)]
-    pub json: bool,
-}
+use crate::args::compare::*;
 
 /// Runs `compare`.
 pub fn run(a: CompareArgs, load: &common::Loader) -> Result<()> {

@@ -6,7 +6,6 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
-use clap::Args;
 use deadreckon_core::calibrate::{self, CalibrationOptions, Iteration, PassState};
 use deadreckon_core::metrics::Summary;
 use deadreckon_core::{Params, ParamsWithStd};
@@ -14,19 +13,7 @@ use deadreckon_core::{Params, ParamsWithStd};
 use super::common;
 use deadreckon_eval::report;
 
-/// Arguments of `demo`.
-#[derive(Args, Debug)]
-pub struct DemoArgs {
-    /// Where the simulated drives, parameters and report go.
-    #[arg(long, default_value = "out/demo")]
-    pub out: PathBuf,
-    /// Seed of the calibration drive (the evaluation drive uses seed + 1).
-    #[arg(long, default_value_t = 1)]
-    pub seed: u64,
-    /// Print JSON instead of tables.
-    #[arg(long)]
-    pub json: bool,
-}
+use crate::args::demo::*;
 
 /// Runs `demo`.
 pub fn run(a: DemoArgs, quiet: bool, load: &common::Loader) -> Result<()> {

@@ -2,127 +2,18 @@
 //! (drift per 100 m, distance before 1 m), evo's (relative pose error per
 //! 100 m, absolute pose error) or over sliding GNSS outages.
 
-use std::path::PathBuf;
-
 use anyhow::{Context, Result};
-use clap::Args;
 use deadreckon_core::ekf::FilterOptions;
-use deadreckon_core::evo;
 use deadreckon_core::metrics::{self, Summary};
 use deadreckon_core::outage;
 
 use deadreckon_core::kinematics::diff_drive::{self, evaluate_diff_drive, DiffDriveDrive};
 use deadreckon_core::kinematics::{self, KinematicOptions, Shape};
 
-use super::kinematic::{ShapeArg, YawArg};
 use super::{common, kinematic};
+use crate::args::kinematic::{ShapeArg, YawArg};
 
-/// `evaluate --metric`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum MetricArg {
-    /// Drift per --segment-m of path, reset to the truth at each segment.
-    Drift,
-    /// Distance travelled before the error reaches --threshold-m, then reset.
-    #[value(name = "reset-1m")]
-    Reset1m,
-    /// evo's relative pose error per --delta-m of path, translation part.
-    Rpe,
-    /// evo's absolute pose error, no alignment.
-    Ape,
-}
-
-impl MetricArg {
-    /// The name on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            MetricArg::Drift => "drift",
-            MetricArg::Reset1m => "reset-1m",
-            MetricArg::Rpe => "rpe",
-            MetricArg::Ape => "ape",
-        }
-    }
-}
-
-/// `evaluate --pairs-from`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum PairsFromArg {
-    /// The estimate's travelled path chooses the pairs (evo's default).
-    Estimate,
-    /// The reference's (evo's --pairs_from_reference).
-    Reference,
-}
-
-/// Arguments of `evaluate`.
-#[derive(Args, Debug)]
-pub struct EvaluateArgs {
-    /// The drive directory or recording (a tricycle `dataset.txt` is dead-reckoned through its own kinematics).
-    pub dir: PathBuf,
-    /// `nominal` or a params.toml. Without it, `--outage` calibrates with RTS on the drive itself.
-    #[arg(long)]
-    pub params: Option<String>,
-    /// drift (reset to the truth every 100 m), reset-1m (reset when the error
-    /// reaches 1 m), rpe (evo's relative pose error per --delta-m of path,
-    /// translation part) or ape (evo's absolute pose error, no alignment).
-    #[arg(long, value_enum, default_value_t = MetricArg::Drift)]
-    pub metric: MetricArg,
-    /// rpe/ape: the estimated track (dead-reckoned, filtered, smoothed).
-    #[arg(long, default_value = "dead-reckoned")]
-    pub track: String,
-    /// rpe/ape: the reference track (truth, or an estimated one).
-    #[arg(long, default_value = "truth")]
-    pub reference: String,
-    /// rpe: path length between the poses of a pair, m (evo's --delta with --delta_unit m).
-    #[arg(long, default_value_t = 100.0, value_parser = common::positive)]
-    pub delta_m: f64,
-    /// rpe: whose travelled path chooses the pairs: estimate (evo's default) or reference (evo's --pairs_from_reference).
-    #[arg(long, value_enum, default_value_t = PairsFromArg::Estimate)]
-    pub pairs_from: PairsFromArg,
-    /// rpe/ape: largest time difference of associated poses, s (evo's --t_max_diff).
-    #[arg(long, default_value_t = evo::DEFAULT_MAX_DIFF_S, value_parser = common::positive)]
-    pub max_diff_s: f64,
-    /// Segment length of the drift metric, m.
-    #[arg(long, default_value_t = 100.0, value_parser = common::positive)]
-    pub segment_m: f64,
-    /// Error threshold of the reset metric, m.
-    #[arg(long, default_value_t = 1.0, value_parser = common::positive)]
-    pub threshold_m: f64,
-    /// Evaluate over sliding GNSS outages of this length, s (instead of --metric).
-    #[arg(long, value_parser = common::positive)]
-    pub outage: Option<f64>,
-    /// Step between outage windows, s (default: half the outage length).
-    #[arg(long, value_parser = common::positive)]
-    pub step: Option<f64>,
-    /// GNSS-aided time before the first outage window, s.
-    #[arg(long, default_value_t = 5.0, value_parser = common::non_negative)]
-    pub warmup: f64,
-    /// Filter timing: wheel or each.
-    #[arg(long, value_enum, default_value_t = common::TimingArg::Wheel)]
-    pub timing: common::TimingArg,
-    /// Print JSON instead of text.
-    #[arg(long)]
-    pub json: bool,
-    /// The vehicle shape: car (the default) or diff-drive (outages start from the alignment of the preceding --align seconds of dead reckoning to the fixes). A tricycle log is recognised by itself.
-    #[arg(long, value_enum, default_value_t = ShapeArg::Car)]
-    pub shape: ShapeArg,
-    /// Differential drive: the yaw rate integrated, gyro or odometry (default: the params file's, else gyro).
-    #[arg(long, value_enum)]
-    pub yaw: Option<YawArg>,
-    /// Differential drive: seconds of fixes before each outage the dead reckoning is aligned to.
-    #[arg(long, default_value_t = 60.0, value_parser = common::positive)]
-    pub align: f64,
-    /// Without --params: the timing and mounting corrections estimated and
-    /// applied before the calibration (all: IMU tilt and every stream's
-    /// delay; gnss: tilt and GNSS delay; none). With --params: those stored
-    /// in the file are applied.
-    #[arg(long, value_enum, default_value_t = common::CorrectionsArg::Gnss)]
-    pub corrections: common::CorrectionsArg,
-    /// Evaluate only data from this time on, s (drive clock).
-    #[arg(long = "from", value_parser = common::finite, allow_hyphen_values = true)]
-    pub from_s: Option<f64>,
-    /// Evaluate only data before this time, s (drive clock).
-    #[arg(long = "until", value_parser = common::finite, allow_hyphen_values = true)]
-    pub until_s: Option<f64>,
-}
+use crate::args::evaluate::*;
 
 /// Runs `evaluate`.
 pub fn run(a: EvaluateArgs, load: &common::Loader) -> Result<()> {

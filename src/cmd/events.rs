@@ -2,20 +2,13 @@
 //! line (the schema is in `docs/events.md`).
 
 use std::io::Write;
-use std::path::PathBuf;
 
 use anyhow::Result;
-use clap::Args;
 use deadreckon_core::ekf::DriveEvents;
 
 use super::common;
 
-/// Arguments of `events`.
-#[derive(Args, Debug)]
-pub struct EventsArgs {
-    /// The drive: a directory or any recording the other commands read.
-    pub dir: PathBuf,
-}
+use crate::args::events::*;
 
 /// Runs `events`.
 pub fn run(a: EventsArgs, load: &common::Loader) -> Result<()> {

@@ -9,33 +9,7 @@ use deadreckon_core::kinematics::tricycle::TricycleDrive;
 use deadreckon_core::kinematics::{KinematicCalibration, KinematicModel, Shape};
 use deadreckon_io::kinematic_toml::{is_kinematic_params, KinematicParamsFile};
 
-/// `--shape`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum ShapeArg {
-    /// Four wheels, front-steered (the paper's car).
-    Car,
-    /// Left/right wheels or an odometry twist.
-    DiffDrive,
-}
-
-/// `--yaw` of a differential drive.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum YawArg {
-    /// The gyro.
-    Gyro,
-    /// The odometry's wheel-speed difference.
-    Odometry,
-}
-
-impl YawArg {
-    /// The name written into params.toml.
-    pub fn name(self) -> &'static str {
-        match self {
-            YawArg::Gyro => "gyro",
-            YawArg::Odometry => "odometry",
-        }
-    }
-}
+use crate::args::kinematic::*;
 
 /// A drive as a differential drive with the chosen yaw source, cut to `[from, until)`.
 pub fn diff_drive(

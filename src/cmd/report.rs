@@ -3,10 +3,7 @@
 //! plain data model (`deadreckon_report::ReportInput`) through
 //! `deadreckon_eval::report`, and writes the page.
 
-use std::path::PathBuf;
-
 use anyhow::{Context, Result};
-use clap::Args;
 use deadreckon_core::{Drive, Params, ParamsWithStd};
 use deadreckon_eval::report::{
     calibrations, four_wheel_input, header, tedris_from_model, NamedParams,
@@ -15,24 +12,7 @@ use deadreckon_report as rp;
 
 use super::{common, progress::Steps};
 
-/// Arguments of `report`.
-#[derive(Args, Debug)]
-pub struct ReportArgs {
-    /// The drive directory.
-    pub dir: PathBuf,
-    /// Extra parameters to show and dead-reckon with (a params.toml), beside the calibrations made on the drive.
-    #[arg(long)]
-    pub params: Option<String>,
-    /// A TedriS model.json: adds the TedriS sections.
-    #[arg(long)]
-    pub model: Option<PathBuf>,
-    /// Also run the sliding-window outage evaluation with windows of this length, s.
-    #[arg(long, value_parser = common::positive)]
-    pub outage: Option<f64>,
-    /// Output HTML file.
-    #[arg(long)]
-    pub out: PathBuf,
-}
+use crate::args::report::*;
 
 /// Runs `report`.
 pub fn run(a: ReportArgs, quiet: bool, load: &common::Loader) -> Result<()> {

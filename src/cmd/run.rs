@@ -2,10 +2,9 @@
 //! and smoothed ones, and the truth) with covariances, or one of them as TUM or
 //! KITTI for `evo`.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use anyhow::{Context, Result};
-use clap::Args;
 use deadreckon_core::ekf::FilterOptions;
 use deadreckon_core::kinematics::tricycle::TricycleParams;
 use deadreckon_core::kinematics::Shape;
@@ -14,59 +13,7 @@ use deadreckon_io::TrackFormat;
 
 use super::{common, kinematic};
 
-/// Arguments of `run`.
-#[derive(Args, Debug)]
-pub struct RunArgs {
-    /// The drive directory.
-    pub dir: PathBuf,
-    /// `nominal` or a params.toml.
-    #[arg(long, default_value = "nominal")]
-    pub params: String,
-    /// Output file, by extension: .csv, .geojson, .mcap (every track), .tum or
-    /// .kitti (one track; KITTI's timestamps go to <stem>.times.txt).
-    #[arg(long)]
-    pub out: PathBuf,
-    /// A track to write (repeatable): dead-reckoned, filtered, smoothed, truth.
-    /// Default: every estimated track; TUM and KITTI need exactly one.
-    #[arg(long)]
-    pub track: Vec<String>,
-    /// TUM/KITTI: keep only the poses evo's time association pairs with this
-    /// track, so two KITTI files line up pose for pose.
-    #[arg(long)]
-    pub sync_with: Option<String>,
-    /// What an .mcap file carries: foxglove (JSON, Foxglove's schemas), ros2
-    /// (nav_msgs/msg/Odometry in CDR, `ros2` profile: what ros2 bag, rosbags
-    /// and evo read) or both (read by Foxglove and MCAP libraries, not by ROS
-    /// tools, which want the ros2 profile).
-    #[arg(long, value_enum, default_value_t = McapContent::Foxglove)]
-    pub mcap: McapContent,
-    /// Largest time difference of associated poses for --sync-with, s (evo's --t_max_diff).
-    #[arg(long, default_value_t = evo::DEFAULT_MAX_DIFF_S, value_parser = common::positive)]
-    pub max_diff_s: f64,
-    /// Filter timing: wheel or each.
-    #[arg(long, value_enum, default_value_t = common::TimingArg::Wheel)]
-    pub timing: common::TimingArg,
-    /// Initial pose for dead reckoning `EAST_M,NORTH_M,YAW_RAD` (default: the truth, else the smoothed GNSS track).
-    #[arg(long)]
-    pub init_pose: Option<String>,
-    /// Fuse every wheel reading: no wheel-health monitor.
-    #[arg(long)]
-    pub no_wheel_monitor: bool,
-    /// Print what was written and the wheel health as JSON.
-    #[arg(long)]
-    pub json: bool,
-}
-
-/// What `run --out x.mcap` writes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum McapContent {
-    /// Foxglove's JSON messages (foxglove.PoseInFrame, foxglove.LocationFix).
-    Foxglove,
-    /// ROS 2 nav_msgs/msg/Odometry in CDR, `ros2` profile (for ros2 bag, rosbags, evo).
-    Ros2,
-    /// Both in one file.
-    Both,
-}
+use crate::args::run::*;
 
 /// The tracks to write: those named (in the order given), or every estimated
 /// track; for TUM and KITTI exactly one, optionally synced with another.

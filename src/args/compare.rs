@@ -1,0 +1,24 @@
+//! The arguments of `deadreckon compare`.
+
+use std::path::PathBuf;
+
+use clap::Args;
+
+/// Arguments of `compare`.
+#[derive(Args, Debug)]
+pub struct CompareArgs {
+    /// The drive directory (or a recording read directly).
+    pub dir: PathBuf,
+    /// A GNSS outage `START_S:END_S` on the drive clock (repeatable).
+    #[arg(long, required = true)]
+    pub outage: Vec<String>,
+    /// Four-wheel parameters (params.toml); default: RTS calibration on the drive with the outages hidden.
+    #[arg(long)]
+    pub params: Option<String>,
+    /// TedriS model (model.json); default: trained on the drive with the outages hidden.
+    #[arg(long)]
+    pub model: Option<PathBuf>,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}

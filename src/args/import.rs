@@ -1,0 +1,81 @@
+//! The arguments of `deadreckon import`.
+
+use std::path::PathBuf;
+
+use clap::Args;
+
+/// `import FORMAT`: what the source is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum FormatArg {
+    /// A comma2k19 segment directory.
+    Comma2k19,
+    /// A candump log or a comma2k19 raw_can directory, decoded with a DBC.
+    Can,
+    /// A tricycle dataset.txt.
+    Tricycle,
+    /// A ROS1 .bag.
+    Rosbag,
+    /// A ROS2 .mcap, or a rosbag2 directory holding one.
+    Mcap,
+}
+
+/// `import comma2k19 --gyro`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum GyroArg {
+    /// gyro_uncalibrated, bias kept.
+    Raw,
+    /// The phone's calibrated gyro.
+    Calibrated,
+}
+
+/// `import comma2k19 --speed-source`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum SpeedSourceArg {
+    /// The CAN SPEED message (0xB4).
+    Can,
+    /// The mean of the four wheel speeds.
+    Processed,
+}
+
+/// Import arguments.
+#[derive(Args, Debug)]
+pub struct ImportArgs {
+    /// Input format: comma2k19 (segment directory), can (candump log or
+    /// comma2k19 raw_can directory), tricycle (dataset.txt), rosbag (ROS1
+    /// .bag), mcap (ROS2 .mcap file, or a rosbag2 directory holding one).
+    #[arg(value_enum)]
+    pub format: FormatArg,
+    /// Source file or directory.
+    pub source: PathBuf,
+    /// Output drive directory.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// vehicle.toml to use (default: comma2k19 the built-in RAV4 profile,
+    /// can the built-in RAV4 profile with the built-in DBC, tricycle the log's header).
+    #[arg(long)]
+    pub vehicle: Option<PathBuf>,
+    /// can: DBC file (default: the built-in Toyota RAV4 subset).
+    #[arg(long)]
+    pub dbc: Option<PathBuf>,
+    /// can: signal-to-stream mapping TOML (default: the built-in RAV4 mapping).
+    #[arg(long)]
+    pub map: Option<PathBuf>,
+    /// Drop and count unsorted, duplicate or invalid samples instead of failing.
+    #[arg(long)]
+    pub gate: bool,
+    /// comma2k19: gyro stream, `raw` (gyro_uncalibrated, bias kept) or `calibrated`.
+    #[arg(long, value_enum, default_value_t = GyroArg::Raw)]
+    pub gyro: GyroArg,
+    /// comma2k19: speed stream, `can` (SPEED message 0xB4) or `processed` (mean of the wheel speeds).
+    #[arg(long, value_enum, default_value_t = SpeedSourceArg::Can)]
+    pub speed_source: SpeedSourceArg,
+    /// comma2k19: forward distance from the rear axle to the device, m (default 1.5).
+    #[arg(long, value_parser = super::finite, allow_hyphen_values = true)]
+    pub device_forward_m: Option<f64>,
+    /// comma2k19: u-blox fix latency subtracted from its log time, s (default 0.1).
+    #[arg(long, value_parser = super::finite, allow_hyphen_values = true)]
+    pub gnss_latency_s: Option<f64>,
+    /// comma2k19: standard deviation given to each u-blox fix, m (default 1.0).
+    #[arg(long, value_parser = super::positive)]
+    pub gnss_std_m: Option<f64>,
+}

@@ -1,0 +1,29 @@
+//! The kinematic shapes' arguments (`--shape`, `--yaw`).
+
+/// `--shape`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum ShapeArg {
+    /// Four wheels, front-steered (the paper's car).
+    Car,
+    /// Left/right wheels or an odometry twist.
+    DiffDrive,
+}
+
+/// `--yaw` of a differential drive.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum YawArg {
+    /// The gyro.
+    Gyro,
+    /// The odometry's wheel-speed difference.
+    Odometry,
+}
+
+impl YawArg {
+    /// The name written into params.toml.
+    pub fn name(self) -> &'static str {
+        match self {
+            YawArg::Gyro => "gyro",
+            YawArg::Odometry => "odometry",
+        }
+    }
+}
