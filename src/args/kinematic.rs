@@ -27,3 +27,12 @@ impl YawArg {
         }
     }
 }
+
+impl From<YawArg> for deadreckon_core::kinematics::diff_drive::YawSource {
+    fn from(y: YawArg) -> Self {
+        match y {
+            YawArg::Gyro => Self::Gyro,
+            YawArg::Odometry => Self::Odometry,
+        }
+    }
+}

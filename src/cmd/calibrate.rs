@@ -6,11 +6,11 @@ use anyhow::{Context, Result};
 use deadreckon_core::calibrate::{CalibrationOptions, Iteration, Method, PassState};
 use deadreckon_core::ekf::FilterOptions;
 
-use deadreckon_core::kinematics::diff_drive::{calibrate_diff_drive, DiffDriveOptions};
-use deadreckon_core::kinematics::{self, KinematicOptions, Shape};
+use deadreckon_core::kinematics::Shape;
 
-use super::{common, kinematic};
+use super::common;
 use crate::args::kinematic::ShapeArg;
+use deadreckon_api::kinematic;
 
 use crate::args::calibrate::*;
 
@@ -22,11 +22,9 @@ pub fn run(a: CalibrateArgs, load: &common::Loader) -> Result<()> {
     if let (Some(out), OutFormat::Params) = (&a.out, a.format) {
         common::check_output(out, &[&a.dir])?;
     }
-    if kinematic::is_tricycle_log(&a.dir) {
-        return run_tricycle(&a);
-    }
-    if a.shape == ShapeArg::DiffDrive {
-        return run_diff_drive(&a, load);
+    let tricycle = kinematic::is_tricycle_log(&a.dir);
+    if tricycle || a.shape == ShapeArg::DiffDrive {
+        return run_kinematic(&a, load, tricycle);
     }
     let method_name = a
         .method
@@ -41,12 +39,7 @@ pub fn run(a: CalibrateArgs, load: &common::Loader) -> Result<()> {
     } else {
         read.without_truth()
     };
-    let drive = load.drive_with(&a.dir, &read)?;
-    let drive = if a.from_s.is_some() || a.until_s.is_some() {
-        drive.time_range(a.from_s, a.until_s)
-    } else {
-        drive
-    };
+    let drive = kinematic::cut(load.drive_with(&a.dir, &read)?, a.from_s, a.until_s)?;
     let iteration = match a.iteration {
         IterationArg::Anderson => Iteration::Anderson,
         IterationArg::Plain => Iteration::Plain,
@@ -124,70 +117,32 @@ pub fn run(a: CalibrateArgs, load: &common::Loader) -> Result<()> {
     Ok(())
 }
 
-/// The tricycle: the seven kinematic parameters against the tracker.
-fn run_tricycle(a: &CalibrateArgs) -> Result<()> {
-    let method = a.method.map_or("truth", common::MethodArg::name);
-    anyhow::ensure!(
-        method == "truth",
-        "a tricycle log has no GNSS and no gyro: it is calibrated against its tracker with --method truth (got `{method}`)"
-    );
-    let drive = kinematic::load_tricycle(&a.dir, a.from_s, a.until_s)?;
-    let shape = Shape::Tricycle;
-    let opts = KinematicOptions {
-        window_s: a.window.unwrap_or(2.0),
-        min_speed_mps: a.min_speed.unwrap_or(shape.default_min_speed_mps()),
-        ..Default::default()
+/// A tricycle log against its tracker, or a differential drive against its
+/// GNSS fixes (`deadreckon_api::kinematic`).
+fn run_kinematic(a: &CalibrateArgs, load: &common::Loader, tricycle: bool) -> Result<()> {
+    let o = kinematic::CalibrateOptions {
+        method: a.method.map(common::MethodArg::name),
+        window_s: a.window,
+        min_speed_mps: a.min_speed,
+        from_s: a.from_s,
+        until_s: a.until_s,
     };
-    let c = kinematics::calibrate(&drive, &opts)
-        .with_context(|| format!("calibrating {}", a.dir.display()))?;
-    if let Some(out) = &a.out {
-        kinematic::write_params(out, shape, method, None, &c)?;
-    }
-    if a.json {
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&deadreckon_api::json::kinematic_calibration_json(
-                shape, method, &c
-            ))?
-        );
+    let c = if tricycle {
+        kinematic::calibrate_tricycle(&a.dir, &o)?
     } else {
-        kinematic::print_table(&c)?;
-        if let Some(out) = &a.out {
-            outln!("wrote {}", out.display());
+        let drive = load.drive(&a.dir)?;
+        kinematic::calibrate_diff(&drive, &a.dir, a.yaw.into(), &o)?
+    };
+    if let Some(out) = &a.out {
+        c.write(out)?;
+    }
+    match (a.json, tricycle) {
+        // A tricycle log is not read through the plausibility checks.
+        (true, true) => common::print_pretty(&c.json()),
+        (true, false) => common::print_json(load, c.json()),
+        (false, _) => {
+            common::print_lines(c.lines())?;
+            common::print_lines(a.out.iter().map(|o| format!("wrote {}", o.display())))
         }
     }
-    Ok(())
-}
-
-/// The differential drive: five parameters against the GNSS fixes.
-fn run_diff_drive(a: &CalibrateArgs, load: &common::Loader) -> Result<()> {
-    let method = a.method.map_or("gnss", common::MethodArg::name);
-    anyhow::ensure!(
-        method == "gnss",
-        "a differential drive is calibrated against its GNSS fixes with --method gnss (got `{method}`)"
-    );
-    let drive = load.drive(&a.dir)?;
-    let dd = kinematic::diff_drive(&drive, a.yaw, a.from_s, a.until_s)?;
-    let shape = Shape::DiffDrive;
-    let opts = DiffDriveOptions {
-        window_s: a.window.unwrap_or(DiffDriveOptions::default().window_s),
-        min_speed_mps: a.min_speed.unwrap_or(shape.default_min_speed_mps()),
-        ..Default::default()
-    };
-    let c = calibrate_diff_drive(&dd, &opts)
-        .with_context(|| format!("calibrating {}", a.dir.display()))?;
-    if let Some(out) = &a.out {
-        kinematic::write_params(out, shape, method, Some(a.yaw.name()), &c)?;
-    }
-    if a.json {
-        let mut v = deadreckon_api::json::kinematic_calibration_json(shape, method, &c);
-        v["yaw_source"] = a.yaw.name().into();
-        common::print_json(load, v)?;
-    } else {
-        kinematic::print_table(&c)?;
-        if let Some(out) = &a.out {
-            outln!("wrote {}", out.display());
-        }
-    }
-    Ok(())
 }

@@ -78,6 +78,20 @@ pub fn print_json(load: &Loader, mut v: serde_json::Value) -> Result<()> {
     Ok(())
 }
 
+/// Prints a `--json` object as it is.
+pub fn print_pretty(v: &serde_json::Value) -> Result<()> {
+    outln!("{}", serde_json::to_string_pretty(v)?);
+    Ok(())
+}
+
+/// Prints lines of text.
+pub fn print_lines(lines: impl IntoIterator<Item = String>) -> Result<()> {
+    for l in lines {
+        outln!("{l}");
+    }
+    Ok(())
+}
+
 /// `--params nominal` or a `params.toml` path.
 pub fn load_params(spec: &str, drive: &Drive) -> Result<Params> {
     if spec == "nominal" {

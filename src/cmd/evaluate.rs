@@ -2,34 +2,24 @@
 //! (drift per 100 m, distance before 1 m), evo's (relative pose error per
 //! 100 m, absolute pose error) or over sliding GNSS outages.
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use deadreckon_core::ekf::FilterOptions;
 use deadreckon_core::metrics::{self, Summary};
 use deadreckon_core::outage;
 
-use deadreckon_core::kinematics::diff_drive::{self, evaluate_diff_drive, DiffDriveDrive};
-use deadreckon_core::kinematics::{self, KinematicOptions, Shape};
-
-use super::{common, kinematic};
-use crate::args::kinematic::{ShapeArg, YawArg};
+use super::common;
+use crate::args::kinematic::ShapeArg;
+use deadreckon_api::kinematic;
 
 use crate::args::evaluate::*;
 
 /// Runs `evaluate`.
 pub fn run(a: EvaluateArgs, load: &common::Loader) -> Result<()> {
-    kinematic::check_range(a.from_s, a.until_s)?;
-    if kinematic::is_tricycle_log(&a.dir) {
-        return run_tricycle(&a);
+    let tricycle = kinematic::is_tricycle_log(&a.dir);
+    if tricycle || a.shape == ShapeArg::DiffDrive {
+        return run_kinematic(&a, load, tricycle);
     }
-    if a.shape == ShapeArg::DiffDrive {
-        return run_diff_drive(&a, load);
-    }
-    let drive = load.drive(&a.dir)?;
-    let drive = if a.from_s.is_some() || a.until_s.is_some() {
-        drive.time_range(a.from_s, a.until_s)
-    } else {
-        drive
-    };
+    let drive = kinematic::cut(load.drive(&a.dir)?, a.from_s, a.until_s)?;
     let timing: deadreckon_core::ekf::Timing = a.timing.into();
     // One rule for every metric (deadreckon_api::evaluate::RULE).
     let (chosen, drive) = match &a.params {
@@ -137,99 +127,29 @@ pub fn run(a: EvaluateArgs, load: &common::Loader) -> Result<()> {
     Ok(())
 }
 
-/// The tricycle: sliding outages from the tracker pose, scored at the
-/// tracked point with the calibrated mounting.
-fn run_tricycle(a: &EvaluateArgs) -> Result<()> {
+/// A tricycle log or a differential drive over sliding outages
+/// (`deadreckon_api::kinematic`).
+fn run_kinematic(a: &EvaluateArgs, load: &common::Loader, tricycle: bool) -> Result<()> {
     let Some(len) = a.outage else {
-        anyhow::bail!(
+        anyhow::bail!(if tricycle {
             "a tricycle log is evaluated over sliding outages: give --outage LEN (and --step S)"
-        );
+        } else {
+            "a differential drive is evaluated over sliding GNSS outages: give --outage LEN (and --step S)"
+        });
     };
-    let shape = Shape::Tricycle;
-    let drive = kinematic::load_tricycle(&a.dir, a.from_s, a.until_s)?;
-    let (params, source) = match &a.params {
-        Some(p) => kinematic::load_params(p, shape, &drive)?,
-        None => {
-            let o = KinematicOptions {
-                min_speed_mps: shape.default_min_speed_mps(),
-                ..Default::default()
-            };
-            let c = kinematics::calibrate(&drive, &o).context("calibrating against the tracker")?;
-            (
-                c.values(),
-                "truth (calibrated on the evaluated range)".to_string(),
-            )
-        }
-    };
-    let ev = kinematics::evaluate(&drive, &params, len, a.step.unwrap_or(len / 2.0))?;
-    if a.json {
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&deadreckon_api::json::kinematic_outages_json(
-                shape, &ev, &source
-            ))?
-        );
+    let step = a.step.unwrap_or(len / 2.0);
+    let params = a.params.as_deref();
+    let ev = if tricycle {
+        kinematic::evaluate_tricycle(&a.dir, params, len, step, a.from_s, a.until_s)?
     } else {
-        let s = ev.final_error();
-        outln!(
-            "{} outage windows of {len} s from the reference pose (parameters: {source})",
-            ev.windows.len()
-        );
-        final_error_table(&s)?;
+        let yaw = kinematic::diff_yaw(params, a.yaw.map(Into::into));
+        let drive = load.drive(&a.dir)?;
+        kinematic::evaluate_diff(&drive, params, yaw, len, step, a.align, a.from_s, a.until_s)?
+    };
+    match (a.json, tricycle) {
+        // A tricycle log is not read through the plausibility checks.
+        (true, true) => common::print_pretty(&ev.json()),
+        (true, false) => common::print_json(load, ev.json()),
+        (false, _) => common::print_lines(ev.lines()),
     }
-    Ok(())
-}
-
-/// The differential drive: sliding outages, each started from the
-/// alignment of the preceding dead reckoning to the fixes, scored against
-/// the hidden fix at its end.
-fn run_diff_drive(a: &EvaluateArgs, load: &common::Loader) -> Result<()> {
-    let Some(len) = a.outage else {
-        anyhow::bail!("a differential drive is evaluated over sliding GNSS outages: give --outage LEN (and --step S)");
-    };
-    let spec = a.params.as_deref().unwrap_or("nominal");
-    let file_yaw = if spec == "nominal" {
-        None
-    } else {
-        deadreckon_io::read_kinematic_params(std::path::Path::new(spec))
-            .ok()
-            .and_then(|f| f.yaw_source)
-    };
-    let yaw = match (a.yaw, file_yaw.as_deref()) {
-        (Some(y), _) => y,
-        (None, Some("odometry")) => YawArg::Odometry,
-        _ => YawArg::Gyro,
-    };
-    let (params, source) = if spec == "nominal" {
-        (DiffDriveDrive::nominal(), "nominal".to_string())
-    } else {
-        kinematic::load_params_file(spec, Shape::DiffDrive, &diff_drive::NAMES, Some(yaw.name()))?
-    };
-    let drive = load.drive(&a.dir)?;
-    let dd = kinematic::diff_drive(&drive, yaw, a.from_s, a.until_s)?;
-    let ev = evaluate_diff_drive(&dd, &params, len, a.step.unwrap_or(len / 2.0), a.align)?;
-    let source = format!("{source}, yaw {}", yaw.name());
-    if a.json {
-        let mut v = deadreckon_api::json::kinematic_outages_json(Shape::DiffDrive, &ev, &source);
-        v["reference"] = "gnss (hidden fixes; start aligned to the preceding fixes)".into();
-        v["align_s"] = a.align.into();
-        common::print_json(load, v)?;
-    } else {
-        let s = ev.final_error();
-        outln!(
-            "{} outage windows of {len} s, each started from {} s of dead reckoning aligned to the fixes (parameters: {source})",
-            ev.windows.len(),
-            a.align
-        );
-        final_error_table(&s)?;
-    }
-    Ok(())
-}
-
-/// The final-error line of the kinematic shapes' outage evaluations.
-fn final_error_table(s: &deadreckon_core::metrics::Summary) -> Result<()> {
-    for l in deadreckon_api::text::summary_table(&[("final error (m)", *s)]) {
-        outln!("{l}");
-    }
-    Ok(())
 }

@@ -42,7 +42,6 @@ pub mod demo;
 pub mod evaluate;
 pub mod events;
 pub mod import;
-pub mod kinematic;
 pub mod progress;
 pub mod report;
 pub mod run;

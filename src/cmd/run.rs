@@ -6,12 +6,11 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 use deadreckon_core::ekf::FilterOptions;
-use deadreckon_core::kinematics::tricycle::TricycleParams;
-use deadreckon_core::kinematics::Shape;
 use deadreckon_core::{evo, track, Track};
 use deadreckon_io::TrackFormat;
 
-use super::{common, kinematic};
+use super::common;
+use deadreckon_api::kinematic;
 
 use crate::args::run::*;
 
@@ -84,10 +83,7 @@ pub fn run(a: RunArgs, load: &common::Loader) -> Result<()> {
             a.init_pose.is_none(),
             "a tricycle log starts from its first tracker pose: --init-pose is not used"
         );
-        let drive = kinematic::load_tricycle(&a.dir, None, None)?;
-        let (p, _) = kinematic::load_params(&a.params, Shape::Tricycle, &drive)?;
-        let params = TricycleParams::from_slice(&p)?;
-        let all = drive.tracks(&params)?;
+        let all = kinematic::tricycle_tracks(&a.dir, &a.params)?;
         let format = TrackFormat::from_path(&a.out)?;
         let t = select(&all, &a, format)?;
         write_tracks(&a.out, format, &t, a.mcap)

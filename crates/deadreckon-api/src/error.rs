@@ -135,6 +135,23 @@ pub enum Error {
         #[source]
         source: deadreckon_core::Error,
     },
+    /// A file error that names its file, line and column itself.
+    #[error(transparent)]
+    Io(#[from] deadreckon_io::IoError),
+    /// The request does not fit the data or the other options (a range
+    /// outside the drive, a method the vehicle's shape does not take).
+    #[error("{0}")]
+    Invalid(String),
+    /// Reading, writing or computing something named failed ("reading
+    /// parameters p.toml", "calibrating DIR"); the cause is the source.
+    #[error("{what}")]
+    While {
+        /// What was being done, and on what.
+        what: String,
+        /// The cause.
+        #[source]
+        source: Box<dyn std::error::Error + Send + Sync>,
+    },
     /// An option word is not one of those allowed.
     #[error("unknown {what} `{value}` ({allowed})")]
     UnknownOption {
@@ -146,6 +163,29 @@ pub enum Error {
         allowed: &'static str,
     },
 }
+
+/// Adds what was being done to an error: [`Error::While`].
+pub(crate) trait While<T> {
+    /// The error, with `what` as its context.
+    fn doing(self, what: impl FnOnce() -> String) -> Result<T, Error>;
+}
+
+impl<T, E: std::error::Error + Send + Sync + 'static> While<T> for Result<T, E> {
+    fn doing(self, what: impl FnOnce() -> String) -> Result<T, Error> {
+        self.map_err(|e| Error::While {
+            what: what(),
+            source: Box::new(e),
+        })
+    }
+}
+
+/// Refuses a request: [`Error::Invalid`].
+macro_rules! invalid {
+    ($($arg:tt)*) => {
+        return Err($crate::Error::Invalid(format!($($arg)*)))
+    };
+}
+pub(crate) use invalid;
 
 /// An error and its sources as one line, `outer: inner: ...`: the form
 /// `anyhow` prints with `{:#}` (the command line's `error:` lines).

@@ -36,6 +36,7 @@ pub mod corrections;
 pub mod evaluate;
 pub mod import;
 pub mod json;
+pub mod kinematic;
 pub mod options;
 pub mod source;
 pub mod tedris;

@@ -440,3 +440,54 @@ pub fn summary_table(rows: &[(&str, deadreckon_core::metrics::Summary)]) -> Vec<
     }
     out
 }
+
+/// A kinematic calibration as a table: value, standard error and status
+/// per parameter; the correlation of the estimated parameters; the fit.
+pub fn kinematic_table(c: &deadreckon_core::kinematics::KinematicCalibration) -> Vec<String> {
+    let mut out = vec![format!(
+        "{:<18} {:>12} {:>12}  status",
+        "parameter", "value", "std"
+    )];
+    for p in &c.params {
+        let std = p.std.map_or("-".to_string(), |s| format!("{s:.6}"));
+        let status = match &p.reason {
+            None => "estimated".to_string(),
+            Some(r) => format!("NOT ESTIMATED (nominal kept): {r}"),
+        };
+        out.push(format!(
+            "{:<18} {:>12.6} {:>12}  {status}",
+            p.name, p.value, std
+        ));
+    }
+    if !c.correlated.is_empty() {
+        out.push("correlation:".into());
+        let mut header = format!("{:<18}", "");
+        for n in &c.correlated {
+            let short: String = n.chars().take(8).collect();
+            header.push_str(&format!(" {short:>8}"));
+        }
+        out.push(header);
+        for (n, row) in c.correlated.iter().zip(&c.correlation) {
+            let mut line = format!("{n:<18}");
+            for v in row {
+                line.push_str(&format!(" {v:>8.3}"));
+            }
+            out.push(line);
+        }
+    }
+    out.push(format!(
+        "{} of {} windows above {} m/s, RMS at the window ends {:.3} m / {:.4} rad; {} ({})",
+        c.windows_used,
+        c.windows_total,
+        c.min_speed_mps,
+        c.rms_position_m,
+        c.rms_heading_rad,
+        if c.converged {
+            "converged"
+        } else {
+            "NOT converged"
+        },
+        c.termination
+    ));
+    out
+}

@@ -1,0 +1,420 @@
+//! The kinematic shapes as the commands run them: a tricycle log calibrated
+//! against its tracker and evaluated over sliding outages from the tracker
+//! pose; a differential drive (odometry + GNSS) calibrated against its fixes
+//! and evaluated over sliding GNSS outages started from the alignment of the
+//! preceding dead reckoning to the fixes. Loading, the `--from`/`--until`
+//! rule, parameter files, tables and `--json` objects.
+
+use std::path::Path;
+
+use deadreckon_core::kinematics::diff_drive::{
+    self, calibrate_diff_drive, evaluate_diff_drive, DiffDriveDrive, DiffDriveOptions, YawSource,
+};
+use deadreckon_core::kinematics::tricycle::{TricycleDrive, TricycleParams};
+use deadreckon_core::kinematics::{
+    self, KinematicCalibration, KinematicModel, KinematicOptions, KinematicOutages, Shape,
+};
+use deadreckon_core::{Drive, Track};
+use deadreckon_io::kinematic_toml::{is_kinematic_params, KinematicParamsFile};
+
+use crate::error::{invalid, While};
+use crate::Error;
+
+/// The one rule for a time range on the drive clock (`--from`, `--until`,
+/// Python's `from_s`, `until_s`): both finite, `from` before `until`.
+pub fn check_range(from: Option<f64>, until: Option<f64>) -> Result<(), Error> {
+    for v in [from, until].into_iter().flatten() {
+        if !v.is_finite() {
+            invalid!("--from / --until must be finite, got {v}");
+        }
+    }
+    if let (Some(a), Some(b)) = (from, until) {
+        if a.partial_cmp(&b) != Some(std::cmp::Ordering::Less) {
+            invalid!("--from {a} must be before --until {b}");
+        }
+    }
+    Ok(())
+}
+
+/// The drive cut to `[from, until)` (checked by [`check_range`]); the
+/// drive itself when neither is given.
+pub fn cut(drive: Drive, from: Option<f64>, until: Option<f64>) -> Result<Drive, Error> {
+    check_range(from, until)?;
+    Ok(if from.is_some() || until.is_some() {
+        drive.time_range(from, until)
+    } else {
+        drive
+    })
+}
+
+/// Whether `path` is a recording read through a kinematic shape (a
+/// tricycle `dataset.txt`), as the format detection says.
+pub fn is_tricycle_log(path: &Path) -> bool {
+    crate::source::detect(path) == crate::source::SourceKind::TricycleLog
+}
+
+/// The name a yaw source has in params.toml and on the command line.
+pub fn yaw_name(yaw: YawSource) -> &'static str {
+    match yaw {
+        YawSource::Gyro => "gyro",
+        YawSource::Odometry => "odometry",
+    }
+}
+
+/// A drive as a differential drive with the chosen yaw source, cut to
+/// `[from, until)`; refused without odometry and GNSS.
+pub fn diff_drive(
+    drive: &Drive,
+    yaw: YawSource,
+    from: Option<f64>,
+    until: Option<f64>,
+) -> Result<DiffDriveDrive, Error> {
+    check_range(from, until)?;
+    let d = DiffDriveDrive::from_drive(drive, yaw, from, until)?;
+    if d.samples.len() < 2 || d.fixes.len() < 3 {
+        invalid!(
+            "{} odometry samples and {} GNSS fixes in the range: a differential drive needs odometry and GNSS",
+            d.samples.len(),
+            d.fixes.len()
+        );
+    }
+    Ok(d)
+}
+
+/// Reads a tricycle log as a kinematic drive cut to `[from, until)`.
+pub fn load_tricycle(
+    path: &Path,
+    from: Option<f64>,
+    until: Option<f64>,
+) -> Result<TricycleDrive, Error> {
+    check_range(from, until)?;
+    let o = deadreckon_import::tricycle::TricycleOptions::default();
+    let d = deadreckon_import::tricycle::read_tricycle_kinematic(path, &o).map_err(|source| {
+        Error::Tricycle {
+            path: path.to_path_buf(),
+            source,
+        }
+    })?;
+    let cut = d.time_range(from, until);
+    if cut.samples.len() < 2 {
+        invalid!(
+            "{}: {} samples in the range --from {} --until {} (the log runs from {:.3} to {:.3} s)",
+            path.display(),
+            cut.samples.len(),
+            from.map_or("start".into(), |v| v.to_string()),
+            until.map_or("end".into(), |v| v.to_string()),
+            d.samples.first().map_or(f64::NAN, |s| s.t_s),
+            d.samples.last().map_or(f64::NAN, |s| s.t_s),
+        );
+    }
+    Ok(cut)
+}
+
+/// `nominal` or a kinematic params.toml, as the model's vector and a
+/// description of where it came from.
+pub fn load_params<M: KinematicModel>(
+    spec: &str,
+    shape: Shape,
+    model: &M,
+) -> Result<(Vec<f64>, String), Error> {
+    if spec == "nominal" {
+        return Ok((model.nominal(), "nominal".into()));
+    }
+    load_params_file(spec, shape, model.names(), None)
+}
+
+/// A kinematic params.toml for `shape` with these parameter names (and, for
+/// a differential drive, this yaw source).
+pub fn load_params_file(
+    spec: &str,
+    shape: Shape,
+    names: &[&str],
+    yaw_source: Option<&str>,
+) -> Result<(Vec<f64>, String), Error> {
+    let path = Path::new(spec);
+    if !is_kinematic_params(path) {
+        invalid!(
+            "{spec}: not a {} parameter file (no `shape` key): write one with `deadreckon calibrate <log> --method truth --out {spec}`",
+            shape.name()
+        );
+    }
+    let f = deadreckon_io::read_kinematic_params(path)
+        .doing(|| format!("reading parameters {spec}"))?;
+    f.check(path, shape, names)?;
+    if let (Some(want), Some(have)) = (yaw_source, f.yaw_source.as_deref()) {
+        if want != have {
+            invalid!("{spec}: calibrated with --yaw {have}, evaluated with --yaw {want}");
+        }
+    }
+    let n_not = f.param.iter().filter(|p| !p.estimated).count();
+    let source = if n_not == 0 {
+        spec.to_string()
+    } else {
+        format!("{spec} ({n_not} parameters not estimated: nominal)")
+    };
+    Ok((f.values(), source))
+}
+
+/// A kinematic calibration with what it was made against, as `calibrate`
+/// prints and writes it.
+#[derive(Debug, Clone)]
+pub struct Calibrated {
+    /// The shape calibrated.
+    pub shape: Shape,
+    /// What it was calibrated against (`truth`: the tracker; `gnss`).
+    pub method: &'static str,
+    /// A differential drive's yaw source.
+    pub yaw: Option<YawSource>,
+    /// The calibration.
+    pub calibration: KinematicCalibration,
+}
+
+impl Calibrated {
+    /// The `--json` object.
+    pub fn json(&self) -> serde_json::Value {
+        let mut v =
+            crate::json::kinematic_calibration_json(self.shape, self.method, &self.calibration);
+        if let Some(y) = self.yaw {
+            v["yaw_source"] = yaw_name(y).into();
+        }
+        v
+    }
+
+    /// The table: value, standard error and status per parameter, the
+    /// correlation of the estimated ones, the fit.
+    pub fn lines(&self) -> Vec<String> {
+        crate::text::kinematic_table(&self.calibration)
+    }
+
+    /// Writes the kinematic params.toml (status, std and reason per
+    /// parameter, correlation).
+    pub fn write(&self, path: &Path) -> Result<(), Error> {
+        let mut f =
+            KinematicParamsFile::from_calibration(self.shape, self.method, &self.calibration);
+        f.yaw_source = self.yaw.map(|y| yaw_name(y).to_string());
+        deadreckon_io::write_kinematic_params(path, &f)
+            .doing(|| format!("writing {}", path.display()))
+    }
+}
+
+/// The method a shape is calibrated with, or why `given` is refused.
+fn method_for(shape: Shape, given: Option<&str>) -> Result<&'static str, Error> {
+    let (want, why) = match shape {
+        Shape::Tricycle => (
+            "truth",
+            "a tricycle log has no GNSS and no gyro: it is calibrated against its tracker with --method truth",
+        ),
+        _ => (
+            "gnss",
+            "a differential drive is calibrated against its GNSS fixes with --method gnss",
+        ),
+    };
+    match given {
+        None => Ok(want),
+        Some(m) if m == want => Ok(want),
+        Some(m) => invalid!("{why} (got `{m}`)"),
+    }
+}
+
+/// Options of the kinematic calibrations; `None` takes the shape's default.
+#[derive(Debug, Clone, Default)]
+pub struct CalibrateOptions<'a> {
+    /// The method asked for (`--method`), checked against the shape.
+    pub method: Option<&'a str>,
+    /// Window length, s.
+    pub window_s: Option<f64>,
+    /// Speed threshold, m/s.
+    pub min_speed_mps: Option<f64>,
+    /// Drive-clock range.
+    pub from_s: Option<f64>,
+    /// Drive-clock range end.
+    pub until_s: Option<f64>,
+}
+
+/// Calibrates a tricycle log against its tracker.
+pub fn calibrate_tricycle(path: &Path, o: &CalibrateOptions) -> Result<Calibrated, Error> {
+    let shape = Shape::Tricycle;
+    let method = method_for(shape, o.method)?;
+    let drive = load_tricycle(path, o.from_s, o.until_s)?;
+    let opts = KinematicOptions {
+        window_s: o.window_s.unwrap_or(2.0),
+        min_speed_mps: o.min_speed_mps.unwrap_or(shape.default_min_speed_mps()),
+        ..Default::default()
+    };
+    let calibration =
+        kinematics::calibrate(&drive, &opts).doing(|| format!("calibrating {}", path.display()))?;
+    Ok(Calibrated {
+        shape,
+        method,
+        yaw: None,
+        calibration,
+    })
+}
+
+/// Calibrates a differential drive (the drive read from `path`) against its
+/// GNSS fixes.
+pub fn calibrate_diff(
+    drive: &Drive,
+    path: &Path,
+    yaw: YawSource,
+    o: &CalibrateOptions,
+) -> Result<Calibrated, Error> {
+    let shape = Shape::DiffDrive;
+    let method = method_for(shape, o.method)?;
+    let dd = diff_drive(drive, yaw, o.from_s, o.until_s)?;
+    let opts = DiffDriveOptions {
+        window_s: o.window_s.unwrap_or(DiffDriveOptions::default().window_s),
+        min_speed_mps: o.min_speed_mps.unwrap_or(shape.default_min_speed_mps()),
+        ..Default::default()
+    };
+    let calibration =
+        calibrate_diff_drive(&dd, &opts).doing(|| format!("calibrating {}", path.display()))?;
+    Ok(Calibrated {
+        shape,
+        method,
+        yaw: Some(yaw),
+        calibration,
+    })
+}
+
+/// Sliding-outage evaluation of a kinematic shape, as `evaluate` prints it.
+#[derive(Debug, Clone)]
+pub struct Evaluated {
+    /// The shape.
+    pub shape: Shape,
+    /// Outage length, s.
+    pub length_s: f64,
+    /// Where the parameters came from.
+    pub source: String,
+    /// A differential drive's alignment span, s.
+    pub align_s: Option<f64>,
+    /// The windows and their errors.
+    pub evaluation: KinematicOutages,
+}
+
+impl Evaluated {
+    /// The `--json` object.
+    pub fn json(&self) -> serde_json::Value {
+        let mut v = crate::json::kinematic_outages_json(self.shape, &self.evaluation, &self.source);
+        if let Some(align) = self.align_s {
+            v["reference"] = "gnss (hidden fixes; start aligned to the preceding fixes)".into();
+            v["align_s"] = align.into();
+        }
+        v
+    }
+
+    /// The text: windows, their start, the final-error line.
+    pub fn lines(&self) -> Vec<String> {
+        let n = self.evaluation.windows.len();
+        let len = self.length_s;
+        let source = &self.source;
+        let mut out = vec![match self.align_s {
+            None => format!("{n} outage windows of {len} s from the reference pose (parameters: {source})"),
+            Some(a) => format!("{n} outage windows of {len} s, each started from {a} s of dead reckoning aligned to the fixes (parameters: {source})"),
+        }];
+        out.extend(crate::text::summary_table(&[(
+            "final error (m)",
+            self.evaluation.final_error(),
+        )]));
+        out
+    }
+}
+
+/// A tricycle log over sliding outages from the tracker pose, scored at the
+/// tracked point with the calibrated mounting; without `params`, calibrated
+/// on the evaluated range itself (said in the source).
+pub fn evaluate_tricycle(
+    path: &Path,
+    params: Option<&str>,
+    length_s: f64,
+    step_s: f64,
+    from_s: Option<f64>,
+    until_s: Option<f64>,
+) -> Result<Evaluated, Error> {
+    let shape = Shape::Tricycle;
+    let drive = load_tricycle(path, from_s, until_s)?;
+    let (params, source) = match params {
+        Some(p) => load_params(p, shape, &drive)?,
+        None => {
+            let o = KinematicOptions {
+                min_speed_mps: shape.default_min_speed_mps(),
+                ..Default::default()
+            };
+            let c = kinematics::calibrate(&drive, &o)
+                .doing(|| "calibrating against the tracker".to_string())?;
+            (
+                c.values(),
+                "truth (calibrated on the evaluated range)".to_string(),
+            )
+        }
+    };
+    let evaluation = kinematics::evaluate(&drive, &params, length_s, step_s)?;
+    Ok(Evaluated {
+        shape,
+        length_s,
+        source,
+        align_s: None,
+        evaluation,
+    })
+}
+
+/// The yaw source a differential drive is evaluated with: the one asked
+/// for, else the params file's, else the gyro.
+pub fn diff_yaw(params: Option<&str>, asked: Option<YawSource>) -> YawSource {
+    if let Some(y) = asked {
+        return y;
+    }
+    let file_yaw = params
+        .filter(|p| *p != "nominal")
+        .and_then(|p| deadreckon_io::read_kinematic_params(Path::new(p)).ok())
+        .and_then(|f| f.yaw_source);
+    match file_yaw.as_deref() {
+        Some("odometry") => YawSource::Odometry,
+        _ => YawSource::Gyro,
+    }
+}
+
+/// A differential drive over sliding GNSS outages, each started from the
+/// alignment of the preceding `align_s` of dead reckoning to the fixes and
+/// scored against the hidden fix at its end.
+#[allow(clippy::too_many_arguments)]
+pub fn evaluate_diff(
+    drive: &Drive,
+    params: Option<&str>,
+    yaw: YawSource,
+    length_s: f64,
+    step_s: f64,
+    align_s: f64,
+    from_s: Option<f64>,
+    until_s: Option<f64>,
+) -> Result<Evaluated, Error> {
+    let spec = params.unwrap_or("nominal");
+    let (params, source) = if spec == "nominal" {
+        (DiffDriveDrive::nominal(), "nominal".to_string())
+    } else {
+        load_params_file(
+            spec,
+            Shape::DiffDrive,
+            &diff_drive::NAMES,
+            Some(yaw_name(yaw)),
+        )?
+    };
+    let dd = diff_drive(drive, yaw, from_s, until_s)?;
+    let evaluation = evaluate_diff_drive(&dd, &params, length_s, step_s, align_s)?;
+    Ok(Evaluated {
+        shape: Shape::DiffDrive,
+        length_s,
+        source: format!("{source}, yaw {}", yaw_name(yaw)),
+        align_s: Some(align_s),
+        evaluation,
+    })
+}
+
+/// A tricycle log's tracks (dead-reckoned through its own kinematics from
+/// the first tracker pose, and the tracker's) with `params`.
+pub fn tricycle_tracks(path: &Path, params: &str) -> Result<Vec<Track>, Error> {
+    let drive = load_tricycle(path, None, None)?;
+    let (p, _) = load_params(params, Shape::Tricycle, &drive)?;
+    let params = TricycleParams::from_slice(&p)?;
+    Ok(drive.tracks(&params)?)
+}
