@@ -108,12 +108,12 @@ fn message(e: &anyhow::Error) -> String {
 
 fn run(cli: Cli) -> anyhow::Result<()> {
     // The global reading options, passed to each command (no global state).
-    let load = cmd::Loader {
-        mapping: cli.mapping,
-        skip_checks: cli.skip_checks,
-        wheels: cli.wheels.map(Into::into),
-        checks: Default::default(),
-    };
+    let load = cmd::Loader::new(
+        cli.mapping,
+        cli.skip_checks,
+        cli.wheels.map(Into::into),
+        Some(|path, f| eprintln!("warning: {}: {} ({})", path.display(), f.message, f.check)),
+    );
     match cli.command {
         Command::Simulate(a) => cmd::simulate::run(a),
         Command::Calibrate(a) => cmd::calibrate::run(a, &load),

@@ -45,13 +45,8 @@ pub fn tedris_train(
     mapping: Option<PathBuf>,
     skip_checks: bool,
 ) -> PyResult<(String, Py<PyAny>)> {
-    if let (Some(a), Some(b)) = (from_s, until_s) {
-        if a.partial_cmp(&b) != Some(std::cmp::Ordering::Less) {
-            return Err(DeadreckonError::new_err(format!(
-                "from_s {a} must be before until_s {b}"
-            )));
-        }
-    }
+    deadreckon_api::load::check_range_named(from_s, until_s, ["from_s", "until_s"])
+        .map_err(|e| DeadreckonError::new_err(e.to_string()))?;
     let drive = drive_arg(py, source, &Default::default(), mapping)?;
     let checks = checked(source, &drive, skip_checks)?;
     let drive = if from_s.is_some() || until_s.is_some() {

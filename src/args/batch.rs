@@ -2,7 +2,13 @@
 
 use std::path::PathBuf;
 
+use anyhow::{Context, Result};
 use clap::Args;
+use deadreckon_core::calibrate::CalibrationOptions;
+use deadreckon_core::ekf::FilterOptions;
+use deadreckon_core::Params;
+use deadreckon_fleet::batch::{BatchOptions, OutageOptions};
+use deadreckon_fleet::history::HistoryOptions;
 
 /// Arguments of `batch`.
 #[derive(Args, Debug)]
@@ -46,4 +52,60 @@ pub struct BatchArgs {
     /// Drive-to-drive tolerance of a parameter, NAME=VALUE in its unit (repeatable; defaults in docs/fleet.md).
     #[arg(long, value_delimiter = ',')]
     pub tolerance: Vec<String>,
+}
+
+impl BatchArgs {
+    /// The calibration and outage options of every drive.
+    pub fn options(&self) -> Result<BatchOptions> {
+        let a = self;
+        let method = a.method.car()?;
+        let options = BatchOptions {
+            calibration: CalibrationOptions {
+                method,
+                max_iterations: a.max_iterations as usize,
+                min_speed_mps: a.min_speed,
+                filter: FilterOptions {
+                    timing: a.timing.into(),
+                    ..Default::default()
+                },
+                ..Default::default()
+            },
+            outage: a.outage.map(|len| OutageOptions {
+                length_s: len,
+                step_s: a.step.unwrap_or(len / 2.0),
+                warmup_s: a.warmup,
+            }),
+            threads: a.threads,
+        };
+        Ok(options)
+    }
+
+    /// `--alpha` and `--tolerance NAME=VALUE` as the history's options.
+    pub fn history_options(&self) -> Result<HistoryOptions> {
+        let a = self;
+        let mut o = HistoryOptions {
+            alpha: a.alpha,
+            ..Default::default()
+        };
+        for t in &a.tolerance {
+            let (name, value) = t
+                .split_once('=')
+                .with_context(|| format!("--tolerance `{t}`: expected NAME=VALUE"))?;
+            let i = Params::NAMES
+                .iter()
+                .position(|n| *n == name.trim())
+                .with_context(|| {
+                    format!(
+                        "--tolerance `{t}`: unknown parameter `{name}` (known: {})",
+                        Params::NAMES.join(", ")
+                    )
+                })?;
+            o.tolerance[i] = value
+                .trim()
+                .parse()
+                .with_context(|| format!("--tolerance `{t}`: `{value}` is not a number"))?;
+        }
+        o.validate()?;
+        Ok(o)
+    }
 }

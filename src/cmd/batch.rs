@@ -2,84 +2,22 @@
 //! CSV row per drive, and each vehicle's calibration history. The work is
 //! `deadreckon_fleet`'s; this parses, reports progress and prints.
 
-use std::io::{IsTerminal, Write};
+use std::io::Write;
 use std::time::Instant;
 
-use anyhow::{Context, Result};
-use deadreckon_core::calibrate::{CalibrationOptions, Method};
-use deadreckon_core::ekf::FilterOptions;
-use deadreckon_core::Params;
-use deadreckon_fleet::batch::{BatchOptions, OutageOptions};
-use deadreckon_fleet::history::HistoryOptions;
+use anyhow::Result;
+use deadreckon_core::calibrate::Method;
 use deadreckon_fleet::{batch, history, inputs, output};
-use indicatif::{ProgressBar, ProgressStyle};
 
 use super::common;
 
 use crate::args::batch::*;
 
-fn history_options(a: &BatchArgs) -> Result<HistoryOptions> {
-    let mut o = HistoryOptions {
-        alpha: a.alpha,
-        ..Default::default()
-    };
-    for t in &a.tolerance {
-        let (name, value) = t
-            .split_once('=')
-            .with_context(|| format!("--tolerance `{t}`: expected NAME=VALUE"))?;
-        let i = Params::NAMES
-            .iter()
-            .position(|n| *n == name.trim())
-            .with_context(|| {
-                format!(
-                    "--tolerance `{t}`: unknown parameter `{name}` (known: {})",
-                    Params::NAMES.join(", ")
-                )
-            })?;
-        o.tolerance[i] = value
-            .trim()
-            .parse()
-            .with_context(|| format!("--tolerance `{t}`: `{value}` is not a number"))?;
-    }
-    o.validate()?;
-    Ok(o)
-}
-
-fn bar(total: usize, quiet: bool) -> Option<ProgressBar> {
-    if quiet || !std::io::stderr().is_terminal() {
-        return None;
-    }
-    let b = ProgressBar::new(total as u64);
-    if let Ok(style) = ProgressStyle::with_template(
-        "{bar:30} {pos}/{len} drives [{elapsed_precise}, eta {eta}] {wide_msg}",
-    ) {
-        b.set_style(style);
-    }
-    Some(b)
-}
-
 /// Runs `batch`.
 pub fn run(a: BatchArgs, quiet: bool, loader: &common::Loader) -> Result<()> {
-    let method: Method = a.method.car()?;
-    let hist_opts = history_options(&a)?;
-    let options = BatchOptions {
-        calibration: CalibrationOptions {
-            method,
-            max_iterations: a.max_iterations as usize,
-            min_speed_mps: a.min_speed,
-            filter: FilterOptions {
-                timing: a.timing.into(),
-                ..Default::default()
-            },
-            ..Default::default()
-        },
-        outage: a.outage.map(|len| OutageOptions {
-            length_s: len,
-            step_s: a.step.unwrap_or(len / 2.0),
-            warmup_s: a.warmup,
-        }),
-        threads: a.threads,
-    };
+    let options = a.options()?;
+    let hist_opts = a.history_options()?;
+    let method = options.calibration.method;
     batch::validate(&options)?;
     let drives = inputs::expand(&a.inputs)?;
     inputs::check_output(&a.out, &drives, "--out")?;
@@ -95,7 +33,7 @@ pub fn run(a: BatchArgs, quiet: bool, loader: &common::Loader) -> Result<()> {
         read.without_truth()
     };
     let load = |p: &std::path::Path| loader.drive_with(p, &read).map_err(|e| format!("{e:#}"));
-    let progress = bar(drives.len(), quiet);
+    let progress = super::progress::drives_bar(drives.len(), quiet);
     let start = Instant::now();
     let results = batch::run(&drives, &load, &options, &|r: &batch::DriveResult| {
         if let Some(b) = &progress {
@@ -125,16 +63,9 @@ pub fn run(a: BatchArgs, quiet: bool, loader: &common::Loader) -> Result<()> {
         }
     }
     drop(err);
-    let mut text = output::summary_line(&results, wall_s, threads);
-    text.push_str(&format!("\nwrote {}", a.out.display()));
-    if let Some(h) = &a.history {
-        text.push_str(&format!("\nwrote {}", h.display()));
-    }
-    text.push('\n');
-    if histories.is_empty() {
-        text.push_str("no drive has a vehicle_id in its vehicle.toml: no calibration history\n");
-    } else {
-        text.push_str(&output::history_table(&histories));
-    }
+    let written: Vec<&std::path::Path> = std::iter::once(a.out.as_path())
+        .chain(a.history.as_deref())
+        .collect();
+    let text = output::summary_text(&results, &histories, wall_s, threads, &written);
     common::quiet_on_broken_pipe(std::io::stdout().lock().write_all(text.as_bytes()))
 }

@@ -16,7 +16,7 @@ use crate::args::calibrate::*;
 
 /// Runs `calibrate`.
 pub fn run(a: CalibrateArgs, load: &common::Loader) -> Result<()> {
-    kinematic::check_range(a.from_s, a.until_s)?;
+    deadreckon_api::load::check_range(a.from_s, a.until_s)?;
     // A params.toml onto the drive's own files; the stack formats write new
     // files into a directory, which may be the drive's.
     if let (Some(out), OutFormat::Params) = (&a.out, a.format) {
@@ -39,7 +39,7 @@ pub fn run(a: CalibrateArgs, load: &common::Loader) -> Result<()> {
     } else {
         read.without_truth()
     };
-    let drive = kinematic::cut(load.drive_with(&a.dir, &read)?, a.from_s, a.until_s)?;
+    let drive = deadreckon_api::load::cut(load.drive_with(&a.dir, &read)?, a.from_s, a.until_s)?;
     let iteration = match a.iteration {
         IterationArg::Anderson => Iteration::Anderson,
         IterationArg::Plain => Iteration::Plain,

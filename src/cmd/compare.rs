@@ -21,7 +21,7 @@ pub fn run(a: CompareArgs, load: &common::Loader) -> Result<()> {
     // A params.toml's stored corrections apply to the drive both estimators read.
     let (params, drive) = match &a.params {
         Some(p) => {
-            let (params, drive) = common::load_params_corrected(p, drive)?;
+            let (params, drive) = deadreckon_api::load::params_corrected(p, drive)?;
             (Some((params, p.clone())), drive)
         }
         None => (None, drive),

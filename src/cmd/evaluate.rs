@@ -19,17 +19,17 @@ pub fn run(a: EvaluateArgs, load: &common::Loader) -> Result<()> {
     if tricycle || a.shape == ShapeArg::DiffDrive {
         return run_kinematic(&a, load, tricycle);
     }
-    let drive = kinematic::cut(load.drive(&a.dir)?, a.from_s, a.until_s)?;
+    let drive = deadreckon_api::load::cut(load.drive(&a.dir)?, a.from_s, a.until_s)?;
     let timing: deadreckon_core::ekf::Timing = a.timing.into();
     // One rule for every metric (deadreckon_api::evaluate::RULE).
     let (chosen, drive) = match &a.params {
         Some(p) => (
             deadreckon_api::evaluate::Parameters {
-                params: common::load_params(p, &drive)?,
+                params: deadreckon_api::load::params(p, &drive)?,
                 label: p.clone(),
                 corrections: None,
             },
-            common::apply_stored(p, drive)?,
+            deadreckon_api::load::apply_stored(p, drive)?,
         ),
         None => deadreckon_api::evaluate::default_parameters(&drive, a.corrections.into())?,
     };

@@ -52,3 +52,18 @@ impl deadreckon_eval::Progress for Steps {
         Steps::step(self, what)
     }
 }
+
+/// A bar counting drives (`batch`), hidden with `--quiet` or when standard
+/// error is not a terminal.
+pub fn drives_bar(total: usize, quiet: bool) -> Option<ProgressBar> {
+    if quiet || !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let b = ProgressBar::new(total as u64);
+    if let Ok(style) = ProgressStyle::with_template(
+        "{bar:30} {pos}/{len} drives [{elapsed_precise}, eta {eta}] {wide_msg}",
+    ) {
+        b.set_style(style);
+    }
+    Some(b)
+}

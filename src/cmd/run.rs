@@ -95,7 +95,7 @@ pub fn run(a: RunArgs, load: &common::Loader) -> Result<()> {
         return Ok(());
     }
     let drive = load.drive(&a.dir)?;
-    let (params, drive) = common::load_params_corrected(&a.params, drive)?;
+    let (params, drive) = deadreckon_api::load::params_corrected(&a.params, drive)?;
     let init_pose = match &a.init_pose {
         Some(s) => {
             let v: Vec<f64> = s

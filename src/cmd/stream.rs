@@ -32,7 +32,7 @@ pub fn run(a: StreamArgs) -> Result<()> {
         let p = Params::nominal(&vehicle);
         (p, default_prior())
     } else {
-        let p = common::read_params_file(&a.params)?;
+        let p = deadreckon_api::load::params_file(&a.params)?;
         let stored = deadreckon_api::corrections::stored_in_file(std::path::Path::new(&a.params))
             .map_err(anyhow::Error::msg)?;
         if stored != Default::default() {

@@ -26,21 +26,12 @@ pub fn run(c: TedrisCommand, load: &super::common::Loader) -> Result<()> {
             until_s,
             json,
         } => {
-            if let (Some(a), Some(b)) = (from_s, until_s) {
-                if a.partial_cmp(&b) != Some(std::cmp::Ordering::Less) {
-                    bail!("--from {a} must be before --until {b}");
-                }
-            }
+            deadreckon_api::load::check_range(from_s, until_s)?;
             let inputs: Vec<&std::path::Path> = std::iter::once(dir.as_path())
                 .chain(config.as_deref())
                 .collect();
             super::common::check_output(&out, &inputs)?;
-            let drive = load.drive(&dir)?;
-            let drive = if from_s.is_some() || until_s.is_some() {
-                drive.time_range(from_s, until_s)
-            } else {
-                drive
-            };
+            let drive = deadreckon_api::load::cut(load.drive(&dir)?, from_s, until_s)?;
             let config = match &config {
                 Some(p) => {
                     let text = std::fs::read_to_string(p)

@@ -138,6 +138,15 @@ pub enum Error {
     /// A file error that names its file, line and column itself.
     #[error(transparent)]
     Io(#[from] deadreckon_io::IoError),
+    /// A scenario that could not be read (its message names the file).
+    #[error(transparent)]
+    Sim(#[from] deadreckon_sim::SimError),
+    /// An evaluation or comparison failed (its message says which step).
+    #[error(transparent)]
+    Eval(#[from] deadreckon_eval::Error),
+    /// A report could not be built or written.
+    #[error(transparent)]
+    Report(#[from] deadreckon_report::ReportError),
     /// The request does not fit the data or the other options (a range
     /// outside the drive, a method the vehicle's shape does not take).
     #[error("{0}")]

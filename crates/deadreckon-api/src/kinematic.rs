@@ -18,34 +18,8 @@ use deadreckon_core::{Drive, Track};
 use deadreckon_io::kinematic_toml::{is_kinematic_params, KinematicParamsFile};
 
 use crate::error::{invalid, While};
+use crate::load::check_range;
 use crate::Error;
-
-/// The one rule for a time range on the drive clock (`--from`, `--until`,
-/// Python's `from_s`, `until_s`): both finite, `from` before `until`.
-pub fn check_range(from: Option<f64>, until: Option<f64>) -> Result<(), Error> {
-    for v in [from, until].into_iter().flatten() {
-        if !v.is_finite() {
-            invalid!("--from / --until must be finite, got {v}");
-        }
-    }
-    if let (Some(a), Some(b)) = (from, until) {
-        if a.partial_cmp(&b) != Some(std::cmp::Ordering::Less) {
-            invalid!("--from {a} must be before --until {b}");
-        }
-    }
-    Ok(())
-}
-
-/// The drive cut to `[from, until)` (checked by [`check_range`]); the
-/// drive itself when neither is given.
-pub fn cut(drive: Drive, from: Option<f64>, until: Option<f64>) -> Result<Drive, Error> {
-    check_range(from, until)?;
-    Ok(if from.is_some() || until.is_some() {
-        drive.time_range(from, until)
-    } else {
-        drive
-    })
-}
 
 /// Whether `path` is a recording read through a kinematic shape (a
 /// tricycle `dataset.txt`), as the format detection says.

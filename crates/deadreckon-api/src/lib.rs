@@ -33,11 +33,14 @@
 pub mod calibrate;
 pub mod checks;
 pub mod corrections;
+pub mod demo;
 pub mod evaluate;
 pub mod import;
 pub mod json;
 pub mod kinematic;
+pub mod load;
 pub mod options;
+pub mod report;
 pub mod source;
 pub mod tedris;
 pub mod text;

@@ -41,10 +41,9 @@ impl Source {
     }
 }
 
-/// A named parameter set for the report.
+/// A parameter set for the report, named by where it comes from
+/// ([`Source::name`]: a user's `--params` set is "given").
 pub struct NamedParams {
-    /// Display name.
-    pub name: String,
     /// Where it comes from.
     pub source: Source,
     /// Parameters.
@@ -149,7 +148,6 @@ pub fn calibrations(drive: &Drive, steps: &dyn Progress) -> Calibrations {
     let nominal = Params::nominal(&drive.vehicle);
     let mut out = Calibrations {
         sets: vec![NamedParams {
-            name: Source::Nominal.name().into(),
             source: Source::Nominal,
             params: ParamsWithStd {
                 params: nominal,
@@ -173,7 +171,6 @@ pub fn calibrations(drive: &Drive, steps: &dyn Progress) -> Calibrations {
             },
         ) {
             Ok(c) => out.sets.push(NamedParams {
-                name: source.name().into(),
                 source,
                 params: c.estimate,
                 calibration: Some(c),
@@ -364,7 +361,7 @@ pub fn four_wheel_input(
     // Dead reckoning with each parameter set.
     let opts = FilterOptions::default();
     for m in methods {
-        steps.step(&format!("dead reckoning with {}", m.name));
+        steps.step(&format!("dead reckoning with {}", m.source.name()));
         // From the truth's start, or (no truth: the Husky) from the start of
         // the smoothed track as `run` does; the report drew no DR track there.
         let dr = if drive.truth.is_empty() {
@@ -375,12 +372,13 @@ pub fn four_wheel_input(
         };
         match dr {
             Ok(dr) => traj.dead_reckoned.push(rp::MethodPath {
-                method: m.name.clone(),
+                method: m.source.name().into(),
                 path: path_of(&dr),
             }),
-            Err(e) => input
-                .not_computed
-                .push(not_computed(format!("dead reckoning with {}", m.name), &e)),
+            Err(e) => input.not_computed.push(not_computed(
+                format!("dead reckoning with {}", m.source.name()),
+                &e,
+            )),
         }
     }
     input.trajectories = Some(traj);
@@ -389,7 +387,7 @@ pub fn four_wheel_input(
     for m in methods {
         let has_std = m.params.std.to_array().iter().any(|s| *s > 0.0);
         cal.rows.push(rp::CalibrationRow {
-            method: m.name.clone(),
+            method: m.source.name().into(),
             values: param_set(&m.params.params),
             std: has_std.then(|| param_set(&m.params.std)),
         });
@@ -410,7 +408,7 @@ pub fn four_wheel_input(
     if !drive.truth.is_empty() {
         let mut d = rp::Drift::default();
         for m in methods {
-            steps.step(&format!("drift with {}", m.name));
+            steps.step(&format!("drift with {}", m.source.name()));
             let p = &m.params.params;
             let (dr, rs) = match (
                 metrics::drift(drive, p, 100.0, opts.timing),
@@ -420,12 +418,12 @@ pub fn four_wheel_input(
                 (Err(e), _) | (_, Err(e)) => {
                     input
                         .not_computed
-                        .push(not_computed(format!("drift with {}", m.name), &e));
+                        .push(not_computed(format!("drift with {}", m.source.name()), &e));
                     continue;
                 }
             };
             d.methods.push(rp::DriftMethod {
-                method: m.name.clone(),
+                method: m.source.name().into(),
                 error_after_segment_m: dr.errors_m,
                 distance_to_threshold_m: rs.distances_m,
             });
@@ -439,15 +437,16 @@ pub fn four_wheel_input(
             methods: Vec::new(),
         };
         for m in methods {
-            steps.step(&format!("{len} s outages with {}", m.name));
+            steps.step(&format!("{len} s outages with {}", m.source.name()));
             match outage::evaluate(drive, &m.params.params, len, len / 2.0, 5.0, &opts) {
                 Ok(o) => ev.methods.push(rp::MethodSample {
-                    method: m.name.clone(),
+                    method: m.source.name().into(),
                     final_error_m: o.windows.iter().map(|w| w.final_error_m).collect(),
                 }),
-                Err(e) => input
-                    .not_computed
-                    .push(not_computed(format!("{len} s outages with {}", m.name), &e)),
+                Err(e) => input.not_computed.push(not_computed(
+                    format!("{len} s outages with {}", m.source.name()),
+                    &e,
+                )),
             }
         }
         if !ev.methods.is_empty() {

@@ -401,3 +401,25 @@ mod tests {
         );
     }
 }
+
+/// What `batch` prints: the summary line, the files written, and each
+/// vehicle's calibration history (or why there is none).
+pub fn summary_text(
+    results: &[DriveResult],
+    histories: &[VehicleHistory],
+    wall_s: f64,
+    threads: usize,
+    written: &[&Path],
+) -> String {
+    let mut text = summary_line(results, wall_s, threads);
+    for w in written {
+        text.push_str(&format!("\nwrote {}", w.display()));
+    }
+    text.push('\n');
+    if histories.is_empty() {
+        text.push_str("no drive has a vehicle_id in its vehicle.toml: no calibration history\n");
+    } else {
+        text.push_str(&history_table(histories));
+    }
+    text
+}

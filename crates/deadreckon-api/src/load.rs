@@ -1,0 +1,192 @@
+//! Reading what a command is given: drives (a directory or any recording,
+//! with the topic mapping, the wheel-file choice and the plausibility
+//! checks), the car's parameters (`nominal` or a params.toml, with the
+//! corrections it stores), simulated drives written to disk.
+
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+use deadreckon_core::plausibility::Finding;
+use deadreckon_core::{Drive, Params, ParamsWithStd};
+use deadreckon_io::{ReadOptions, WheelFile};
+use deadreckon_sim::{Scenario, SimOutput};
+
+use crate::checks::Checks;
+use crate::error::{invalid, While};
+use crate::Error;
+
+/// How drives are read: the global options `--mapping`, `--skip-checks`
+/// and `--wheels`, passed to each command explicitly (no global state).
+#[derive(Debug, Default)]
+pub struct Loader {
+    /// The mapping file for ROS recordings (`None`: the built-in mapping).
+    pub mapping: Option<PathBuf>,
+    /// Read drives without the cross-stream plausibility checks.
+    pub skip_checks: bool,
+    /// The wheel file to read when a drive directory has both.
+    pub wheels: Option<WheelFile>,
+    /// Told of each warning of the checks as a drive is read (the command
+    /// line prints them on standard error); `None`: kept in
+    /// [`Loader::checks`] only.
+    pub on_warning: Option<fn(&Path, &Finding)>,
+    /// What the checks said of the last drive read.
+    checks: Mutex<Checks>,
+}
+
+impl Loader {
+    /// A loader with these options.
+    pub fn new(
+        mapping: Option<PathBuf>,
+        skip_checks: bool,
+        wheels: Option<WheelFile>,
+        on_warning: Option<fn(&Path, &Finding)>,
+    ) -> Loader {
+        Loader {
+            mapping,
+            skip_checks,
+            wheels,
+            on_warning,
+            checks: Default::default(),
+        }
+    }
+
+    /// Reads a drive from a drive directory or a recording a reader
+    /// understands ([`crate::read_drive_with`]), checked.
+    pub fn drive(&self, path: &Path) -> Result<Drive, Error> {
+        self.drive_with(path, &ReadOptions::default())
+    }
+
+    /// [`Loader::drive`] with reading options for drive directories
+    /// (recordings are read whole); `wheels` fills the wheel-file choice
+    /// they leave open.
+    pub fn drive_with(&self, path: &Path, options: &ReadOptions) -> Result<Drive, Error> {
+        let mut options = options.clone();
+        if options.prefer_wheels.is_none() {
+            options.prefer_wheels = self.wheels;
+        }
+        let drive = crate::read_drive_with(path, &options, self.mapping.as_deref())?;
+        let checks = crate::checks::check(path, &drive, self.skip_checks)?;
+        if let Some(warn) = self.on_warning {
+            for f in &checks.warnings {
+                warn(path, f);
+            }
+        }
+        // A poisoned lock holds a whole `Checks` still: take it.
+        *self.checks.lock().unwrap_or_else(|p| p.into_inner()) = checks;
+        Ok(drive)
+    }
+
+    /// The plausibility checks' verdict on the last drive read, and its
+    /// time span.
+    pub fn checks(&self) -> Checks {
+        self.checks
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .clone()
+    }
+}
+
+/// Reads a params.toml with its standard errors, validated.
+pub fn params_file(spec: &str) -> Result<ParamsWithStd, Error> {
+    let p = deadreckon_io::read_params(Path::new(spec))
+        .doing(|| format!("reading parameters {spec}"))?;
+    p.params
+        .validate()
+        .doing(|| format!("parameters in {spec}"))?;
+    Ok(p)
+}
+
+/// `nominal` (the vehicle's) or a params.toml's parameters.
+pub fn params(spec: &str, drive: &Drive) -> Result<Params, Error> {
+    if spec == "nominal" {
+        return Ok(Params::nominal(&drive.vehicle));
+    }
+    Ok(params_file(spec)?.params)
+}
+
+/// The drive with the corrections stored in the params.toml `spec`
+/// applied (none for `nominal` or a file without them).
+pub fn apply_stored(spec: &str, drive: Drive) -> Result<Drive, Error> {
+    let stored = crate::corrections::stored_in_file(Path::new(spec)).map_err(Error::Invalid)?;
+    Ok(stored.apply(&drive))
+}
+
+/// `nominal` or a params.toml, and the drive with the corrections that
+/// file stores applied (its delays, IMU tilt and gyro scale): the
+/// parameters were calibrated on the corrected streams, and on the raw ones
+/// they are wrong (a tilted, scaled gyro turns the track).
+pub fn params_corrected(spec: &str, drive: Drive) -> Result<(Params, Drive), Error> {
+    let params = params(spec, &drive)?;
+    if spec == "nominal" {
+        return Ok((params, drive));
+    }
+    Ok((params, apply_stored(spec, drive)?))
+}
+
+/// A built-in scenario by name, or a scenario file (`.toml`).
+pub fn scenario(spec: &str) -> Result<Scenario, Error> {
+    let path = Path::new(spec);
+    if path.extension().is_some_and(|e| e == "toml") || path.is_file() {
+        return Ok(Scenario::load(path)?);
+    }
+    Ok(Scenario::builtin(spec)?)
+}
+
+/// Simulates `spec` with `seed` and writes the drive and
+/// `truth_params.toml` into `dir` ([`write_simulated`]).
+pub fn simulate_to(spec: &str, seed: u64, dir: &Path) -> Result<SimOutput, Error> {
+    write_simulated(scenario(spec)?, spec, seed, dir)
+}
+
+/// Simulates a scenario and writes the drive and `truth_params.toml` into
+/// `dir`, whole: a failure leaves no partial drive.
+pub fn write_simulated(
+    sc: Scenario,
+    spec: &str,
+    seed: u64,
+    dir: &Path,
+) -> Result<SimOutput, Error> {
+    let out = deadreckon_sim::simulate(&sc, seed).doing(|| format!("simulating {spec}"))?;
+    deadreckon_io::write_drive_whole(dir, &out.drive, |tmp| {
+        deadreckon_io::write_truth_params(&tmp.join("truth_params.toml"), &out.truth_params)
+    })
+    .doing(|| format!("writing {}", dir.display()))?;
+    Ok(out)
+}
+
+/// The one rule for a time range on the drive clock (`--from`, `--until`):
+/// both finite, `from` before `until`.
+pub fn check_range(from: Option<f64>, until: Option<f64>) -> Result<(), Error> {
+    check_range_named(from, until, ["--from", "--until"])
+}
+
+/// [`check_range`] with the options' names as the caller spells them
+/// (Python's `from_s`, `until_s`).
+pub fn check_range_named(
+    from: Option<f64>,
+    until: Option<f64>,
+    [from_name, until_name]: [&str; 2],
+) -> Result<(), Error> {
+    for v in [from, until].into_iter().flatten() {
+        if !v.is_finite() {
+            invalid!("{from_name} / {until_name} must be finite, got {v}");
+        }
+    }
+    if let (Some(a), Some(b)) = (from, until) {
+        if a.partial_cmp(&b) != Some(std::cmp::Ordering::Less) {
+            invalid!("{from_name} {a} must be before {until_name} {b}");
+        }
+    }
+    Ok(())
+}
+
+/// The drive cut to `[from, until)` (checked by [`check_range`]); the
+/// drive itself when neither is given.
+pub fn cut(drive: Drive, from: Option<f64>, until: Option<f64>) -> Result<Drive, Error> {
+    check_range(from, until)?;
+    Ok(if from.is_some() || until.is_some() {
+        drive.time_range(from, until)
+    } else {
+        drive
+    })
+}

@@ -1,0 +1,89 @@
+//! `deadreckon report`: one self-contained HTML page for a drive. The
+//! calibrations the drive allows (a skipped one is shown with its reason), a
+//! user's parameters as "given", filter health, dead reckoning, drift,
+//! outages ([`deadreckon_eval::report`]) and, with a trained model, the
+//! TedriS sections; written whole by [`deadreckon_report::write_report`].
+
+use std::path::Path;
+
+use deadreckon_core::{Drive, Params, ParamsWithStd};
+use deadreckon_eval::report::{
+    calibrations, four_wheel_input, header, tedris_from_model, NamedParams, Source,
+};
+use deadreckon_eval::Progress;
+use deadreckon_report as rp;
+
+use crate::error::While;
+use crate::Error;
+
+/// What goes into a drive's report besides the drive.
+#[derive(Debug, Clone, Copy)]
+pub struct ReportOptions<'a> {
+    /// The drive's path, named in the header.
+    pub dir: &'a Path,
+    /// A user's parameters (`nominal` or a params.toml), shown as "given".
+    pub params: Option<&'a str>,
+    /// A trained TedriS model: its sections.
+    pub model: Option<&'a Path>,
+    /// The outage length, s (default: the report's and TedriS's own).
+    pub outage_s: Option<f64>,
+}
+
+/// Builds the report of `drive` and writes it to `out`.
+pub fn write(
+    drive: &Drive,
+    o: &ReportOptions,
+    out: &Path,
+    steps: &dyn Progress,
+    footer: &rp::Footer,
+) -> Result<(), Error> {
+    let mut methods = calibrations(drive, steps);
+    if let Some(p) = o.params {
+        methods.sets.push(NamedParams {
+            source: Source::Given,
+            params: ParamsWithStd {
+                params: crate::load::params(p, drive)?,
+                std: Params::from_array([0.0; 6]),
+            },
+            calibration: None,
+        });
+    }
+    let mut input = four_wheel_input(drive, &methods, o.outage_s, steps)?;
+    if let Some(m) = o.model {
+        steps.step("TedriS");
+        input.tedris = Some(tedris_section(drive, m, o.outage_s)?);
+    }
+    let name = o
+        .dir
+        .file_name()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| o.dir.display().to_string());
+    input.header = header(
+        drive,
+        &name,
+        vec![("drive".into(), o.dir.display().to_string())],
+    );
+    input.footer = footer.clone();
+    rp::write_report(out, &input).doing(|| format!("writing {}", out.display()))
+}
+
+/// The TedriS sections for a drive and a trained model: the
+/// cross-correlation, the regression tables of every model kind, the
+/// repositories, the training heading against the reference, and the errors
+/// through outages of `outage_s` (default 80 s) at a quarter, half and three
+/// quarters of the drive, as `compare --model` gives them for those windows.
+pub fn tedris_section(
+    drive: &Drive,
+    model_path: &Path,
+    outage_s: Option<f64>,
+) -> Result<rp::Tedris, Error> {
+    let m = crate::tedris::read_model(model_path)?;
+    let windows = deadreckon_eval::compare::default_windows(drive, outage_s.unwrap_or(80.0))?;
+    let c = deadreckon_eval::compare::compare(
+        drive,
+        &windows,
+        None,
+        Some((m, model_path.display().to_string())),
+    )?;
+    Ok(tedris_from_model(drive, &c.model, &c)?)
+}
