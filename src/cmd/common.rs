@@ -91,4 +91,4 @@ pub fn print_comparison(c: &deadreckon_eval::compare::Comparison, t0: f64) -> Re
     Ok(())
 }
 
-pub use deadreckon_api::text::{gated_text, stats_line};
+pub use deadreckon_api::text::gated_text;

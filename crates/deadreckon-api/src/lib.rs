@@ -42,6 +42,7 @@ pub mod load;
 pub mod options;
 pub mod report;
 pub mod source;
+pub mod stream;
 pub mod tedris;
 pub mod text;
 

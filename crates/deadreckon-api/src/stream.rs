@@ -1,0 +1,196 @@
+//! `deadreckon stream`: the four-wheel filter on JSON-line events
+//! (`docs/events.md`), one JSON pose per filter epoch out, resumable from a
+//! state file, optionally learning the six parameters and saving them as it
+//! goes.
+
+use std::io::{BufRead, Write};
+use std::path::{Path, PathBuf};
+
+use deadreckon_core::ekf::FilterOptions;
+use deadreckon_core::online::{LearnTargets, Learned, Online, Start};
+use deadreckon_core::{Params, ParamsWithStd, Vehicle};
+
+use crate::error::While;
+use crate::Error;
+
+/// Prior standard deviations of the learned parameters without a
+/// params.toml `[std]` (those of the offline calibration's augmented pass).
+pub fn default_prior() -> Params {
+    deadreckon_core::calibrate::CalibrationOptions::default().prior_std
+}
+
+/// The starting parameters and the learning prior: `nominal` (the
+/// vehicle's, the default prior) or a params.toml (its values; its `[std]`
+/// where positive — a std of 0 would freeze a parameter —, else the default
+/// prior). The third value is a warning when the file stores corrections
+/// (delays, IMU tilt, gyro scale) that live events cannot be given.
+pub fn start_params(
+    spec: &str,
+    vehicle: &Vehicle,
+) -> Result<(Params, Params, Option<String>), Error> {
+    if spec == "nominal" {
+        return Ok((Params::nominal(vehicle), default_prior(), None));
+    }
+    let p = crate::load::params_file(spec)?;
+    let stored = crate::corrections::stored_in_file(Path::new(spec)).map_err(Error::Invalid)?;
+    let warning = (stored != Default::default()).then(|| {
+        format!(
+            "{spec} stores corrections that `stream` does not apply to the events (delays {:?} s, IMU vertical {:?}, gyro scale error {}); its parameters were calibrated on corrected streams (calibrate --corrections none gives parameters for raw events)",
+            stored.delays_s, stored.up, stored.gyro_scale_error
+        )
+    });
+    let d = default_prior().to_array();
+    let s = p.std.to_array();
+    let prior = Params::from_array(std::array::from_fn(
+        |i| if s[i] > 0.0 { s[i] } else { d[i] },
+    ));
+    Ok((p.params, prior, warning))
+}
+
+/// How a stream runs.
+#[derive(Debug, Clone)]
+pub struct StreamOptions {
+    /// The filter's options.
+    pub filter: FilterOptions,
+    /// Resume from this state file if it exists, and write the state to it
+    /// at the end.
+    pub state: Option<PathBuf>,
+    /// Learn the six parameters (the 11-state filter).
+    pub learn: bool,
+    /// Write the learned parameters here at the end (and every
+    /// `save_every_s` of stream time).
+    pub params_out: Option<PathBuf>,
+    /// Save period, s of stream time.
+    pub save_every_s: Option<f64>,
+    /// Skip (and count) bad lines instead of refusing them.
+    pub skip_bad_lines: bool,
+}
+
+/// What a stream did.
+#[derive(Debug)]
+pub struct StreamSummary {
+    /// The filter's statistics line.
+    pub stats: Option<String>,
+    /// The bad lines skipped.
+    pub skipped: u64,
+    /// The parameters learned at the end.
+    pub learned: Option<Learned>,
+    /// The writing of the poses failed (a closed pipe): the stream stopped
+    /// there, and neither the state nor the learned parameters were written.
+    pub write_error: Option<std::io::Error>,
+}
+
+/// The filter: resumed from `o.state` if that file exists, else started
+/// from GNSS with `params` (learning from `prior` with `o.learn`).
+pub fn open(
+    vehicle: &Vehicle,
+    params: &Params,
+    prior: &Params,
+    o: &StreamOptions,
+) -> Result<Online, Error> {
+    Ok(match o.state.as_ref().filter(|p| p.exists()) {
+        Some(path) => {
+            let text = std::fs::read_to_string(path)
+                .doing(|| format!("reading state {}", path.display()))?;
+            serde_json::from_str::<Online>(&text).doing(|| format!("state {}", path.display()))?
+        }
+        None if o.learn => Online::learning(vehicle, params, prior, &o.filter, Start::Gnss)?,
+        None => Online::new(vehicle, params, &o.filter, Start::Gnss)?,
+    })
+}
+
+/// Runs the filter over the event lines of `input` (named `source` in
+/// errors), writing one JSON pose a line to `out`; saves the learned
+/// parameters as asked and the state at the end. A bad line skipped is
+/// told to `on_skipped` as it comes.
+pub fn run(
+    online: &mut Online,
+    input: impl BufRead,
+    source: &str,
+    mut out: impl Write,
+    o: &StreamOptions,
+    on_skipped: &mut dyn FnMut(&str),
+) -> Result<StreamSummary, Error> {
+    let write_error: std::cell::RefCell<Option<std::io::Error>> = Default::default();
+    let mut emit = |p: deadreckon_core::TrackPoint| {
+        if write_error.borrow().is_some() {
+            return;
+        }
+        let line = serde_json::to_string(&p).unwrap_or_default();
+        if let Err(e) = writeln!(out, "{line}").and_then(|_| out.flush()) {
+            *write_error.borrow_mut() = Some(e);
+        }
+    };
+    let targets = LearnTargets::default();
+    let mut skipped = 0;
+    let mut last_save: Option<f64> = None;
+    for (i, line) in input.lines().enumerate() {
+        let line_no = i as u64 + 1;
+        let line = line.doing(|| format!("{source}: line {line_no}"))?;
+        if line.trim().is_empty() {
+            continue;
+        }
+        let ev = match deadreckon_io::events::parse_line(&line, source, line_no) {
+            Ok(ev) => ev,
+            Err(e) if o.skip_bad_lines => {
+                on_skipped(&e.to_string());
+                skipped += 1;
+                continue;
+            }
+            Err(e) => return Err(e.into()),
+        };
+        online
+            .push(ev, &mut emit)
+            .doing(|| format!("{source}: line {line_no}"))?;
+        if let (Some(every), Some(path)) = (o.save_every_s, &o.params_out) {
+            if last_save.is_none_or(|t| ev.t_s - t >= every) {
+                if let Some(l) = online.learned(&targets) {
+                    save_learned(path, &l)?;
+                    last_save = Some(ev.t_s);
+                }
+            }
+        }
+        if write_error.borrow().is_some() {
+            break;
+        }
+    }
+    if write_error.borrow().is_none() {
+        online.finish(&mut emit)?;
+    }
+    let write_error = write_error.take();
+    let learned = online.learned(&targets);
+    if write_error.is_none() {
+        if let Some(path) = &o.state {
+            let text = serde_json::to_string(&*online).doing(|| "the filter's state".into())?;
+            deadreckon_io::atomic_write(path, |w| w.write_all(text.as_bytes()))
+                .doing(|| format!("writing state {}", path.display()))?;
+        }
+        if let (Some(l), Some(path)) = (&learned, &o.params_out) {
+            save_learned(path, l)?;
+        }
+    }
+    Ok(StreamSummary {
+        stats: online.stats().map(|s| crate::text::stats_line(&s)),
+        skipped,
+        learned,
+        write_error,
+    })
+}
+
+/// Writes learned parameters as a params.toml (method `online`, whether
+/// they are valid yet, the percentage calibrated).
+pub fn save_learned(path: &Path, l: &Learned) -> Result<(), Error> {
+    let mut extra = toml::Table::new();
+    extra.insert("method".into(), "online".into());
+    extra.insert("valid".into(), l.valid.into());
+    extra.insert("calibrated_pct".into(), l.calibrated_pct.into());
+    deadreckon_io::write_params(
+        path,
+        &ParamsWithStd {
+            params: l.params,
+            std: l.std,
+        },
+        Some(&extra),
+    )
+    .doing(|| format!("writing {}", path.display()))
+}
