@@ -168,11 +168,7 @@ pub fn run_tracks<'py>(
         ..Default::default()
     };
     let tracks = py
-        .detach(|| -> Result<Vec<track::Track>, deadreckon_core::Error> {
-            let mut t = track::drive_tracks(&drive, &params, &opts, init_pose)?;
-            t.extend(track::Track::from_truth(&drive));
-            Ok(t)
-        })
+        .detach(|| deadreckon_api::tracks::drive_tracks(&drive, &params, &opts, init_pose))
         .map_err(to_py_err)?;
     let out = PyDict::new(py);
     for t in &tracks {

@@ -58,3 +58,42 @@ pub enum McapContent {
     /// Both in one file.
     Both,
 }
+
+impl RunArgs {
+    /// `--init-pose EAST_M,NORTH_M,YAW_RAD`.
+    pub fn init_pose(&self) -> anyhow::Result<Option<(f64, f64, f64)>> {
+        use anyhow::Context;
+        let Some(s) = &self.init_pose else {
+            return Ok(None);
+        };
+        let v: Vec<f64> = s
+            .split(',')
+            .map(|x| x.trim().parse::<f64>())
+            .collect::<Result<_, _>>()
+            .context("--init-pose EAST_M,NORTH_M,YAW_RAD")?;
+        anyhow::ensure!(
+            v.len() == 3 && v.iter().all(|x| x.is_finite()),
+            "--init-pose needs three finite numbers EAST_M,NORTH_M,YAW_RAD"
+        );
+        Ok(Some((v[0], v[1], v[2])))
+    }
+
+    /// `--track`, `--sync-with`, `--max-diff-s`.
+    pub fn selection(&self) -> deadreckon_api::tracks::Selection {
+        deadreckon_api::tracks::Selection {
+            names: self.track.clone(),
+            sync_with: self.sync_with.clone(),
+            max_diff_s: self.max_diff_s,
+        }
+    }
+}
+
+impl From<McapContent> for deadreckon_ros::McapOptions {
+    fn from(m: McapContent) -> Self {
+        match m {
+            McapContent::Foxglove => Self::FOXGLOVE,
+            McapContent::Ros2 => Self::ROS2,
+            McapContent::Both => Self::BOTH,
+        }
+    }
+}

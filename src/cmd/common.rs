@@ -49,19 +49,6 @@ pub fn quiet_on_broken_pipe(r: std::io::Result<()>) -> Result<()> {
     }
 }
 
-/// Every track of a drive: the estimated ones
-/// ([`deadreckon_core::track::drive_tracks`]) and, with truth, `truth`.
-pub fn all_tracks(
-    drive: &deadreckon_core::Drive,
-    params: &deadreckon_core::Params,
-    opts: &deadreckon_core::ekf::FilterOptions,
-    init_pose: Option<(f64, f64, f64)>,
-) -> Result<Vec<deadreckon_core::Track>> {
-    let mut t = deadreckon_core::track::drive_tracks(drive, params, opts, init_pose)?;
-    t.extend(deadreckon_core::Track::from_truth(drive));
-    Ok(t)
-}
-
 /// The footer: version and command line.
 pub fn footer() -> deadreckon_report::Footer {
     deadreckon_report::Footer {
@@ -73,14 +60,6 @@ pub fn footer() -> deadreckon_report::Footer {
 /// The wheel-health monitor's settings: the defaults, or none with `--no-wheel-monitor`.
 pub fn wheel_monitor(off: bool) -> Option<deadreckon_core::wheel_health::WheelMonitorConfig> {
     (!off).then(Default::default)
-}
-
-/// The wheel-health lines of `run` and `calibrate`.
-pub fn print_wheel_health(h: &deadreckon_core::wheel_health::WheelHealth) -> Result<()> {
-    for l in deadreckon_api::text::wheel_health_lines(h) {
-        outln!("{l}");
-    }
-    Ok(())
 }
 
 /// Prints the comparison table of `compare` and `demo`; `t0` is subtracted from the outage times.

@@ -45,6 +45,7 @@ pub mod source;
 pub mod stream;
 pub mod tedris;
 pub mod text;
+pub mod tracks;
 
 mod error;
 pub use error::{chain_text, Error};

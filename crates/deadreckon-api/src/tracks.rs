@@ -1,0 +1,196 @@
+//! `deadreckon run`: tracks written for other tools. The tracks of a drive
+//! (dead-reckoned, filtered, smoothed, and the truth), those chosen
+//! (optionally time-synced with another, as evo pairs them), written in the
+//! format of the file's extension (CSV, GeoJSON, TUM, KITTI, MCAP), with the
+//! wheel-health verdict of the aided run.
+
+use std::path::{Path, PathBuf};
+
+use deadreckon_core::ekf::FilterOptions;
+use deadreckon_core::wheel_health::WheelHealth;
+use deadreckon_core::{evo, track, Drive, Params, Track};
+use deadreckon_io::TrackFormat;
+
+use crate::error::{invalid, While};
+use crate::Error;
+
+/// Which tracks go into the file.
+#[derive(Debug, Clone, Default)]
+pub struct Selection {
+    /// Those named, in this order (empty: every estimated track).
+    pub names: Vec<String>,
+    /// TUM/KITTI: the track's poses paired in time with this one's.
+    pub sync_with: Option<String>,
+    /// Largest time difference of paired poses, s.
+    pub max_diff_s: f64,
+}
+
+/// Every track of a drive: the estimated ones
+/// ([`deadreckon_core::track::drive_tracks`]) and, with truth, `truth`.
+pub fn drive_tracks(
+    drive: &Drive,
+    params: &Params,
+    opts: &FilterOptions,
+    init_pose: Option<(f64, f64, f64)>,
+) -> Result<Vec<Track>, Error> {
+    let mut t = track::drive_tracks(drive, params, opts, init_pose)?;
+    t.extend(Track::from_truth(drive));
+    Ok(t)
+}
+
+/// The tracks to write into `out`: those named, or every estimated track;
+/// for TUM and KITTI exactly one, optionally synced with another.
+pub fn select(
+    all: &[Track],
+    s: &Selection,
+    out: &Path,
+    format: TrackFormat,
+) -> Result<Vec<Track>, Error> {
+    let mut chosen: Vec<Track> = if s.names.is_empty() {
+        all.iter()
+            .filter(|t| t.name != track::names::TRUTH)
+            .cloned()
+            .collect()
+    } else {
+        s.names
+            .iter()
+            .map(|n| track::find(all, n).cloned())
+            .collect::<Result<_, _>>()?
+    };
+    if format.holds_one_track() && chosen.len() != 1 {
+        let have: Vec<&str> = all.iter().map(|t| t.name.as_str()).collect();
+        invalid!(
+            "{} holds one track: choose it with --track NAME ({})",
+            out.display(),
+            have.join(", ")
+        );
+    }
+    if let Some(with) = &s.sync_with {
+        if !format.holds_one_track() {
+            invalid!("--sync-with is for TUM and KITTI files (one track)");
+        }
+        let other = track::find(all, with)?;
+        chosen[0] = evo::synced(&chosen[0], other, s.max_diff_s)?;
+    }
+    Ok(chosen)
+}
+
+/// Writes tracks in `format` (MCAP with `mcap`'s schemas).
+pub fn write(
+    path: &Path,
+    format: TrackFormat,
+    tracks: &[Track],
+    mcap: deadreckon_ros::McapOptions,
+) -> Result<(), Error> {
+    let context = || format!("writing {}", path.display());
+    match format {
+        TrackFormat::Csv => deadreckon_io::write_track_csv(path, tracks).doing(context),
+        TrackFormat::GeoJson => deadreckon_io::write_track_geojson(path, tracks).doing(context),
+        TrackFormat::Tum => deadreckon_io::write_track_tum(path, &tracks[0]).doing(context),
+        TrackFormat::Kitti => deadreckon_io::write_track_kitti(path, &tracks[0]).doing(context),
+        TrackFormat::Mcap => {
+            deadreckon_ros::write_mcap_with(path, tracks, None, mcap).doing(context)
+        }
+        f => Err(Error::While {
+            what: context(),
+            source: format!("{}: format {f:?} is not written by run", path.display()).into(),
+        }),
+    }
+}
+
+/// What `run` wrote.
+#[derive(Debug)]
+pub struct Written {
+    /// The file.
+    pub path: PathBuf,
+    /// Its format.
+    pub format: TrackFormat,
+    /// Each track's name and number of poses.
+    pub tracks: Vec<(String, usize)>,
+    /// The wheel monitor over the GNSS-aided run, or why it was not run
+    /// (`None`: not asked, as for a tricycle).
+    pub health: Option<Result<WheelHealth, String>>,
+}
+
+impl Written {
+    /// The `--json` object.
+    pub fn json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "wrote": self.path.display().to_string(),
+            "tracks": self.tracks.iter().map(|(name, n)| serde_json::json!({"name": name, "poses": n})).collect::<Vec<_>>(),
+            "wheel_health": self.health.as_ref().and_then(|h| h.as_ref().ok()).map(crate::json::wheel_health_json),
+        })
+    }
+
+    /// The text: the tracks, the wheel health, the files written.
+    pub fn lines(&self) -> Vec<String> {
+        let mut out: Vec<String> = self
+            .tracks
+            .iter()
+            .map(|(name, n)| format!("{name:<14} {n:>7} poses"))
+            .collect();
+        match &self.health {
+            Some(Ok(h)) => out.extend(crate::text::wheel_health_lines(h)),
+            Some(Err(why)) => out.push(format!("wheel health: not checked ({why})")),
+            None => {}
+        }
+        out.push(format!("wrote {}", self.path.display()));
+        if self.format == TrackFormat::Kitti {
+            out.push(format!(
+                "wrote {} (the poses' timestamps)",
+                deadreckon_io::kitti_times_path(&self.path).display()
+            ));
+        }
+        out
+    }
+}
+
+/// Writes the chosen tracks of a car's drive to `out` and checks the
+/// wheels over the aided run (unless the monitor is off).
+pub fn write_car(
+    drive: &Drive,
+    params: &Params,
+    opts: &FilterOptions,
+    init_pose: Option<(f64, f64, f64)>,
+    out: &Path,
+    s: &Selection,
+    mcap: deadreckon_ros::McapOptions,
+) -> Result<Written, Error> {
+    let format = TrackFormat::from_path(out)?;
+    let all = drive_tracks(drive, params, opts, init_pose)?;
+    let t = select(&all, s, out, format)?;
+    write(out, format, &t, mcap)?;
+    // (A drive without GNSS has no aided run: the health is then not checked.)
+    let health = match opts.wheel_monitor {
+        Some(_) => deadreckon_core::wheel_health::check_drive(drive, params, opts)
+            .map_err(|e| e.to_string()),
+        None => Err("--no-wheel-monitor".into()),
+    };
+    Ok(Written {
+        path: out.to_path_buf(),
+        format,
+        tracks: t.iter().map(|t| (t.name.clone(), t.points.len())).collect(),
+        health: Some(health),
+    })
+}
+
+/// Writes a tricycle log's chosen tracks (dead-reckoned through its own
+/// kinematics from the first tracker pose, and the tracker's).
+pub fn write_tricycle(
+    log: &Path,
+    params: &str,
+    out: &Path,
+    s: &Selection,
+    mcap: deadreckon_ros::McapOptions,
+) -> Result<Written, Error> {
+    let all = crate::kinematic::tricycle_tracks(log, params)?;
+    let format = TrackFormat::from_path(out)?;
+    let t = select(&all, s, out, format)?;
+    write(out, format, &t, mcap)?;
+    Ok(Written {
+        path: out.to_path_buf(),
+        format,
+        tracks: t.iter().map(|t| (t.name.clone(), t.points.len())).collect(),
+        health: None,
+    })
+}
