@@ -1,5 +1,9 @@
 //! The arguments of `deadreckon calibrate`.
 
+use deadreckon_core::calibrate::{CalibrationOptions, Iteration, PassState};
+use deadreckon_core::ekf::FilterOptions;
+use deadreckon_core::kinematics::Shape;
+
 use std::path::PathBuf;
 
 use clap::Args;
@@ -113,4 +117,51 @@ pub struct CalibrateArgs {
     /// wheels are then neither dropped nor reported).
     #[arg(long)]
     pub no_wheel_monitor: bool,
+}
+
+impl CalibrateArgs {
+    /// The car's calibration: the method as the user named it and the
+    /// options; a stack format without `--out` refused.
+    pub fn car_options(&self) -> anyhow::Result<(String, CalibrationOptions)> {
+        let a = self;
+        let method = a.method.unwrap_or(super::MethodArg::Rts);
+        let opts = CalibrationOptions {
+            method: method.car()?,
+            state: match a.state {
+                StateArg::Augmented => PassState::Augmented,
+                StateArg::Paper => PassState::Paper,
+            },
+            iteration: match a.iteration {
+                IterationArg::Anderson => Iteration::Anderson,
+                IterationArg::Plain => Iteration::Plain,
+            },
+            max_iterations: a.max_iterations as usize,
+            min_speed_mps: a
+                .min_speed
+                .unwrap_or(Shape::FourWheel.default_min_speed_mps()),
+            filter: FilterOptions {
+                timing: a.timing.into(),
+                wheel_monitor: (!a.no_wheel_monitor).then(Default::default),
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        if a.out.is_none() && a.format != OutFormat::Params {
+            anyhow::bail!(
+                "--format {} needs --out DIR",
+                format!("{:?}", a.format).to_lowercase()
+            );
+        }
+        Ok((method.name().to_string(), opts))
+    }
+}
+
+impl From<OutFormat> for deadreckon_api::calibrate::Export {
+    fn from(f: OutFormat) -> Self {
+        match f {
+            OutFormat::Params => Self::Params,
+            OutFormat::Autoware => Self::Autoware,
+            OutFormat::Eagleye => Self::Eagleye,
+        }
+    }
 }

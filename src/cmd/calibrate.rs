@@ -2,11 +2,8 @@
 //! parameters of the four-wheel car; for a tricycle log, the kinematic
 //! calibration of its seven parameters against the tracker.
 
-use anyhow::{Context, Result};
-use deadreckon_core::calibrate::{CalibrationOptions, Iteration, Method, PassState};
-use deadreckon_core::ekf::FilterOptions;
-
-use deadreckon_core::kinematics::Shape;
+use anyhow::Result;
+use deadreckon_core::calibrate::Method;
 
 use super::common;
 use crate::args::kinematic::ShapeArg;
@@ -26,43 +23,15 @@ pub fn run(a: CalibrateArgs, load: &common::Loader) -> Result<()> {
     if tricycle || a.shape == ShapeArg::DiffDrive {
         return run_kinematic(&a, load, tricycle);
     }
-    let method_name = a
-        .method
-        .unwrap_or(common::MethodArg::Rts)
-        .name()
-        .to_string();
-    let method: Method = a.method.unwrap_or(common::MethodArg::Rts).car()?;
+    let (method_name, opts) = a.car_options()?;
     // Only the truth calibration reads truth.csv.
     let read = deadreckon_io::ReadOptions::default();
-    let read = if method == Method::Truth {
+    let read = if opts.method == Method::Truth {
         read
     } else {
         read.without_truth()
     };
     let drive = deadreckon_api::load::cut(load.drive_with(&a.dir, &read)?, a.from_s, a.until_s)?;
-    let iteration = match a.iteration {
-        IterationArg::Anderson => Iteration::Anderson,
-        IterationArg::Plain => Iteration::Plain,
-    };
-    let state = match a.state {
-        StateArg::Augmented => PassState::Augmented,
-        StateArg::Paper => PassState::Paper,
-    };
-    let opts = CalibrationOptions {
-        method,
-        state,
-        iteration,
-        max_iterations: a.max_iterations as usize,
-        min_speed_mps: a
-            .min_speed
-            .unwrap_or(Shape::FourWheel.default_min_speed_mps()),
-        filter: FilterOptions {
-            timing: a.timing.into(),
-            wheel_monitor: common::wheel_monitor(a.no_wheel_monitor),
-            ..Default::default()
-        },
-        ..Default::default()
-    };
     let cc = deadreckon_api::calibrate::calibrate_car(
         &drive,
         &method_name,
@@ -70,39 +39,15 @@ pub fn run(a: CalibrateArgs, load: &common::Loader) -> Result<()> {
         a.corrections.into(),
         &a.dir.display().to_string(),
     )?;
-    let mut written = Vec::new();
-    if let Some(out) = &a.out {
-        let export = || deadreckon_io::stack_params::StackExport {
-            estimate: &cc.calibration.estimate,
-            samples: cc.calibration.samples,
-            noise: &drive.vehicle.noise,
-            provenance: cc.provenance(&a.dir.display().to_string()),
-        };
-        let context = || format!("writing {}", out.display());
-        match a.format {
-            OutFormat::Params => {
-                deadreckon_io::write_params(
-                    out,
-                    &cc.calibration.estimate,
-                    Some(&cc.params_extra()),
-                )
-                .with_context(context)?;
-                written.push(out.clone());
-            }
-            OutFormat::Autoware => written.extend(
-                deadreckon_io::stack_params::write_autoware(out, &export())
-                    .with_context(context)?,
-            ),
-            OutFormat::Eagleye => written.extend(
-                deadreckon_io::stack_params::write_eagleye(out, &export()).with_context(context)?,
-            ),
-        }
-    } else if a.format != OutFormat::Params {
-        anyhow::bail!(
-            "--format {} needs --out DIR",
-            format!("{:?}", a.format).to_lowercase()
-        );
-    }
+    let written = match &a.out {
+        Some(out) => cc.write(
+            out,
+            a.format.into(),
+            &drive.vehicle.noise,
+            &a.dir.display().to_string(),
+        )?,
+        None => Vec::new(),
+    };
     if a.json {
         common::print_json(load, cc.json())?;
     } else {

@@ -209,3 +209,52 @@ fn steering_toml(st: &SteeringCalibration) -> toml::Table {
     t.insert("samples".into(), (st.samples as i64).into());
     t
 }
+
+/// The file formats a car calibration is written in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Export {
+    /// deadreckon's params.toml (a file).
+    Params,
+    /// Autoware's imu_corrector and vehicle_velocity_converter parameter
+    /// files (into a directory).
+    Autoware,
+    /// Eagleye's configuration keys and saved velocity scale factor (into a
+    /// directory).
+    Eagleye,
+}
+
+impl CarCalibration {
+    /// Writes the calibration of the drive `source` (its path, for the
+    /// provenance; `noise`: its vehicle's noise) to `out` in `format`;
+    /// returns the files written.
+    pub fn write(
+        &self,
+        out: &std::path::Path,
+        format: Export,
+        noise: &deadreckon_core::vehicle::Noise,
+        source: &str,
+    ) -> Result<Vec<std::path::PathBuf>, Error> {
+        use crate::error::While;
+        use deadreckon_io::stack_params;
+        let export = || stack_params::StackExport {
+            estimate: &self.calibration.estimate,
+            samples: self.calibration.samples,
+            noise,
+            provenance: self.provenance(source),
+        };
+        let context = || format!("writing {}", out.display());
+        match format {
+            Export::Params => {
+                deadreckon_io::write_params(
+                    out,
+                    &self.calibration.estimate,
+                    Some(&self.params_extra()),
+                )
+                .doing(context)?;
+                Ok(vec![out.to_path_buf()])
+            }
+            Export::Autoware => stack_params::write_autoware(out, &export()).doing(context),
+            Export::Eagleye => stack_params::write_eagleye(out, &export()).doing(context),
+        }
+    }
+}
