@@ -113,3 +113,36 @@ pub struct EvaluateArgs {
     #[arg(long = "until", value_parser = super::finite, allow_hyphen_values = true)]
     pub until_s: Option<f64>,
 }
+
+impl EvaluateArgs {
+    /// What a car's drive is measured by: `--outage`, else `--metric`.
+    pub fn metric(&self) -> deadreckon_api::evaluate::Metric<'_> {
+        use deadreckon_api::evaluate::Metric;
+        if let Some(len) = self.outage {
+            return Metric::Outages {
+                length_s: len,
+                step_s: self.step.unwrap_or(len / 2.0),
+                warmup_s: self.warmup,
+            };
+        }
+        match self.metric {
+            MetricArg::Drift => Metric::Drift {
+                segment_m: self.segment_m,
+            },
+            MetricArg::Reset1m => Metric::Reset {
+                threshold_m: self.threshold_m,
+            },
+            MetricArg::Rpe | MetricArg::Ape => Metric::Evo(deadreckon_api::json::EvoQuery {
+                metric: self.metric.name(),
+                track: &self.track,
+                reference: &self.reference,
+                max_diff_s: self.max_diff_s,
+                delta_m: self.delta_m,
+                pairs_from: match self.pairs_from {
+                    PairsFromArg::Estimate => "estimate",
+                    PairsFromArg::Reference => "reference",
+                },
+            }),
+        }
+    }
+}

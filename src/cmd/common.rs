@@ -69,5 +69,3 @@ pub fn print_comparison(c: &deadreckon_eval::compare::Comparison, t0: f64) -> Re
     }
     Ok(())
 }
-
-pub use deadreckon_api::text::gated_text;

@@ -6,6 +6,8 @@
 use deadreckon_core::calibrate::{self, CalibrationOptions};
 use deadreckon_core::ekf::{FilterOptions, Timing};
 use deadreckon_core::evo::{self, TrajectoryError};
+use deadreckon_core::metrics::{self, DriftResult, ResetResult, Summary};
+use deadreckon_core::outage::{self, OutageEvaluation};
 use deadreckon_core::timing::{Corrections, Which};
 use deadreckon_core::{track, Drive, Params};
 
@@ -83,8 +85,7 @@ pub fn evo_metric(
         timing,
         ..Default::default()
     };
-    let mut all = track::drive_tracks(drive, params, &opts, None)?;
-    all.extend(track::Track::from_truth(drive));
+    let all = crate::tracks::drive_tracks(drive, params, &opts, None)?;
     let reference = &evo::as_written(track::find(&all, q.reference)?);
     let estimate = &evo::as_written(track::find(&all, q.track)?);
     let step = || format!("{} of `{}` against `{}`", q.metric, q.track, q.reference);
@@ -111,4 +112,151 @@ pub fn evo_metric(
         step: step(),
         source,
     })
+}
+
+/// `params.toml` or `nominal` given by the user, with the drive the
+/// corrections the file stores were applied to.
+pub fn given_parameters(spec: &str, drive: Drive) -> Result<(Parameters, Drive), Error> {
+    Ok((
+        Parameters {
+            params: crate::load::params(spec, &drive)?,
+            label: spec.to_string(),
+            corrections: None,
+        },
+        crate::load::apply_stored(spec, drive)?,
+    ))
+}
+
+/// What `evaluate` measures on a car's drive.
+#[derive(Debug, Clone, Copy)]
+pub enum Metric<'a> {
+    /// Drift per `segment_m` of path, reset to the truth at each segment.
+    Drift {
+        /// Segment length, m.
+        segment_m: f64,
+    },
+    /// Distance travelled before the error reaches `threshold_m`, then reset.
+    Reset {
+        /// Error threshold, m.
+        threshold_m: f64,
+    },
+    /// evo's RPE or APE of one track against another.
+    Evo(crate::json::EvoQuery<'a>),
+    /// Sliding GNSS outages.
+    Outages {
+        /// Outage length, s.
+        length_s: f64,
+        /// Step between windows, s.
+        step_s: f64,
+        /// GNSS-aided time before the first window, s.
+        warmup_s: f64,
+    },
+}
+
+/// A metric's result.
+#[derive(Debug, Clone)]
+pub enum Measured<'a> {
+    /// Drift per segment, with the segment length.
+    Drift(DriftResult, f64),
+    /// Distances before the threshold, with the threshold.
+    Reset(ResetResult, f64),
+    /// RPE or APE, with what was asked.
+    Evo(crate::json::EvoQuery<'a>, evo::TrajectoryError),
+    /// Sliding outages, with their length.
+    Outages(f64, OutageEvaluation),
+}
+
+/// What `evaluate` measured on a car's drive, and with which parameters.
+#[derive(Debug, Clone)]
+pub struct Evaluation<'a> {
+    /// Where the parameters come from.
+    pub source: String,
+    /// The corrections estimated before the calibration, if any.
+    pub corrections: Option<Corrections>,
+    /// The result.
+    pub measured: Measured<'a>,
+}
+
+/// Measures `metric` on `drive` with `parameters` (their drive: corrected
+/// as they ask).
+pub fn measure<'a>(
+    drive: &Drive,
+    parameters: Parameters,
+    timing: Timing,
+    metric: Metric<'a>,
+) -> Result<Evaluation<'a>, Error> {
+    let params = &parameters.params;
+    let measured = match metric {
+        Metric::Drift { segment_m } => {
+            Measured::Drift(metrics::drift(drive, params, segment_m, timing)?, segment_m)
+        }
+        Metric::Reset { threshold_m } => Measured::Reset(
+            metrics::reset_on_error(drive, params, threshold_m, timing)?,
+            threshold_m,
+        ),
+        Metric::Evo(q) => Measured::Evo(q, evo_metric(drive, params, timing, &q)?),
+        Metric::Outages {
+            length_s,
+            step_s,
+            warmup_s,
+        } => {
+            let base = FilterOptions {
+                timing,
+                ..Default::default()
+            };
+            Measured::Outages(
+                length_s,
+                outage::evaluate(drive, params, length_s, step_s, warmup_s, &base)?,
+            )
+        }
+    };
+    Ok(Evaluation {
+        source: parameters.label,
+        corrections: parameters.corrections,
+        measured,
+    })
+}
+
+impl Evaluation<'_> {
+    /// The `--json` object.
+    pub fn json(&self) -> serde_json::Value {
+        let mut v = match &self.measured {
+            Measured::Outages(len, ev) => crate::json::outage_json(*len, &self.source, ev),
+            Measured::Drift(r, seg) => crate::json::drift_json(r, *seg),
+            Measured::Reset(r, th) => crate::json::reset_json(r, *th),
+            Measured::Evo(q, r) => crate::json::evo_json(q, r),
+        };
+        if !matches!(self.measured, Measured::Outages(..)) {
+            v["params"] = self.source.clone().into();
+        }
+        if let Some(c) = &self.corrections {
+            v["corrections"] = crate::corrections::corrections_json(c);
+        }
+        v
+    }
+
+    /// The text.
+    pub fn lines(&self) -> Vec<String> {
+        let gated = |g| format!("rejected by the χ² gates: {}", crate::text::gated_text(g));
+        match &self.measured {
+            Measured::Outages(_, ev) => {
+                crate::text::outage_lines(ev, &self.source, self.corrections.as_ref())
+            }
+            Measured::Drift(r, seg) => {
+                let s = Summary::of(&r.errors_pct());
+                vec![
+                    format!("drift per {seg} m over {} segments: mean {:.3}%, std {:.3}%, median {:.3}%, max {:.3}%", s.n, s.mean, s.std, s.median, s.max),
+                    gated(&r.gates),
+                ]
+            }
+            Measured::Reset(r, th) => {
+                let s = Summary::of(&r.distances_m);
+                vec![
+                    format!("distance before {th} m of error over {} resets: mean {:.1} m, median {:.1} m, min {:.1} m, max {:.1} m", s.n, s.mean, s.median, s.min, s.max),
+                    gated(&r.gates),
+                ]
+            }
+            Measured::Evo(q, r) => crate::text::evo_lines(q, r),
+        }
+    }
 }
