@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use clap::{Subcommand, ValueEnum};
+use clap::{Args, Subcommand, ValueEnum};
 use deadreckon_tedris::ReferenceSource;
 
 /// The reference heading the model learns from.
@@ -62,69 +62,77 @@ pub enum Kind {
 pub enum TedrisCommand {
     /// Train a model on a drive (GNSS good throughout) and print the regression
     /// table, lag, µ, W_L, W_H, ε and the repository fill.
-    Train {
-        /// The drive directory.
-        dir: PathBuf,
-        /// Where to write the model (JSON).
-        #[arg(long)]
-        out: PathBuf,
-        /// Reference heading.
-        #[arg(long, value_enum, default_value = "auto")]
-        reference: Reference,
-        /// Regression kind.
-        #[arg(long, value_enum, default_value = "auto")]
-        model: Kind,
-        /// τ, samples per block.
-        #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
-        tau: Option<u32>,
-        /// k of ε = k·(W_H − W_L); `inf` for one repository (the paper's robot).
-        #[arg(long, value_parser = epsilon_k)]
-        epsilon_k: Option<EpsilonK>,
-        /// Fit each repository separately, as in the paper (default: pooled slopes).
-        #[arg(long)]
-        separate_repositories: bool,
-        /// The method: `paper` (the paper's alone: its regression, ε = 1.5,
-        /// separate repositories, eq. 6) or `extended` (default; see docs/tedris.md).
-        #[arg(long, value_enum)]
-        variant: Option<VariantArg>,
-        /// A TedriS configuration (JSON; missing keys take their defaults; every
-        /// key with its unit and default: docs/tedris.md).
-        #[arg(long)]
-        config: Option<PathBuf>,
-        /// Train only on data from this time on, s (drive clock).
-        #[arg(long = "from", value_parser = super::finite, allow_hyphen_values = true)]
-        from_s: Option<f64>,
-        /// Train only on data before this time, s (drive clock).
-        #[arg(long = "until", value_parser = super::finite, allow_hyphen_values = true)]
-        until_s: Option<f64>,
-        /// Print JSON instead of tables.
-        #[arg(long)]
-        json: bool,
-    },
+    Train(TrainArgs),
     /// Blank GNSS in the outage windows, predict through them, write the track and
     /// report the error over each outage.
-    Run {
-        /// The drive directory.
-        dir: PathBuf,
-        /// The trained model.
-        #[arg(long)]
-        model: PathBuf,
-        /// An outage window `START_S:END_S` (drive clock); repeatable.
-        #[arg(long = "outage", required = true)]
-        outages: Vec<String>,
-        /// Where to write the track (CSV).
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// Reference heading.
-        #[arg(long, value_enum, default_value = "auto")]
-        reference: Reference,
-        /// The error threshold reported as `time_to_threshold_s`, m.
-        #[arg(long, default_value_t = 1.0, value_parser = super::positive)]
-        threshold_m: f64,
-        /// Print JSON.
-        #[arg(long)]
-        json: bool,
-    },
+    Run(RunArgs),
+}
+
+/// Arguments of `tedris train`.
+#[derive(Args, Debug)]
+pub struct TrainArgs {
+    /// The drive directory.
+    pub dir: PathBuf,
+    /// Where to write the model (JSON).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Reference heading.
+    #[arg(long, value_enum, default_value = "auto")]
+    pub reference: Reference,
+    /// Regression kind.
+    #[arg(long, value_enum, default_value = "auto")]
+    pub model: Kind,
+    /// τ, samples per block.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    pub tau: Option<u32>,
+    /// k of ε = k·(W_H − W_L); `inf` for one repository (the paper's robot).
+    #[arg(long, value_parser = epsilon_k)]
+    pub epsilon_k: Option<EpsilonK>,
+    /// Fit each repository separately, as in the paper (default: pooled slopes).
+    #[arg(long)]
+    pub separate_repositories: bool,
+    /// The method: `paper` (the paper's alone: its regression, ε = 1.5,
+    /// separate repositories, eq. 6) or `extended` (default; see docs/tedris.md).
+    #[arg(long, value_enum)]
+    pub variant: Option<VariantArg>,
+    /// A TedriS configuration (JSON; missing keys take their defaults; every
+    /// key with its unit and default: docs/tedris.md).
+    #[arg(long)]
+    pub config: Option<PathBuf>,
+    /// Train only on data from this time on, s (drive clock).
+    #[arg(long = "from", value_parser = super::finite, allow_hyphen_values = true)]
+    pub from_s: Option<f64>,
+    /// Train only on data before this time, s (drive clock).
+    #[arg(long = "until", value_parser = super::finite, allow_hyphen_values = true)]
+    pub until_s: Option<f64>,
+    /// Print JSON instead of tables.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Arguments of `tedris run`.
+#[derive(Args, Debug)]
+pub struct RunArgs {
+    /// The drive directory.
+    pub dir: PathBuf,
+    /// The trained model.
+    #[arg(long)]
+    pub model: PathBuf,
+    /// An outage window `START_S:END_S` (drive clock); repeatable.
+    #[arg(long = "outage", required = true)]
+    pub outages: Vec<String>,
+    /// Where to write the track (CSV).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Reference heading.
+    #[arg(long, value_enum, default_value = "auto")]
+    pub reference: Reference,
+    /// The error threshold reported as `time_to_threshold_s`, m.
+    #[arg(long, default_value_t = 1.0, value_parser = super::positive)]
+    pub threshold_m: f64,
+    /// Print JSON.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// `--epsilon-k`: a positive finite factor, or `inf` (`None`) for one
@@ -137,5 +145,51 @@ fn epsilon_k(s: &str) -> std::result::Result<EpsilonK, String> {
         Ok(EpsilonK(None))
     } else {
         super::positive(s).map(|k| EpsilonK(Some(k)))
+    }
+}
+
+impl TrainArgs {
+    /// The training options, with the configuration file read.
+    pub fn options(&self) -> anyhow::Result<deadreckon_api::tedris::TrainOptions> {
+        use anyhow::Context;
+        use deadreckon_tedris::{ModelKind, TedrisConfig, Variant};
+        let config = match &self.config {
+            Some(p) => {
+                let text = std::fs::read_to_string(p)
+                    .with_context(|| format!("reading {}", p.display()))?;
+                Some(
+                    serde_json::from_str::<TedrisConfig>(&text)
+                        .with_context(|| format!("parsing {}", p.display()))?,
+                )
+            }
+            None => None,
+        };
+        Ok(deadreckon_api::tedris::TrainOptions {
+            reference: self.reference.source(),
+            config,
+            variant: self.variant.map(|v| match v {
+                VariantArg::Paper => Variant::Paper,
+                VariantArg::Extended => Variant::Extended,
+            }),
+            model: match self.model {
+                Kind::Auto => None,
+                Kind::Paper => Some(ModelKind::Paper),
+                Kind::Distance => Some(ModelKind::Distance),
+                Kind::Arx => Some(ModelKind::Arx),
+                Kind::Baseline => Some(ModelKind::Baseline),
+            },
+            tau_samples: self.tau.map(|t| t as usize),
+            epsilon_factor: self.epsilon_k.map(|k| k.0),
+            separate_repositories: self.separate_repositories,
+        })
+    }
+}
+
+impl RunArgs {
+    /// The `--outage START_S:END_S` windows.
+    pub fn outage_windows(
+        &self,
+    ) -> Result<Vec<deadreckon_tedris::Outage>, deadreckon_tedris::Error> {
+        self.outages.iter().map(|s| s.parse()).collect()
     }
 }

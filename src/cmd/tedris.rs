@@ -1,139 +1,60 @@
 //! `deadreckon tedris train|run`: TedriS over a drive directory (the library is
-//! `deadreckon-tedris`; this file parses, calls and prints).
+//! `deadreckon-tedris`, the commands' steps `deadreckon_api::tedris`).
 
-use anyhow::{bail, Context, Result};
-use deadreckon_tedris::{
-    run_outages_with, ModelKind, Outage, ReferenceSource, RunOptions, TedrisConfig, TedrisModel,
-    Variant,
-};
+use anyhow::Result;
+use deadreckon_api::tedris;
+use deadreckon_tedris::RunOptions;
 
-use crate::args::tedris::*;
+use super::common;
+use crate::args::tedris::{RunArgs, TedrisCommand, TrainArgs};
 
 /// Runs a TedriS subcommand.
-pub fn run(c: TedrisCommand, load: &super::common::Loader) -> Result<()> {
+pub fn run(c: TedrisCommand, load: &common::Loader) -> Result<()> {
     match c {
-        TedrisCommand::Train {
-            dir,
-            out,
-            reference,
-            model,
-            tau,
-            epsilon_k,
-            separate_repositories,
-            variant,
-            config,
-            from_s,
-            until_s,
-            json,
-        } => {
-            deadreckon_api::load::check_range(from_s, until_s)?;
-            let inputs: Vec<&std::path::Path> = std::iter::once(dir.as_path())
-                .chain(config.as_deref())
-                .collect();
-            super::common::check_output(&out, &inputs)?;
-            let drive = deadreckon_api::load::cut(load.drive(&dir)?, from_s, until_s)?;
-            let config = match &config {
-                Some(p) => {
-                    let text = std::fs::read_to_string(p)
-                        .with_context(|| format!("reading {}", p.display()))?;
-                    Some(
-                        serde_json::from_str::<TedrisConfig>(&text)
-                            .with_context(|| format!("parsing {}", p.display()))?,
-                    )
-                }
-                None => None,
-            };
-            let options = deadreckon_api::tedris::TrainOptions {
-                reference: reference.source(),
-                config,
-                variant: variant.map(|v| match v {
-                    VariantArg::Paper => Variant::Paper,
-                    VariantArg::Extended => Variant::Extended,
-                }),
-                model: match model {
-                    Kind::Auto => None,
-                    Kind::Paper => Some(ModelKind::Paper),
-                    Kind::Distance => Some(ModelKind::Distance),
-                    Kind::Arx => Some(ModelKind::Arx),
-                    Kind::Baseline => Some(ModelKind::Baseline),
-                },
-                tau_samples: tau.map(|t| t as usize),
-                epsilon_factor: epsilon_k.map(|k| k.0),
-                separate_repositories,
-            };
-            let (m, source) = deadreckon_api::tedris::train(&drive, &options)?;
-            let text = serde_json::to_string_pretty(&m)?;
-            // Whole or not at all (a temporary beside it, renamed), with
-            // the permissions of a model it replaces.
-            deadreckon_io::atomic_write(&out, |w| w.write_all(text.as_bytes()))
-                .with_context(|| format!("writing {}", out.display()))?;
-            if json {
-                super::common::print_json(
-                    load,
-                    deadreckon_api::json::tedris_train_json(&m, source),
-                )?;
-            } else {
-                print_train(&m, source)?;
-                outln!("model written to {}", out.display());
-            }
-            Ok(())
-        }
-        TedrisCommand::Run {
-            dir,
-            model,
-            outages,
-            out,
-            reference,
-            threshold_m,
-            json,
-        } => {
-            if let Some(p) = &out {
-                super::common::check_output(p, &[&dir, &model])?;
-            }
-            let m = deadreckon_api::tedris::read_model(&model)?;
-            let outages: Vec<Outage> = outages
-                .iter()
-                .map(|s| s.parse())
-                .collect::<Result<_, _>>()?;
-            if !(threshold_m.is_finite() && threshold_m > 0.0) {
-                bail!("--threshold-m must be a positive number");
-            }
-            let drive = load.drive(&dir)?;
-            let opts = RunOptions {
-                source: reference.source(),
-                threshold_m: Some(threshold_m),
-            };
-            let r = run_outages_with(&drive, &m, &outages, &opts)?;
-            if let Some(p) = &out {
-                deadreckon_io::write_track_csv(p, std::slice::from_ref(&r.track))
-                    .with_context(|| format!("writing {}", p.display()))?;
-            }
-            if json {
-                let v = serde_json::json!({
-                    "outages": r.outages,
-                    "reference": r.reference,
-                    "source": r.source,
-                    "model": m.chosen.name(),
-                    "checks": r.machine.checks(),
-                    "track": out.as_ref().map(|p| p.display().to_string()),
-                });
-                super::common::print_json(load, v)?;
-            } else {
-                for l in deadreckon_api::text::tedris_outage_lines(&r, threshold_m) {
-                    outln!("{l}");
-                }
-                if let Some(p) = &out {
-                    outln!("track written to {}", p.display());
-                }
-            }
-            Ok(())
-        }
+        TedrisCommand::Train(a) => train(a, load),
+        TedrisCommand::Run(a) => run_outages(a, load),
     }
 }
 
-fn print_train(m: &TedrisModel, source: ReferenceSource) -> anyhow::Result<()> {
-    for l in deadreckon_api::text::tedris_train_lines(m, source) {
-        outln!("{l}");
+/// `tedris train`.
+fn train(a: TrainArgs, load: &common::Loader) -> Result<()> {
+    deadreckon_api::load::check_range(a.from_s, a.until_s)?;
+    let inputs: Vec<&std::path::Path> = std::iter::once(a.dir.as_path())
+        .chain(a.config.as_deref())
+        .collect();
+    common::check_output(&a.out, &inputs)?;
+    let drive = deadreckon_api::load::cut(load.drive(&a.dir)?, a.from_s, a.until_s)?;
+    let (m, source) = tedris::train(&drive, &a.options()?)?;
+    tedris::write_model(&a.out, &m)?;
+    if a.json {
+        common::print_json(load, deadreckon_api::json::tedris_train_json(&m, source))
+    } else {
+        common::print_lines(deadreckon_api::text::tedris_train_lines(&m, source))?;
+        outln!("model written to {}", a.out.display());
+        Ok(())
     }
-    Ok(())
+}
+
+/// `tedris run`.
+fn run_outages(a: RunArgs, load: &common::Loader) -> Result<()> {
+    if let Some(p) = &a.out {
+        common::check_output(p, &[&a.dir, &a.model])?;
+    }
+    let m = tedris::read_model(&a.model)?;
+    let outages = a.outage_windows()?;
+    let drive = load.drive(&a.dir)?;
+    let opts = RunOptions {
+        source: a.reference.source(),
+        threshold_m: Some(a.threshold_m),
+    };
+    let r = tedris::run_outages(&drive, &m, &outages, &opts, a.out.as_deref())?;
+    if a.json {
+        common::print_json(load, tedris::run_json(&r, &m, a.out.as_deref()))
+    } else {
+        common::print_lines(deadreckon_api::text::tedris_outage_lines(&r, a.threshold_m))?;
+        if let Some(p) = &a.out {
+            outln!("track written to {}", p.display());
+        }
+        Ok(())
+    }
 }

@@ -147,6 +147,10 @@ pub enum Error {
     /// A report could not be built or written.
     #[error(transparent)]
     Report(#[from] deadreckon_report::ReportError),
+    /// TedriS through outages failed, or an outage window is malformed (its
+    /// message says which and why).
+    #[error(transparent)]
+    Outages(deadreckon_tedris::Error),
     /// The request does not fit the data or the other options (a range
     /// outside the drive, a method the vehicle's shape does not take).
     #[error("{0}")]

@@ -70,6 +70,50 @@ pub fn train(drive: &Drive, o: &TrainOptions) -> Result<(TedrisModel, ReferenceS
     deadreckon_tedris::train(drive, cfg, source).map_err(Error::Tedris)
 }
 
+/// Writes a model as JSON, whole or not at all (a temporary beside it,
+/// renamed), with the permissions of a model it replaces.
+pub fn write_model(path: &Path, m: &TedrisModel) -> Result<(), Error> {
+    use crate::error::While;
+    let text = serde_json::to_string_pretty(m).doing(|| "the model as JSON".into())?;
+    deadreckon_io::atomic_write(path, |w| w.write_all(text.as_bytes()))
+        .doing(|| format!("writing {}", path.display()))
+}
+
+/// TedriS through outages as `tedris run` does it: the model run through
+/// them, the track written as CSV to `track` if given.
+pub fn run_outages(
+    drive: &Drive,
+    model: &TedrisModel,
+    outages: &[deadreckon_tedris::Outage],
+    opts: &deadreckon_tedris::RunOptions,
+    track: Option<&Path>,
+) -> Result<deadreckon_tedris::OutageReport, Error> {
+    use crate::error::While;
+    let r =
+        deadreckon_tedris::run_outages_with(drive, model, outages, opts).map_err(Error::Outages)?;
+    if let Some(p) = track {
+        deadreckon_io::write_track_csv(p, std::slice::from_ref(&r.track))
+            .doing(|| format!("writing {}", p.display()))?;
+    }
+    Ok(r)
+}
+
+/// `tedris run --json`.
+pub fn run_json(
+    r: &deadreckon_tedris::OutageReport,
+    model: &TedrisModel,
+    track: Option<&Path>,
+) -> serde_json::Value {
+    serde_json::json!({
+        "outages": r.outages,
+        "reference": r.reference,
+        "source": r.source,
+        "model": model.chosen.name(),
+        "checks": r.machine.checks(),
+        "track": track.map(|p| p.display().to_string()),
+    })
+}
+
 /// The model in the JSON file `path` (`tedris train --out`), checked:
 /// errors name the file.
 pub fn read_model(path: &Path) -> Result<TedrisModel, Error> {
