@@ -1,5 +1,9 @@
 //! The arguments of `deadreckon import`.
 
+use deadreckon_api::import::{ImportFormat, ImportOptions};
+use deadreckon_import::comma2k19::{Comma2k19Options, GyroSource, SpeedSource};
+use deadreckon_import::TimeOrderPolicy;
+
 use std::path::PathBuf;
 
 use clap::Args;
@@ -78,4 +82,75 @@ pub struct ImportArgs {
     /// comma2k19: standard deviation given to each u-blox fix, m (default 1.0).
     #[arg(long, value_parser = super::positive)]
     pub gnss_std_m: Option<f64>,
+}
+
+impl ImportArgs {
+    /// The format and the importer's options (`mapping`: the global
+    /// `--mapping`); options that do not apply to the format refused.
+    pub fn options(
+        &self,
+        mapping: Option<std::path::PathBuf>,
+    ) -> anyhow::Result<(ImportFormat, ImportOptions)> {
+        use anyhow::{bail, Context};
+        let a = self;
+        let policy = if a.gate {
+            TimeOrderPolicy::Gate
+        } else {
+            TimeOrderPolicy::Error
+        };
+        let vehicle = match &a.vehicle {
+            Some(p) => Some(
+                deadreckon_io::read_vehicle(p)
+                    .with_context(|| format!("reading vehicle {}", p.display()))?,
+            ),
+            None => None,
+        };
+        let comma_only = a.gyro != GyroArg::Raw
+            || a.speed_source != SpeedSourceArg::Can
+            || a.device_forward_m.is_some()
+            || a.gnss_latency_s.is_some()
+            || a.gnss_std_m.is_some();
+        if a.format != FormatArg::Comma2k19 && comma_only {
+            bail!("--gyro, --speed-source, --device-forward-m, --gnss-latency-s and --gnss-std-m apply to comma2k19 only");
+        }
+        if a.format != FormatArg::Can && (a.dbc.is_some() || a.map.is_some()) {
+            bail!("--dbc and --map apply to the can format only");
+        }
+        if a.gate && matches!(a.format, FormatArg::Rosbag | FormatArg::Mcap) {
+            // Their readers always drop and count (see the report); the topics
+            // and the vehicle come from `--mapping` (default: the built-in Husky).
+            bail!(
+                "--gate does not apply to rosbag/mcap: their readers always drop and count bad samples"
+            );
+        }
+        let d = Comma2k19Options::default();
+        let options = ImportOptions {
+            vehicle,
+            dbc: a.dbc.clone(),
+            can_map: a.map.clone(),
+            ros_mapping: mapping,
+            policy,
+            comma2k19: Comma2k19Options {
+                gyro: match a.gyro {
+                    GyroArg::Raw => GyroSource::Uncalibrated,
+                    GyroArg::Calibrated => GyroSource::Calibrated,
+                },
+                speed: match a.speed_source {
+                    SpeedSourceArg::Can => SpeedSource::CanSpeedMessage,
+                    SpeedSourceArg::Processed => SpeedSource::Processed,
+                },
+                device_forward_m: a.device_forward_m.unwrap_or(d.device_forward_m),
+                gnss_latency_s: a.gnss_latency_s.unwrap_or(d.gnss_latency_s),
+                gnss_std_m: a.gnss_std_m.unwrap_or(d.gnss_std_m),
+                ..d
+            },
+        };
+        let format = match a.format {
+            FormatArg::Comma2k19 => ImportFormat::Comma2k19,
+            FormatArg::Can => ImportFormat::Can,
+            FormatArg::Tricycle => ImportFormat::Tricycle,
+            FormatArg::Rosbag | FormatArg::Mcap => ImportFormat::Ros,
+        };
+        Ok((format, options))
+    }
 }

@@ -137,3 +137,27 @@ pub fn import(format: ImportFormat, source: &Path, o: &ImportOptions) -> Result<
         }
     })
 }
+
+/// Writes an imported drive into `out` whole (written beside it under a
+/// temporary name, then renamed): a failure leaves the old drive or
+/// nothing, never a mixture.
+pub fn write(out: &Path, drive: &Drive) -> Result<(), Error> {
+    use crate::error::While;
+    deadreckon_io::write_drive_whole(out, drive, |_| Ok(()))
+        .doing(|| format!("writing drive {}", out.display()))
+}
+
+/// The line `import` prints of what the drive holds.
+pub fn counts_line(d: &Drive) -> String {
+    let span = d.time_span().map_or(0.0, |(a, b)| b - a);
+    format!(
+        "drive: {:.3} s, wheels {}, yaw_rate {}, speed {}, steering {}, gnss {}, truth {}",
+        span,
+        d.wheels.len(),
+        d.yaw_rate.len(),
+        d.speed.len(),
+        d.steering.len(),
+        d.gnss.len(),
+        d.truth.len()
+    )
+}
