@@ -32,7 +32,11 @@ pub fn run(a: BatchArgs, quiet: bool, loader: &common::Loader) -> Result<()> {
     } else {
         read.without_truth()
     };
-    let load = |p: &std::path::Path| loader.drive_with(p, &read).map_err(|e| format!("{e:#}"));
+    let load = |p: &std::path::Path| {
+        loader
+            .drive_with(p, &read)
+            .map_err(|e| deadreckon_api::chain_text(&e))
+    };
     let progress = super::progress::drives_bar(drives.len(), quiet);
     let start = Instant::now();
     let results = batch::run(&drives, &load, &options, &|r: &batch::DriveResult| {

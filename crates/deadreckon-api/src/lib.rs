@@ -2,7 +2,17 @@
 //!
 //! The operations the `deadreckon` command line and the Python bindings
 //! (`python/`) share, so both read the same sources and print the same
-//! numbers under the same keys:
+//! numbers under the same keys; and each command's steps, so the command
+//! line only parses, calls one function here and prints:
+//!
+//! - [`load`]: drives through a [`load::Loader`] (mapping, wheel file,
+//!   plausibility checks), parameters (`nominal` or a params.toml with its
+//!   stored corrections), the one `--from`/`--until` rule, scenarios and
+//!   simulated drives written to disk.
+//! - [`kinematic`]: the tricycle and differential-drive shapes calibrated
+//!   and evaluated over sliding outages, with their tables and JSON.
+//! - [`tracks`]: `run`'s tracks chosen and written for other tools.
+//! - [`demo`], [`report`], [`stream`]: those commands whole.
 //!
 //! - [`source`]: a drive from any source the tool reads: a drive directory
 //!   (`deadreckon-io`), a comma2k19 segment, a ROS1 bag or ROS2 MCAP (with a
@@ -14,7 +24,8 @@
 //! - [`checks`]: the cross-stream plausibility checks applied to a drive
 //!   read (errors refuse it, warnings go to `"checks"` in `--json`).
 //! - [`evaluate`]: the parameters `evaluate` measures when none are given
-//!   (one rule for every metric).
+//!   (one rule for every metric), and the metric measured
+//!   ([`evaluate::measure`]).
 //! - [`import`]: a log (comma2k19, CAN with a DBC, tricycle, ROS) read into
 //!   a drive with the importer's report, as `deadreckon import` writes it.
 //! - [`json`]: the objects `calibrate --json`, `evaluate --json` and
