@@ -178,7 +178,7 @@ pub fn outage_json(outage_s: f64, params: &str, ev: &OutageEvaluation) -> Value 
         "final_error_m": summary_json(&ev.final_error()),
         "drift_pct": summary_json(&ev.drift_pct()),
         "distance_to_1m_m": summary_json(&ev.distance_to_1m()),
-        "windows_reaching_1m": ev.windows.iter().filter(|w| w.reached_1m).count(),
+        "windows_reaching_1m": ev.windows.iter().filter(|w| w.time_to(1.0).is_some()).count(),
         "gates": gates_json(&ev.gates),
     })
 }
@@ -269,10 +269,11 @@ pub fn tedris_train_json(m: &TedrisModel, source: ReferenceSource) -> Value {
 
 /// The object of `compare --json` (and the demo's `tedris_comparison`).
 pub fn comparison_json(c: &deadreckon_eval::compare::Comparison) -> Value {
-    let row_json = |r: &Option<deadreckon_eval::compare::Row>| match r {
-        Some(r) => {
-            json!({"mean_error_m": r.mean, "max_error_m": r.max, "final_error_m": r.fin, "time_to_1m_s": r.to_1m})
-        }
+    let row_json = |r: &Option<deadreckon_core::compared::OutageResult>| match r {
+        Some(r) => json!({
+            "mean_error_m": r.mean_m(), "max_error_m": r.max_m(), "final_error_m": r.final_m(),
+            "time_to_1m_s": r.time_to(1.0), "point": r.point.name(),
+        }),
         None => Value::Null,
     };
     json!({

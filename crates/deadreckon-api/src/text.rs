@@ -1,6 +1,8 @@
 //! The commands' text tables and summary lines, built from library results
 //! (the command line prints them line by line).
 
+use deadreckon_core::compared::OutageResult;
+
 use deadreckon_core::ParamsWithStd;
 
 /// The corrections as text lines (one per stream, and the tilt).
@@ -118,27 +120,39 @@ pub fn gated_text(g: &deadreckon_core::filter::GateCounts) -> String {
 
 /// The comparison table of `compare` and `demo`; `t0` is subtracted from the outage times.
 pub fn comparison_lines(c: &deadreckon_eval::compare::Comparison, t0: f64) -> Vec<String> {
+    // The point each estimator's errors were measured at (its rows say).
+    let point =
+        |pick: fn(&(_, Option<OutageResult>, Option<OutageResult>)) -> Option<&OutageResult>| {
+            c.rows
+                .iter()
+                .find_map(pick)
+                .map_or(String::new(), |r| format!(" at the {}", r.point.name()))
+        };
     let mut out = vec![
         format!(
-            "four-wheel EKF: {}; errors against the {}",
-            c.params_source, c.four_wheel_reference
+            "four-wheel EKF: {}; errors against the {}{}",
+            c.params_source,
+            c.four_wheel_reference,
+            point(|r| r.1.as_ref())
         ),
         format!(
-            "TedriS: {}; errors against the {}",
-            c.model_source, c.tedris_reference
+            "TedriS: {}; errors against the {}{}",
+            c.model_source,
+            c.tedris_reference,
+            point(|r| r.2.as_ref())
         ),
     ];
     out.push(format!(
         "{:<20} {:<12} {:>10} {:>10} {:>10} {:>16}",
         "outage (s)", "method", "mean (m)", "max (m)", "final (m)", "time to 1 m (s)"
     ));
-    let fmt = |r: &Option<deadreckon_eval::compare::Row>| match r {
+    let fmt = |r: &Option<deadreckon_core::compared::OutageResult>| match r {
         Some(r) => format!(
             "{:>10.2} {:>10.2} {:>10.2} {:>16}",
-            r.mean,
-            r.max,
-            r.fin,
-            r.to_1m
+            r.mean_m(),
+            r.max_m(),
+            r.final_m(),
+            r.time_to(1.0)
                 .map(|t| format!("{t:.1}"))
                 .unwrap_or_else(|| "never".into())
         ),
@@ -157,7 +171,7 @@ pub fn comparison_lines(c: &deadreckon_eval::compare::Comparison, t0: f64) -> Ve
 /// column only when it is not the 1 m one), and the machine's checks.
 pub fn tedris_outage_lines(r: &deadreckon_tedris::OutageReport, threshold_m: f64) -> Vec<String> {
     let mut out = vec![format!(
-        "reference heading: {:?}; errors against {}",
+        "reference heading: {:?}; errors of the rear axle against {}",
         r.source, r.reference
     )];
     let extra = (threshold_m != 1.0).then(|| format!("to_{threshold_m}m_s"));
@@ -177,15 +191,15 @@ pub fn tedris_outage_lines(r: &deadreckon_tedris::OutageReport, threshold_m: f64
     for o in &r.outages {
         out.push(format!(
             "{:>9.1} {:>9.1} {:>10.2} {:>9.2} {:>10.2} {:>12}{}",
-            o.start_s,
-            o.end_s,
-            o.mean_error_m,
-            o.max_error_m,
-            o.final_error_m,
-            opt(o.time_to_1m_s),
+            o.result.start_s,
+            o.result.end_s,
+            o.mean_error_m(),
+            o.max_error_m(),
+            o.final_error_m(),
+            opt(o.time_to_1m_s()),
             extra.as_ref().map_or(String::new(), |_| format!(
                 " {:>12}",
-                opt(o.time_to_threshold_s)
+                opt(o.time_to_threshold_s())
             ))
         ));
     }

@@ -9,6 +9,7 @@
 //! travelled before the error first reaches 1 m (the window's distance when it
 //! never does, flagged as censored).
 
+use crate::compared::{Antenna, Position, RearAxle};
 use crate::drive::Drive;
 use crate::ekf::{self, EpochHook, EpochOut, FilterOptions};
 use crate::filter::{CarLayout, Filter, GateCounts};
@@ -18,45 +19,7 @@ use crate::reference::Reference;
 use crate::vehicle::Params;
 use crate::Error;
 
-/// What the errors are measured against.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ReferenceKind {
-    /// `truth.csv`.
-    Truth,
-    /// The hidden GNSS fixes.
-    Gnss,
-}
-
-impl ReferenceKind {
-    /// "truth" or "gnss".
-    pub fn name(&self) -> &'static str {
-        match self {
-            ReferenceKind::Truth => "truth",
-            ReferenceKind::Gnss => "gnss",
-        }
-    }
-}
-
-/// One outage window.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Window {
-    /// Start, s.
-    pub start_s: f64,
-    /// End, s.
-    pub end_s: f64,
-    /// Horizontal error at the end of the window, m.
-    pub final_error_m: f64,
-    /// Largest error in the window, m.
-    pub max_error_m: f64,
-    /// Distance travelled in the window, m.
-    pub distance_m: f64,
-    /// Distance before the error first reached 1 m, m.
-    pub distance_to_1m_m: f64,
-    /// False when the error never reached 1 m (the distance is the window's).
-    pub reached_1m: bool,
-    /// Errors over the window: (time since start s, error m).
-    pub errors: Vec<(f64, f64)>,
-}
+pub use crate::compared::{Against, OutageResult};
 
 /// The result over all windows.
 #[derive(Debug, Clone, PartialEq)]
@@ -64,9 +27,10 @@ pub struct OutageEvaluation {
     /// Window length, s.
     pub outage_s: f64,
     /// Reference used.
-    pub reference: ReferenceKind,
-    /// Every window.
-    pub windows: Vec<Window>,
+    pub reference: Against,
+    /// Every window: the rear axle against the truth, or the antenna
+    /// against the hidden fixes.
+    pub windows: Vec<OutageResult>,
     /// The χ² gate counters summed over every filter run of the evaluation:
     /// the GNSS-aided run and the dead reckoning through every window.
     pub gates: GateCounts,
@@ -75,13 +39,7 @@ pub struct OutageEvaluation {
 impl OutageEvaluation {
     /// Summary of the final errors, m.
     pub fn final_error(&self) -> Summary {
-        Summary::of(
-            &self
-                .windows
-                .iter()
-                .map(|w| w.final_error_m)
-                .collect::<Vec<_>>(),
-        )
+        Summary::of(&self.windows.iter().map(|w| w.final_m()).collect::<Vec<_>>())
     }
     /// Summary of the drift per 100 m, % (windows that travelled at least 10 m).
     pub fn drift_pct(&self) -> Summary {
@@ -90,7 +48,7 @@ impl OutageEvaluation {
                 .windows
                 .iter()
                 .filter(|w| w.distance_m >= 10.0)
-                .map(|w| 100.0 * w.final_error_m / w.distance_m)
+                .map(|w| 100.0 * w.final_m() / w.distance_m)
                 .collect::<Vec<_>>(),
         )
     }
@@ -100,7 +58,7 @@ impl OutageEvaluation {
             &self
                 .windows
                 .iter()
-                .map(|w| w.distance_to_1m_m)
+                .map(|w| w.distance_to(1.0).unwrap_or(w.distance_m))
                 .collect::<Vec<_>>(),
         )
     }
@@ -164,11 +122,11 @@ pub fn evaluate(
     }
     let truth = Reference::from_truth(&drive.truth);
     let reference = if truth.is_some() {
-        ReferenceKind::Truth
+        Against::Truth
     } else {
-        ReferenceKind::Gnss
+        Against::Gnss
     };
-    if reference == ReferenceKind::Gnss && drive.gnss.len() < 2 {
+    if reference == Against::Gnss && drive.gnss.len() < 2 {
         return Err(Error::Insufficient(
             "outage evaluation needs truth.csv or GNSS fixes".into(),
         ));
@@ -274,7 +232,7 @@ fn window_errors(
     t0: f64,
     start: f64,
     end: f64,
-) -> Option<Window> {
+) -> Option<OutageResult> {
     let lever = drive.vehicle.gnss_lever_arm_m;
     let states: Vec<(f64, State)> = states
         .iter()
@@ -286,7 +244,11 @@ fn window_errors(
         Some(t) => {
             for (ts, x) in &states {
                 if let Some(r) = t.state_at(*ts) {
-                    errors.push((*ts - t0, (x[X] - r[X]).hypot(x[Y] - r[Y])));
+                    let (est, truth) = (
+                        Position::<RearAxle>::new(x[X], x[Y]),
+                        Position::<RearAxle>::new(r[X], r[Y]),
+                    );
+                    errors.push((*ts - t0, est.distance_to(&truth)));
                 }
             }
         }
@@ -298,13 +260,14 @@ fn window_errors(
             let first = drive.gnss.partition_point(|g| g.t_s <= t0);
             for g in drive.gnss[first..].iter().take_while(|g| g.t_s <= end) {
                 if let Some(x) = traj.state_at(g.t_s) {
-                    let (ae, an) = (x[X] + lever * x[YAW].cos(), x[Y] + lever * x[YAW].sin());
-                    errors.push((g.t_s - t0, (ae - g.east_m).hypot(an - g.north_m)));
+                    let antenna = Position::<RearAxle>::new(x[X], x[Y]).antenna(x[YAW], lever);
+                    let fix = Position::<Antenna>::new(g.east_m, g.north_m);
+                    errors.push((g.t_s - t0, antenna.distance_to(&fix)));
                 }
             }
         }
     }
-    let &(_, final_error_m) = errors.last()?;
+    errors.last()?;
     let mut dist = vec![0.0];
     for w in states.windows(2) {
         let d = dist.last().copied().unwrap_or(0.0)
@@ -316,16 +279,14 @@ fn window_errors(
         let k = states.partition_point(|s| s.0 - t0 <= dt);
         dist[k.saturating_sub(1).min(dist.len() - 1)]
     };
-    let hit = errors.iter().find(|e| e.1 >= 1.0);
-    Some(Window {
-        start_s: start,
-        end_s: end,
-        final_error_m,
-        max_error_m: errors.iter().map(|e| e.1).fold(0.0, f64::max),
-        distance_m,
-        distance_to_1m_m: hit.map(|h| dist_at(h.0)).unwrap_or(distance_m),
-        reached_1m: hit.is_some(),
-        errors,
+    let travelled = errors.iter().map(|e| dist_at(e.0)).collect();
+    Some(match truth {
+        Some(_) => {
+            OutageResult::new::<RearAxle>(start, end, Against::Truth, errors, travelled, distance_m)
+        }
+        None => {
+            OutageResult::new::<Antenna>(start, end, Against::Gnss, errors, travelled, distance_m)
+        }
     })
 }
 
@@ -341,9 +302,9 @@ pub fn through_windows(
     check_windows(drive, windows)?;
     let truth = Reference::from_truth(&drive.truth);
     let reference = if truth.is_some() {
-        ReferenceKind::Truth
+        Against::Truth
     } else {
-        ReferenceKind::Gnss
+        Against::Gnss
     };
     let opts = FilterOptions {
         gnss_outages: windows.to_vec(),

@@ -3,25 +3,12 @@
 //! inside the outages, not even for calibration or training.
 
 use deadreckon_core::calibrate::{self, CalibrationOptions};
+use deadreckon_core::compared::{Against, OutageResult};
 use deadreckon_core::ekf::FilterOptions;
 use deadreckon_core::{outage, Drive, Params};
 use deadreckon_tedris::{Outage, TedrisConfig, TedrisModel};
 
 use crate::Error;
-
-/// One method's errors through one outage.
-pub struct Row {
-    /// Mean horizontal error, m.
-    pub mean: f64,
-    /// Largest error, m.
-    pub max: f64,
-    /// Error at the end, m.
-    pub fin: f64,
-    /// Time until the error first reaches 1 m, s.
-    pub to_1m: Option<f64>,
-    /// The errors summarised: (time since the outage start, s; error, m).
-    pub errors: Vec<(f64, f64)>,
-}
 
 /// The comparison through a set of outages.
 pub struct Comparison {
@@ -29,12 +16,13 @@ pub struct Comparison {
     pub params_source: String,
     /// Where the TedriS model came from.
     pub model_source: String,
-    /// The four-wheel reference ("truth" or "gnss").
-    pub four_wheel_reference: String,
-    /// The TedriS reference.
-    pub tedris_reference: String,
-    /// Per outage: the window, the four-wheel row, the TedriS row.
-    pub rows: Vec<(Outage, Option<Row>, Option<Row>)>,
+    /// The four-wheel reference (the truth, or the hidden fixes at the antenna).
+    pub four_wheel_reference: Against,
+    /// The TedriS reference (compared at the rear axle).
+    pub tedris_reference: Against,
+    /// Per outage: the window, the four-wheel errors, TedriS's errors (one
+    /// type for both: the point compared is in it).
+    pub rows: Vec<(Outage, Option<OutageResult>, Option<OutageResult>)>,
     /// The TedriS model used.
     pub model: TedrisModel,
     /// TedriS's track through the drive, GNSS hidden in the outages.
@@ -97,35 +85,19 @@ pub fn compare(
     let td = deadreckon_tedris::run_outages(drive, &model, outages)?;
     let mut rows = Vec::new();
     for o in outages {
-        let f = fw
-            .windows
-            .iter()
-            .find(|w| w.start_s == o.start_s)
-            .map(|w| Row {
-                mean: w.errors.iter().map(|e| e.1).sum::<f64>() / w.errors.len().max(1) as f64,
-                max: w.max_error_m,
-                fin: w.final_error_m,
-                to_1m: w.errors.iter().find(|e| e.1 >= 1.0).map(|e| e.0),
-                errors: w.errors.clone(),
-            });
+        let f = fw.windows.iter().find(|w| w.start_s == o.start_s).cloned();
         let t = td
             .outages
             .iter()
-            .find(|e| e.start_s == o.start_s)
-            .map(|e| Row {
-                mean: e.mean_error_m,
-                max: e.max_error_m,
-                fin: e.final_error_m,
-                to_1m: e.time_to_1m_s,
-                errors: e.errors.clone(),
-            });
+            .find(|e| e.start_s() == o.start_s)
+            .map(|e| e.result.clone());
         rows.push((*o, f, t));
     }
     Ok(Comparison {
         params_source,
         model_source,
-        four_wheel_reference: fw.reference.name().into(),
-        tedris_reference: td.reference.clone(),
+        four_wheel_reference: fw.reference,
+        tedris_reference: td.reference,
         rows,
         model,
         tedris_track: td.track,

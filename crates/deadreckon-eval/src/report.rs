@@ -441,7 +441,7 @@ pub fn four_wheel_input(
             match outage::evaluate(drive, &m.params.params, len, len / 2.0, 5.0, &opts) {
                 Ok(o) => ev.methods.push(rp::MethodSample {
                     method: m.source.name().into(),
-                    final_error_m: o.windows.iter().map(|w| w.final_error_m).collect(),
+                    final_error_m: o.windows.iter().map(|w| w.final_m()).collect(),
                 }),
                 Err(e) => input.not_computed.push(not_computed(
                     format!("{len} s outages with {}", m.source.name()),

@@ -67,14 +67,14 @@ fn the_demo_printed_one_comparison_and_reported_another() {
             // The printed final, largest and mean errors are the curve's.
             assert_eq!(
                 s.error_m.last().copied(),
-                Some(row.fin),
+                Some(row.final_m()),
                 "{name} {}",
                 run.name
             );
             let max = s.error_m.iter().copied().fold(f64::NAN, f64::max);
-            assert_eq!(max, row.max, "{name} {}", run.name);
+            assert_eq!(max, row.max_m(), "{name} {}", run.name);
             let mean = s.error_m.iter().sum::<f64>() / s.error_m.len() as f64;
-            assert!((mean - row.mean).abs() < 1e-12, "{name} {}", run.name);
+            assert!((mean - row.mean_m()).abs() < 1e-12, "{name} {}", run.name);
             // The four-wheel filter's last epoch may fall 0.04 s after the end.
             let len = o.end_s - o.start_s + 0.05;
             assert!(

@@ -262,7 +262,7 @@ fn sliding_outage_windows_forgot_the_wheel_monitors_verdict() {
                 .windows
                 .iter()
                 .filter(|w| w.start_s > from_s)
-                .map(|w| w.final_error_m)
+                .map(|w| w.final_m())
                 .collect();
             assert!(w.len() >= 10, "seed {seed}: {} windows", w.len());
             w.iter().sum::<f64>() / w.len() as f64

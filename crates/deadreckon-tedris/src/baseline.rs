@@ -194,6 +194,13 @@ impl Baseline {
             }
         }
         let n = errs.len();
-        Ok(crate::outage::summarise_errors(outage, &errs, n, n, 1.0))
+        Ok(crate::outage::summarise_errors(
+            outage,
+            deadreckon_core::compared::Against::Truth,
+            &errs,
+            n,
+            n,
+            1.0,
+        ))
     }
 }

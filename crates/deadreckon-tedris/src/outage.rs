@@ -1,14 +1,17 @@
 //! Batch use over a whole drive: training ([`train`]) and prediction through
 //! GNSS outages with the errors of figures 6 and 7 ([`run_outages`]).
 //!
-//! The error reference, in order of preference:
+//! The errors are of the rear axle ([`OutageResult`], the type the
+//! four-wheel filter's outages have too), against, in order of preference
+//! ([`Against`]):
 //! - `truth`: `truth.csv` (rear-axle centre), interpolated at each estimate;
 //! - `truth aligned at outage start`: for drives without GNSS positions (the robot),
 //!   both tracks are translated to agree at the outage start, so the error is the
 //!   dead-reckoning drift during the outage;
-//! - `hidden gnss`: the blanked fixes, moved from the antenna to the rear-axle
+//! - `gnss`: the hidden fixes, moved from the antenna to the rear-axle
 //!   centre with the lever arm along the course (or the estimated yaw).
 
+use deadreckon_core::compared::{Against, Antenna, OutageResult, Position, RearAxle};
 use serde::{Deserialize, Serialize};
 
 use deadreckon_core::drive::Drive;
@@ -48,40 +51,76 @@ impl std::str::FromStr for Outage {
     }
 }
 
-/// The errors over one outage.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+/// The errors over one outage: the rear axle against the reference
+/// ([`OutageResult`], the type the four-wheel filter's outages have too), the
+/// threshold of `time_to_threshold_s`, and how much of it TedriS predicted.
+/// Its JSON keeps the figures' names (`mean_error_m`, `time_to_1m_s`, ...).
+#[derive(Debug, Clone, PartialEq)]
 pub struct OutageError {
-    /// Start, s.
-    pub start_s: f64,
-    /// End, s.
-    pub end_s: f64,
-    /// Mean horizontal error, m.
-    pub mean_error_m: f64,
-    /// Largest horizontal error, m.
-    pub max_error_m: f64,
-    /// Error at the last estimate of the outage, m.
-    pub final_error_m: f64,
-    /// Time from the outage start until the error first exceeds 1 m, s (`None`: never).
-    pub time_to_1m_s: Option<f64>,
+    /// The errors and what they compare.
+    pub result: OutageResult,
     /// The threshold of `time_to_threshold_s`, m (1 m for a car; 0.159 m for the paper's robot).
     pub threshold_m: f64,
-    /// Time from the outage start until the error first exceeds `threshold_m`, s (`None`: never).
-    pub time_to_threshold_s: Option<f64>,
-    /// Points compared.
-    pub points: usize,
     /// Estimates of the outage made while the machine was predicting with a model.
     pub predicted_fraction: f64,
-    /// The errors the figures above summarise: (time since the outage
-    /// start, s; horizontal error, m), for plots (not in the JSON).
-    #[serde(skip)]
-    pub errors: Vec<(f64, f64)>,
+}
+
+impl OutageError {
+    /// Start, s.
+    pub fn start_s(&self) -> f64 {
+        self.result.start_s
+    }
+
+    /// Mean horizontal error, m.
+    pub fn mean_error_m(&self) -> f64 {
+        self.result.mean_m()
+    }
+
+    /// Largest horizontal error, m.
+    pub fn max_error_m(&self) -> f64 {
+        self.result.max_m()
+    }
+
+    /// Error at the last estimate of the outage, m.
+    pub fn final_error_m(&self) -> f64 {
+        self.result.final_m()
+    }
+
+    /// Time from the outage start until the error first reaches 1 m, s.
+    pub fn time_to_1m_s(&self) -> Option<f64> {
+        self.result.time_to(1.0)
+    }
+
+    /// Time from the outage start until the error first reaches
+    /// `threshold_m`, s.
+    pub fn time_to_threshold_s(&self) -> Option<f64> {
+        self.result.time_to(self.threshold_m)
+    }
+}
+
+impl Serialize for OutageError {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeStruct;
+        let mut m = s.serialize_struct("OutageError", 10)?;
+        m.serialize_field("start_s", &self.result.start_s)?;
+        m.serialize_field("end_s", &self.result.end_s)?;
+        m.serialize_field("mean_error_m", &self.mean_error_m())?;
+        m.serialize_field("max_error_m", &self.max_error_m())?;
+        m.serialize_field("final_error_m", &self.final_error_m())?;
+        m.serialize_field("time_to_1m_s", &self.time_to_1m_s())?;
+        m.serialize_field("threshold_m", &self.threshold_m)?;
+        m.serialize_field("time_to_threshold_s", &self.time_to_threshold_s())?;
+        m.serialize_field("points", &self.result.points())?;
+        m.serialize_field("predicted_fraction", &self.predicted_fraction)?;
+        m.end()
+    }
 }
 
 /// The result of [`run_outages`].
 #[derive(Debug, Clone)]
 pub struct OutageReport {
-    /// What the errors are measured against (`truth`, `truth aligned at outage start`, `hidden gnss`).
-    pub reference: String,
+    /// What the errors are measured against.
+    pub reference: Against,
     /// The reference heading source used.
     pub source: ReferenceSource,
     /// One entry per outage.
@@ -214,13 +253,13 @@ pub fn run_outages_with(
     let threshold = opts.threshold_m.unwrap_or(1.0);
     let (reference, errors) = if drive.truth.len() >= 2 {
         let aligned = drive.gnss.is_empty() || input.source == ReferenceSource::Gyro;
-        let name = if aligned {
-            "truth aligned at outage start"
+        let against = if aligned {
+            Against::TruthAlignedAtStart
         } else {
-            "truth"
+            Against::Truth
         };
         (
-            name.to_string(),
+            against,
             outages
                 .iter()
                 .map(|o| truth_errors(drive, &points, &phases, o, aligned, threshold))
@@ -228,7 +267,7 @@ pub fn run_outages_with(
         )
     } else {
         (
-            "hidden gnss".to_string(),
+            Against::Gnss,
             outages
                 .iter()
                 .map(|o| gnss_errors(drive, &points, &phases, o, threshold))
@@ -270,33 +309,27 @@ pub(crate) fn truth_at(drive: &Drive, t: f64) -> Option<(f64, f64)> {
 /// The summary of the errors `(t, m)` over an outage.
 pub(crate) fn summarise_errors(
     o: &Outage,
+    against: Against,
     errs: &[(f64, f64)],
     predicted: usize,
     total: usize,
     threshold: f64,
 ) -> OutageError {
-    let first_above = |th: f64| errs.iter().find(|e| e.1 > th).map(|e| e.0 - o.start_s);
-    let n = errs.len();
     OutageError {
-        start_s: o.start_s,
-        end_s: o.end_s,
-        mean_error_m: if n > 0 {
-            errs.iter().map(|e| e.1).sum::<f64>() / n as f64
-        } else {
-            f64::NAN
-        },
-        max_error_m: errs.iter().map(|e| e.1).fold(f64::NAN, f64::max),
-        final_error_m: errs.last().map_or(f64::NAN, |e| e.1),
-        time_to_1m_s: first_above(1.0),
+        result: OutageResult::new::<RearAxle>(
+            o.start_s,
+            o.end_s,
+            against,
+            errs.iter().map(|e| (e.0 - o.start_s, e.1)).collect(),
+            Vec::new(),
+            f64::NAN,
+        ),
         threshold_m: threshold,
-        time_to_threshold_s: first_above(threshold),
-        points: n,
         predicted_fraction: if total > 0 {
             predicted as f64 / total as f64
         } else {
             0.0
         },
-        errors: errs.iter().map(|e| (e.0 - o.start_s, e.1)).collect(),
     }
 }
 
@@ -325,9 +358,15 @@ fn truth_errors(
         } else {
             (0.0, 0.0)
         };
-        errs.push((p.t_s, (p.east_m + oe - te).hypot(p.north_m + on - tn)));
+        let est = Position::<RearAxle>::new(p.east_m + oe, p.north_m + on);
+        errs.push((p.t_s, est.distance_to(&Position::new(te, tn))));
     }
-    summarise_errors(o, &errs, pred, total, threshold)
+    let against = if aligned {
+        Against::TruthAlignedAtStart
+    } else {
+        Against::Truth
+    };
+    summarise_errors(o, against, &errs, pred, total, threshold)
 }
 
 fn gnss_errors(
@@ -344,7 +383,7 @@ fn gnss_errors(
         pred += usize::from(phases[i] == Phase::Predicting);
         errs.push((g_t, e));
     }
-    summarise_errors(o, &errs, pred, total, threshold)
+    summarise_errors(o, Against::Gnss, &errs, pred, total, threshold)
 }
 
 /// The horizontal error of a TedriS track (`pts`, rear axle) against the
@@ -370,14 +409,13 @@ pub fn gnss_error_points(
             continue;
         };
         let yaw = g.course_yaw_rad().unwrap_or(p.yaw_rad);
-        let (me, mn) = (g.east_m - l * yaw.cos(), g.north_m - l * yaw.sin());
+        let fix = Position::<Antenna>::new(g.east_m, g.north_m).rear_axle(yaw, l);
         let ahead = (g.t_s - p.t_s) * p.speed_mps;
-        out.push((
-            g.t_s,
-            i,
-            (p.east_m + ahead * p.yaw_rad.cos() - me)
-                .hypot(p.north_m + ahead * p.yaw_rad.sin() - mn),
-        ));
+        let est = Position::<RearAxle>::new(
+            p.east_m + ahead * p.yaw_rad.cos(),
+            p.north_m + ahead * p.yaw_rad.sin(),
+        );
+        out.push((g.t_s, i, est.distance_to(&fix)));
     }
     out
 }

@@ -43,7 +43,7 @@ fn car_seed_means(cfg: &TedrisConfig, name: &str) -> Vec<f64> {
             };
             let r = run_outages_with(&run_drive, &model, &[o], &RunOptions::default()).unwrap();
             let e = &r.outages[0];
-            assert_eq!(r.reference, "truth");
+            assert_eq!(r.reference.name(), "truth");
             assert!(
                 e.predicted_fraction > 0.95,
                 "the machine must predict through the outage"
@@ -51,10 +51,10 @@ fn car_seed_means(cfg: &TedrisConfig, name: &str) -> Vec<f64> {
             line += &format!(
                 " [{start:.0},{:.0}) mean {:.2} max {:.2} m;",
                 start + 80.0,
-                e.mean_error_m,
-                e.max_error_m
+                e.mean_error_m(),
+                e.max_error_m()
             );
-            sum += e.mean_error_m;
+            sum += e.mean_error_m();
         }
         let m = sum / CAR_WINDOWS.len() as f64;
         eprintln!("{line} seed mean {m:.2} m");
@@ -141,10 +141,10 @@ fn robot_time_under_0_159_m() {
                 end_s: start + 90.0,
             };
             let r = run_outages_with(&run_drive, &model, &[o], &opts).unwrap();
-            assert_eq!(r.reference, "truth aligned at outage start");
+            assert_eq!(r.reference.name(), "truth aligned at outage start");
             let e = &r.outages[0];
-            let t = e.time_to_threshold_s.unwrap_or(90.0);
-            line += &format!(" [{start:.0}: {t:.0} s, mean {:.3} m]", e.mean_error_m);
+            let t = e.time_to_threshold_s().unwrap_or(90.0);
+            line += &format!(" [{start:.0}: {t:.0} s, mean {:.3} m]", e.mean_error_m());
             times.push(t);
         }
         eprintln!("{line}");
