@@ -121,6 +121,46 @@ impl Stored {
     pub fn apply(&self, drive: &Drive) -> Drive {
         timing::apply_known(drive, self.delays_s, self.up, self.gyro_scale_error)
     }
+
+    /// Whether there is nothing to apply (a file without the tables, or
+    /// every delay 0, no tilt and no scale error).
+    pub fn is_empty(&self) -> bool {
+        *self == Stored::default()
+    }
+
+    /// The report's rows of what is applied: each stored delay, the tilt
+    /// of the stored vertical, the gyro scale error (no standard errors:
+    /// params.toml keeps the values applied).
+    pub fn report_rows(&self) -> Vec<deadreckon_report::CorrectionRow> {
+        let row = |what: String, unit: &str, value: f64| deadreckon_report::CorrectionRow {
+            what,
+            unit: unit.into(),
+            value: Some(value),
+            std: None,
+            status: "stored, applied".into(),
+        };
+        let mut rows: Vec<_> = Stream::ALL
+            .iter()
+            .zip(self.delays_s)
+            .filter(|(_, d)| *d != 0.0)
+            .map(|(s, d)| row(format!("{} delay", s.name()), "s", d))
+            .collect();
+        if let Some(up) = self.up {
+            rows.push(row(
+                "IMU tilt".into(),
+                "°",
+                up[2].clamp(-1.0, 1.0).acos().to_degrees(),
+            ));
+        }
+        if self.gyro_scale_error != 0.0 {
+            rows.push(row(
+                "gyro scale error".into(),
+                "%",
+                100.0 * self.gyro_scale_error,
+            ));
+        }
+        rows
+    }
 }
 
 /// The corrections stored in the params.toml at `spec` (nothing for

@@ -121,25 +121,21 @@ pub fn gated_text(g: &deadreckon_core::filter::GateCounts) -> String {
 /// The comparison table of `compare` and `demo`; `t0` is subtracted from the outage times.
 pub fn comparison_lines(c: &deadreckon_eval::compare::Comparison, t0: f64) -> Vec<String> {
     // The point each estimator's errors were measured at (its rows say).
-    let point =
-        |pick: fn(&(_, Option<OutageResult>, Option<OutageResult>)) -> Option<&OutageResult>| {
-            c.rows
-                .iter()
-                .find_map(pick)
-                .map_or(String::new(), |r| format!(" at the {}", r.point.name()))
-        };
+    let point = |r: Option<&OutageResult>| {
+        r.map_or(String::new(), |r| format!(" at the {}", r.point.name()))
+    };
     let mut out = vec![
         format!(
             "four-wheel EKF: {}; errors against the {}{}",
             c.params_source,
             c.four_wheel_reference,
-            point(|r| r.1.as_ref())
+            point(c.rows.iter().find_map(|r| r.1.as_ref()))
         ),
         format!(
             "TedriS: {}; errors against the {}{}",
             c.model_source,
             c.tedris_reference,
-            point(|r| r.2.as_ref())
+            point(c.rows.iter().find_map(|r| r.2.as_ref()))
         ),
     ];
     out.push(format!(
