@@ -105,62 +105,41 @@ pub fn corrections_toml(c: &Corrections) -> toml::Table {
     out
 }
 
-/// Corrections read back from params.toml.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct Stored {
-    /// Delays, s, in [`Stream::ALL`] order (0 where absent or not estimated).
-    pub delays_s: [f64; 4],
-    /// The IMU's vertical in its own axes, when estimated.
-    pub up: Option<[f64; 3]>,
-    /// The gyro's relative scale error (0 when absent or not estimated).
-    pub gyro_scale_error: f64,
-}
+/// Corrections read back from params.toml (applied as they are).
+pub type Stored = timing::KnownCorrections;
 
-impl Stored {
-    /// Applies them to `drive` ([`timing::apply_known`]).
-    pub fn apply(&self, drive: &Drive) -> Drive {
-        timing::apply_known(drive, self.delays_s, self.up, self.gyro_scale_error)
+/// The report's rows of what is applied: each stored delay, the tilt of
+/// the stored vertical, the gyro scale error (no standard errors: params.toml
+/// keeps the values applied).
+pub fn stored_rows(stored: &Stored) -> Vec<deadreckon_report::CorrectionRow> {
+    let row = |what: String, unit: &str, value: f64| deadreckon_report::CorrectionRow {
+        what,
+        unit: unit.into(),
+        value: Some(value),
+        std: None,
+        status: "stored, applied".into(),
+    };
+    let mut rows: Vec<_> = Stream::ALL
+        .iter()
+        .zip(stored.delays_s)
+        .filter(|(_, d)| *d != 0.0)
+        .map(|(s, d)| row(format!("{} delay", s.name()), "s", d))
+        .collect();
+    if let Some(up) = stored.up {
+        rows.push(row(
+            "IMU tilt".into(),
+            "°",
+            up[2].clamp(-1.0, 1.0).acos().to_degrees(),
+        ));
     }
-
-    /// Whether there is nothing to apply (a file without the tables, or
-    /// every delay 0, no tilt and no scale error).
-    pub fn is_empty(&self) -> bool {
-        *self == Stored::default()
+    if stored.gyro_scale_error != 0.0 {
+        rows.push(row(
+            "gyro scale error".into(),
+            "%",
+            100.0 * stored.gyro_scale_error,
+        ));
     }
-
-    /// The report's rows of what is applied: each stored delay, the tilt
-    /// of the stored vertical, the gyro scale error (no standard errors:
-    /// params.toml keeps the values applied).
-    pub fn report_rows(&self) -> Vec<deadreckon_report::CorrectionRow> {
-        let row = |what: String, unit: &str, value: f64| deadreckon_report::CorrectionRow {
-            what,
-            unit: unit.into(),
-            value: Some(value),
-            std: None,
-            status: "stored, applied".into(),
-        };
-        let mut rows: Vec<_> = Stream::ALL
-            .iter()
-            .zip(self.delays_s)
-            .filter(|(_, d)| *d != 0.0)
-            .map(|(s, d)| row(format!("{} delay", s.name()), "s", d))
-            .collect();
-        if let Some(up) = self.up {
-            rows.push(row(
-                "IMU tilt".into(),
-                "°",
-                up[2].clamp(-1.0, 1.0).acos().to_degrees(),
-            ));
-        }
-        if self.gyro_scale_error != 0.0 {
-            rows.push(row(
-                "gyro scale error".into(),
-                "%",
-                100.0 * self.gyro_scale_error,
-            ));
-        }
-        rows
-    }
+    rows
 }
 
 /// The corrections stored in the params.toml at `spec` (nothing for

@@ -50,7 +50,7 @@ pub fn corrected(
         if !stored.is_empty() {
             let c = rp::Corrections {
                 source: format!("stored in {p}"),
-                rows: stored.report_rows(),
+                rows: crate::corrections::stored_rows(&stored),
             };
             return Ok((stored.apply(drive), Some(c)));
         }

@@ -298,6 +298,12 @@ pub fn tedris_train_lines(
     let mut out = Vec::new();
     let s = m.straight();
     out.push(format!("reference heading: {source:?}"));
+    if let Some(c) = &m.corrections {
+        out.push(format!(
+            "trained on corrected streams (kept in the model, applied by tedris run): {}",
+            known_corrections_text(c)
+        ));
+    }
     out.push(format!(
         "tau = {} samples, sample period {:.4} s, lag h = {} samples (peak corr {:.3})",
         m.config.tau_samples,
@@ -500,4 +506,29 @@ pub fn kinematic_table(c: &deadreckon_core::kinematics::KinematicCalibration) ->
         c.termination
     ));
     out
+}
+
+/// Known corrections in one line: the non-zero delays, the tilt of the
+/// vertical, the gyro scale error.
+pub fn known_corrections_text(c: &deadreckon_core::timing::KnownCorrections) -> String {
+    use deadreckon_core::timing::Stream;
+    let mut parts: Vec<String> = Stream::ALL
+        .iter()
+        .zip(c.delays_s)
+        .filter(|(_, d)| *d != 0.0)
+        .map(|(s, d)| format!("{} delay {d:+.4} s", s.name()))
+        .collect();
+    if let Some(u) = c.up {
+        parts.push(format!(
+            "IMU tilt {:.2}°",
+            u[2].clamp(-1.0, 1.0).acos().to_degrees()
+        ));
+    }
+    if c.gyro_scale_error != 0.0 {
+        parts.push(format!(
+            "gyro scale error {:+.3}%",
+            100.0 * c.gyro_scale_error
+        ));
+    }
+    parts.join(", ")
 }

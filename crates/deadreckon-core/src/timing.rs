@@ -859,3 +859,55 @@ pub fn apply_known(
         d
     }
 }
+
+/// Corrections known beforehand and applied as they are: those a
+/// params.toml stores (`[delays]`, `[imu]`, `[gyro_scale]`), or those a
+/// TedriS model was trained with.
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+pub struct KnownCorrections {
+    /// Delays, s, in [`Stream::ALL`] order (0: none).
+    pub delays_s: [f64; 4],
+    /// The IMU's vertical in its own axes (`None`: the gyro as it is).
+    pub up: Option<[f64; 3]>,
+    /// The gyro's relative scale error (0: none).
+    pub gyro_scale_error: f64,
+}
+
+impl KnownCorrections {
+    /// Applies them to `drive` ([`apply_known`]).
+    pub fn apply(&self, drive: &Drive) -> Drive {
+        apply_known(drive, self.delays_s, self.up, self.gyro_scale_error)
+    }
+
+    /// Whether there is nothing to apply.
+    pub fn is_empty(&self) -> bool {
+        *self == KnownCorrections::default()
+    }
+
+    /// Checks the values are plausible: delays finite and under 10 s, `up`
+    /// a unit vector, the scale error within
+    /// [`crate::gyro_scale::MAX_SCALE_ERROR`]. The error names the key.
+    pub fn validate(&self) -> Result<(), String> {
+        for (s, v) in Stream::ALL.iter().zip(self.delays_s) {
+            if !(v.is_finite() && v.abs() < 10.0) {
+                return Err(format!(
+                    "`delays.{}.delay_s` = {v} is not a plausible delay (|d| < 10 s)",
+                    s.name()
+                ));
+            }
+        }
+        if let Some(u) = self.up {
+            let n = u.iter().map(|x| x * x).sum::<f64>().sqrt();
+            if (n - 1.0).abs().is_nan() || (n - 1.0).abs() >= 1e-3 {
+                return Err("`imu.up` must be a unit vector of 3 numbers".into());
+            }
+        }
+        let g = self.gyro_scale_error;
+        if !(g.is_finite() && g.abs() <= crate::gyro_scale::MAX_SCALE_ERROR) {
+            return Err(format!(
+                "`gyro_scale.scale_error` = {g} is not a plausible gyro scale error"
+            ));
+        }
+        Ok(())
+    }
+}

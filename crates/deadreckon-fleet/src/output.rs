@@ -331,6 +331,28 @@ pub fn summary_line(results: &[DriveResult], wall_s: f64, threads: usize) -> Str
     )
 }
 
+/// What `batch` prints: the summary line, the files written, and each
+/// vehicle's calibration history (or why there is none).
+pub fn summary_text(
+    results: &[DriveResult],
+    histories: &[VehicleHistory],
+    wall_s: f64,
+    threads: usize,
+    written: &[&Path],
+) -> String {
+    let mut text = summary_line(results, wall_s, threads);
+    for w in written {
+        text.push_str(&format!("\nwrote {}", w.display()));
+    }
+    text.push('\n');
+    if histories.is_empty() {
+        text.push_str("no drive has a vehicle_id in its vehicle.toml: no calibration history\n");
+    } else {
+        text.push_str(&history_table(histories));
+    }
+    text
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -400,26 +422,4 @@ mod tests {
             &["4".to_string(), "d3".to_string(), "2026-01-04".to_string()]
         );
     }
-}
-
-/// What `batch` prints: the summary line, the files written, and each
-/// vehicle's calibration history (or why there is none).
-pub fn summary_text(
-    results: &[DriveResult],
-    histories: &[VehicleHistory],
-    wall_s: f64,
-    threads: usize,
-    written: &[&Path],
-) -> String {
-    let mut text = summary_line(results, wall_s, threads);
-    for w in written {
-        text.push_str(&format!("\nwrote {}", w.display()));
-    }
-    text.push('\n');
-    if histories.is_empty() {
-        text.push_str("no drive has a vehicle_id in its vehicle.toml: no calibration history\n");
-    } else {
-        text.push_str(&history_table(histories));
-    }
-    text
 }
