@@ -749,12 +749,13 @@ pub fn estimate_with_params(
 }
 
 /// Which corrections [`prepare_with`] estimates and applies.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Which {
     /// The IMU tilt and every stream's delay.
     All,
     /// The IMU tilt, the GNSS delay and the gyro scale (the other streams'
-    /// delays estimated and reported, not applied).
+    /// delays estimated and reported, not applied): `calibrate`'s default.
+    #[default]
     Gnss,
     /// Nothing estimated or applied.
     None,

@@ -6,6 +6,7 @@ use std::io::Write;
 use std::path::Path;
 
 use deadreckon_core::filter::SensorKind;
+use deadreckon_core::timing::{Corrections, Stream};
 use deadreckon_core::Params;
 
 use crate::batch::DriveResult;
@@ -62,7 +63,68 @@ pub fn results_header() -> Vec<String> {
     ] {
         h.push(k.into());
     }
+    for st in Stream::ALL {
+        h.push(format!("delay_{}_s", st.name()));
+        h.push(format!("std_delay_{}_s", st.name()));
+        h.push(format!("status_delay_{}", st.name()));
+    }
+    for k in [
+        "imu_tilt_deg",
+        "std_imu_tilt_deg",
+        "status_imu_tilt",
+        "gyro_scale_error",
+        "std_gyro_scale_error",
+        "status_gyro_scale_error",
+    ] {
+        h.push(k.into());
+    }
     h
+}
+
+/// The corrections' columns: per stream its delay, standard error and
+/// status (`applied`, `not-estimated`; empty without corrections), then the
+/// IMU tilt and the gyro scale error likewise (`none` where the drive has no
+/// three-axis IMU or the scale was not attempted).
+fn corrections_cells(c: &Corrections) -> Vec<String> {
+    let value = |estimated: bool, v: f64| {
+        if estimated && v.is_finite() {
+            num(v)
+        } else {
+            String::new()
+        }
+    };
+    let status = |estimated: bool| {
+        if estimated {
+            "applied"
+        } else {
+            "not-estimated"
+        }
+    };
+    let mut row = Vec::new();
+    for st in Stream::ALL {
+        let d = c.delays.get(st);
+        let e = d.status.is_estimated();
+        row.extend([value(e, d.delay_s), value(e, d.std_s), status(e).into()]);
+    }
+    match &c.tilt {
+        Some(t) => {
+            let e = t.is_estimated();
+            row.extend([
+                value(e, t.tilt_rad.to_degrees()),
+                value(e, t.std_rad.to_degrees()),
+                status(e).into(),
+            ]);
+        }
+        None => row.extend([String::new(), String::new(), "none".into()]),
+    }
+    match &c.gyro_scale {
+        Some(g) => {
+            let e = g.is_estimated();
+            row.extend([value(e, g.scale_error), value(e, g.std), status(e).into()]);
+        }
+        None => row.extend([String::new(), String::new(), "none".into()]),
+    }
+    row
 }
 
 /// One row of the results CSV (empty fields where a value does not apply).
@@ -108,8 +170,8 @@ pub fn results_row(r: &DriveResult) -> Vec<String> {
                 }
                 None => row.extend(std::iter::repeat_n(String::new(), 4 + 18)),
             }
-            if let Some(o) = &c.outage {
-                row.extend([
+            match &c.outage {
+                Some(o) => row.extend([
                     num(o.options.length_s),
                     o.final_error_m.n.to_string(),
                     o.reference.to_string(),
@@ -117,7 +179,11 @@ pub fn results_row(r: &DriveResult) -> Vec<String> {
                     num(o.final_error_m.p95),
                     num(o.final_error_m.max),
                     num(o.drift_pct.mean),
-                ]);
+                ]),
+                None => row.extend(std::iter::repeat_n(String::new(), 7)),
+            }
+            if let Some(k) = &c.corrections {
+                row.extend(corrections_cells(k));
             }
         }
     }
