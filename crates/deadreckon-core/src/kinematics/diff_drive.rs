@@ -279,10 +279,12 @@ struct Window {
 }
 
 mod calibration;
+pub mod filter;
 mod outages;
 
 pub use calibration::{calibrate_diff_drive, DiffDriveOptions};
-pub use outages::evaluate_diff_drive;
+pub use filter::{DiffDriveFilter, FilterNoise};
+pub use outages::{evaluate_diff_drive, DiffDriveOutages, OutageStart};
 
 #[cfg(test)]
 mod tests;
