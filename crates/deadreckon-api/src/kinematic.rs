@@ -307,9 +307,11 @@ impl Evaluated {
                             .into();
                     v["fixes_used"] = d.fixes_used.into();
                     v["fixes_rejected"] = d.fixes_rejected.into();
-                    let s = deadreckon_core::metrics::Summary::of(&d.predicted_std_m);
-                    v["predicted_std_m"] =
-                        serde_json::json!({"mean": s.mean, "median": s.median, "max": s.max});
+                    v["fix_jumps"] = d.fix_jumps.into();
+                    if let Some((predicted, achieved)) = d.rms_per_axis() {
+                        v["predicted_rms_per_axis_m"] = predicted.into();
+                        v["achieved_rms_per_axis_m"] = achieved.into();
+                    }
                 }
             }
         }
@@ -332,11 +334,15 @@ impl Evaluated {
             self.evaluation.final_error(),
         )]));
         if let Some(d) = self.diff.as_ref().filter(|d| d.start != OutageStart::Align) {
-            let s = deadreckon_core::metrics::Summary::of(&d.predicted_std_m);
             out.push(format!(
-                "filter: {} fixes used, {} rejected by the gate; predicted error per axis {:.3} m (mean σ)",
-                d.fixes_used, d.fixes_rejected, s.mean
+                "filter: {} fixes used, {} rejected by the gate, {} jumps of the fixes taken",
+                d.fixes_used, d.fixes_rejected, d.fix_jumps
             ));
+            if let Some((predicted, achieved)) = d.rms_per_axis() {
+                out.push(format!(
+                    "final error per axis (RMS): predicted {predicted:.3} m, achieved {achieved:.3} m"
+                ));
+            }
         }
         out
     }

@@ -287,4 +287,6 @@ pub use filter::{DiffDriveFilter, FilterNoise};
 pub use outages::{evaluate_diff_drive, DiffDriveOutages, OutageStart};
 
 #[cfg(test)]
+mod filter_tests;
+#[cfg(test)]
 mod tests;

@@ -139,6 +139,14 @@ pub struct FilterNoise {
     /// χ² threshold of the Mahalanobis gate on a fix (2 degrees of
     /// freedom). Default 13.82, the 99.9% quantile.
     pub gate_chi2: f64,
+    /// How long the gate may keep rejecting fixes before the filter takes
+    /// them to have jumped, s: the wander's variance is then widened by
+    /// `fix_wander_m²` and the fix taken (counted as a jump). Default 2: a
+    /// multipath spike lasts a fix or two; a shift that persists for 2 s
+    /// (5 fixes at 2.5 Hz) while the odometry runs smoothly is a new level
+    /// of the fixes' error (an SBAS correction or satellite change), not
+    /// motion, and the fixes an outage is scored against keep it.
+    pub jump_after_s: f64,
     /// Path over which the first pose is taken by aligning the dead
     /// reckoning to the fixes, m. Default 10: the heading then starts
     /// within about 0.2 rad of the fixes' track (a few metres of wander
@@ -161,6 +169,7 @@ impl Default for FilterNoise {
             fix_wander_m: 2.5,
             fix_wander_tau_s: 120.0,
             gate_chi2: 13.815510557964274,
+            jump_after_s: 2.0,
             init_path_m: 10.0,
         }
     }
@@ -206,6 +215,7 @@ impl FilterNoise {
             ("fix_wander_m", self.fix_wander_m),
             ("fix_wander_tau_s", self.fix_wander_tau_s),
             ("gate_chi2", self.gate_chi2),
+            ("jump_after_s", self.jump_after_s),
             ("init_path_m", self.init_path_m),
         ];
         match v.iter().find(|(_, x)| !(x.is_finite() && *x > 0.0)) {
@@ -306,6 +316,11 @@ pub struct DiffDriveFilter<'a> {
     pub fixes_used: usize,
     /// Fixes rejected by the gate.
     pub fixes_rejected: usize,
+    /// Jumps of the fixes' error: fixes taken after the gate rejected
+    /// fixes for [`FilterNoise::jump_after_s`], the wander widened.
+    pub fix_jumps: usize,
+    /// When the current run of rejected fixes began, s.
+    rejecting_since: Option<f64>,
 }
 
 impl<'a> DiffDriveFilter<'a> {
@@ -390,6 +405,8 @@ impl<'a> DiffDriveFilter<'a> {
                     next: k + 1,
                     fixes_used: 0,
                     fixes_rejected: 0,
+                    fix_jumps: 0,
+                    rejecting_since: None,
                 }));
             }
         }
@@ -437,16 +454,27 @@ impl<'a> DiffDriveFilter<'a> {
     }
 
     /// Updates with the fix `(east, north)` at the filter's time, gated by
-    /// its Mahalanobis distance; returns whether it was used.
+    /// its Mahalanobis distance; after [`FilterNoise::jump_after_s`] of
+    /// rejections the wander's variance is widened by `fix_wander_m²` and
+    /// the fix taken (a jump). Returns whether the fix was used.
     pub fn update_fix(&mut self, east_m: f64, north_m: f64) -> Result<bool, Error> {
         let (z, h) = predicted_fix(&self.x, self.antenna);
         let y = SVector::<f64, 2>::new(east_m - z[0], north_m - z[1]);
         let r = SMatrix::<f64, 2, 2>::identity() * self.noise.fix_white_m.powi(2);
         let (_, _, nis) = innovation_stats(&self.p, &y, &h, &r, self.t_s)?;
         if nis > self.noise.gate_chi2 {
-            self.fixes_rejected += 1;
-            return Ok(false);
+            let since = *self.rejecting_since.get_or_insert(self.t_s);
+            if self.t_s - since < self.noise.jump_after_s {
+                self.fixes_rejected += 1;
+                return Ok(false);
+            }
+            // A persistent shift: the fixes' error jumped.
+            let widen = self.noise.fix_wander_m.powi(2);
+            self.p[(FIX_E, FIX_E)] += widen;
+            self.p[(FIX_N, FIX_N)] += widen;
+            self.fix_jumps += 1;
         }
+        self.rejecting_since = None;
         update_vector(
             &mut self.x,
             &mut self.p,
@@ -466,6 +494,36 @@ impl<'a> DiffDriveFilter<'a> {
         let (z, h) = predicted_fix(&self.x, self.antenna);
         (z, h * self.p * h.transpose())
     }
+}
+
+/// The mean log-likelihood per fix of the fixes' innovations,
+/// `−ln 2π − ½·ln det S − ½·yᵀS⁻¹y` (2-D Gaussian), with every fix taken
+/// (no gate: the likelihood of the model itself), and the number of fixes
+/// it averages: how well `noise` describes the fixes given the odometry —
+/// what the fix-error model is identified by. `None` when the filter
+/// cannot start or no fix follows its start.
+pub fn fix_log_likelihood(
+    d: &DiffDriveDrive,
+    params: &[f64],
+    noise: &FilterNoise,
+) -> Result<Option<(f64, usize)>, Error> {
+    let Some(mut f) = DiffDriveFilter::start(d, params, noise)? else {
+        return Ok(None);
+    };
+    f.noise.gate_chi2 = f64::INFINITY;
+    let (mut sum, mut n) = (0.0, 0usize);
+    let t_start = f.t_s;
+    for &(t, east, north) in d.fixes.iter().filter(|x| x.0 > t_start) {
+        f.predict_to(t);
+        let (z, h) = predicted_fix(&f.x, f.antenna);
+        let y = SVector::<f64, 2>::new(east - z[0], north - z[1]);
+        let r = SMatrix::<f64, 2, 2>::identity() * f.noise.fix_white_m.powi(2);
+        let (s, _, nis) = innovation_stats(&f.p, &y, &h, &r, t)?;
+        sum += -(2.0 * std::f64::consts::PI).ln() - 0.5 * s.determinant().ln() - 0.5 * nis;
+        n += 1;
+        f.update_fix(east, north)?;
+    }
+    Ok((n > 0).then(|| (sum / n as f64, n)))
 }
 
 /// The inputs of the step from `t0` to `t1` inside the odometry interval

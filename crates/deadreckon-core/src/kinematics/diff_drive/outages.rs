@@ -43,10 +43,35 @@ pub struct DiffDriveOutages {
     /// Filter start only: fixes rejected by the gate before the last
     /// outage's start.
     pub fixes_rejected: usize,
+    /// Filter start only: jumps of the fixes' error taken (the gate kept
+    /// rejecting, the wander was widened) before the last outage's start.
+    pub fix_jumps: usize,
     /// Filter start only: for each window, the filter's predicted standard
     /// deviation of the final error per axis, m (the root of half the trace
     /// of the predicted fix's covariance plus the fix's white noise).
     pub predicted_std_m: Vec<f64>,
+}
+
+impl DiffDriveOutages {
+    /// Filter start only: the root mean square over the windows of the
+    /// predicted standard deviation per axis, and of the final error per
+    /// axis (`√(mean e²/2)`), m. The two agree when the filter's covariance
+    /// is honest.
+    pub fn rms_per_axis(&self) -> Option<(f64, f64)> {
+        let n = self.predicted_std_m.len();
+        if n == 0 || n != self.outages.windows.len() {
+            return None;
+        }
+        let predicted = self.predicted_std_m.iter().map(|s| s * s).sum::<f64>() / n as f64;
+        let achieved = self
+            .outages
+            .windows
+            .iter()
+            .map(|w| 0.5 * w.final_error_m.powi(2))
+            .sum::<f64>()
+            / n as f64;
+        Some((predicted.sqrt(), achieved.sqrt()))
+    }
 }
 
 /// Dead reckons through outages of `outage_s` every `step_s`, the first
@@ -91,7 +116,7 @@ pub fn evaluate_diff_drive(
         .map_or(0, |f| d.fixes.partition_point(|x| x.0 <= f.t_s));
     let mut windows = Vec::new();
     let mut predicted_std_m = Vec::new();
-    let (mut used, mut rejected) = (0, 0);
+    let (mut used, mut rejected, mut jumps) = (0, 0, 0);
     let mut ts = first.t_s + warmup_s;
     while ts + outage_s <= last.t_s {
         let t_a = ts - warmup_s;
@@ -136,6 +161,7 @@ pub fn evaluate_diff_drive(
                 f.predict_to(start_s);
                 used = f.fixes_used;
                 rejected = f.fixes_rejected;
+                jumps = f.fix_jumps;
                 let mut blind = f.clone();
                 blind.predict_to(tf);
                 let (z, cov) = blind.predicted_fix();
@@ -175,6 +201,7 @@ pub fn evaluate_diff_drive(
         start: *start,
         fixes_used: used,
         fixes_rejected: rejected,
+        fix_jumps: jumps,
         predicted_std_m,
     })
 }
