@@ -106,18 +106,28 @@ pub fn load_params_file(
     names: &[&str],
     yaw_source: Option<&str>,
 ) -> Result<(Vec<f64>, String), Error> {
-    let (values, _, source) = load_params_file_with_std(spec, shape, names, yaw_source)?;
-    Ok((values, source))
+    let p = load_params_file_with_std(spec, shape, names, yaw_source)?;
+    Ok((p.values, p.source))
 }
 
-/// [`load_params_file`] with each parameter's standard error (`None` where
-/// it was not estimated).
+/// A kinematic params.toml as read: values, standard errors, where from.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LoadedParams {
+    /// The values, in the shape's order.
+    pub values: Vec<f64>,
+    /// Each one's standard error (`None` where it was not estimated).
+    pub std: Vec<Option<f64>>,
+    /// Where they came from, for reports.
+    pub source: String,
+}
+
+/// [`load_params_file`] with each parameter's standard error.
 pub fn load_params_file_with_std(
     spec: &str,
     shape: Shape,
     names: &[&str],
     yaw_source: Option<&str>,
-) -> Result<(Vec<f64>, Vec<Option<f64>>, String), Error> {
+) -> Result<LoadedParams, Error> {
     let path = Path::new(spec);
     if !is_kinematic_params(path) {
         invalid!(
@@ -144,7 +154,11 @@ pub fn load_params_file_with_std(
         .iter()
         .map(|p| if p.estimated { p.std } else { None })
         .collect();
-    Ok((f.values(), std, source))
+    Ok(LoadedParams {
+        values: f.values(),
+        std,
+        source,
+    })
 }
 
 /// A kinematic calibration with what it was made against, as `calibrate`
@@ -421,12 +435,16 @@ pub fn evaluate_diff(
     until_s: Option<f64>,
 ) -> Result<Evaluated, Error> {
     let spec = params.unwrap_or("nominal");
-    let (params, std, source) = if spec == "nominal" {
-        (
-            DiffDriveDrive::nominal(),
-            vec![None; diff_drive::N_PARAMS],
-            "nominal".to_string(),
-        )
+    let LoadedParams {
+        values: params,
+        std,
+        source,
+    } = if spec == "nominal" {
+        LoadedParams {
+            values: DiffDriveDrive::nominal(),
+            std: vec![None; diff_drive::N_PARAMS],
+            source: "nominal".to_string(),
+        }
     } else {
         load_params_file_with_std(
             spec,

@@ -25,15 +25,23 @@
 //! `z = p + R(ψ)·(x_a, y_a) + e + w`, `w` white. The wander `e` is a
 //! first-order Gauss–Markov process of standard deviation `σ_e` and time
 //! constant `τ` (process noise `σ_e²·(1 − φ²)` per step, so its variance
-//! stays `σ_e²`). Every fix is gated by its Mahalanobis distance and counted.
+//! stays `σ_e²`). Every fix is gated by its Mahalanobis distance and counted;
+//! when the gate keeps rejecting for [`FilterNoise::jump_after_s`] the fixes
+//! are taken to have jumped (an SBAS correction change): the wander's
+//! variance is widened and the fix taken, counted as a jump.
+//!
+//! The filter starts once the odometry has travelled
+//! [`FilterNoise::init_path_m`]: the dead reckoning over that stretch aligned
+//! to its fixes gives the pose; the bias and the scales start at the
+//! parameters' values with their standard errors (or the defaults' priors).
 //!
 //! Through an outage the filter keeps predicting without fixes: the base is
-//! dead-reckoned with the estimated bias and scale, and the wander estimate
+//! dead-reckoned with the estimated bias and scales, and the wander estimate
 //! at the outage's start decays as `e·exp(−t/τ)` — the part of the fixes'
 //! error still expected at the fix the outage is scored against.
 //!
-//! The noise values live in [`FilterNoise`], each with its unit and the
-//! physical argument for its default.
+//! The noise values live in [`FilterNoise`], each with its unit, its
+//! meaning and where its default comes from.
 
 use nalgebra::{SMatrix, SVector};
 
@@ -76,9 +84,10 @@ type FixJacobian = SMatrix<f64, 2, N>;
 /// The kinematic values are set by a physical argument (stated with each).
 /// The fixes' error model (`fix_white_m`, `fix_wander_m`,
 /// `fix_wander_tau_s`) was identified by maximising the likelihood of the
-/// fixes' innovations on the first half of the Husky bag only (its first
-/// 197.7 s, nominal parameters; `docs/kinematic-shapes.md` gives the grid):
-/// never on the outage errors, and never on the second half.
+/// fixes' innovations ([`fix_log_likelihood`]) on the first half of the
+/// Husky bag only (its first 197.7 s, nominal parameters, the grid of
+/// `examples/diff_drive_fix_model.rs`): never on outage errors, and never
+/// on the second half.
 ///
 /// The three `*_prior` values are the standard deviations of the kinematic
 /// parameters the filter refines, used for a parameter whose source states
@@ -121,9 +130,11 @@ pub struct FilterNoise {
     /// scale's.
     pub yaw_scale_walk_per_sqrt_s: f64,
     /// White noise of a fix, per axis, m. Default 0.05: on the first half
-    /// of the Husky bag the likelihood rises as this falls (per fix −2.128
-    /// at 0.05 m, −2.163 at 0.01 m; the wander explains everything); 0.05
-    /// is kept as a floor, the output noise of a carrier-smoothed receiver.
+    /// of the Husky bag the likelihood rises as this falls to the grid's
+    /// floor (log-likelihood per fix 0.290 at 0.05 m, 0.325 at 0.01 m: the
+    /// wander explains everything), so it is not identified; 0.05 m is kept
+    /// as the output noise of a carrier-smoothed receiver (the outage
+    /// errors differ by 0.015 m between the two).
     pub fix_white_m: f64,
     /// Standard deviation of the fixes' wander, per axis, m. Default 2.5:
     /// the likelihood's maximum on the first half of the Husky bag (the
