@@ -12,10 +12,10 @@
 //!
 //! | parameters | filter | alignment |
 //! |---|---|---|
-//! | calibrated on the whole drive (in-sample) | 2.832 m | 3.154 m |
-//! | calibrated on the first half, second half evaluated | 3.817 m | 4.015 m |
-//! | calibrated on the second half, first half evaluated | 4.505 m | 5.656 m |
-//! | nominal | 3.373 m | 3.290 m |
+//! | calibrated on the whole drive (in-sample) | 2.848 m | 3.154 m |
+//! | calibrated on the first half, second half evaluated | 3.832 m | 4.015 m |
+//! | calibrated on the second half, first half evaluated | 4.408 m | 5.656 m |
+//! | nominal | 3.307 m | 3.290 m |
 //!
 //! The issue's target (under 3.05 m with the parameters calibrated on the
 //! drive) is met by the filter start. The bounds pin these numbers within
@@ -102,9 +102,9 @@ fn husky_diff_drive_calibrated_against_gnss_through_30_s_outages() {
     assert!(vf["windows"].as_u64().unwrap() >= 30, "{vf}");
     // The issue's target, and the numbers measured at this commit.
     assert!(filter < 3.05, "{filter}");
-    near("calibrated, filter start", filter, 2.832, 0.15);
+    near("calibrated, filter start", filter, 2.848, 0.15);
     near("calibrated, aligned start", aligned, 3.154, 0.15);
-    near("nominal gyro, filter start", gyro_filter, 3.373, 0.15);
+    near("nominal gyro, filter start", gyro_filter, 3.307, 0.15);
     near("nominal gyro, aligned start", gyro, 3.290, 0.15);
     near("nominal odometry, aligned start", odo, 3.865, 0.2);
     // The filter's fix counts: one jump of the SBAS fixes (at 55 s) taken
@@ -151,8 +151,8 @@ fn husky_diff_drive_calibrated_on_one_half_and_evaluated_on_the_other() {
          {f21:.3} m, aligned {a21:.3} m"
     );
     assert_eq!(v["windows"], 11, "{v}");
-    near("first half -> second, filter start", f12, 3.817, 0.25);
+    near("first half -> second, filter start", f12, 3.832, 0.25);
     near("first half -> second, aligned start", a12, 4.015, 0.25);
-    near("second half -> first, filter start", f21, 4.505, 0.25);
+    near("second half -> first, filter start", f21, 4.408, 0.25);
     near("second half -> first, aligned start", a21, 5.656, 0.25);
 }

@@ -131,21 +131,22 @@ pub struct FilterNoise {
     pub yaw_scale_walk_per_sqrt_s: f64,
     /// White noise of a fix, per axis, m. Default 0.05: on the first half
     /// of the Husky bag the likelihood rises as this falls to the grid's
-    /// floor (log-likelihood per fix 0.290 at 0.05 m, 0.325 at 0.01 m: the
+    /// floor (log-likelihood per fix 0.292 at 0.05 m, 0.327 at 0.01 m: the
     /// wander explains everything), so it is not identified; 0.05 m is kept
     /// as the output noise of a carrier-smoothed receiver (the outage
-    /// errors differ by 0.015 m between the two).
+    /// errors differ by a few millimetres between the two).
     pub fix_white_m: f64,
-    /// Standard deviation of the fixes' wander, per axis, m. Default 2.5:
-    /// the likelihood's maximum on the first half of the Husky bag (the
-    /// receiver reports σ = 0.9 m, which the fixes' drift against the
-    /// odometry exceeds).
+    /// Standard deviation of the fixes' wander, per axis, m. Default 3.0:
+    /// with the white noise at 0.05 m, the likelihood's maximum on the
+    /// first half of the Husky bag (the receiver reports σ = 0.9 m, which
+    /// the fixes' drift against the odometry exceeds).
     pub fix_wander_m: f64,
-    /// Time constant of the wander, s. Default 120, with `fix_wander_m`
+    /// Time constant of the wander, s. Default 180, with `fix_wander_m`
     /// the likelihood's maximum on the first half of the Husky bag. The
-    /// likelihood is flat along σ²/τ ≈ 0.05 m²/s (1.5 m with 45 s and 3 m
-    /// with 180 s are within 0.003 per fix): over a 30 s outage the wander
-    /// moves like a random walk of that diffusion.
+    /// likelihood is flat along σ²/τ ≈ 0.05 m²/s (2.5 m with 120 s and 4 m
+    /// with 300 s are within 0.002 per fix; 1.5 m with 45 s within 0.005):
+    /// over a 30 s outage the wander moves like a random walk of that
+    /// diffusion, and a half of the bag (200 s) does not tell σ from τ.
     pub fix_wander_tau_s: f64,
     /// χ² threshold of the Mahalanobis gate on a fix (2 degrees of
     /// freedom). Default 13.82, the 99.9% quantile.
@@ -160,8 +161,9 @@ pub struct FilterNoise {
     pub jump_after_s: f64,
     /// Path over which the first pose is taken by aligning the dead
     /// reckoning to the fixes, m. Default 10: the heading then starts
-    /// within about 0.2 rad of the fixes' track (a few metres of wander
-    /// are common to the stretch), inside the filter's linear range.
+    /// within about 0.2 rad (σ = 2·the fixes' error across the stretch /
+    /// its length; the wander common to the stretch only shifts it),
+    /// inside the filter's linear range.
     pub init_path_m: f64,
 }
 
@@ -177,8 +179,8 @@ impl Default for FilterNoise {
             speed_scale_walk_per_sqrt_s: 1e-5,
             yaw_scale_walk_per_sqrt_s: 1e-5,
             fix_white_m: 0.05,
-            fix_wander_m: 2.5,
-            fix_wander_tau_s: 120.0,
+            fix_wander_m: 3.0,
+            fix_wander_tau_s: 180.0,
             gate_chi2: 13.815510557964274,
             jump_after_s: 2.0,
             init_path_m: 10.0,
@@ -394,7 +396,13 @@ impl<'a> DiffDriveFilter<'a> {
                 x[YAW] += th;
                 let n = q_fix.len() as f64;
                 let wander = noise.fix_wander_m.powi(2);
-                let total = wander + noise.fix_white_m.powi(2);
+                // The heading comes from the fixes' error across the
+                // stretch: their white noise and how far the wander moved
+                // in its duration (what is common to the stretch only
+                // shifts it), over its length.
+                let dur = t - first.t_s;
+                let moved = wander * (1.0 - (-2.0 * dur / noise.fix_wander_tau_s).exp());
+                let across = (moved + noise.fix_white_m.powi(2)).sqrt();
                 let mut p = Cov::zeros();
                 for (pos, fix) in [(X, FIX_E), (Y, FIX_N)] {
                     p[(pos, pos)] = wander + noise.fix_white_m.powi(2) / n;
@@ -402,7 +410,7 @@ impl<'a> DiffDriveFilter<'a> {
                     p[(pos, fix)] = -wander;
                     p[(fix, pos)] = -wander;
                 }
-                p[(YAW, YAW)] = (2.0 * total.sqrt() / path).powi(2);
+                p[(YAW, YAW)] = (2.0 * across / path).powi(2);
                 p[(YAW_BIAS, YAW_BIAS)] = noise.yaw_bias_prior_rps.powi(2);
                 p[(SPEED_SCALE, SPEED_SCALE)] = noise.speed_scale_prior.powi(2);
                 p[(YAW_SCALE, YAW_SCALE)] = noise.yaw_scale_prior.powi(2);
