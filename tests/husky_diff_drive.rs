@@ -1,17 +1,26 @@
 //! The Husky bag (`husky-gps-bag/husky_gps.bag`, 395 s, about 1 m/s, SBAS
 //! fixes) as a differential drive: the five kinematic parameters calibrated
-//! against the fixes, and 30 s outages every 10 s, each started from 60 s of
-//! dead reckoning aligned to the fixes and scored against the hidden fix at
-//! its end. Runs the real binary.
+//! against the fixes, and 30 s outages every 10 s scored against the hidden
+//! fix at each outage's end. Each outage starts from the GNSS-aided filter
+//! (the default; the fixes' wander carried into the outage) or, the
+//! baseline, from 60 s of dead reckoning aligned to the fixes. Runs the real
+//! binary.
 //!
-//! Measured at this commit (mean final error): nominal parameters with the
-//! gyro 3.29 m, with the odometry yaw rate 3.87 m; calibrated on the whole
-//! drive (gyro, 90 s windows) 3.15 m. The issue's target (3.05 m) is not
-//! reached, and across halves the calibration does worse than the nominal
-//! parameters (first half → second 4.01 m against 2.56 m nominal; second →
-//! first 5.66 m against 5.15 m): the fit follows the SBAS fixes' slow wander
-//! (an antenna 0.6–1 m behind the axle). The bounds pin these numbers with
-//! a margin of about 10% so that a degradation shows.
+//! Measured at this commit (mean final error, gyro yaw rate; the filter's
+//! fix-error model identified on the first half's innovations, nothing
+//! chosen on outage errors):
+//!
+//! | parameters | filter | alignment |
+//! |---|---|---|
+//! | calibrated on the whole drive (in-sample) | 2.848 m | 3.154 m |
+//! | calibrated on the first half, second half evaluated | 3.832 m | 4.015 m |
+//! | calibrated on the second half, first half evaluated | 4.408 m | 5.656 m |
+//! | nominal | 3.307 m | 3.290 m |
+//!
+//! The issue's target (under 3.05 m with the parameters calibrated on the
+//! drive) is met by the filter start. The bounds pin these numbers within
+//! about 5% (0.15 m; 0.25 m on the 11-window halves) so that a degradation
+//! shows.
 
 mod common;
 use common::run_ok;
@@ -19,6 +28,9 @@ use common::run_ok;
 use std::process::Command;
 
 const HUSKY: &str = "../shared/data/husky-gps-bag/husky_gps.bag";
+/// The middle of the bag on its clock (odometry from 1432235498.028 s for
+/// 395.3 s).
+const MIDDLE: &str = "1432235695.7";
 
 fn outage_mean(params: &str, extra: &[&str]) -> (f64, serde_json::Value) {
     let mut args = vec![
@@ -39,36 +51,67 @@ fn outage_mean(params: &str, extra: &[&str]) -> (f64, serde_json::Value) {
     (v["final_error_m"]["mean"].as_f64().unwrap(), v)
 }
 
-#[test]
-fn husky_diff_drive_calibrated_against_gnss_through_30_s_outages() {
-    let tmp = tempfile::tempdir().unwrap();
-    let p = tmp.path().join("husky.toml");
-    let c: serde_json::Value = serde_json::from_str(&run_ok(&[
+fn calibrate(out: &std::path::Path, extra: &[&str]) -> serde_json::Value {
+    let mut args = vec![
         "calibrate",
         HUSKY,
         "--shape",
         "diff-drive",
         "--json",
         "--out",
-        p.to_str().unwrap(),
-    ]))
-    .unwrap();
+        out.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    serde_json::from_str(&run_ok(&args)).unwrap()
+}
+
+fn near(what: &str, got: f64, measured: f64, margin: f64) {
+    assert!(
+        (got - measured).abs() < margin,
+        "{what}: {got:.3} m, measured {measured:.3} m ± {margin}"
+    );
+}
+
+#[test]
+fn husky_diff_drive_calibrated_against_gnss_through_30_s_outages() {
+    let tmp = tempfile::tempdir().unwrap();
+    let p = tmp.path().join("husky.toml");
+    let c = calibrate(&p, &[]);
     eprintln!("husky diff-drive calibration: {c}");
     assert_eq!(c["shape"], "diff_drive");
     assert_eq!(c["yaw_source"], "gyro");
     assert_eq!(c["converged"], true, "{c}");
     let speed = c["params"]["speed_scale"]["value"].as_f64().unwrap();
     assert!((speed - 0.969).abs() < 0.02, "{c}");
+    let p = p.to_str().unwrap();
 
-    let (gyro, v) = outage_mean("nominal", &["--yaw", "gyro"]);
-    let (odo, _) = outage_mean("nominal", &["--yaw", "odometry"]);
-    let (cal, vc) = outage_mean(p.to_str().unwrap(), &[]);
-    eprintln!("nominal gyro {gyro:.3} m, nominal odometry {odo:.3} m, calibrated {cal:.3} m\n{vc}");
-    assert_eq!(v["windows"], vc["windows"]);
-    assert!(v["windows"].as_u64().unwrap() >= 30, "{v}");
-    assert!((gyro - 3.29).abs() < 0.3, "{gyro}");
-    assert!((odo - 3.87).abs() < 0.4, "{odo}");
-    assert!(cal < 3.5, "{cal}");
+    let (filter, vf) = outage_mean(p, &[]);
+    let (aligned, va) = outage_mean(p, &["--start", "align"]);
+    let (gyro, vg) = outage_mean("nominal", &["--yaw", "gyro", "--start", "align"]);
+    let (gyro_filter, _) = outage_mean("nominal", &["--yaw", "gyro"]);
+    let (odo, _) = outage_mean("nominal", &["--yaw", "odometry", "--start", "align"]);
+    eprintln!(
+        "calibrated: filter {filter:.3} m, aligned {aligned:.3} m; nominal gyro: filter \
+         {gyro_filter:.3} m, aligned {gyro:.3} m; nominal odometry aligned {odo:.3} m\n{vf}"
+    );
+    assert_eq!(vf["start"], "filter");
+    assert_eq!(va["start"], "align");
+    for v in [&va, &vg] {
+        assert_eq!(vf["windows"], v["windows"]);
+    }
+    assert!(vf["windows"].as_u64().unwrap() >= 30, "{vf}");
+    // The issue's target, and the numbers measured at this commit.
+    assert!(filter < 3.05, "{filter}");
+    near("calibrated, filter start", filter, 2.848, 0.15);
+    near("calibrated, aligned start", aligned, 3.154, 0.15);
+    near("nominal gyro, filter start", gyro_filter, 3.307, 0.15);
+    near("nominal gyro, aligned start", gyro, 3.290, 0.15);
+    near("nominal odometry, aligned start", odo, 3.865, 0.2);
+    // The filter's fix counts: one jump of the SBAS fixes (at 55 s) taken
+    // after 2 s of rejections.
+    assert_eq!(vf["fix_jumps"], 1, "{vf}");
+    assert!(vf["fixes_rejected"].as_u64().unwrap() <= 10, "{vf}");
+
     // The params file carries its yaw source: evaluating it with the other is an error.
     let out = Command::new(env!("CARGO_BIN_EXE_deadreckon"))
         .args([
@@ -79,7 +122,7 @@ fn husky_diff_drive_calibrated_against_gnss_through_30_s_outages() {
             "--yaw",
             "odometry",
             "--params",
-            p.to_str().unwrap(),
+            p,
             "--outage",
             "30",
         ])
@@ -87,4 +130,29 @@ fn husky_diff_drive_calibrated_against_gnss_through_30_s_outages() {
         .unwrap();
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("--yaw gyro"));
+}
+
+#[test]
+fn husky_diff_drive_calibrated_on_one_half_and_evaluated_on_the_other() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (first, second) = (
+        tmp.path().join("first.toml"),
+        tmp.path().join("second.toml"),
+    );
+    calibrate(&first, &["--until", MIDDLE]);
+    calibrate(&second, &["--from", MIDDLE]);
+    let (first, second) = (first.to_str().unwrap(), second.to_str().unwrap());
+    let (f12, v) = outage_mean(first, &["--from", MIDDLE]);
+    let (a12, _) = outage_mean(first, &["--from", MIDDLE, "--start", "align"]);
+    let (f21, _) = outage_mean(second, &["--until", MIDDLE]);
+    let (a21, _) = outage_mean(second, &["--until", MIDDLE, "--start", "align"]);
+    eprintln!(
+        "first -> second: filter {f12:.3} m, aligned {a12:.3} m; second -> first: filter \
+         {f21:.3} m, aligned {a21:.3} m"
+    );
+    assert_eq!(v["windows"], 11, "{v}");
+    near("first half -> second, filter start", f12, 3.832, 0.25);
+    near("first half -> second, aligned start", a12, 4.015, 0.25);
+    near("second half -> first, filter start", f21, 4.408, 0.25);
+    near("second half -> first, aligned start", a21, 5.656, 0.25);
 }

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use clap::Args;
 use deadreckon_core::evo;
 
-use super::kinematic::{ShapeArg, YawArg};
+use super::kinematic::{ShapeArg, StartArg, YawArg};
 
 /// `evaluate --metric`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -91,15 +91,18 @@ pub struct EvaluateArgs {
     /// Print JSON instead of text.
     #[arg(long)]
     pub json: bool,
-    /// The vehicle shape: car (the default) or diff-drive (outages start from the alignment of the preceding --align seconds of dead reckoning to the fixes). A tricycle log is recognised by itself.
+    /// The vehicle shape: car (the default) or diff-drive (outages start from the GNSS-aided filter, or with --start align from the alignment of the preceding --align seconds of dead reckoning to the fixes). A tricycle log is recognised by itself.
     #[arg(long, value_enum, default_value_t = ShapeArg::Car)]
     pub shape: ShapeArg,
     /// Differential drive: the yaw rate integrated, gyro or odometry (default: the params file's, else gyro).
     #[arg(long, value_enum)]
     pub yaw: Option<YawArg>,
-    /// Differential drive: seconds of fixes before each outage the dead reckoning is aligned to.
+    /// Differential drive: seconds before the first outage, and the span of fixes before each outage the dead reckoning is aligned to (--start align).
     #[arg(long, default_value_t = 60.0, value_parser = super::positive)]
     pub align: f64,
+    /// Differential drive: where each outage starts from: filter (the GNSS-aided filter's state, the fixes' wander carried into the outage) or align (the preceding --align seconds of dead reckoning aligned to the fixes, the baseline).
+    #[arg(long, value_enum, default_value_t = StartArg::Filter)]
+    pub start: StartArg,
     /// Without --params: the timing and mounting corrections estimated and
     /// applied before the calibration (all: IMU tilt and every stream's
     /// delay; gnss: tilt and GNSS delay; none). With --params: those stored

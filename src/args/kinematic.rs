@@ -36,3 +36,21 @@ impl From<YawArg> for deadreckon_core::kinematics::diff_drive::YawSource {
         }
     }
 }
+
+/// `evaluate --start` of a differential drive.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum StartArg {
+    /// The rigid alignment of the preceding --align seconds of dead reckoning to the fixes.
+    Align,
+    /// The GNSS-aided filter's state at the outage's start (the fixes' wander carried into it).
+    Filter,
+}
+
+impl From<StartArg> for deadreckon_core::kinematics::diff_drive::OutageStart {
+    fn from(s: StartArg) -> Self {
+        match s {
+            StartArg::Align => Self::Align,
+            StartArg::Filter => Self::Filter(Default::default()),
+        }
+    }
+}

@@ -53,7 +53,17 @@ fn run_kinematic(a: &EvaluateArgs, load: &common::Loader, tricycle: bool) -> Res
     } else {
         let yaw = kinematic::diff_yaw(params, a.yaw.map(Into::into));
         let drive = load.drive(&a.dir)?;
-        kinematic::evaluate_diff(&drive, params, yaw, len, step, a.align, a.from_s, a.until_s)?
+        kinematic::evaluate_diff(
+            &drive,
+            params,
+            yaw,
+            len,
+            step,
+            a.align,
+            &a.start.into(),
+            a.from_s,
+            a.until_s,
+        )?
     };
     match (a.json, tricycle) {
         // A tricycle log is not read through the plausibility checks.

@@ -8,7 +8,8 @@
 use std::path::Path;
 
 use deadreckon_core::kinematics::diff_drive::{
-    self, calibrate_diff_drive, evaluate_diff_drive, DiffDriveDrive, DiffDriveOptions, YawSource,
+    self, calibrate_diff_drive, evaluate_diff_drive, DiffDriveDrive, DiffDriveOptions,
+    DiffDriveOutages, OutageStart, YawSource,
 };
 use deadreckon_core::kinematics::tricycle::{TricycleDrive, TricycleParams};
 use deadreckon_core::kinematics::{
@@ -105,6 +106,28 @@ pub fn load_params_file(
     names: &[&str],
     yaw_source: Option<&str>,
 ) -> Result<(Vec<f64>, String), Error> {
+    let p = load_params_file_with_std(spec, shape, names, yaw_source)?;
+    Ok((p.values, p.source))
+}
+
+/// A kinematic params.toml as read: values, standard errors, where from.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LoadedParams {
+    /// The values, in the shape's order.
+    pub values: Vec<f64>,
+    /// Each one's standard error (`None` where it was not estimated).
+    pub std: Vec<Option<f64>>,
+    /// Where they came from, for reports.
+    pub source: String,
+}
+
+/// [`load_params_file`] with each parameter's standard error.
+pub fn load_params_file_with_std(
+    spec: &str,
+    shape: Shape,
+    names: &[&str],
+    yaw_source: Option<&str>,
+) -> Result<LoadedParams, Error> {
     let path = Path::new(spec);
     if !is_kinematic_params(path) {
         invalid!(
@@ -126,7 +149,16 @@ pub fn load_params_file(
     } else {
         format!("{spec} ({n_not} parameters not estimated: nominal)")
     };
-    Ok((f.values(), source))
+    let std = f
+        .param
+        .iter()
+        .map(|p| if p.estimated { p.std } else { None })
+        .collect();
+    Ok(LoadedParams {
+        values: f.values(),
+        std,
+        source,
+    })
 }
 
 /// A kinematic calibration with what it was made against, as `calibrate`
@@ -260,10 +292,13 @@ pub struct Evaluated {
     pub length_s: f64,
     /// Where the parameters came from.
     pub source: String,
-    /// A differential drive's alignment span, s.
+    /// A differential drive's warm-up (and alignment span), s.
     pub align_s: Option<f64>,
     /// The windows and their errors.
     pub evaluation: KinematicOutages,
+    /// A differential drive's outages: how they started, the filter's fix
+    /// counts and predicted errors.
+    pub diff: Option<DiffDriveOutages>,
 }
 
 impl Evaluated {
@@ -271,8 +306,28 @@ impl Evaluated {
     pub fn json(&self) -> serde_json::Value {
         let mut v = crate::json::kinematic_outages_json(self.shape, &self.evaluation, &self.source);
         if let Some(align) = self.align_s {
-            v["reference"] = "gnss (hidden fixes; start aligned to the preceding fixes)".into();
             v["align_s"] = align.into();
+        }
+        if let Some(d) = &self.diff {
+            v["start"] = d.start.name().into();
+            match d.start {
+                OutageStart::Align => {
+                    v["reference"] =
+                        "gnss (hidden fixes; start aligned to the preceding fixes)".into();
+                }
+                OutageStart::Filter(_) => {
+                    v["reference"] =
+                        "gnss (hidden fixes; start from the GNSS-aided filter, fix wander carried)"
+                            .into();
+                    v["fixes_used"] = d.fixes_used.into();
+                    v["fixes_rejected"] = d.fixes_rejected.into();
+                    v["fix_jumps"] = d.fix_jumps.into();
+                    if let Some((predicted, achieved)) = d.rms_per_axis() {
+                        v["predicted_rms_per_axis_m"] = predicted.into();
+                        v["achieved_rms_per_axis_m"] = achieved.into();
+                    }
+                }
+            }
         }
         v
     }
@@ -282,14 +337,27 @@ impl Evaluated {
         let n = self.evaluation.windows.len();
         let len = self.length_s;
         let source = &self.source;
-        let mut out = vec![match self.align_s {
-            None => format!("{n} outage windows of {len} s from the reference pose (parameters: {source})"),
-            Some(a) => format!("{n} outage windows of {len} s, each started from {a} s of dead reckoning aligned to the fixes (parameters: {source})"),
+        let start = self.diff.as_ref().map(|d| d.start);
+        let mut out = vec![match (self.align_s, start) {
+            (Some(a), Some(OutageStart::Align)) => format!("{n} outage windows of {len} s, each started from {a} s of dead reckoning aligned to the fixes (parameters: {source})"),
+            (Some(a), Some(OutageStart::Filter(_))) => format!("{n} outage windows of {len} s (the first {a} s in), each started from the GNSS-aided filter (parameters: {source})"),
+            _ => format!("{n} outage windows of {len} s from the reference pose (parameters: {source})"),
         }];
         out.extend(crate::text::summary_table(&[(
             "final error (m)",
             self.evaluation.final_error(),
         )]));
+        if let Some(d) = self.diff.as_ref().filter(|d| d.start != OutageStart::Align) {
+            out.push(format!(
+                "filter: {} fixes used, {} rejected by the gate, {} jumps of the fixes taken",
+                d.fixes_used, d.fixes_rejected, d.fix_jumps
+            ));
+            if let Some((predicted, achieved)) = d.rms_per_axis() {
+                out.push(format!(
+                    "final error per axis (RMS): predicted {predicted:.3} m, achieved {achieved:.3} m"
+                ));
+            }
+        }
         out
     }
 }
@@ -329,6 +397,7 @@ pub fn evaluate_tricycle(
         source,
         align_s: None,
         evaluation,
+        diff: None,
     })
 }
 
@@ -348,9 +417,11 @@ pub fn diff_yaw(params: Option<&str>, asked: Option<YawSource>) -> YawSource {
     }
 }
 
-/// A differential drive over sliding GNSS outages, each started from the
-/// alignment of the preceding `align_s` of dead reckoning to the fixes and
-/// scored against the hidden fix at its end.
+/// A differential drive over sliding GNSS outages, the first `align_s` in,
+/// each started as `start` says (the alignment spans the preceding
+/// `align_s`; the filter's priors on the scales and the bias are the
+/// params file's standard errors where it states them) and scored against
+/// the hidden fix at its end.
 #[allow(clippy::too_many_arguments)]
 pub fn evaluate_diff(
     drive: &Drive,
@@ -359,28 +430,44 @@ pub fn evaluate_diff(
     length_s: f64,
     step_s: f64,
     align_s: f64,
+    start: &OutageStart,
     from_s: Option<f64>,
     until_s: Option<f64>,
 ) -> Result<Evaluated, Error> {
     let spec = params.unwrap_or("nominal");
-    let (params, source) = if spec == "nominal" {
-        (DiffDriveDrive::nominal(), "nominal".to_string())
+    let LoadedParams {
+        values: params,
+        std,
+        source,
+    } = if spec == "nominal" {
+        LoadedParams {
+            values: DiffDriveDrive::nominal(),
+            std: vec![None; diff_drive::N_PARAMS],
+            source: "nominal".to_string(),
+        }
     } else {
-        load_params_file(
+        load_params_file_with_std(
             spec,
             Shape::DiffDrive,
             &diff_drive::NAMES,
             Some(yaw_name(yaw)),
         )?
     };
+    // The filter refines the scales and the bias from their stated
+    // standard errors (the defaults where none is stated).
+    let start = match start {
+        OutageStart::Filter(noise) => OutageStart::Filter(noise.with_param_std(&std)),
+        OutageStart::Align => OutageStart::Align,
+    };
     let dd = diff_drive(drive, yaw, from_s, until_s)?;
-    let evaluation = evaluate_diff_drive(&dd, &params, length_s, step_s, align_s)?;
+    let diff = evaluate_diff_drive(&dd, &params, length_s, step_s, align_s, &start)?;
     Ok(Evaluated {
         shape: Shape::DiffDrive,
         length_s,
         source: format!("{source}, yaw {}", yaw_name(yaw)),
         align_s: Some(align_s),
-        evaluation,
+        evaluation: diff.outages.clone(),
+        diff: Some(diff),
     })
 }
 

@@ -10,7 +10,8 @@
 //!   stored corrections), the one `--from`/`--until` rule, scenarios and
 //!   simulated drives written to disk.
 //! - [`kinematic`]: the tricycle and differential-drive shapes calibrated
-//!   and evaluated over sliding outages, with their tables and JSON.
+//!   and evaluated over sliding outages (a differential drive's started from
+//!   its GNSS-aided filter, or aligned), with their tables and JSON.
 //! - [`tracks`]: `run`'s tracks chosen and written for other tools.
 //! - [`demo`], [`report`], [`stream`]: those commands whole.
 //!

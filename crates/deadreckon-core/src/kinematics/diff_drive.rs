@@ -13,11 +13,13 @@
 //! pose. The calibration ([`calibrate_diff_drive`]) cuts the drive into
 //! windows, gives each its own start pose (three nuisance parameters), and
 //! fits everything by Levenberg–Marquardt on the antenna positions at the
-//! fixes; the outage evaluation ([`evaluate_diff_drive`]) starts each outage
-//! from the rigid alignment (closed-form Procrustes) of the preceding
-//! dead-reckoned stretch to its fixes — what a user does without a heading
-//! reference — and scores the dead-reckoned antenna against the first hidden
-//! fix at or before the outage's end.
+//! fixes. The outage evaluation ([`evaluate_diff_drive`]) starts each outage
+//! from the state of a GNSS-aided filter ([`filter`]: pose, bias, scales and
+//! the fixes' slowly wandering error, which it carries into the outage) or,
+//! the baseline, from the rigid alignment (closed-form Procrustes) of the
+//! preceding dead-reckoned stretch to its fixes — what a user does without a
+//! filter — and scores the dead-reckoned antenna against the last hidden fix
+//! at or before the outage's end.
 
 use crate::drive::Wheels;
 use crate::{Drive, Error};
@@ -279,10 +281,14 @@ struct Window {
 }
 
 mod calibration;
+pub mod filter;
 mod outages;
 
 pub use calibration::{calibrate_diff_drive, DiffDriveOptions};
-pub use outages::evaluate_diff_drive;
+pub use filter::{DiffDriveFilter, FilterNoise};
+pub use outages::{evaluate_diff_drive, DiffDriveOutages, OutageStart};
 
+#[cfg(test)]
+mod filter_tests;
 #[cfg(test)]
 mod tests;

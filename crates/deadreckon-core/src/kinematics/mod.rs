@@ -19,7 +19,10 @@
 //! ([`calibrate`]) through the [`KinematicModel`] trait, which a shape
 //! implements with an analytic Jacobian. Outages are evaluated by
 //! [`evaluate`]: each window starts from the reference pose and is scored at
-//! the point the reference measures.
+//! the point the reference measures. A differential drive, calibrated and
+//! scored against GNSS fixes rather than a reference pose, has its own
+//! calibration and outages ([`diff_drive`]), the outages started from a
+//! GNSS-aided filter ([`diff_drive::filter`]).
 //!
 //! Frames: poses are `(x, y, ψ)` in the reference's frame (m, m, rad
 //! counter-clockwise). The *base* is the shape's kinematic centre (the rear

@@ -93,8 +93,19 @@ fn calibration_recovers_simulated_scales_bias_and_antenna() {
             truth[k]
         );
     }
-    let ev = evaluate_diff_drive(&d, &c.values(), 30.0, 10.0, 60.0).unwrap();
-    let nominal = evaluate_diff_drive(&d, &DiffDriveDrive::nominal(), 30.0, 10.0, 60.0).unwrap();
+    let ev = evaluate_diff_drive(&d, &c.values(), 30.0, 10.0, 60.0, &OutageStart::Align)
+        .unwrap()
+        .outages;
+    let nominal = evaluate_diff_drive(
+        &d,
+        &DiffDriveDrive::nominal(),
+        30.0,
+        10.0,
+        60.0,
+        &OutageStart::Align,
+    )
+    .unwrap()
+    .outages;
     assert!(
         ev.final_error().mean < 0.1 * nominal.final_error().mean,
         "{} vs {}",
