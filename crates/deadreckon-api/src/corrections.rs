@@ -46,6 +46,18 @@ fn tilt_json(t: &Tilt) -> Value {
     })
 }
 
+fn traction_json(t: &deadreckon_core::traction::TractionSlip) -> Value {
+    let num = |x: f64| if x.is_finite() { json!(x) } else { Value::Null };
+    json!({
+        "slip_per_mps2": num(t.slip_per_mps2),
+        "std": num(t.std),
+        "axle": t.is_estimated().then(|| t.axle.name()),
+        "blocks": t.blocks,
+        "estimated": t.is_estimated(),
+        "reason": t.status.reason(),
+    })
+}
+
 fn scale_json(g: &deadreckon_core::gyro_scale::GyroScale) -> Value {
     let num = |x: f64| if x.is_finite() { json!(x) } else { Value::Null };
     json!({
@@ -57,7 +69,8 @@ fn scale_json(g: &deadreckon_core::gyro_scale::GyroScale) -> Value {
     })
 }
 
-/// `{"delays": {stream: {...}}, "imu": {...} | null, "gyro_scale": {...} | null}`.
+/// `{"delays": {stream: {...}}, "traction": {...} | null, "imu": {...} | null,
+/// "gyro_scale": {...} | null}`.
 pub fn corrections_json(c: &Corrections) -> Value {
     let delays: serde_json::Map<String, Value> = Stream::ALL
         .iter()
@@ -65,12 +78,14 @@ pub fn corrections_json(c: &Corrections) -> Value {
         .collect();
     json!({
         "delays": delays,
+        "traction": c.traction.as_ref().map(traction_json),
         "imu": c.tilt.as_ref().map(tilt_json),
         "gyro_scale": c.gyro_scale.as_ref().map(scale_json),
     })
 }
 
-/// The `[delays.<stream>]`, `[imu]` and `[gyro_scale]` tables of params.toml.
+/// The `[delays.<stream>]`, `[traction]`, `[imu]` and `[gyro_scale]` tables
+/// of params.toml.
 pub fn corrections_toml(c: &Corrections) -> toml::Table {
     let mut out = toml::Table::new();
     let mut delays = toml::Table::new();
@@ -86,6 +101,17 @@ pub fn corrections_toml(c: &Corrections) -> toml::Table {
         delays.insert(s.name().into(), t.into());
     }
     out.insert("delays".into(), delays.into());
+    if let Some(tr) = &c.traction {
+        let mut t = toml::Table::new();
+        if tr.is_estimated() {
+            t.insert("slip_per_mps2".into(), tr.slip_per_mps2.into());
+            t.insert("std".into(), tr.std.into());
+            t.insert("axle".into(), tr.axle.name().into());
+        } else if let Some(r) = tr.status.reason() {
+            t.insert("not_estimated".into(), r.into());
+        }
+        out.insert("traction".into(), t.into());
+    }
     if let Some(tilt) = &c.tilt {
         let mut t = toml::Table::new();
         if tilt.is_estimated() {
@@ -123,11 +149,22 @@ pub struct Stored {
     pub up: Option<[f64; 3]>,
     /// The gyro's relative scale error (0 when absent or not estimated).
     pub gyro_scale_error: f64,
+    /// The driven axle's slip per m/s² of forward specific force (0 when
+    /// absent or not estimated; the sign names the axle).
+    pub traction_slip_per_mps2: f64,
 }
 
 impl Stored {
-    /// Applies them to `drive` ([`timing::apply_known`]).
+    /// Applies them to `drive`: the slip first ([`deadreckon_core::traction::apply`]),
+    /// then [`timing::apply_known`], in [`timing::prepare_with`]'s order.
     pub fn apply(&self, drive: &Drive) -> Drive {
+        let slipped;
+        let drive = if self.traction_slip_per_mps2 != 0.0 {
+            slipped = deadreckon_core::traction::apply(drive, self.traction_slip_per_mps2);
+            &slipped
+        } else {
+            drive
+        };
         timing::apply_known(drive, self.delays_s, self.up, self.gyro_scale_error)
     }
 }
@@ -149,8 +186,8 @@ pub fn stored_in_file(spec: &std::path::Path) -> Result<Stored, String> {
     stored_corrections(&extra).map_err(|e| format!("parameters {}: {e}", spec.display()))
 }
 
-/// Reads the `[delays]` and `[imu]` tables from the extra keys of a
-/// params.toml (absent: nothing to apply).
+/// Reads the `[delays]`, `[traction]`, `[imu]` and `[gyro_scale]` tables
+/// from the extra keys of a params.toml (absent: nothing to apply).
 pub fn stored_corrections(extra: &toml::Table) -> Result<Stored, String> {
     let mut s = Stored::default();
     if let Some(d) = extra.get("delays") {
@@ -185,6 +222,21 @@ pub fn stored_corrections(extra: &toml::Table) -> Result<Stored, String> {
             s.up = Some([v[0], v[1], v[2]]);
         }
     }
+    if let Some(t) = extra.get("traction") {
+        let t = t.as_table().ok_or("`traction` must be a table")?;
+        if let Some(v) = t.get("slip_per_mps2") {
+            let v = v
+                .as_float()
+                .ok_or("`traction.slip_per_mps2` must be a number")?;
+            if !(v.is_finite() && v.abs() <= deadreckon_core::traction::MAX_SLIP_PER_MPS2) {
+                return Err(format!(
+                    "`traction.slip_per_mps2` = {v} is not a plausible tyre slip (|κ| ≤ {} per m/s²)",
+                    deadreckon_core::traction::MAX_SLIP_PER_MPS2
+                ));
+            }
+            s.traction_slip_per_mps2 = v;
+        }
+    }
     if let Some(g) = extra.get("gyro_scale") {
         let g = g.as_table().ok_or("`gyro_scale` must be a table")?;
         if let Some(v) = g.get("scale_error") {
@@ -202,7 +254,8 @@ pub fn stored_corrections(extra: &toml::Table) -> Result<Stored, String> {
     Ok(s)
 }
 
-/// Estimates the corrections `which` asks for (IMU tilt, delays, gyro scale)
+/// Estimates the corrections `which` asks for (driven axle's slip, IMU tilt,
+/// delays, gyro scale)
 /// and applies them: the drive a calibration runs on, and what was found.
 /// The one call `calibrate`, `evaluate` and Python make.
 pub fn estimate_and_apply(

@@ -29,6 +29,18 @@ pub fn corrections_lines(c: &deadreckon_core::timing::Corrections) -> Vec<String
             ),
         });
     }
+    if let Some(t) = &c.traction {
+        out.push(match t.status.reason() {
+            None => format!(
+                "driven axle: {}, slip {:+.3}% ± {:.3}% per m/s² of forward specific force ({} one-second blocks), its wheel speeds corrected",
+                t.axle.name(),
+                100.0 * t.slip_per_mps2.abs(),
+                100.0 * t.std,
+                t.blocks
+            ),
+            Some(r) => format!("driven axle slip: not estimated: {r}"),
+        });
+    }
     match &c.tilt {
         None => out.push("imu tilt: no three-axis IMU in the drive".into()),
         Some(t) => out.push(match t.status.reason() {

@@ -224,7 +224,7 @@ impl Default for DelayOptions {
 }
 
 /// Lag-one autocorrelation of `r`.
-fn lag1(r: &[f64]) -> f64 {
+pub(crate) fn lag1(r: &[f64]) -> f64 {
     if r.len() < 3 {
         return 0.0;
     }
@@ -751,10 +751,11 @@ pub fn estimate_with_params(
 /// Which corrections [`prepare_with`] estimates and applies.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Which {
-    /// The IMU tilt and every stream's delay.
+    /// The driven axle's slip, the IMU tilt, every stream's delay and the
+    /// gyro scale.
     All,
-    /// The IMU tilt, the GNSS delay and the gyro scale (the other streams'
-    /// delays estimated and reported, not applied).
+    /// The driven axle's slip, the IMU tilt, the GNSS delay and the gyro
+    /// scale (the other streams' delays estimated and reported, not applied).
     Gnss,
     /// Nothing estimated or applied.
     None,
@@ -763,6 +764,9 @@ pub enum Which {
 /// What [`prepare`] found and applied.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Corrections {
+    /// The driven axle's slip (`None`: no accelerometer in the drive, or
+    /// not attempted).
+    pub traction: Option<crate::traction::TractionSlip>,
     /// The IMU's tilt (`None`: no three-axis IMU in the drive).
     pub tilt: Option<crate::imu::Tilt>,
     /// The streams' delays.
@@ -772,8 +776,9 @@ pub struct Corrections {
     pub gyro_scale: Option<crate::gyro_scale::GyroScale>,
 }
 
-/// Estimates the IMU tilt (projecting the gyro on the vertical when
-/// estimated), every stream's delay and the gyro scale error
+/// Estimates the driven axle's slip ([`crate::traction`], correcting its
+/// wheel speeds when estimated), the IMU tilt (projecting the gyro on the
+/// vertical when estimated), every stream's delay and the gyro scale error
 /// ([`crate::gyro_scale`], with the bias of a calibration at the final
 /// delays), and returns the drive with them applied.
 pub fn prepare(
@@ -796,12 +801,24 @@ pub fn prepare_with(
         return Ok((
             drive.clone(),
             Corrections {
+                traction: None,
                 tilt: None,
                 delays: Delays::none(),
                 gyro_scale: None,
             },
         ));
     }
+    // The driven axle's slip first: the wheels are the clock and the scale
+    // every other correction is measured against.
+    let traction = crate::traction::estimate(drive);
+    let slipped;
+    let drive = match &traction {
+        Some(t) if t.is_estimated() => {
+            slipped = crate::traction::apply(drive, t.slip_per_mps2);
+            &slipped
+        }
+        _ => drive,
+    };
     let (levelled, tilt) = crate::imu::level(drive);
     let (mut delays, params) = estimate_with_params(&levelled, copts, o)?;
     if which == Which::Gnss {
@@ -831,6 +848,7 @@ pub fn prepare_with(
     Ok((
         out,
         Corrections {
+            traction,
             tilt,
             delays,
             gyro_scale,
