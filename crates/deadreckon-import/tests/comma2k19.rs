@@ -415,3 +415,99 @@ fn the_truth_speed_was_taken_along_the_tilted_camera_axis() {
     );
     assert!(rel.abs() < 5e-4, "{:+.3} %", 100.0 * rel);
 }
+
+#[test]
+fn the_gnss_delay_was_measured_against_slipping_front_wheels() {
+    use deadreckon_core::calibrate::CalibrationOptions;
+    use deadreckon_core::timing::{self, DelayOptions};
+    use deadreckon_core::traction::{self, Axle};
+    let d = read_comma2k19(&common::data("comma2k19-rav4"), None).unwrap();
+    let delay = |d: &deadreckon_core::Drive| {
+        let (g, _) =
+            timing::gnss_delay(d, &CalibrationOptions::default(), &DelayOptions::default())
+                .unwrap();
+        assert!(g.status.is_estimated(), "{g:?}");
+        g
+    };
+    // The RAV4's front wheels are driven: they read high while pulling (0.32 %
+    // per m/s² of forward specific force against the reference, the rear
+    // −0.03 %), so the four wheels' speed looked early and the GNSS late.
+    let mut rear = d.clone();
+    rear.vehicle.wheels_present = [false, false, true, true];
+    let (all, rear) = (delay(&d), delay(&rear));
+    let t = traction::estimate(&d).unwrap();
+    let corrected = delay(&traction::apply(&d, t.slip_per_mps2));
+    println!(
+        "{t:?}\nGNSS delay against all four wheels {:.4} ± {:.4} s, the rear {:.4} ± {:.4} s, all corrected {:.4} ± {:.4} s",
+        all.delay_s, all.std_s, rear.delay_s, rear.std_s, corrected.delay_s, corrected.std_s
+    );
+    assert!(t.is_estimated() && t.axle == Axle::Front, "{t:?}");
+    // Against the reference: each axle's speed over the reference's
+    // horizontal speed, per one-second block, regressed on the block's
+    // forward specific force (measured: front +0.316 %, rear −0.033 % per
+    // m/s²);
+    // the estimate from the wheels and the accelerometer alone is 0.325 % ±
+    // 0.024 %.
+    let (front, rear_slip) = reference_slips(&d);
+    println!("against the reference: front {front:+.5}, rear {rear_slip:+.5} per m/s²");
+    assert!(front > 0.0025 && rear_slip.abs() < 0.001);
+    assert!(
+        (t.slip_per_mps2 - (front - rear_slip)).abs() <= 3.0 * t.std,
+        "{t:?}"
+    );
+    // Measured 0.108 s (all), 0.084 s (rear), 0.087 s (all, corrected).
+    assert!(all.delay_s - rear.delay_s > 0.02);
+    assert!((corrected.delay_s - rear.delay_s).abs() < 0.01);
+    assert!((corrected.delay_s - 0.1).abs() < 0.02);
+}
+
+/// The slope of (axle speed / reference horizontal speed − 1) on the forward
+/// specific force over one-second blocks, for the front and the rear axle.
+fn reference_slips(d: &deadreckon_core::Drive) -> (f64, f64) {
+    let Wheels::Speeds(ws) = &d.wheels else {
+        panic!("wheel speeds expected")
+    };
+    let mean = |xs: &mut dyn Iterator<Item = f64>| {
+        let (s, n) = xs.fold((0.0, 0usize), |(s, n), x| (s + x, n + 1));
+        (n > 0).then(|| s / n as f64)
+    };
+    let (t0, t1) = (d.truth[0].t_s, d.truth[d.truth.len() - 1].t_s);
+    let mut rows = Vec::new();
+    let mut t = t0 + 1.0;
+    while t + 1.0 < t1 {
+        let within = |x: f64| x >= t && x < t + 1.0;
+        let v = mean(
+            &mut d
+                .truth
+                .iter()
+                .filter(|p| within(p.t_s))
+                .map(|p| p.speed_mps.unwrap()),
+        );
+        let f = mean(
+            &mut ws
+                .iter()
+                .filter(|w| within(w.t_s))
+                .map(|w| 0.5 * (w.fl_mps + w.fr_mps)),
+        );
+        let r = mean(
+            &mut ws
+                .iter()
+                .filter(|w| within(w.t_s))
+                .map(|w| 0.5 * (w.rl_mps + w.rr_mps)),
+        );
+        let a = mean(&mut d.imu.accel.iter().filter(|s| within(s.t_s)).map(|s| s.x));
+        if let (Some(v), Some(f), Some(r), Some(a)) = (v, f, r, a) {
+            rows.push((a, f / v - 1.0, r / v - 1.0));
+        }
+        t += 1.0;
+    }
+    let slope = |y: fn(&(f64, f64, f64)) -> f64| {
+        let n = rows.len() as f64;
+        let mx = rows.iter().map(|r| r.0).sum::<f64>() / n;
+        let my = rows.iter().map(y).sum::<f64>() / n;
+        let sxy: f64 = rows.iter().map(|r| (r.0 - mx) * (y(r) - my)).sum();
+        let sxx: f64 = rows.iter().map(|r| (r.0 - mx).powi(2)).sum();
+        sxy / sxx
+    };
+    (slope(|r| r.1), slope(|r| r.2))
+}
