@@ -10,18 +10,34 @@
 //! below [`STANDSTILL_MPS`] for at least [`MIN_STANDSTILL_S`] in total) it is
 //! gravity alone. Without such stops (a highway segment) the vehicle's own
 //! acceleration is removed first: the forward acceleration (the wheel speed's
-//! derivative) from x and the centripetal acceleration (speed × gyro z rate)
-//! from y; what is left of a drive's accelerations and road slopes averages
-//! out over its one-second blocks.
+//! derivative) from x and the centripetal acceleration, speed × (gyro z −
+//! its bias), from y. The bias comes from the GNSS course
+//! ([`gyro_bias_from_course`]): a phone's raw gyro carries tens of mrad/s
+//! (0.068 rad/s on the comma2k19 segment), and left in the centripetal term
+//! at 15 m/s it reads as a 6° roll. What is left of a drive's accelerations
+//! and road slopes averages out over its one-second blocks; the vertical
+//! found is the drive's mean one, its mean grade and bank included.
 //!
-//! **Standard error**: the tilt from the block means of one second each
-//! (their scatter, divided by √blocks), so vibration and correlated noise count.
+//! **Standard error**: of each horizontal component of the vertical, in
+//! quadrature: the scatter of the one-second block means divided by
+//! √blocks (vibration and correlated noise count); the accelerometer's own
+//! error, which gravity alone cannot tell from a tilt, taken as large across
+//! as it is along the vertical (`| |f| − γ |`, γ the normal gravity at the
+//! drive's origin, [`normal_gravity`]); and, driving, the bias's standard
+//! error times the mean speed (y only). On comma2k19 the accelerometer reads
+//! |f| 0.12 m/s² short, and against the reference's specific force it is
+//! (−0.075, +0.076, +0.142) m/s² off in (forward, right, down): the tilt is
+//! 3.75° ± 0.77° where the reference's mean vertical in the camera's axes is
+//! 3.46° (pitch −3.67° ± 0.77° against −3.22°, roll +0.81° ± 0.73° against
+//! +1.24°).
 //!
 //! **Status**: not estimated without an accelerometer and three-axis gyro,
-//! with fewer than [`MIN_BLOCKS`] blocks, when the mean specific force is not
-//! gravity (|f| outside 9.81 ± 0.5 m/s²: units or axes wrong), or when the
-//! tilt is above [`MAX_TILT_DEG`] (axes not as documented): rejected, never
-//! clamped.
+//! with fewer than [`MIN_BLOCKS`] blocks, without standstill and without a
+//! GNSS course to take the gyro bias from (fewer than [`MIN_COURSE_BLOCKS`]
+//! blocks of [`COURSE_BLOCK_S`]), when the mean specific force is not gravity
+//! (|f| more than [`MAX_GRAVITY_ERROR_MPS2`] from it: units or axes wrong),
+//! or when the tilt is above [`MAX_TILT_DEG`] (axes not as documented):
+//! rejected, never clamped.
 
 use crate::drive::{Axes, Drive, Scalar};
 use crate::timing::Status;

@@ -171,7 +171,7 @@ pub fn estimate(drive: &Drive) -> Option<TractionSlip> {
     let my = b.iter().map(|r| r.2).sum::<f64>() / n as f64;
     let sxx: f64 = b.iter().map(|r| (r.1 - mx).powi(2)).sum();
     let sxy: f64 = b.iter().map(|r| (r.1 - mx) * (r.2 - my)).sum();
-    if !(sxx > 0.0) {
+    if sxx.is_nan() || sxx <= 0.0 {
         return Some(TractionSlip::not_estimated(
             n,
             "the forward specific force never changes".into(),
