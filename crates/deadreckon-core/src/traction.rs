@@ -28,7 +28,9 @@
 //! rear wheels alone give 0.084 s, the corrected four 0.087 s.
 //!
 //! **Status**: not estimated without an accelerometer, with wheel ticks (a
-//! count cannot be corrected), without all four wheels, with fewer than
+//! count cannot be corrected), without all four wheels, when gravity is not
+//! within [`crate::imu::MAX_TILT_DEG`] of the accelerometer's z axis (its x
+//! is then not forward), with fewer than
 //! [`MIN_BLOCKS`] blocks, a standard error above [`MAX_STD_PER_MPS2`] (too
 //! little acceleration or grade), or `|κ|` above [`MAX_SLIP_PER_MPS2`]
 //! (rejected, never clamped).
@@ -156,6 +158,20 @@ pub fn estimate(drive: &Drive) -> Option<TractionSlip> {
         return Some(TractionSlip::not_estimated(
             0,
             "the front and rear axles are compared: all four wheels are needed".into(),
+        ));
+    }
+    // The x axis must be the forward one: gravity within the tilt's bound
+    // of z (a sensor mounted on its side reads its forward force elsewhere).
+    let acc = &drive.imu.accel;
+    let mean = [0, 1, 2].map(|k| acc.iter().map(|a| a.xyz()[k]).sum::<f64>() / acc.len() as f64);
+    let norm = mean.iter().map(|c| c * c).sum::<f64>().sqrt();
+    if !(norm > 0.0 && (mean[2] / norm).acos().to_degrees() <= crate::imu::MAX_TILT_DEG) {
+        return Some(TractionSlip::not_estimated(
+            0,
+            format!(
+                "the accelerometer's mean specific force ({:.2}, {:.2}, {:.2}) m/s² is not along z: its axes are not x forward, y left, z up",
+                mean[0], mean[1], mean[2]
+            ),
         ));
     }
     let f = forward_force(drive);

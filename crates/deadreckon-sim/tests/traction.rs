@@ -126,3 +126,14 @@ fn an_implausible_slip_is_rejected_not_clamped() {
         "{t:?}"
     );
 }
+
+#[test]
+fn an_accelerometer_on_its_side_gives_no_slip() {
+    let mut d = with_slip(&drive(), Axle::Front, 0.004);
+    for a in &mut d.imu.accel {
+        std::mem::swap(&mut a.x, &mut a.z);
+    }
+    let t = traction::estimate(&d).expect("accelerometer");
+    assert!(!t.is_estimated(), "{t:?}");
+    assert!(t.status.reason().unwrap().contains("not along z"), "{t:?}");
+}
