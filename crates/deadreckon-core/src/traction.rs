@@ -25,7 +25,10 @@
 //! forward specific force (against the reference's horizontal speed: front
 //! +0.316 %, rear −0.033 %), which made the four wheels' mean speed look
 //! about 0.03 s early and the GNSS delay estimated against it 0.108 s; the
-//! rear wheels alone give 0.084 s, the corrected four 0.087 s.
+//! rear wheels alone give 0.084 s, the corrected four 0.087 s. One slope is
+//! an approximation: braking loads both axles, and on that segment's first
+//! half (pulling away) the slope is 0.40 % ± 0.02 %, on its second (mostly
+//! braking) 0.26 % ± 0.03 %.
 //!
 //! **Status**: not estimated without an accelerometer, with wheel ticks (a
 //! count cannot be corrected), without all four wheels, when gravity is not
