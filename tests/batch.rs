@@ -120,7 +120,8 @@ fn batch_writes_a_row_per_drive_and_the_history() {
         .expect("windows");
     assert!(windows >= 2, "{windows}");
     // The same numbers as `evaluate --outage` on that drive (without the
-    // timing and mounting corrections, which `batch` does not estimate).
+    // timing and mounting corrections, which `batch` does not estimate by
+    // default).
     let e = run(&[
         "evaluate",
         &fleet.join("a").to_string_lossy(),
@@ -213,4 +214,53 @@ fn a_closed_standard_output_ends_quietly() {
     assert!(o.status.success(), "{e}");
     assert!(!e.contains("panicked"), "{e}");
     assert_eq!(rows(&out).len(), 1);
+}
+
+/// Regression (issue 13): `batch` calibrated every drive without the
+/// timing and mounting corrections `calibrate` estimates, and had no column
+/// for them. With `--corrections gnss` each row has the delays (the GNSS
+/// one applied, equal to `calibrate --json`'s on that drive); by default
+/// none are estimated and the columns are empty.
+#[test]
+fn batch_had_no_corrections_and_no_columns_for_them() {
+    let t = tempfile::tempdir().expect("temp dir");
+    let drive = t.path().join("fleet").join("a");
+    simulate(&drive, 1, "car-1", 2);
+    let d = drive.to_string_lossy();
+    let out = t.path().join("results.csv");
+    let o = run(&[
+        "batch",
+        &d,
+        "--out",
+        &out.to_string_lossy(),
+        "--corrections",
+        "gnss",
+        "--quiet",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let r = rows(&out);
+    assert_eq!(&r[0][column(&out, "status_delay_gnss")], "applied");
+    assert_eq!(&r[0][column(&out, "status_imu_tilt")], "none");
+    let delay: f64 = r[0][column(&out, "delay_gnss_s")].parse().expect("number");
+    let c = run(&["calibrate", &d, "--json"]);
+    assert!(c.status.success());
+    let cal: serde_json::Value = serde_json::from_slice(&c.stdout).expect("json");
+    assert_eq!(
+        Some(delay),
+        cal["corrections"]["delays"]["gnss"]["delay_s"].as_f64(),
+        "{}",
+        cal["corrections"]
+    );
+    // The same calibration as calibrate's, corrections included.
+    let fl: f64 = r[0][column(&out, "circumference_fl_m")]
+        .parse()
+        .expect("number");
+    assert_eq!(Some(fl), cal["circumference_fl_m"].as_f64());
+
+    let plain = t.path().join("plain.csv");
+    let o = run(&["batch", &d, "--out", &plain.to_string_lossy(), "--quiet"]);
+    assert!(o.status.success());
+    let r = rows(&plain);
+    assert_eq!(&r[0][column(&plain, "delay_gnss_s")], "");
+    assert_eq!(&r[0][column(&plain, "status_delay_gnss")], "");
 }

@@ -86,3 +86,81 @@ fn run_applied_the_parameters_without_the_corrections_they_were_calibrated_with(
     eprintln!("dead reckoning over the drive: {with:.2} m with the stored corrections, {without:.2} m without");
     assert!(with < 0.5 * without, "{with} vs {without}");
 }
+
+/// Regression (issue 13): `report --params` took the parameters of a
+/// params.toml without the corrections stored beside them, and without
+/// `--params` the report's own calibrations ran on uncorrected streams
+/// where `calibrate` estimates and applies them first.
+#[test]
+fn the_report_ignored_the_corrections_of_its_params_and_estimated_none() {
+    use deadreckon_api::report::{corrected, ReportOptions};
+    use deadreckon_core::timing::Which;
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("drive");
+    let seed = 5;
+    let mut sc = CarFamily::draw(seed).drive(seed, 300.0);
+    let g = sc.sensors.gyro.as_mut().expect("family gyro");
+    g.tilt_deg = Some([3.0, -2.5]);
+    let sim = deadreckon_sim::simulate(&sc, seed).unwrap();
+    deadreckon_io::write_drive_whole(&dir, &sim.drive, |_| Ok(())).unwrap();
+    let d = dir.to_str().unwrap();
+    let p = tmp.path().join("params.toml");
+    run_ok(&["calibrate", d, "--out", p.to_str().unwrap()]);
+    let drive = deadreckon_io::read_drive(&dir).unwrap();
+    fn options<'a>(
+        dir: &'a Path,
+        params: Option<&'a str>,
+        corrections: Which,
+    ) -> ReportOptions<'a> {
+        ReportOptions {
+            dir,
+            params,
+            model: None,
+            outage_s: None,
+            corrections,
+        }
+    }
+
+    // --params with stored corrections: those are applied, none estimated.
+    let ps = p.to_str().unwrap();
+    let (with_stored, rows) =
+        corrected(&drive, &options(&dir, Some(ps), Which::Gnss), &()).unwrap();
+    let rows = rows.expect("stored corrections shown");
+    assert_eq!(rows.source, format!("stored in {ps}"));
+    let stored = deadreckon_api::corrections::stored_in_file(&p).unwrap();
+    assert_eq!(with_stored.yaw_rate, stored.apply(&drive).yaw_rate);
+    assert_ne!(
+        with_stored.yaw_rate, drive.yaw_rate,
+        "the stored tilt levels the gyro"
+    );
+    let tilt = rows
+        .rows
+        .iter()
+        .find(|r| r.what == "IMU tilt")
+        .expect("tilt row");
+    let truth = 3f64.hypot(2.5);
+    assert!(
+        (tilt.value.unwrap() - truth).abs() < 0.5,
+        "{tilt:?} vs {truth:.2}°"
+    );
+
+    // No --params: estimated on the drive, the tilt with its standard error.
+    let (_, rows) = corrected(&drive, &options(&dir, None, Which::Gnss), &()).unwrap();
+    let rows = rows.expect("estimated corrections shown");
+    assert!(
+        rows.source.contains("estimated on this drive"),
+        "{}",
+        rows.source
+    );
+    let tilt = rows.rows.iter().find(|r| r.what == "IMU tilt").unwrap();
+    let (v, s) = (tilt.value.unwrap(), tilt.std.unwrap());
+    assert!(
+        (v - truth).abs() < 3.0 * s.max(0.05),
+        "{v} ± {s} vs {truth:.2}°"
+    );
+    // --corrections none with nominal parameters: nothing applied or shown.
+    let (same, rows) =
+        corrected(&drive, &options(&dir, Some("nominal"), Which::None), &()).unwrap();
+    assert!(rows.is_none());
+    assert_eq!(same.yaw_rate, drive.yaw_rate);
+}

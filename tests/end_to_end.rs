@@ -643,3 +643,53 @@ fn car_truth_calibration_with_zero_samples_is_not_converged() {
     // The simulator's true ratio is the nominal 15.9 here.
     assert!((ratio / 15.9 - 1.0).abs() < 0.005, "{v}");
 }
+
+/// Regressions (issue 13): `tedris train` and `tedris run` could not apply
+/// the corrections a params.toml stores (a GNSS delay here), and `tedris
+/// run --json` put TedriS's checks under `"checks"`, where every `--json`
+/// object's plausibility checks then replaced them.
+#[test]
+fn tedris_ignored_the_stored_corrections_and_its_json_lost_its_checks() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("drive");
+    let seed = 7;
+    let mut sc = deadreckon_sim::family::CarFamily::draw(seed).drive_forward(seed, 500.0);
+    sc.sensors.gnss.as_mut().expect("family gnss").latency_s = 0.2;
+    let sim = deadreckon_sim::simulate(&sc, seed).unwrap();
+    deadreckon_io::write_drive_whole(&dir, &sim.drive, |_| Ok(())).unwrap();
+    let d = dir.to_str().unwrap();
+    let p = tmp.path().join("params.toml");
+    let ps = p.to_str().unwrap();
+    run_ok(&["calibrate", d, "--out", ps]);
+    let stored: toml::Table = std::fs::read_to_string(&p).unwrap().parse().unwrap();
+    let delay = stored["delays"]["gnss"]["delay_s"].as_float().unwrap();
+    assert!(delay > 0.1, "{stored}");
+    let model = tmp.path().join("model.json");
+    let m = model.to_str().unwrap();
+    let t = json(&run_ok(&[
+        "tedris", "train", d, "--params", ps, "--out", m, "--json",
+    ]));
+    // Stream::ALL order: gyro, speed, steering, gnss.
+    assert_eq!(t["corrections"]["delays_s"][3].as_f64(), Some(delay), "{t}");
+    let saved = json(&std::fs::read_to_string(&model).unwrap());
+    assert_eq!(saved["corrections"], t["corrections"]);
+    // tedris run applies the model's corrections without --params, a
+    // params.toml's with it.
+    let end = sim.drive.gnss.last().unwrap().t_s;
+    let window = format!("{:.0}:{:.0}", end - 200.0, end - 120.0);
+    let r = json(&run_ok(&[
+        "tedris", "run", d, "--model", m, "--outage", &window, "--json",
+    ]));
+    assert_eq!(r["corrections"], "the model's (trained with them)", "{r}");
+    assert!(
+        r["tedris_checks"]["heading_segments"].as_u64().unwrap() >= 2,
+        "{r}"
+    );
+    assert_eq!(r["checks"]["skipped"], false, "{r}");
+    let r = json(&run_ok(&[
+        "tedris", "run", d, "--model", m, "--outage", &window, "--params", ps, "--json",
+    ]));
+    assert_eq!(r["corrections"], format!("stored in {ps}"), "{r}");
+    let text = run_ok(&["tedris", "run", d, "--model", m, "--outage", &window]);
+    assert!(text.contains("corrections applied: the model's"), "{text}");
+}

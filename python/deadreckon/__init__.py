@@ -344,6 +344,7 @@ def tedris_train(
     until_s: Optional[float] = None,
     mapping: Optional[PathLike] = None,
     skip_checks: bool = False,
+    params: Optional[PathLike] = None,
 ) -> TedrisModel:
     """Trains TedriS on a drive (``deadreckon tedris train``).
 
@@ -353,6 +354,9 @@ def tedris_train(
     ``from_s``/``until_s``: train on that part of the drive only. The drive
     is checked across its streams first, as by :func:`calibrate`
     (``skip_checks``); the summary's ``checks`` holds the warnings.
+    ``params``: a params.toml whose stored corrections (delays, IMU tilt,
+    gyro scale) are applied to the drive first; the model keeps them
+    (``corrections``) and :func:`tedris_run` applies them too.
     """
     text, summary = _native.tedris_train(
         _source(drive),
@@ -364,6 +368,7 @@ def tedris_train(
         until_s,
         _opt_path(mapping),
         skip_checks,
+        _opt_path(params),
     )
     return TedrisModel(text, summary)
 
@@ -377,11 +382,15 @@ def tedris_run(
     threshold_m: float = 1.0,
     mapping: Optional[PathLike] = None,
     skip_checks: bool = False,
+    params: Optional[PathLike] = None,
 ) -> Dict[str, Any]:
     """Runs TedriS with GNSS blanked in ``outages`` ((start_s, end_s), drive
     clock); returns ``tedris run --json``'s object (``outages``,
-    ``reference``, ``source``, ``model``, ``checks``) with ``track``: the
-    predicted track as a DataFrame (instead of the CSV's path)."""
+    ``reference``, ``source``, ``model``, ``corrections``,
+    ``tedris_checks``, ``checks``) with ``track``: the predicted track as a
+    DataFrame (instead of the CSV's path). The drive gets the corrections
+    stored in ``params`` (a params.toml), or else those the model was
+    trained with."""
     r = _native.tedris_run(
         _source(drive),
         model.json,
@@ -390,6 +399,7 @@ def tedris_run(
         threshold_m,
         _opt_path(mapping),
         skip_checks,
+        _opt_path(params),
     )
     r["track"] = pd.DataFrame(r["track"])
     return r

@@ -144,6 +144,7 @@ def tedris_train(
     until_s: Optional[float] = None,
     mapping: Optional[str] = None,
     skip_checks: bool = False,
+    params: Optional[str] = None,
 ) -> Tuple[str, Dict[str, Any]]: ...
 def tedris_run(
     source: Union[Drive, str],
@@ -153,4 +154,5 @@ def tedris_run(
     threshold_m: float = 1.0,
     mapping: Optional[str] = None,
     skip_checks: bool = False,
+    params: Optional[str] = None,
 ) -> Dict[str, Any]: ...

@@ -3,8 +3,7 @@
 use std::path::PathBuf;
 
 use deadreckon_tedris::{
-    run_outages_with, ModelKind, Outage, ReferenceSource, RunOptions, TedrisConfig, TedrisModel,
-    Variant,
+    ModelKind, Outage, ReferenceSource, RunOptions, TedrisConfig, TedrisModel, Variant,
 };
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -31,7 +30,7 @@ fn reference_source(s: &str) -> PyResult<Option<ReferenceSource>> {
 /// `tedris train`: the model as JSON text (what `--out` writes) and the
 /// summary `tedris train --json` prints.
 #[pyfunction]
-#[pyo3(signature = (source, reference="auto", variant=None, model="auto", config_json=None, from_s=None, until_s=None, mapping=None, skip_checks=false))]
+#[pyo3(signature = (source, reference="auto", variant=None, model="auto", config_json=None, from_s=None, until_s=None, mapping=None, skip_checks=false, params=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn tedris_train(
     py: Python<'_>,
@@ -44,6 +43,7 @@ pub fn tedris_train(
     until_s: Option<f64>,
     mapping: Option<PathBuf>,
     skip_checks: bool,
+    params: Option<String>,
 ) -> PyResult<(String, Py<PyAny>)> {
     deadreckon_api::load::check_range_named(from_s, until_s, ["from_s", "until_s"])
         .map_err(|e| DeadreckonError::new_err(e.to_string()))?;
@@ -88,6 +88,7 @@ pub fn tedris_train(
         config,
         variant,
         model,
+        params,
         ..Default::default()
     };
     let (m, source) = py
@@ -101,7 +102,7 @@ pub fn tedris_train(
 
 /// `tedris run --json` as a dict, plus `track`: the predicted track's columns.
 #[pyfunction]
-#[pyo3(signature = (source, model_json, outages, reference="auto", threshold_m=1.0, mapping=None, skip_checks=false))]
+#[pyo3(signature = (source, model_json, outages, reference="auto", threshold_m=1.0, mapping=None, skip_checks=false, params=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn tedris_run<'py>(
     py: Python<'py>,
@@ -112,6 +113,7 @@ pub fn tedris_run<'py>(
     threshold_m: f64,
     mapping: Option<PathBuf>,
     skip_checks: bool,
+    params: Option<String>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = TedrisModel::from_json(model_json)
         .map_err(|e| DeadreckonError::new_err(format!("the model: {e}")))?;
@@ -136,15 +138,22 @@ pub fn tedris_run<'py>(
         source: reference_source(reference)?,
         threshold_m: Some(threshold_m),
     };
-    let r = py
-        .detach(|| run_outages_with(&drive, &m, &outages, &opts))
+    let (r, corrections) = py
+        .detach(|| {
+            deadreckon_api::tedris::run_outages(
+                &drive,
+                &m,
+                &outages,
+                &opts,
+                None,
+                params.as_deref(),
+            )
+        })
         .map_err(to_py_err)?;
-    let mut v = serde_json::json!({
-        "outages": r.outages,
-        "reference": r.reference,
-        "source": r.source,
-        "model": m.chosen.name(),
-    });
+    let mut v = deadreckon_api::tedris::run_json(&r, &m, None, corrections.as_deref());
+    if let Some(o) = v.as_object_mut() {
+        o.remove("track");
+    }
     checks.annotate(&mut v);
     let out: Bound<'py, PyDict> = to_py(py, &v)?.into_bound(py).cast_into()?;
     out.set_item("track", track_columns(py, &r.track)?)?;

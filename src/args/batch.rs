@@ -46,6 +46,12 @@ pub struct BatchArgs {
     /// GNSS-aided time before the first outage window, s.
     #[arg(long, default_value_t = 5.0, value_parser = super::non_negative)]
     pub warmup: f64,
+    /// The timing and mounting corrections estimated and applied on each drive
+    /// before calibrating, as `calibrate --corrections`: all, gnss or none
+    /// (default: per-drive delays add variance the history's χ² test does
+    /// not know of; see docs/fleet.md).
+    #[arg(long, value_enum, default_value_t = super::CorrectionsArg::None)]
+    pub corrections: super::CorrectionsArg,
     /// Significance level of the history's χ² and change-point tests.
     #[arg(long, default_value_t = 1e-3, value_parser = super::probability)]
     pub alpha: f64,
@@ -70,6 +76,7 @@ impl BatchArgs {
                 },
                 ..Default::default()
             },
+            corrections: a.corrections.into(),
             outage: a.outage.map(|len| OutageOptions {
                 length_s: len,
                 step_s: a.step.unwrap_or(len / 2.0),

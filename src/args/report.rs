@@ -18,6 +18,12 @@ pub struct ReportArgs {
     /// Also run the sliding-window outage evaluation with windows of this length, s.
     #[arg(long, value_parser = super::positive)]
     pub outage: Option<f64>,
+    /// The timing and mounting corrections estimated on the drive and applied
+    /// for every section when --params stores none: all, gnss or none (as
+    /// `calibrate --corrections`). A params.toml that stores corrections
+    /// applies those instead.
+    #[arg(long, value_enum, default_value_t = super::CorrectionsArg::Gnss)]
+    pub corrections: super::CorrectionsArg,
     /// Output HTML file.
     #[arg(long)]
     pub out: PathBuf,

@@ -99,6 +99,11 @@ pub struct TrainArgs {
     /// key with its unit and default: docs/tedris.md).
     #[arg(long)]
     pub config: Option<PathBuf>,
+    /// A params.toml whose stored corrections (delays, IMU tilt, gyro scale;
+    /// `calibrate` writes them) are applied to the drive before training;
+    /// the model keeps them and `tedris run` applies them too.
+    #[arg(long)]
+    pub params: Option<String>,
     /// Train only on data from this time on, s (drive clock).
     #[arg(long = "from", value_parser = super::finite, allow_hyphen_values = true)]
     pub from_s: Option<f64>,
@@ -127,6 +132,10 @@ pub struct RunArgs {
     /// Reference heading.
     #[arg(long, value_enum, default_value = "auto")]
     pub reference: Reference,
+    /// A params.toml whose stored corrections are applied to the drive
+    /// (default: those the model was trained with, if any).
+    #[arg(long)]
+    pub params: Option<String>,
     /// The error threshold reported as `time_to_threshold_s`, m.
     #[arg(long, default_value_t = 1.0, value_parser = super::positive)]
     pub threshold_m: f64,
@@ -181,6 +190,7 @@ impl TrainArgs {
             tau_samples: self.tau.map(|t| t as usize),
             epsilon_factor: self.epsilon_k.map(|k| k.0),
             separate_repositories: self.separate_repositories,
+            params: self.params.clone(),
         })
     }
 }

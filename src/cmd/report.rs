@@ -14,7 +14,7 @@ pub fn run(a: ReportArgs, quiet: bool, load: &common::Loader) -> Result<()> {
         .flatten()
         .collect();
     common::check_output(&a.out, &inputs)?;
-    let steps = Steps::new(8, quiet);
+    let steps = Steps::new(9, quiet);
     steps.step("reading the drive");
     let drive = load.drive(&a.dir)?;
     let o = deadreckon_api::report::ReportOptions {
@@ -22,6 +22,7 @@ pub fn run(a: ReportArgs, quiet: bool, load: &common::Loader) -> Result<()> {
         params: a.params.as_deref(),
         model: a.model.as_deref(),
         outage_s: a.outage,
+        corrections: a.corrections.into(),
     };
     deadreckon_api::report::write(&drive, &o, &a.out, &steps, &common::footer())?;
     steps.finish();

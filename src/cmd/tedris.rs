@@ -21,6 +21,7 @@ fn train(a: TrainArgs, load: &common::Loader) -> Result<()> {
     deadreckon_api::load::check_range(a.from_s, a.until_s)?;
     let inputs: Vec<&std::path::Path> = std::iter::once(a.dir.as_path())
         .chain(a.config.as_deref())
+        .chain(a.params.as_deref().map(std::path::Path::new))
         .collect();
     common::check_output(&a.out, &inputs)?;
     let drive = deadreckon_api::load::cut(load.drive(&a.dir)?, a.from_s, a.until_s)?;
@@ -38,7 +39,9 @@ fn train(a: TrainArgs, load: &common::Loader) -> Result<()> {
 /// `tedris run`.
 fn run_outages(a: RunArgs, load: &common::Loader) -> Result<()> {
     if let Some(p) = &a.out {
-        common::check_output(p, &[&a.dir, &a.model])?;
+        let mut inputs = vec![a.dir.as_path(), a.model.as_path()];
+        inputs.extend(a.params.as_deref().map(std::path::Path::new));
+        common::check_output(p, &inputs)?;
     }
     let m = tedris::read_model(&a.model)?;
     let outages = a.outage_windows()?;
@@ -47,10 +50,21 @@ fn run_outages(a: RunArgs, load: &common::Loader) -> Result<()> {
         source: a.reference.source(),
         threshold_m: Some(a.threshold_m),
     };
-    let r = tedris::run_outages(&drive, &m, &outages, &opts, a.out.as_deref())?;
+    let (r, corrections) = tedris::run_outages(
+        &drive,
+        &m,
+        &outages,
+        &opts,
+        a.out.as_deref(),
+        a.params.as_deref(),
+    )?;
     if a.json {
-        common::print_json(load, tedris::run_json(&r, &m, a.out.as_deref()))
+        let c = corrections.as_deref();
+        common::print_json(load, tedris::run_json(&r, &m, a.out.as_deref(), c))
     } else {
+        if let Some(c) = &corrections {
+            outln!("corrections applied: {c}");
+        }
         common::print_lines(deadreckon_api::text::tedris_outage_lines(&r, a.threshold_m))?;
         if let Some(p) = &a.out {
             outln!("track written to {}", p.display());

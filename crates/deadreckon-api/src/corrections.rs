@@ -140,33 +140,50 @@ pub fn corrections_toml(c: &Corrections) -> toml::Table {
     out
 }
 
-/// Corrections read back from params.toml.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct Stored {
-    /// Delays, s, in [`Stream::ALL`] order (0 where absent or not estimated).
-    pub delays_s: [f64; 4],
-    /// The IMU's vertical in its own axes, when estimated.
-    pub up: Option<[f64; 3]>,
-    /// The gyro's relative scale error (0 when absent or not estimated).
-    pub gyro_scale_error: f64,
-    /// The driven axle's slip per m/s² of forward specific force (0 when
-    /// absent or not estimated; the sign names the axle).
-    pub traction_slip_per_mps2: f64,
-}
+/// Corrections read back from params.toml (applied as they are).
+pub type Stored = timing::KnownCorrections;
 
-impl Stored {
-    /// Applies them to `drive`: the slip first ([`deadreckon_core::traction::apply`]),
-    /// then [`timing::apply_known`], in [`timing::prepare_with`]'s order.
-    pub fn apply(&self, drive: &Drive) -> Drive {
-        let slipped;
-        let drive = if self.traction_slip_per_mps2 != 0.0 {
-            slipped = deadreckon_core::traction::apply(drive, self.traction_slip_per_mps2);
-            &slipped
-        } else {
-            drive
-        };
-        timing::apply_known(drive, self.delays_s, self.up, self.gyro_scale_error)
+/// The report's rows of what is applied: each stored delay, the tilt of
+/// the stored vertical, the gyro scale error, the driven axle's slip (no
+/// standard errors: params.toml keeps the values applied).
+pub fn stored_rows(stored: &Stored) -> Vec<deadreckon_report::CorrectionRow> {
+    let row = |what: String, unit: &str, value: f64| deadreckon_report::CorrectionRow {
+        what,
+        unit: unit.into(),
+        value: Some(value),
+        std: None,
+        status: "stored, applied".into(),
+    };
+    let mut rows: Vec<_> = Stream::ALL
+        .iter()
+        .zip(stored.delays_s)
+        .filter(|(_, d)| *d != 0.0)
+        .map(|(s, d)| row(format!("{} delay", s.name()), "s", d))
+        .collect();
+    if let Some(up) = stored.up {
+        rows.push(row(
+            "IMU tilt".into(),
+            "°",
+            up[2].clamp(-1.0, 1.0).acos().to_degrees(),
+        ));
     }
+    if stored.gyro_scale_error != 0.0 {
+        rows.push(row(
+            "gyro scale error".into(),
+            "%",
+            100.0 * stored.gyro_scale_error,
+        ));
+    }
+    let k = stored.traction_slip_per_mps2;
+    if k != 0.0 {
+        let axle = if k > 0.0 { "front" } else { "rear" };
+        rows.push(row(
+            format!("{axle} axle slip per m/s²"),
+            "%",
+            100.0 * k.abs(),
+        ));
+    }
+    rows
 }
 
 /// The corrections stored in the params.toml at `spec` (nothing for

@@ -259,6 +259,8 @@ pub fn tedris_train_json(m: &TedrisModel, source: ReferenceSource) -> Value {
         // From GNSS chords; null while not estimated.
         "distance_scale": m.distance_scale.estimated(),
         "distance_scale_chords": m.distance_scale.chords,
+        // The corrections the training drive had (from --params); null: none.
+        "corrections": m.corrections,
         "per_metre_straight": m.per_metre_straight,
         "course_convention": m.course_convention,
         "complete": m.complete,

@@ -3,6 +3,11 @@
 //! user's parameters as "given", filter health, dead reckoning, drift,
 //! outages ([`deadreckon_eval::report`]) and, with a trained model, the
 //! TedriS sections; written whole by [`deadreckon_report::write_report`].
+//!
+//! Every section reads the drive with the same timing and mounting
+//! corrections, shown in the calibration section: those a `--params` file
+//! stores (its parameters were calibrated on streams corrected so), or
+//! else those estimated on the drive as `calibrate --corrections` would.
 
 use std::path::Path;
 
@@ -27,6 +32,45 @@ pub struct ReportOptions<'a> {
     pub model: Option<&'a Path>,
     /// The outage length, s (default: the report's and TedriS's own).
     pub outage_s: Option<f64>,
+    /// The corrections estimated on the drive when `params` stores none.
+    pub corrections: deadreckon_core::timing::Which,
+}
+
+/// The drive with the corrections every section uses applied, and their
+/// rows: those stored in `o.params`, or else those `o.corrections` asks to
+/// estimate (`None` when none are asked).
+pub fn corrected(
+    drive: &Drive,
+    o: &ReportOptions,
+    steps: &dyn Progress,
+) -> Result<(Drive, Option<rp::Corrections>), Error> {
+    use deadreckon_core::timing::Which;
+    if let Some(p) = o.params.filter(|p| *p != "nominal") {
+        let stored = crate::corrections::stored_in_file(Path::new(p)).map_err(Error::Invalid)?;
+        if !stored.is_empty() {
+            let c = rp::Corrections {
+                source: format!("stored in {p}"),
+                rows: crate::corrections::stored_rows(&stored),
+            };
+            return Ok((stored.apply(drive), Some(c)));
+        }
+    }
+    let name = match o.corrections {
+        Which::None => return Ok((drive.clone(), None)),
+        Which::Gnss => "gnss",
+        Which::All => "all",
+    };
+    steps.step("corrections");
+    let (d, c) = crate::corrections::estimate_and_apply(
+        drive,
+        &deadreckon_core::calibrate::CalibrationOptions::default(),
+        o.corrections,
+    )?;
+    let rows = rp::Corrections {
+        source: format!("estimated on this drive (--corrections {name})"),
+        rows: deadreckon_eval::report::correction_rows(&c),
+    };
+    Ok((d, Some(rows)))
 }
 
 /// Builds the report of `drive` and writes it to `out`.
@@ -37,6 +81,8 @@ pub fn write(
     steps: &dyn Progress,
     footer: &rp::Footer,
 ) -> Result<(), Error> {
+    let (corrected, corrections) = corrected(drive, o, steps)?;
+    let drive = &corrected;
     let mut methods = calibrations(drive, steps);
     if let Some(p) = o.params {
         methods.sets.push(NamedParams {
@@ -49,6 +95,10 @@ pub fn write(
         });
     }
     let mut input = four_wheel_input(drive, &methods, o.outage_s, steps)?;
+    input
+        .calibration
+        .get_or_insert_with(Default::default)
+        .corrections = corrections;
     if let Some(m) = o.model {
         steps.step("TedriS");
         input.tedris = Some(tedris_section(drive, m, o.outage_s)?);

@@ -3,6 +3,7 @@
 
 use std::path::Path;
 
+use deadreckon_core::timing::KnownCorrections;
 use deadreckon_core::Drive;
 use deadreckon_tedris::{
     ModelChoice, ModelKind, ReferenceSource, RepositoryFit, TedrisConfig, TedrisModel, Variant,
@@ -30,6 +31,16 @@ pub struct TrainOptions {
     pub epsilon_factor: Option<Option<f64>>,
     /// Fit each repository separately, as in the paper.
     pub separate_repositories: bool,
+    /// A params.toml whose stored corrections (delays, IMU tilt, gyro
+    /// scale) the drive gets before training; the model keeps them.
+    pub params: Option<String>,
+}
+
+/// The corrections stored in the params.toml `spec`, `None` when it stores
+/// none (or is `nominal`).
+fn stored(spec: &str) -> Result<Option<KnownCorrections>, Error> {
+    let k = crate::corrections::stored_in_file(Path::new(spec)).map_err(Error::Invalid)?;
+    Ok((!k.is_empty()).then_some(k))
 }
 
 /// The reference heading and the configuration `o` asks for on `drive`,
@@ -64,10 +75,43 @@ pub fn train_config(
     Ok((source, cfg))
 }
 
-/// Trains a model on `drive` as `o` asks ([`train_config`]).
+/// Trains a model on `drive` as `o` asks ([`train_config`]), with the
+/// corrections of `o.params` applied first and kept in the model.
 pub fn train(drive: &Drive, o: &TrainOptions) -> Result<(TedrisModel, ReferenceSource), Error> {
+    let known = match &o.params {
+        Some(p) => stored(p)?,
+        None => None,
+    };
+    let corrected;
+    let drive = match &known {
+        Some(k) => {
+            corrected = k.apply(drive);
+            &corrected
+        }
+        None => drive,
+    };
     let (source, cfg) = train_config(drive, o)?;
-    deadreckon_tedris::train(drive, cfg, source).map_err(Error::Tedris)
+    let (mut m, source) = deadreckon_tedris::train(drive, cfg, source).map_err(Error::Tedris)?;
+    m.corrections = known;
+    Ok((m, source))
+}
+
+/// The drive a model runs on: with the corrections stored in `params` when
+/// given, else with those the model was trained with; and which were
+/// applied (`None`: none).
+pub fn corrected_for_run(
+    drive: &Drive,
+    model: &TedrisModel,
+    params: Option<&str>,
+) -> Result<(Drive, Option<String>), Error> {
+    let (known, from) = match params {
+        Some(p) => (stored(p)?, format!("stored in {p}")),
+        None => (model.corrections, "the model's (trained with them)".into()),
+    };
+    Ok(match known {
+        Some(k) => (k.apply(drive), Some(from)),
+        None => (drive.clone(), None),
+    })
 }
 
 /// Writes a model as JSON, whole or not at all (a temporary beside it,
@@ -87,15 +131,17 @@ pub fn run_outages(
     outages: &[deadreckon_tedris::Outage],
     opts: &deadreckon_tedris::RunOptions,
     track: Option<&Path>,
-) -> Result<deadreckon_tedris::OutageReport, Error> {
+    params: Option<&str>,
+) -> Result<(deadreckon_tedris::OutageReport, Option<String>), Error> {
     use crate::error::While;
-    let r =
-        deadreckon_tedris::run_outages_with(drive, model, outages, opts).map_err(Error::Outages)?;
+    let (drive, corrections) = corrected_for_run(drive, model, params)?;
+    let r = deadreckon_tedris::run_outages_with(&drive, model, outages, opts)
+        .map_err(Error::Outages)?;
     if let Some(p) = track {
         deadreckon_io::write_track_csv(p, std::slice::from_ref(&r.track))
             .doing(|| format!("writing {}", p.display()))?;
     }
-    Ok(r)
+    Ok((r, corrections))
 }
 
 /// `tedris run --json`.
@@ -103,13 +149,16 @@ pub fn run_json(
     r: &deadreckon_tedris::OutageReport,
     model: &TedrisModel,
     track: Option<&Path>,
+    corrections: Option<&str>,
 ) -> serde_json::Value {
     serde_json::json!({
+        "corrections": corrections,
         "outages": r.outages,
         "reference": r.reference,
         "source": r.source,
         "model": model.chosen.name(),
-        "checks": r.machine.checks(),
+        // Not "checks": that key holds the plausibility checks of every --json object.
+        "tedris_checks": r.machine.checks(),
         "track": track.map(|p| p.display().to_string()),
     })
 }

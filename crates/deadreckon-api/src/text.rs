@@ -140,25 +140,21 @@ pub fn gated_text(g: &deadreckon_core::filter::GateCounts) -> String {
 /// The comparison table of `compare` and `demo`; `t0` is subtracted from the outage times.
 pub fn comparison_lines(c: &deadreckon_eval::compare::Comparison, t0: f64) -> Vec<String> {
     // The point each estimator's errors were measured at (its rows say).
-    let point =
-        |pick: fn(&(_, Option<OutageResult>, Option<OutageResult>)) -> Option<&OutageResult>| {
-            c.rows
-                .iter()
-                .find_map(pick)
-                .map_or(String::new(), |r| format!(" at the {}", r.point.name()))
-        };
+    let point = |r: Option<&OutageResult>| {
+        r.map_or(String::new(), |r| format!(" at the {}", r.point.name()))
+    };
     let mut out = vec![
         format!(
             "four-wheel EKF: {}; errors against the {}{}",
             c.params_source,
             c.four_wheel_reference,
-            point(|r| r.1.as_ref())
+            point(c.rows.iter().find_map(|r| r.1.as_ref()))
         ),
         format!(
             "TedriS: {}; errors against the {}{}",
             c.model_source,
             c.tedris_reference,
-            point(|r| r.2.as_ref())
+            point(c.rows.iter().find_map(|r| r.2.as_ref()))
         ),
     ];
     out.push(format!(
@@ -321,6 +317,12 @@ pub fn tedris_train_lines(
     let mut out = Vec::new();
     let s = m.straight();
     out.push(format!("reference heading: {source:?}"));
+    if let Some(c) = &m.corrections {
+        out.push(format!(
+            "trained on corrected streams (kept in the model, applied by tedris run): {}",
+            known_corrections_text(c)
+        ));
+    }
     out.push(format!(
         "tau = {} samples, sample period {:.4} s, lag h = {} samples (peak corr {:.3})",
         m.config.tau_samples,
@@ -523,4 +525,29 @@ pub fn kinematic_table(c: &deadreckon_core::kinematics::KinematicCalibration) ->
         c.termination
     ));
     out
+}
+
+/// Known corrections in one line: the non-zero delays, the tilt of the
+/// vertical, the gyro scale error.
+pub fn known_corrections_text(c: &deadreckon_core::timing::KnownCorrections) -> String {
+    use deadreckon_core::timing::Stream;
+    let mut parts: Vec<String> = Stream::ALL
+        .iter()
+        .zip(c.delays_s)
+        .filter(|(_, d)| *d != 0.0)
+        .map(|(s, d)| format!("{} delay {d:+.4} s", s.name()))
+        .collect();
+    if let Some(u) = c.up {
+        parts.push(format!(
+            "IMU tilt {:.2}°",
+            u[2].clamp(-1.0, 1.0).acos().to_degrees()
+        ));
+    }
+    if c.gyro_scale_error != 0.0 {
+        parts.push(format!(
+            "gyro scale error {:+.3}%",
+            100.0 * c.gyro_scale_error
+        ));
+    }
+    parts.join(", ")
 }

@@ -16,7 +16,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::vehicle::Noise;
+use crate::vehicle::{Noise, YawIntegration};
 
 /// Dimension of the car state.
 pub const N: usize = 5;
@@ -130,6 +130,8 @@ fn has_jacobian_shape(f: &Mat) -> bool {
 ///
 /// Table I gives standard deviations per 20 ms step; for other steps the
 /// variances scale linearly with `dt / noise.process_step_s` (random-walk noise).
+/// With [`YawIntegration::Trapezoidal`] the yaw rate's noise `q_ψ̇` also
+/// reaches the yaw over the step: `Q_ψψ̇ = dt/2 · q_ψ̇`, `Q_ψψ += dt²/4 · q_ψ̇`.
 pub fn process_noise(noise: &Noise, dt: f64) -> Mat {
     let k = (dt / noise.process_step_s).max(0.0);
     let mut q = Mat::zeros();
@@ -138,6 +140,13 @@ pub fn process_noise(noise: &Noise, dt: f64) -> Mat {
     q[(YAW, YAW)] = k * noise.process_yaw_rad.powi(2);
     q[(V, V)] = k * noise.process_speed_mps.powi(2);
     q[(YAW_RATE, YAW_RATE)] = k * noise.process_yaw_rate_rps.powi(2);
+    if noise.yaw_integration == YawIntegration::Trapezoidal {
+        // ψ_{k+1} = ψ_k + dt ψ̇_k + dt/2 · w, ψ̇_{k+1} = ψ̇_k + w, w ~ N(0, q_ψ̇).
+        let w = q[(YAW_RATE, YAW_RATE)];
+        q[(YAW, YAW)] += 0.25 * dt * dt * w;
+        q[(YAW, YAW_RATE)] = 0.5 * dt * w;
+        q[(YAW_RATE, YAW)] = 0.5 * dt * w;
+    }
     q
 }
 

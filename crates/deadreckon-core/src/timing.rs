@@ -749,13 +749,15 @@ pub fn estimate_with_params(
 }
 
 /// Which corrections [`prepare_with`] estimates and applies.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Which {
     /// The driven axle's slip, the IMU tilt, every stream's delay and the
     /// gyro scale.
     All,
     /// The driven axle's slip, the IMU tilt, the GNSS delay and the gyro
-    /// scale (the other streams' delays estimated and reported, not applied).
+    /// scale (the other streams' delays estimated and reported, not
+    /// applied): `calibrate`'s default.
+    #[default]
     Gnss,
     /// Nothing estimated or applied.
     None,
@@ -875,5 +877,77 @@ pub fn apply_known(
         crate::gyro_scale::apply(&d, gyro_scale_error)
     } else {
         d
+    }
+}
+
+/// Corrections known beforehand and applied as they are: those a
+/// params.toml stores (`[delays]`, `[traction]`, `[imu]`, `[gyro_scale]`), or those a
+/// TedriS model was trained with.
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+pub struct KnownCorrections {
+    /// Delays, s, in [`Stream::ALL`] order (0: none).
+    pub delays_s: [f64; 4],
+    /// The IMU's vertical in its own axes (`None`: the gyro as it is).
+    pub up: Option<[f64; 3]>,
+    /// The gyro's relative scale error (0: none).
+    pub gyro_scale_error: f64,
+    /// The driven axle's slip per m/s² of forward specific force
+    /// ([`crate::traction`]; 0: none; the sign names the axle). Absent from
+    /// models and files written before it: 0.
+    #[serde(default)]
+    pub traction_slip_per_mps2: f64,
+}
+
+impl KnownCorrections {
+    /// Applies them to `drive`: the slip first ([`crate::traction::apply`]),
+    /// then [`apply_known`], in [`prepare_with`]'s order.
+    pub fn apply(&self, drive: &Drive) -> Drive {
+        let slipped;
+        let drive = if self.traction_slip_per_mps2 != 0.0 {
+            slipped = crate::traction::apply(drive, self.traction_slip_per_mps2);
+            &slipped
+        } else {
+            drive
+        };
+        apply_known(drive, self.delays_s, self.up, self.gyro_scale_error)
+    }
+
+    /// Whether there is nothing to apply.
+    pub fn is_empty(&self) -> bool {
+        *self == KnownCorrections::default()
+    }
+
+    /// Checks the values are plausible: delays finite and under 10 s, `up`
+    /// a unit vector, the scale error within
+    /// [`crate::gyro_scale::MAX_SCALE_ERROR`]. The error names the key.
+    pub fn validate(&self) -> Result<(), String> {
+        for (s, v) in Stream::ALL.iter().zip(self.delays_s) {
+            if !(v.is_finite() && v.abs() < 10.0) {
+                return Err(format!(
+                    "`delays.{}.delay_s` = {v} is not a plausible delay (|d| < 10 s)",
+                    s.name()
+                ));
+            }
+        }
+        if let Some(u) = self.up {
+            let n = u.iter().map(|x| x * x).sum::<f64>().sqrt();
+            if (n - 1.0).abs().is_nan() || (n - 1.0).abs() >= 1e-3 {
+                return Err("`imu.up` must be a unit vector of 3 numbers".into());
+            }
+        }
+        let g = self.gyro_scale_error;
+        if !(g.is_finite() && g.abs() <= crate::gyro_scale::MAX_SCALE_ERROR) {
+            return Err(format!(
+                "`gyro_scale.scale_error` = {g} is not a plausible gyro scale error"
+            ));
+        }
+        let k = self.traction_slip_per_mps2;
+        if !(k.is_finite() && k.abs() <= crate::traction::MAX_SLIP_PER_MPS2) {
+            return Err(format!(
+                "`traction.slip_per_mps2` = {k} is not a plausible tyre slip (|κ| ≤ {} per m/s²)",
+                crate::traction::MAX_SLIP_PER_MPS2
+            ));
+        }
+        Ok(())
     }
 }

@@ -562,3 +562,78 @@ pub fn tedris_from_model(
     }
     Ok(t)
 }
+
+/// The corrections estimated on a drive ([`deadreckon_core::timing::prepare_with`])
+/// as the report's rows: each stream's delay, the driven axle's slip, the IMU
+/// tilt, the gyro scale error, with their standard errors and whether they
+/// were applied.
+pub fn correction_rows(c: &deadreckon_core::timing::Corrections) -> Vec<rp::CorrectionRow> {
+    use deadreckon_core::timing::Stream;
+    let finite = |v: f64| v.is_finite().then_some(v);
+    let status = |reason: Option<&str>| match reason {
+        None => "estimated, applied".to_string(),
+        Some(r) => format!("not estimated: {r}"),
+    };
+    let mut rows: Vec<rp::CorrectionRow> = Stream::ALL
+        .iter()
+        .map(|&s| {
+            let d = c.delays.get(s);
+            let estimated = d.status.is_estimated();
+            rp::CorrectionRow {
+                what: format!("{} delay", s.name()),
+                unit: "s".into(),
+                value: finite(d.delay_s).filter(|_| estimated),
+                std: finite(d.std_s).filter(|_| estimated),
+                status: status(d.status.reason()),
+            }
+        })
+        .collect();
+    if let Some(t) = &c.traction {
+        let estimated = t.is_estimated();
+        rows.push(rp::CorrectionRow {
+            what: "driven axle slip per m/s²".into(),
+            unit: "%".into(),
+            value: finite(100.0 * t.slip_per_mps2.abs()).filter(|_| estimated),
+            std: finite(100.0 * t.std).filter(|_| estimated),
+            status: match t.status.reason() {
+                None => format!(
+                    "estimated on the {} axle from the front/rear wheel speeds against the forward specific force, its wheel speeds corrected",
+                    t.axle.name()
+                ),
+                Some(r) => format!("not estimated: {r}"),
+            },
+        });
+    }
+    if let Some(t) = &c.tilt {
+        let estimated = t.is_estimated();
+        rows.push(rp::CorrectionRow {
+            what: "IMU tilt".into(),
+            unit: "°".into(),
+            value: finite(t.tilt_rad.to_degrees()).filter(|_| estimated),
+            std: finite(t.std_rad.to_degrees()).filter(|_| estimated),
+            status: match t.status.reason() {
+                None => format!(
+                    "estimated from gravity while {} (pitch {:+.2}°, roll {:+.2}°), yaw rate projected on the vertical",
+                    t.source.name(),
+                    t.pitch_rad.to_degrees(),
+                    t.roll_rad.to_degrees()
+                ),
+                Some(r) => format!("not estimated: {r}"),
+            },
+        });
+    }
+    if let Some(g) = &c.gyro_scale {
+        let estimated = g.is_estimated();
+        rows.push(rp::CorrectionRow {
+            what: "gyro scale error".into(),
+            unit: "%".into(),
+            value: finite(100.0 * g.scale_error).filter(|_| estimated),
+            std: finite(100.0 * g.std).filter(|_| estimated),
+            status: match g.status.reason() {
+                None => format!("estimated from {} turns, applied", g.turns),
+                Some(r) => format!("not estimated: {r}"),
+            },
+        });
+    }
+    rows
+}

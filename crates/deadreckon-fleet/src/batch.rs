@@ -7,6 +7,7 @@ use std::time::Instant;
 use deadreckon_core::calibrate::{self, CalibrationOptions};
 use deadreckon_core::ekf::{FilterOptions, FilterStats};
 use deadreckon_core::metrics::Summary;
+use deadreckon_core::timing::{self, Corrections, Which};
 use deadreckon_core::{outage, Drive, ParamsWithStd};
 use rayon::prelude::*;
 
@@ -25,14 +26,32 @@ pub struct OutageOptions {
 }
 
 /// How a batch runs.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone)]
 pub struct BatchOptions {
     /// The calibration of every drive.
     pub calibration: CalibrationOptions,
+    /// The timing and mounting corrections estimated and applied on each
+    /// drive before it is calibrated (as `calibrate --corrections`).
+    /// Default [`Which::None`]: a delay estimated anew on each drive moves
+    /// that drive's gyro bias and speed scale by more than their standard
+    /// errors say (they do not include the delay's uncertainty), and the
+    /// history then flags an unchanged car (docs/fleet.md).
+    pub corrections: Which,
     /// Also evaluate each drive through sliding outages.
     pub outage: Option<OutageOptions>,
     /// Worker threads; 0 for one per core.
     pub threads: usize,
+}
+
+impl Default for BatchOptions {
+    fn default() -> Self {
+        BatchOptions {
+            calibration: CalibrationOptions::default(),
+            corrections: Which::None,
+            outage: None,
+            threads: 0,
+        }
+    }
 }
 
 /// Whether a parameter was estimated on a drive.
@@ -87,6 +106,8 @@ pub struct DriveCalibration {
     pub filter_stats: Option<FilterStats>,
     /// The outage evaluation, when asked for.
     pub outage: Option<OutageResult>,
+    /// The corrections estimated and applied (`None` with [`Which::None`]).
+    pub corrections: Option<Corrections>,
 }
 
 /// One drive of a batch: where, which vehicle, and what came of it.
@@ -130,8 +151,24 @@ pub fn validate(options: &BatchOptions) -> Result<(), FleetError> {
     Ok(())
 }
 
-/// Calibrates one drive already read.
+/// Calibrates one drive already read: the corrections `options` asks for
+/// estimated and applied first, then the calibration and the outages on
+/// the corrected drive.
 pub fn calibrate_drive(drive: &Drive, options: &BatchOptions) -> Result<DriveCalibration, String> {
+    let (corrected, corrections) = match options.corrections {
+        Which::None => (None, None),
+        which => {
+            let (d, c) = timing::prepare_with(
+                drive,
+                &options.calibration,
+                &timing::DelayOptions::default(),
+                which,
+            )
+            .map_err(|e| format!("estimating the streams' delays and the IMU tilt: {e}"))?;
+            (Some(d), Some(c))
+        }
+    };
+    let drive = corrected.as_ref().unwrap_or(drive);
     let c = calibrate::calibrate(drive, &options.calibration)
         .map_err(|e| format!("calibrating: {e}"))?;
     let std = c.estimate.std.to_array();
@@ -181,6 +218,7 @@ pub fn calibrate_drive(drive: &Drive, options: &BatchOptions) -> Result<DriveCal
         duration_s,
         filter_stats: c.filter_stats,
         outage,
+        corrections,
     })
 }
 

@@ -6,6 +6,7 @@ use std::io::Write;
 use std::path::Path;
 
 use deadreckon_core::filter::SensorKind;
+use deadreckon_core::timing::{Corrections, Stream};
 use deadreckon_core::Params;
 
 use crate::batch::DriveResult;
@@ -62,7 +63,79 @@ pub fn results_header() -> Vec<String> {
     ] {
         h.push(k.into());
     }
+    for st in Stream::ALL {
+        h.push(format!("delay_{}_s", st.name()));
+        h.push(format!("std_delay_{}_s", st.name()));
+        h.push(format!("status_delay_{}", st.name()));
+    }
+    for k in [
+        "imu_tilt_deg",
+        "std_imu_tilt_deg",
+        "status_imu_tilt",
+        "gyro_scale_error",
+        "std_gyro_scale_error",
+        "status_gyro_scale_error",
+        "traction_slip_per_mps2",
+        "std_traction_slip_per_mps2",
+        "status_traction_slip",
+    ] {
+        h.push(k.into());
+    }
     h
+}
+
+/// The corrections' columns: per stream its delay, standard error and
+/// status (`applied`, `not-estimated`; empty without corrections), then the
+/// IMU tilt, the gyro scale error and the driven axle's slip likewise
+/// (`none` where the drive has no three-axis IMU or accelerometer, or the
+/// scale was not attempted).
+fn corrections_cells(c: &Corrections) -> Vec<String> {
+    let value = |estimated: bool, v: f64| {
+        if estimated && v.is_finite() {
+            num(v)
+        } else {
+            String::new()
+        }
+    };
+    let status = |estimated: bool| {
+        if estimated {
+            "applied"
+        } else {
+            "not-estimated"
+        }
+    };
+    let mut row = Vec::new();
+    for st in Stream::ALL {
+        let d = c.delays.get(st);
+        let e = d.status.is_estimated();
+        row.extend([value(e, d.delay_s), value(e, d.std_s), status(e).into()]);
+    }
+    match &c.tilt {
+        Some(t) => {
+            let e = t.is_estimated();
+            row.extend([
+                value(e, t.tilt_rad.to_degrees()),
+                value(e, t.std_rad.to_degrees()),
+                status(e).into(),
+            ]);
+        }
+        None => row.extend([String::new(), String::new(), "none".into()]),
+    }
+    match &c.gyro_scale {
+        Some(g) => {
+            let e = g.is_estimated();
+            row.extend([value(e, g.scale_error), value(e, g.std), status(e).into()]);
+        }
+        None => row.extend([String::new(), String::new(), "none".into()]),
+    }
+    match &c.traction {
+        Some(t) => {
+            let e = t.is_estimated();
+            row.extend([value(e, t.slip_per_mps2), value(e, t.std), status(e).into()]);
+        }
+        None => row.extend([String::new(), String::new(), "none".into()]),
+    }
+    row
 }
 
 /// One row of the results CSV (empty fields where a value does not apply).
@@ -108,8 +181,8 @@ pub fn results_row(r: &DriveResult) -> Vec<String> {
                 }
                 None => row.extend(std::iter::repeat_n(String::new(), 4 + 18)),
             }
-            if let Some(o) = &c.outage {
-                row.extend([
+            match &c.outage {
+                Some(o) => row.extend([
                     num(o.options.length_s),
                     o.final_error_m.n.to_string(),
                     o.reference.to_string(),
@@ -117,7 +190,11 @@ pub fn results_row(r: &DriveResult) -> Vec<String> {
                     num(o.final_error_m.p95),
                     num(o.final_error_m.max),
                     num(o.drift_pct.mean),
-                ]);
+                ]),
+                None => row.extend(std::iter::repeat_n(String::new(), 7)),
+            }
+            if let Some(k) = &c.corrections {
+                row.extend(corrections_cells(k));
             }
         }
     }
@@ -331,6 +408,28 @@ pub fn summary_line(results: &[DriveResult], wall_s: f64, threads: usize) -> Str
     )
 }
 
+/// What `batch` prints: the summary line, the files written, and each
+/// vehicle's calibration history (or why there is none).
+pub fn summary_text(
+    results: &[DriveResult],
+    histories: &[VehicleHistory],
+    wall_s: f64,
+    threads: usize,
+    written: &[&Path],
+) -> String {
+    let mut text = summary_line(results, wall_s, threads);
+    for w in written {
+        text.push_str(&format!("\nwrote {}", w.display()));
+    }
+    text.push('\n');
+    if histories.is_empty() {
+        text.push_str("no drive has a vehicle_id in its vehicle.toml: no calibration history\n");
+    } else {
+        text.push_str(&history_table(histories));
+    }
+    text
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -400,26 +499,4 @@ mod tests {
             &["4".to_string(), "d3".to_string(), "2026-01-04".to_string()]
         );
     }
-}
-
-/// What `batch` prints: the summary line, the files written, and each
-/// vehicle's calibration history (or why there is none).
-pub fn summary_text(
-    results: &[DriveResult],
-    histories: &[VehicleHistory],
-    wall_s: f64,
-    threads: usize,
-    written: &[&Path],
-) -> String {
-    let mut text = summary_line(results, wall_s, threads);
-    for w in written {
-        text.push_str(&format!("\nwrote {}", w.display()));
-    }
-    text.push('\n');
-    if histories.is_empty() {
-        text.push_str("no drive has a vehicle_id in its vehicle.toml: no calibration history\n");
-    } else {
-        text.push_str(&history_table(histories));
-    }
-    text
 }

@@ -203,6 +203,37 @@ pub struct Calibration {
     pub iterations: Vec<ParamSet>,
     /// Standard errors after each iteration: empty, or as long as `iterations`.
     pub iteration_std: Vec<ParamSet>,
+    /// The timing and mounting corrections every section's streams had
+    /// applied (`None`: not given).
+    pub corrections: Option<Corrections>,
+}
+
+/// The timing and mounting corrections of the drive's streams (delays, IMU
+/// tilt, gyro scale): where they came from and one row each.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Corrections {
+    /// Where they come from (`estimated on this drive (--corrections gnss)`,
+    /// `stored in params.toml`).
+    pub source: String,
+    /// One row per correction.
+    pub rows: Vec<CorrectionRow>,
+}
+
+/// One correction.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct CorrectionRow {
+    /// What (`GNSS delay`, `IMU tilt`, `gyro scale error`).
+    pub what: String,
+    /// Its unit (`s`, `°`, `%`).
+    pub unit: String,
+    /// The value (`None`: not estimated).
+    pub value: Option<f64>,
+    /// Its standard error (`None`: not known, as for a stored value).
+    pub std: Option<f64>,
+    /// Applied, reported only, or not estimated and why.
+    pub status: String,
 }
 
 /// The drift evaluation of one method.

@@ -206,6 +206,25 @@ pub fn sample_input(duration_s: f64) -> ReportInput {
         iterated_method: "RTS".into(),
         iterations,
         iteration_std,
+        corrections: Some(Corrections {
+            source: "estimated on this drive (--corrections gnss)".into(),
+            rows: vec![
+                CorrectionRow {
+                    what: "GNSS delay".into(),
+                    unit: "s".into(),
+                    value: Some(0.1078),
+                    std: Some(0.0069),
+                    status: "estimated, applied".into(),
+                },
+                CorrectionRow {
+                    what: "steering delay".into(),
+                    unit: "s".into(),
+                    value: None,
+                    std: None,
+                    status: "not estimated: too little excitation".into(),
+                },
+            ],
+        }),
     };
 
     let mut drift_method = |name: &str, mean: f64, std: f64, reach: f64| DriftMethod {

@@ -308,6 +308,11 @@ pub struct TedrisModel {
     /// The rear wheels' distance scale (see [`DistanceScale`]).
     #[serde(default)]
     pub distance_scale: DistanceScale,
+    /// The timing and mounting corrections the training drive had applied
+    /// (a params.toml's delays, IMU tilt and gyro scale; `None`: none). A
+    /// drive run through the model needs the same ones.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub corrections: Option<deadreckon_core::timing::KnownCorrections>,
 }
 
 /// The rear wheels' distance scale: metres travelled per metre the rear
@@ -404,6 +409,7 @@ impl TedrisModel {
             straight_sigma_m,
             turn_gain: 1.0,
             distance_scale: DistanceScale::default(),
+            corrections: None,
         };
         m.set_dcf0();
         Ok(m)
@@ -496,6 +502,10 @@ impl TedrisModel {
     /// Checks a loaded model is usable (non-empty fits, finite numbers).
     pub fn validate(&self) -> Result<(), Error> {
         self.config.validate()?;
+        if let Some(c) = &self.corrections {
+            c.validate()
+                .map_err(|e| Error::Model(format!("the stored corrections: {e}")))?;
+        }
         if self.fits.is_empty() || !self.fits.iter().any(|f| f.kind == self.chosen) {
             return Err(Error::Model(
                 "the model has no fit for its chosen kind".into(),

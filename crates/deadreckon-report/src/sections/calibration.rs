@@ -73,6 +73,36 @@ pub(crate) fn section(
             }],
         });
     }
+    if let Some(k) = &c.corrections {
+        let rows = k
+            .rows
+            .iter()
+            .map(|r| {
+                let num = |v: Option<f64>| v.map_or("–".to_string(), |v| fmt_sig(v, 3));
+                RowView {
+                    swatch: None,
+                    cells: vec![
+                        format!("{} ({})", r.what, r.unit),
+                        num(r.value),
+                        num(r.std),
+                        r.status.clone(),
+                    ],
+                }
+            })
+            .collect();
+        blocks.push(Block::Tables {
+            tables: vec![TableView {
+                caption: format!(
+                    "Timing and mounting corrections of the streams every section uses: {}.",
+                    k.source
+                ),
+                headers: ["correction", "value", "std", "status"]
+                    .map(String::from)
+                    .to_vec(),
+                rows,
+            }],
+        });
+    }
     if c.iterations.len() >= 2 {
         let color = palette.color(&c.iterated_method);
         let refs: Vec<(String, RGBColor, [f64; 6])> = c
