@@ -410,12 +410,14 @@ fn comma2k19_import_calibrate_evaluate_report() {
         assert!(o["windows"].as_u64().unwrap() >= 3, "{o}");
         finals.push(o["final_error_m"]["mean"].as_f64().unwrap());
         // The GNSS delay the importer no longer corrects, estimated (issue
-        // 13: within 0.02 s of u-blox's 0.1 s; measured 0.108 ± 0.007 s), and
-        // the phone's tilt reported (measured 8.3°).
+        // 13: within 0.02 s of u-blox's 0.1 s; measured 0.086 ± 0.007 s with
+        // the front wheels' slip corrected), the phone's tilt reported
+        // (measured 3.75° ± 0.77°) and the driven axle found.
         let c = &o["corrections"];
         let d = c["delays"]["gnss"]["delay_s"].as_f64().unwrap();
         assert!((d - 0.1).abs() < 0.02, "{c}");
         assert_eq!(c["imu"]["estimated"], true, "{c}");
+        assert_eq!(c["traction"]["axle"], "front", "{c}");
     }
     // Bounds on the measured figures (see the closing note of the readers issue).
     assert!(
@@ -423,9 +425,9 @@ fn comma2k19_import_calibrate_evaluate_report() {
         "final errors {finals:?}"
     );
     // (Issue 13 dropped "40 s outages drift further than 20 s": on this
-    // 60 s segment they are 3 windows against 7, and with the GNSS at its
-    // estimated delay and the tilt applied the means are 0.74 m (20 s) and
-    // 0.55 m (40 s); without the corrections 1.51 m and 1.41 m.)
+    // 60 s segment they are 3 windows against 7; with the corrections the
+    // means are 0.59 m (20 s) and 0.80 m (40 s), without them 1.51 m and
+    // 1.41 m.)
     let html = tmp.path().join("rav4.html");
     run_ok(&[
         "report",

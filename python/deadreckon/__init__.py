@@ -193,8 +193,9 @@ def calibrate(
     gyro bias) or ``truth``. The options are ``calibrate``'s: ``state``
     (``augmented`` or ``paper``), ``iteration`` (``anderson`` or ``plain``),
     ``max_iterations``, ``timing`` (``wheel`` or ``each``), ``min_speed``
-    (m/s), ``corrections`` (``gnss``: estimate the streams' delays, the IMU
-    tilt and the gyro scale, apply the tilt, the GNSS delay and the scale;
+    (m/s), ``corrections`` (``gnss``: estimate the streams' delays, the
+    driven axle's slip, the IMU tilt and the gyro scale, apply the slip, the
+    tilt, the GNSS delay and the scale;
     ``all``: apply every delay too; ``none``). Keys: the six parameters,
     ``std``, ``iterations``, ``converged``, ``corrections``,
     ``method``, ``samples``, ``history``, ``checks`` and, when the filter

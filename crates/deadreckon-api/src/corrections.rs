@@ -28,9 +28,30 @@ fn tilt_json(t: &Tilt) -> Value {
         "tilt_deg": num(t.tilt_rad.to_degrees()),
         "std_deg": num(t.std_rad.to_degrees()),
         "pitch_deg": num(t.pitch_rad.to_degrees()),
+        "pitch_std_deg": num(t.pitch_std_rad.to_degrees()),
         "roll_deg": num(t.roll_rad.to_degrees()),
+        "roll_std_deg": num(t.roll_std_rad.to_degrees()),
+        "std_blocks_deg": t.std_blocks_rad.map(|s| num(s.to_degrees())),
+        "accel_error_mps2": num(t.accel_error_mps2),
+        "gyro_bias": t.gyro_bias.map(|b| json!({
+            "bias_rps": num(b.bias_rps),
+            "std_rps": num(b.std_rps),
+            "span_s": num(b.span_s),
+        })),
         "up": t.up,
         "source": t.source.name(),
+        "blocks": t.blocks,
+        "estimated": t.is_estimated(),
+        "reason": t.status.reason(),
+    })
+}
+
+fn traction_json(t: &deadreckon_core::traction::TractionSlip) -> Value {
+    let num = |x: f64| if x.is_finite() { json!(x) } else { Value::Null };
+    json!({
+        "slip_per_mps2": num(t.slip_per_mps2),
+        "std": num(t.std),
+        "axle": t.is_estimated().then(|| t.axle.name()),
         "blocks": t.blocks,
         "estimated": t.is_estimated(),
         "reason": t.status.reason(),
@@ -48,7 +69,8 @@ fn scale_json(g: &deadreckon_core::gyro_scale::GyroScale) -> Value {
     })
 }
 
-/// `{"delays": {stream: {...}}, "imu": {...} | null, "gyro_scale": {...} | null}`.
+/// `{"delays": {stream: {...}}, "traction": {...} | null, "imu": {...} | null,
+/// "gyro_scale": {...} | null}`.
 pub fn corrections_json(c: &Corrections) -> Value {
     let delays: serde_json::Map<String, Value> = Stream::ALL
         .iter()
@@ -56,12 +78,14 @@ pub fn corrections_json(c: &Corrections) -> Value {
         .collect();
     json!({
         "delays": delays,
+        "traction": c.traction.as_ref().map(traction_json),
         "imu": c.tilt.as_ref().map(tilt_json),
         "gyro_scale": c.gyro_scale.as_ref().map(scale_json),
     })
 }
 
-/// The `[delays.<stream>]`, `[imu]` and `[gyro_scale]` tables of params.toml.
+/// The `[delays.<stream>]`, `[traction]`, `[imu]` and `[gyro_scale]` tables
+/// of params.toml.
 pub fn corrections_toml(c: &Corrections) -> toml::Table {
     let mut out = toml::Table::new();
     let mut delays = toml::Table::new();
@@ -77,6 +101,17 @@ pub fn corrections_toml(c: &Corrections) -> toml::Table {
         delays.insert(s.name().into(), t.into());
     }
     out.insert("delays".into(), delays.into());
+    if let Some(tr) = &c.traction {
+        let mut t = toml::Table::new();
+        if tr.is_estimated() {
+            t.insert("slip_per_mps2".into(), tr.slip_per_mps2.into());
+            t.insert("std".into(), tr.std.into());
+            t.insert("axle".into(), tr.axle.name().into());
+        } else if let Some(r) = tr.status.reason() {
+            t.insert("not_estimated".into(), r.into());
+        }
+        out.insert("traction".into(), t.into());
+    }
     if let Some(tilt) = &c.tilt {
         let mut t = toml::Table::new();
         if tilt.is_estimated() {
@@ -109,8 +144,8 @@ pub fn corrections_toml(c: &Corrections) -> toml::Table {
 pub type Stored = timing::KnownCorrections;
 
 /// The report's rows of what is applied: each stored delay, the tilt of
-/// the stored vertical, the gyro scale error (no standard errors: params.toml
-/// keeps the values applied).
+/// the stored vertical, the gyro scale error, the driven axle's slip (no
+/// standard errors: params.toml keeps the values applied).
 pub fn stored_rows(stored: &Stored) -> Vec<deadreckon_report::CorrectionRow> {
     let row = |what: String, unit: &str, value: f64| deadreckon_report::CorrectionRow {
         what,
@@ -139,6 +174,15 @@ pub fn stored_rows(stored: &Stored) -> Vec<deadreckon_report::CorrectionRow> {
             100.0 * stored.gyro_scale_error,
         ));
     }
+    let k = stored.traction_slip_per_mps2;
+    if k != 0.0 {
+        let axle = if k > 0.0 { "front" } else { "rear" };
+        rows.push(row(
+            format!("{axle} axle slip per m/s²"),
+            "%",
+            100.0 * k.abs(),
+        ));
+    }
     rows
 }
 
@@ -159,8 +203,8 @@ pub fn stored_in_file(spec: &std::path::Path) -> Result<Stored, String> {
     stored_corrections(&extra).map_err(|e| format!("parameters {}: {e}", spec.display()))
 }
 
-/// Reads the `[delays]` and `[imu]` tables from the extra keys of a
-/// params.toml (absent: nothing to apply).
+/// Reads the `[delays]`, `[traction]`, `[imu]` and `[gyro_scale]` tables
+/// from the extra keys of a params.toml (absent: nothing to apply).
 pub fn stored_corrections(extra: &toml::Table) -> Result<Stored, String> {
     let mut s = Stored::default();
     if let Some(d) = extra.get("delays") {
@@ -195,6 +239,21 @@ pub fn stored_corrections(extra: &toml::Table) -> Result<Stored, String> {
             s.up = Some([v[0], v[1], v[2]]);
         }
     }
+    if let Some(t) = extra.get("traction") {
+        let t = t.as_table().ok_or("`traction` must be a table")?;
+        if let Some(v) = t.get("slip_per_mps2") {
+            let v = v
+                .as_float()
+                .ok_or("`traction.slip_per_mps2` must be a number")?;
+            if !(v.is_finite() && v.abs() <= deadreckon_core::traction::MAX_SLIP_PER_MPS2) {
+                return Err(format!(
+                    "`traction.slip_per_mps2` = {v} is not a plausible tyre slip (|κ| ≤ {} per m/s²)",
+                    deadreckon_core::traction::MAX_SLIP_PER_MPS2
+                ));
+            }
+            s.traction_slip_per_mps2 = v;
+        }
+    }
     if let Some(g) = extra.get("gyro_scale") {
         let g = g.as_table().ok_or("`gyro_scale` must be a table")?;
         if let Some(v) = g.get("scale_error") {
@@ -212,7 +271,8 @@ pub fn stored_corrections(extra: &toml::Table) -> Result<Stored, String> {
     Ok(s)
 }
 
-/// Estimates the corrections `which` asks for (IMU tilt, delays, gyro scale)
+/// Estimates the corrections `which` asks for (driven axle's slip, IMU tilt,
+/// delays, gyro scale)
 /// and applies them: the drive a calibration runs on, and what was found.
 /// The one call `calibrate`, `evaluate` and Python make.
 pub fn estimate_and_apply(

@@ -23,7 +23,8 @@ pub fn default_prior() -> Params {
 /// vehicle's, the default prior) or a params.toml (its values; its `[std]`
 /// where positive — a std of 0 would freeze a parameter —, else the default
 /// prior). The third value is a warning when the file stores corrections
-/// (delays, IMU tilt, gyro scale) that live events cannot be given.
+/// (delays, driven-axle slip, IMU tilt, gyro scale) that live events cannot
+/// be given.
 pub fn start_params(
     spec: &str,
     vehicle: &Vehicle,
@@ -35,8 +36,8 @@ pub fn start_params(
     let stored = crate::corrections::stored_in_file(Path::new(spec)).map_err(Error::Invalid)?;
     let warning = (stored != Default::default()).then(|| {
         format!(
-            "{spec} stores corrections that `stream` does not apply to the events (delays {:?} s, IMU vertical {:?}, gyro scale error {}); its parameters were calibrated on corrected streams (calibrate --corrections none gives parameters for raw events)",
-            stored.delays_s, stored.up, stored.gyro_scale_error
+            "{spec} stores corrections that `stream` does not apply to the events (delays {:?} s, IMU vertical {:?}, gyro scale error {}, driven-axle slip {} per m/s²); its parameters were calibrated on corrected streams (calibrate --corrections none gives parameters for raw events)",
+            stored.delays_s, stored.up, stored.gyro_scale_error, stored.traction_slip_per_mps2
         )
     });
     let d = default_prior().to_array();

@@ -29,16 +29,35 @@ pub fn corrections_lines(c: &deadreckon_core::timing::Corrections) -> Vec<String
             ),
         });
     }
+    if let Some(t) = &c.traction {
+        out.push(match t.status.reason() {
+            None => format!(
+                "driven axle: {}, slip {:+.3}% ± {:.3}% per m/s² of forward specific force ({} one-second blocks), its wheel speeds corrected",
+                t.axle.name(),
+                100.0 * t.slip_per_mps2.abs(),
+                100.0 * t.std,
+                t.blocks
+            ),
+            Some(r) => format!("driven axle slip: not estimated: {r}"),
+        });
+    }
     match &c.tilt {
         None => out.push("imu tilt: no three-axis IMU in the drive".into()),
         Some(t) => out.push(match t.status.reason() {
             None => format!(
-                "imu tilt: {:.2}° ± {:.2}° (pitch {:+.2}°, roll {:+.2}°, from gravity while {}), yaw rate projected on the vertical",
+                "imu tilt: {:.2}° ± {:.2}° (pitch {:+.2}° ± {:.2}°, roll {:+.2}° ± {:.2}°, from gravity while {}{}; |f| − g {:+.3} m/s²), yaw rate projected on the vertical",
                 t.tilt_rad.to_degrees(),
                 t.std_rad.to_degrees(),
                 t.pitch_rad.to_degrees(),
+                t.pitch_std_rad.to_degrees(),
                 t.roll_rad.to_degrees(),
-                t.source.name()
+                t.roll_std_rad.to_degrees(),
+                t.source.name(),
+                t.gyro_bias.map_or(String::new(), |b| format!(
+                    ", gyro bias {:+.4} ± {:.4} rad/s from the GNSS course",
+                    b.bias_rps, b.std_rps
+                )),
+                t.accel_error_mps2
             ),
             Some(r) => format!("imu tilt: not estimated: {r}"),
         }),

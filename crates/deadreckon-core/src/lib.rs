@@ -49,6 +49,7 @@ pub mod reference;
 pub mod rts;
 pub mod timing;
 pub mod track;
+pub mod traction;
 pub mod vehicle;
 pub mod wheel_health;
 

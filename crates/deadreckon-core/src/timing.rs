@@ -224,7 +224,7 @@ impl Default for DelayOptions {
 }
 
 /// Lag-one autocorrelation of `r`.
-fn lag1(r: &[f64]) -> f64 {
+pub(crate) fn lag1(r: &[f64]) -> f64 {
     if r.len() < 3 {
         return 0.0;
     }
@@ -751,10 +751,12 @@ pub fn estimate_with_params(
 /// Which corrections [`prepare_with`] estimates and applies.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Which {
-    /// The IMU tilt and every stream's delay.
+    /// The driven axle's slip, the IMU tilt, every stream's delay and the
+    /// gyro scale.
     All,
-    /// The IMU tilt, the GNSS delay and the gyro scale (the other streams'
-    /// delays estimated and reported, not applied): `calibrate`'s default.
+    /// The driven axle's slip, the IMU tilt, the GNSS delay and the gyro
+    /// scale (the other streams' delays estimated and reported, not
+    /// applied): `calibrate`'s default.
     #[default]
     Gnss,
     /// Nothing estimated or applied.
@@ -764,6 +766,9 @@ pub enum Which {
 /// What [`prepare`] found and applied.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Corrections {
+    /// The driven axle's slip (`None`: no accelerometer in the drive, or
+    /// not attempted).
+    pub traction: Option<crate::traction::TractionSlip>,
     /// The IMU's tilt (`None`: no three-axis IMU in the drive).
     pub tilt: Option<crate::imu::Tilt>,
     /// The streams' delays.
@@ -773,8 +778,9 @@ pub struct Corrections {
     pub gyro_scale: Option<crate::gyro_scale::GyroScale>,
 }
 
-/// Estimates the IMU tilt (projecting the gyro on the vertical when
-/// estimated), every stream's delay and the gyro scale error
+/// Estimates the driven axle's slip ([`crate::traction`], correcting its
+/// wheel speeds when estimated), the IMU tilt (projecting the gyro on the
+/// vertical when estimated), every stream's delay and the gyro scale error
 /// ([`crate::gyro_scale`], with the bias of a calibration at the final
 /// delays), and returns the drive with them applied.
 pub fn prepare(
@@ -797,12 +803,24 @@ pub fn prepare_with(
         return Ok((
             drive.clone(),
             Corrections {
+                traction: None,
                 tilt: None,
                 delays: Delays::none(),
                 gyro_scale: None,
             },
         ));
     }
+    // The driven axle's slip first: the wheels are the clock and the scale
+    // every other correction is measured against.
+    let traction = crate::traction::estimate(drive);
+    let slipped;
+    let drive = match &traction {
+        Some(t) if t.is_estimated() => {
+            slipped = crate::traction::apply(drive, t.slip_per_mps2);
+            &slipped
+        }
+        _ => drive,
+    };
     let (levelled, tilt) = crate::imu::level(drive);
     let (mut delays, params) = estimate_with_params(&levelled, copts, o)?;
     if which == Which::Gnss {
@@ -832,6 +850,7 @@ pub fn prepare_with(
     Ok((
         out,
         Corrections {
+            traction,
             tilt,
             delays,
             gyro_scale,
@@ -862,7 +881,7 @@ pub fn apply_known(
 }
 
 /// Corrections known beforehand and applied as they are: those a
-/// params.toml stores (`[delays]`, `[imu]`, `[gyro_scale]`), or those a
+/// params.toml stores (`[delays]`, `[traction]`, `[imu]`, `[gyro_scale]`), or those a
 /// TedriS model was trained with.
 #[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct KnownCorrections {
@@ -872,11 +891,24 @@ pub struct KnownCorrections {
     pub up: Option<[f64; 3]>,
     /// The gyro's relative scale error (0: none).
     pub gyro_scale_error: f64,
+    /// The driven axle's slip per m/s² of forward specific force
+    /// ([`crate::traction`]; 0: none; the sign names the axle). Absent from
+    /// models and files written before it: 0.
+    #[serde(default)]
+    pub traction_slip_per_mps2: f64,
 }
 
 impl KnownCorrections {
-    /// Applies them to `drive` ([`apply_known`]).
+    /// Applies them to `drive`: the slip first ([`crate::traction::apply`]),
+    /// then [`apply_known`], in [`prepare_with`]'s order.
     pub fn apply(&self, drive: &Drive) -> Drive {
+        let slipped;
+        let drive = if self.traction_slip_per_mps2 != 0.0 {
+            slipped = crate::traction::apply(drive, self.traction_slip_per_mps2);
+            &slipped
+        } else {
+            drive
+        };
         apply_known(drive, self.delays_s, self.up, self.gyro_scale_error)
     }
 
@@ -907,6 +939,13 @@ impl KnownCorrections {
         if !(g.is_finite() && g.abs() <= crate::gyro_scale::MAX_SCALE_ERROR) {
             return Err(format!(
                 "`gyro_scale.scale_error` = {g} is not a plausible gyro scale error"
+            ));
+        }
+        let k = self.traction_slip_per_mps2;
+        if !(k.is_finite() && k.abs() <= crate::traction::MAX_SLIP_PER_MPS2) {
+            return Err(format!(
+                "`traction.slip_per_mps2` = {k} is not a plausible tyre slip (|κ| ≤ {} per m/s²)",
+                crate::traction::MAX_SLIP_PER_MPS2
             ));
         }
         Ok(())

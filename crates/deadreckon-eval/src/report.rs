@@ -564,8 +564,9 @@ pub fn tedris_from_model(
 }
 
 /// The corrections estimated on a drive ([`deadreckon_core::timing::prepare_with`])
-/// as the report's rows: each stream's delay, the IMU tilt, the gyro scale
-/// error, with their standard errors and whether they were applied.
+/// as the report's rows: each stream's delay, the driven axle's slip, the IMU
+/// tilt, the gyro scale error, with their standard errors and whether they
+/// were applied.
 pub fn correction_rows(c: &deadreckon_core::timing::Corrections) -> Vec<rp::CorrectionRow> {
     use deadreckon_core::timing::Stream;
     let finite = |v: f64| v.is_finite().then_some(v);
@@ -587,6 +588,22 @@ pub fn correction_rows(c: &deadreckon_core::timing::Corrections) -> Vec<rp::Corr
             }
         })
         .collect();
+    if let Some(t) = &c.traction {
+        let estimated = t.is_estimated();
+        rows.push(rp::CorrectionRow {
+            what: "driven axle slip per m/s²".into(),
+            unit: "%".into(),
+            value: finite(100.0 * t.slip_per_mps2.abs()).filter(|_| estimated),
+            std: finite(100.0 * t.std).filter(|_| estimated),
+            status: match t.status.reason() {
+                None => format!(
+                    "estimated on the {} axle from the front/rear wheel speeds against the forward specific force, its wheel speeds corrected",
+                    t.axle.name()
+                ),
+                Some(r) => format!("not estimated: {r}"),
+            },
+        });
+    }
     if let Some(t) = &c.tilt {
         let estimated = t.is_estimated();
         rows.push(rp::CorrectionRow {

@@ -75,6 +75,9 @@ pub fn results_header() -> Vec<String> {
         "gyro_scale_error",
         "std_gyro_scale_error",
         "status_gyro_scale_error",
+        "traction_slip_per_mps2",
+        "std_traction_slip_per_mps2",
+        "status_traction_slip",
     ] {
         h.push(k.into());
     }
@@ -83,8 +86,9 @@ pub fn results_header() -> Vec<String> {
 
 /// The corrections' columns: per stream its delay, standard error and
 /// status (`applied`, `not-estimated`; empty without corrections), then the
-/// IMU tilt and the gyro scale error likewise (`none` where the drive has no
-/// three-axis IMU or the scale was not attempted).
+/// IMU tilt, the gyro scale error and the driven axle's slip likewise
+/// (`none` where the drive has no three-axis IMU or accelerometer, or the
+/// scale was not attempted).
 fn corrections_cells(c: &Corrections) -> Vec<String> {
     let value = |estimated: bool, v: f64| {
         if estimated && v.is_finite() {
@@ -121,6 +125,13 @@ fn corrections_cells(c: &Corrections) -> Vec<String> {
         Some(g) => {
             let e = g.is_estimated();
             row.extend([value(e, g.scale_error), value(e, g.std), status(e).into()]);
+        }
+        None => row.extend([String::new(), String::new(), "none".into()]),
+    }
+    match &c.traction {
+        Some(t) => {
+            let e = t.is_estimated();
+            row.extend([value(e, t.slip_per_mps2), value(e, t.std), status(e).into()]);
         }
         None => row.extend([String::new(), String::new(), "none".into()]),
     }
