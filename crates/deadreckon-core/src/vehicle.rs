@@ -36,13 +36,15 @@ impl Origin {
 }
 
 /// Noise standard deviations: the paper's tables I (evolution, per 20 ms step) and
-/// II (observations). Every field has the paper's value as its default.
+/// II (observations). Every field has the paper's value as its default but
+/// `process_yaw_rad` ([`PROCESS_YAW_RAD`]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Noise {
     /// α_xy: position process noise per reference step, m (table I: 1e-3).
     pub process_xy_m: f64,
-    /// α_ψ: yaw process noise per reference step, rad (table I: 1e-5).
+    /// α_ψ: yaw process noise per reference step, rad (default
+    /// [`PROCESS_YAW_RAD`], 5e-5; table I: 1e-5).
     pub process_yaw_rad: f64,
     /// α_v: speed process noise per reference step, m/s (table I: 10).
     pub process_speed_mps: f64,
@@ -93,6 +95,24 @@ pub struct Noise {
     pub max_rejections: u32,
 }
 
+/// The default yaw process noise per 20 ms step, rad: 5e-5, five times table
+/// I's 1e-5, so that the filter's pose covariance covers its errors (NEES).
+///
+/// With table I's value the pose NEES through 30 s dead-reckoning windows of
+/// the simulated evaluation drive is over-confident (×1.7–2.3 on most
+/// seeds) at every point of the windows: the yaw errors of turns (eq. 3
+/// integrates the yaw with the yaw rate at the start of each step, so the
+/// yaw lags by half a step of yaw-rate change, see [`YawIntegration`]) are
+/// larger than its covariance. Chosen on the evaluation drives' seeds 3–6
+/// (truth parameters, 30 s windows every 60 s) as the value of 1e-5, 3e-5,
+/// 5e-5, 7e-5, 1e-4, 2e-4 whose averaged NEES is nearest 3 with every seed
+/// consistent; then measured on seeds the choice did not see: the demo's
+/// seed 2 consistent (ε̄ 4.67, 2.96, 3.11, 3.48 against 1.68..4.70), seeds
+/// 7–11 merged over-confident ×1.5 at a quarter of the window only (×1.9 at
+/// 1e-5). On the comma2k19 segment it changes the 20 s outage error by at
+/// most 0.02 m (held-out second half → first: 0.714 → 0.697 m median).
+pub const PROCESS_YAW_RAD: f64 = 5e-5;
+
 /// How the process noise of the yaw rate reaches the yaw over one step.
 ///
 /// Eq. (3) integrates the yaw with the yaw rate at the start of the step,
@@ -134,7 +154,7 @@ impl Default for Noise {
     fn default() -> Self {
         Noise {
             process_xy_m: 1e-3,
-            process_yaw_rad: 1e-5,
+            process_yaw_rad: PROCESS_YAW_RAD,
             process_speed_mps: 10.0,
             process_yaw_rate_rps: 1.0,
             yaw_integration: YawIntegration::Euler,

@@ -66,13 +66,17 @@ fn factor(v: Verdict) -> f64 {
 }
 
 #[test]
-fn with_the_papers_noise_the_pose_is_over_confident_and_the_motion_consistent() {
-    let c = nees_seeds(Noise::default(), &SEEDS);
-    print("defaults, seeds 2-6", &c);
-    print("defaults, seed 2 (the demo's)", &nees(Noise::default()));
-    // 45 windows of 30 s. Measured: pose ε̄ 4.28, 4.12, 3.75, 4.13 at a
-    // quarter, half, three quarters and the end (bounds 2.36..3.72 for n = 3),
-    // over-confident by ×1.4; motion ε̄ 2.09–2.14 (bounds 1.48..2.59).
+fn with_table_ones_yaw_noise_the_pose_was_over_confident() {
+    // The paper's α_ψ = 1e-5 (the default until vehicle::PROCESS_YAW_RAD):
+    // the yaw errors of turns are larger than the yaw covariance.
+    let n = Noise {
+        process_yaw_rad: 1e-5,
+        ..Noise::default()
+    };
+    let c = nees_seeds(n, &SEEDS);
+    print("table I's yaw noise, seeds 2-6", &c);
+    // Measured: pose ε̄ 4.28, 4.12, 3.75, 4.13 (bounds 2.36..3.72),
+    // over-confident by ×1.4; motion consistent.
     assert_eq!(c.pose.points.len(), 4);
     assert!(c.pose.points.iter().all(|p| p.windows >= 40));
     let k = factor(c.pose.verdict());
@@ -81,24 +85,27 @@ fn with_the_papers_noise_the_pose_is_over_confident_and_the_motion_consistent() 
 }
 
 #[test]
-fn three_times_the_papers_position_process_noise_makes_the_pose_consistent() {
-    // process_xy_m 0.003 instead of table I's 0.001: pose ε̄ 3.25, 2.89,
-    // 2.74, 3.24 (bounds 2.36..3.72); 0.01 is under-confident by ×4.4. Not
-    // the default: on the real comma2k19 segment it takes the 20 s outage
-    // error from 0.722 to 0.757 m (see the report of issue 13).
-    let n = Noise {
-        process_xy_m: 3e-3,
-        ..Noise::default()
-    };
-    let c = nees_seeds(n, &SEEDS);
-    print("process_xy_m 0.003, seeds 2-6", &c);
+fn the_default_noise_is_consistent_on_the_evaluation_drives() {
+    let c = nees_seeds(Noise::default(), &SEEDS);
+    print("defaults, seeds 2-6", &c);
+    let demo = nees(Noise::default());
+    print("defaults, seed 2 (the demo's)", &demo);
+    // Measured: seeds 2-6 pose ε̄ 3.36, 3.42, 2.96, 3.00 (bounds
+    // 2.36..3.72), motion 2.09–2.14 (1.48..2.59); seed 2 pose 4.67, 2.96,
+    // 3.11, 3.47 (1.68..4.70: its first point is close to the bound). Out of
+    // these seeds, 7–11 read over-confident ×1.5 at a quarter of the window
+    // (vehicle::PROCESS_YAW_RAD).
     assert_eq!(c.pose.verdict(), Verdict::Consistent);
     assert_eq!(c.motion.verdict(), Verdict::Consistent);
+    // The demo's own windows (what its report's filter health reads).
+    assert_eq!(demo.pose.verdict(), Verdict::Consistent);
+    assert_eq!(demo.motion.verdict(), Verdict::Consistent);
+    // Ten times the position process noise: under-confident (the test
+    // tells both ways).
     let n = Noise {
         process_xy_m: 1e-2,
-        process_yaw_rad: 1e-4,
         ..Noise::default()
     };
     let c = nees_seeds(n, &SEEDS);
-    assert!(factor(c.pose.verdict()) < -3.0, "{}", c.pose.verdict());
+    assert!(factor(c.pose.verdict()) < -2.0, "{}", c.pose.verdict());
 }
