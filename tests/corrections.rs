@@ -164,3 +164,29 @@ fn the_report_ignored_the_corrections_of_its_params_and_estimated_none() {
     assert!(rows.is_none());
     assert_eq!(same.yaw_rate, drive.yaw_rate);
 }
+
+/// Regressions: `--corrections none` printed "imu tilt: no three-axis IMU
+/// in the drive" on a drive that has one, and a car's `evaluate` accepted
+/// the differential drive's `--start` and `--align` and ignored them.
+#[test]
+fn corrections_none_said_the_drive_had_no_imu_and_a_car_ignored_start() {
+    let seg = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/comma2k19-rav4");
+    let out = run_ok(&["evaluate", seg, "--outage", "20", "--corrections", "none"]);
+    assert!(
+        out.contains("corrections: none estimated or applied"),
+        "{out}"
+    );
+    assert!(!out.contains("no three-axis IMU"), "{out}");
+    let out = run_ok(&["evaluate", seg, "--outage", "20"]);
+    assert!(out.contains("imu tilt: 3."), "{out}");
+    for extra in [["--start", "align"], ["--align", "30"]] {
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_deadreckon"))
+            .args(["evaluate", seg, "--outage", "20"])
+            .args(extra)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(1), "{extra:?}");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains("apply to a differential drive"), "{err}");
+    }
+}

@@ -97,12 +97,12 @@ pub struct EvaluateArgs {
     /// Differential drive: the yaw rate integrated, gyro or odometry (default: the params file's, else gyro).
     #[arg(long, value_enum)]
     pub yaw: Option<YawArg>,
-    /// Differential drive: seconds before the first outage, and the span of fixes before each outage the dead reckoning is aligned to (--start align).
-    #[arg(long, default_value_t = 60.0, value_parser = super::positive)]
-    pub align: f64,
-    /// Differential drive: where each outage starts from: filter (the GNSS-aided filter's state, the fixes' wander carried into the outage) or align (the preceding --align seconds of dead reckoning aligned to the fixes, the baseline).
-    #[arg(long, value_enum, default_value_t = StartArg::Filter)]
-    pub start: StartArg,
+    /// Differential drive: seconds before the first outage, and the span of fixes before each outage the dead reckoning is aligned to (--start align) [default: 60].
+    #[arg(long, value_parser = super::positive)]
+    pub align: Option<f64>,
+    /// Differential drive: where each outage starts from: filter (the GNSS-aided filter's state, the fixes' wander carried into the outage) or align (the preceding --align seconds of dead reckoning aligned to the fixes, the baseline) [default: filter].
+    #[arg(long, value_enum)]
+    pub start: Option<StartArg>,
     /// Without --params: the timing and mounting corrections estimated and
     /// applied before the calibration (all: IMU tilt and every stream's
     /// delay; gnss: tilt and GNSS delay; none). With --params: those stored

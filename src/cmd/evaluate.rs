@@ -5,7 +5,7 @@
 use anyhow::Result;
 
 use super::common;
-use crate::args::kinematic::ShapeArg;
+use crate::args::kinematic::{ShapeArg, StartArg};
 use deadreckon_api::{evaluate, kinematic};
 
 use crate::args::evaluate::*;
@@ -15,6 +15,9 @@ pub fn run(a: EvaluateArgs, load: &common::Loader) -> Result<()> {
     let tricycle = kinematic::is_tricycle_log(&a.dir);
     if tricycle || a.shape == ShapeArg::DiffDrive {
         return run_kinematic(&a, load, tricycle);
+    }
+    if a.start.is_some() || a.align.is_some() {
+        anyhow::bail!("--start and --align apply to a differential drive (--shape diff-drive)");
     }
     let drive = deadreckon_api::load::cut(load.drive(&a.dir)?, a.from_s, a.until_s)?;
     // One rule for every metric (deadreckon_api::evaluate::RULE).
@@ -59,8 +62,8 @@ fn run_kinematic(a: &EvaluateArgs, load: &common::Loader, tricycle: bool) -> Res
             yaw,
             len,
             step,
-            a.align,
-            &a.start.into(),
+            a.align.unwrap_or(60.0),
+            &a.start.unwrap_or(StartArg::Filter).into(),
             a.from_s,
             a.until_s,
         )?

@@ -7,7 +7,16 @@ use deadreckon_core::ParamsWithStd;
 
 /// The corrections as text lines (one per stream, and the tilt).
 pub fn corrections_lines(c: &deadreckon_core::timing::Corrections) -> Vec<String> {
-    use deadreckon_core::timing::Stream;
+    use deadreckon_core::timing::{Stream, NOT_ASKED};
+    let asked = |s: Stream| c.delays.get(s).status.reason() != Some(NOT_ASKED);
+    if !Stream::ALL.into_iter().any(asked)
+        && c.tilt.is_none()
+        && c.gyro_scale.is_none()
+        && c.traction.is_none()
+    {
+        // --corrections none: not "no three-axis IMU in the drive".
+        return vec!["corrections: none estimated or applied".into()];
+    }
     let mut out = vec![format!(
         "{:<10} {:>10} {:>9}  status",
         "delay of", "s", "std s"

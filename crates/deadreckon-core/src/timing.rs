@@ -140,10 +140,13 @@ pub struct Delays {
     pub gnss: Delay,
 }
 
+/// The reason of a delay [`Which::None`] did not ask for.
+pub const NOT_ASKED: &str = "not asked for";
+
 impl Delays {
-    /// No delay known for any stream.
+    /// No delay asked for any stream ([`Which::None`]).
     pub fn none() -> Delays {
-        let n = || Delay::not_estimated("not estimated");
+        let n = || Delay::not_estimated(NOT_ASKED);
         Delays {
             gyro: n(),
             speed: n(),
