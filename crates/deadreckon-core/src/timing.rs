@@ -242,6 +242,61 @@ pub(crate) fn lag1(r: &[f64]) -> f64 {
 }
 
 /// Least squares `y ≈ a + b·x`: `(a, b, residuals)`, `None` if `x` is constant.
+/// Blocks of consecutive points of the delay's jackknife.
+pub const JACKKNIFE_BLOCKS: usize = 20;
+
+/// The sums of a straight-line fit y = a + b x.
+#[derive(Debug, Clone, Copy, Default)]
+struct LineSums {
+    n: f64,
+    x: f64,
+    y: f64,
+    xx: f64,
+    xy: f64,
+    yy: f64,
+}
+
+impl LineSums {
+    fn add(&mut self, x: f64, y: f64) {
+        self.n += 1.0;
+        self.x += x;
+        self.y += y;
+        self.xx += x * x;
+        self.xy += x * y;
+        self.yy += y * y;
+    }
+    fn total(parts: &[LineSums]) -> LineSums {
+        parts.iter().fold(LineSums::default(), |a, p| LineSums {
+            n: a.n + p.n,
+            x: a.x + p.x,
+            y: a.y + p.y,
+            xx: a.xx + p.xx,
+            xy: a.xy + p.xy,
+            yy: a.yy + p.yy,
+        })
+    }
+    fn without(&self, p: &LineSums) -> LineSums {
+        LineSums {
+            n: self.n - p.n,
+            x: self.x - p.x,
+            y: self.y - p.y,
+            xx: self.xx - p.xx,
+            xy: self.xy - p.xy,
+            yy: self.yy - p.yy,
+        }
+    }
+    /// The residual sum of squares of the fit (`None`: x does not vary).
+    fn sse(&self) -> Option<f64> {
+        if self.n < 3.0 {
+            return None;
+        }
+        let sxx = self.xx - self.x * self.x / self.n;
+        let sxy = self.xy - self.x * self.y / self.n;
+        let syy = self.yy - self.y * self.y / self.n;
+        (sxx > 1e-12 * self.xx.max(1e-300)).then(|| (syy - sxy * sxy / sxx).max(0.0))
+    }
+}
+
 fn line_fit(x: &[f64], y: &[f64]) -> Option<(f64, f64, Vec<f64>)> {
     let n = x.len() as f64;
     let (mx, my) = (x.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
@@ -313,6 +368,10 @@ impl<'a> Integral<'a> {
 /// The delay of `signal` (`(t, value)`, stream clock) behind `reference`
 /// (`(t, value)`, wheel clock, sorted); `keep(t)` selects the windows used.
 ///
+/// The standard error is the larger of the Gauss–Newton one (with the
+/// residuals' lag-1 correlation) and a delete-a-block jackknife over
+/// [`JACKKNIFE_BLOCKS`] blocks of consecutive points.
+///
 /// Both series are compared smoothed by a triangle of half-width
 /// [`DelayOptions::window_s`] (exact double integrals of the linearly
 /// interpolated samples), at points that far apart: interpolating a noisy
@@ -341,12 +400,13 @@ pub fn scalar_delay(
     // Points spaced w on the reference clock, inside both spans at every lag
     // searched; the signal is read at the point + the lag.
     let (start, end) = (r0.max(s0 + margin) + w, r1.min(s1 - margin) - w);
-    let mut pts: Vec<(f64, f64)> = Vec::new();
+    // (t, smoothed reference, its derivative)
+    let mut pts: Vec<(f64, f64, f64)> = Vec::new();
     let mut t = start;
     while t <= end {
         if keep(t) {
-            if let Some((m, _)) = iref.smooth(t, w) {
-                pts.push((t, m));
+            if let Some((m, dm)) = iref.smooth(t, w) {
+                pts.push((t, m, dm));
             }
         }
         t += w;
@@ -361,62 +421,119 @@ pub fn scalar_delay(
     let x: Vec<f64> = pts.iter().map(|s| s.1).collect();
     let ys = |d: f64| -> Vec<(f64, f64)> {
         pts.iter()
-            .map(|&(t, _)| isig.smooth(t + d, w).unwrap_or((f64::NAN, 0.0)))
+            .map(|&(t, _, _)| isig.smooth(t + d, w).unwrap_or((f64::NAN, 0.0)))
             .collect()
     };
-    let sse = |d: f64| -> Option<f64> {
-        let y: Vec<f64> = ys(d).iter().map(|p| p.0).collect();
-        line_fit(&x, &y).map(|(_, _, r)| r.iter().map(|e| e * e).sum::<f64>())
-    };
+    // Per lag of the grid and per block of consecutive points, the sums of a
+    // line fit, so that the fit without one block is the totals minus it.
     let k = (o.max_delay_s / o.step_s).round() as i64;
-    let grid: Vec<(f64, f64)> = (-k..=k)
-        .filter_map(|i| {
-            let d = i as f64 * o.step_s;
-            sse(d).map(|e| (d, e))
+    let lags: Vec<f64> = (-k..=k).map(|i| i as f64 * o.step_s).collect();
+    let blocks = JACKKNIFE_BLOCKS.min(pts.len() / 10).max(1);
+    let block_of = |i: usize| i * blocks / pts.len();
+    let mx = x.iter().sum::<f64>() / x.len() as f64;
+    let sums: Vec<Vec<LineSums>> = lags
+        .iter()
+        .map(|&d| {
+            let mut per = vec![LineSums::default(); blocks];
+            for (i, (yv, _)) in ys(d).into_iter().enumerate() {
+                if yv.is_finite() {
+                    per[block_of(i)].add(x[i] - mx, yv);
+                }
+            }
+            per
         })
         .collect();
-    if grid.len() < 3 {
-        return Delay::not_estimated("the reference does not vary");
-    }
-    let ib = grid
-        .iter()
-        .enumerate()
-        .min_by(|a, b| a.1 .1.total_cmp(&b.1 .1))
-        .map_or(0, |(i, _)| i);
-    if ib == 0 || ib + 1 == grid.len() {
-        return Delay::not_estimated(format!(
-            "best lag {:+.3} s on the search bound ±{} s",
-            grid[ib].0, o.max_delay_s
-        ));
-    }
-    // Parabola through the minimum and its neighbours.
-    let (e0, e1, e2) = (grid[ib - 1].1, grid[ib].1, grid[ib + 1].1);
-    let den = e0 - 2.0 * e1 + e2;
-    let d = grid[ib].0
-        + if den > 0.0 {
-            0.5 * o.step_s * (e0 - e2) / den
-        } else {
-            0.0
-        };
-    // Gauss–Newton standard error at the refined lag, with the derivative of
-    // the smoothed signal.
+    let totals: Vec<LineSums> = sums.iter().map(|per| LineSums::total(per)).collect();
+    // The refined lag of a set of SSE values over the grid: the minimum, a
+    // parabola through it and its neighbours; `Err` on the bound.
+    let refine = |sse: &[Option<f64>]| -> Result<f64, f64> {
+        let grid: Vec<(f64, f64)> = lags
+            .iter()
+            .zip(sse)
+            .filter_map(|(d, e)| e.map(|e| (*d, e)))
+            .collect();
+        if grid.len() < 3 {
+            return Err(f64::NAN);
+        }
+        let ib = grid
+            .iter()
+            .enumerate()
+            .min_by(|a, b| a.1 .1.total_cmp(&b.1 .1))
+            .map_or(0, |(i, _)| i);
+        if ib == 0 || ib + 1 == grid.len() {
+            return Err(grid[ib].0);
+        }
+        let (e0, e1, e2) = (grid[ib - 1].1, grid[ib].1, grid[ib + 1].1);
+        let den = e0 - 2.0 * e1 + e2;
+        Ok(grid[ib].0
+            + if den > 0.0 {
+                0.5 * o.step_s * (e0 - e2) / den
+            } else {
+                0.0
+            })
+    };
+    let full: Vec<Option<f64>> = totals.iter().map(LineSums::sse).collect();
+    let d = match refine(&full) {
+        Ok(d) => d,
+        Err(b) if b.is_nan() => return Delay::not_estimated("the reference does not vary"),
+        Err(b) => {
+            return Delay::not_estimated(format!(
+                "best lag {b:+.3} s on the search bound ±{} s",
+                o.max_delay_s
+            ))
+        }
+    };
+    // Delete-a-block jackknife: the lag without each block in turn.
+    let jack: Vec<f64> = (0..blocks)
+        .filter_map(|b| {
+            let sse: Vec<Option<f64>> = totals
+                .iter()
+                .zip(&sums)
+                .map(|(t, per)| t.without(&per[b]).sse())
+                .collect();
+            refine(&sse).ok()
+        })
+        .collect();
+    let jack_std = if jack.len() == blocks && blocks >= 5 {
+        let m = jack.iter().sum::<f64>() / blocks as f64;
+        let g = blocks as f64;
+        ((g - 1.0) / g * jack.iter().map(|v| (v - m).powi(2)).sum::<f64>()).sqrt()
+    } else {
+        f64::INFINITY
+    };
+    // Gauss–Newton standard error at the refined lag. The sensitivity to the
+    // lag is the signal's derivative, estimated two ways: the smoothed
+    // signal's own derivative, and the fitted slope times the reference's.
+    // Each is the true derivative plus its series' smoothed noise, which
+    // only adds to Σ j² (a steering wheel read with 0.3 rad of white noise
+    // made the standard error five to ten times too small): the smaller sum
+    // is taken.
     let yd = ys(d);
     let y: Vec<f64> = yd.iter().map(|p| p.0).collect();
-    let Some((_, _, r)) = line_fit(&x, &y) else {
+    let Some((_, slope, r)) = line_fit(&x, &y) else {
         return Delay::not_estimated("the reference does not vary");
     };
-    let j: Vec<f64> = yd.iter().map(|p| p.1).collect();
-    let n = j.len();
-    let mj = j.iter().sum::<f64>() / n as f64;
-    let sjj: f64 = j.iter().map(|v| (v - mj).powi(2)).sum();
+    let centred_ss = |j: &[f64]| -> f64 {
+        let mj = j.iter().sum::<f64>() / j.len() as f64;
+        j.iter().map(|v| (v - mj).powi(2)).sum()
+    };
+    let j_signal: Vec<f64> = yd.iter().map(|p| p.1).collect();
+    let j_reference: Vec<f64> = pts.iter().map(|p| slope * p.2).collect();
+    let n = j_signal.len();
+    let sjj = centred_ss(&j_signal).min(centred_ss(&j_reference));
     let s2 = r.iter().map(|e| e * e).sum::<f64>() / (n as f64 - 3.0);
     let rho = lag1(&r);
-    let std = if sjj > 0.0 {
+    let gn_std = if sjj > 0.0 {
         (s2 / sjj * (1.0 + rho) / (1.0 - rho)).sqrt()
     } else {
         f64::INFINITY
     };
-    status_of(d, std, n, o)
+    // The Gauss–Newton error sees the signal's noise only; the jackknife
+    // also sees the reference's and whatever varies along the drive. On a
+    // simulated steering wheel (0.3 rad of white noise) over ten noise seeds
+    // the lag scattered by 0.0069 and 0.0142 s where the Gauss–Newton error
+    // said 0.0044 and 0.0064 s.
+    status_of(d, gn_std.max(jack_std), n, o)
 }
 
 fn status_of(d: f64, std: f64, n: usize, o: &DelayOptions) -> Delay {
