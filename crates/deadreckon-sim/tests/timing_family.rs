@@ -99,7 +99,18 @@ fn delays_tilt_and_gyro_scale_are_recovered_on_the_car_family() {
                 d.std_s,
                 d.status
             );
-            assert!(d.status.is_estimated(), "car {seed} {}: {:?}", s.name(), d);
+            // Estimated, or refused for a standard error above 0.02 s (car
+            // 4's GNSS since the jackknife: 0.027 s, its true delay 0.007 s),
+            // and then not applied; the value is checked either way.
+            assert!(
+                d.status.is_estimated()
+                    || d.status
+                        .reason()
+                        .is_some_and(|r| r.contains("too little excitation")),
+                "car {seed} {}: {:?}",
+                s.name(),
+                d
+            );
             // The steering too since its standard error sees the noise
             // (car 2: +0.0900 ± 0.0084 s against +0.0753 s; it read
             // ± 0.0027 s before).
