@@ -8,6 +8,18 @@ use std::path::Path;
 
 use deadreckon_sim::family::CarFamily;
 
+/// A 300 s drive of family car 5 whose gyro is tilted by 3° and −2.5° (pitch,
+/// roll) with the relative scale error `scale_error`, written to `dir`.
+fn tilted_drive(dir: &Path, scale_error: f64) {
+    let seed = 5;
+    let mut sc = CarFamily::draw(seed).drive(seed, 300.0);
+    let g = sc.sensors.gyro.as_mut().expect("family gyro");
+    g.tilt_deg = Some([3.0, -2.5]);
+    g.scale_error = scale_error;
+    let sim = deadreckon_sim::simulate(&sc, seed).unwrap();
+    deadreckon_io::write_drive_whole(dir, &sim.drive, |_| Ok(())).unwrap();
+}
+
 /// Mean horizontal distance between the dead-reckoned track and the truth
 /// in a track CSV (truth interpolated at the dead-reckoned times).
 fn mean_dr_error(csv_path: &Path) -> f64 {
@@ -47,13 +59,7 @@ fn mean_dr_error(csv_path: &Path) -> f64 {
 fn run_applied_the_parameters_without_the_corrections_they_were_calibrated_with() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path().join("drive");
-    let seed = 5;
-    let mut sc = CarFamily::draw(seed).drive(seed, 300.0);
-    let g = sc.sensors.gyro.as_mut().expect("family gyro");
-    g.tilt_deg = Some([3.0, -2.5]);
-    g.scale_error = 0.02;
-    let sim = deadreckon_sim::simulate(&sc, seed).unwrap();
-    deadreckon_io::write_drive_whole(&dir, &sim.drive, |_| Ok(())).unwrap();
+    tilted_drive(&dir, 0.02);
     let d = dir.to_str().unwrap();
 
     let p = tmp.path().join("params.toml");
@@ -97,12 +103,7 @@ fn the_report_ignored_the_corrections_of_its_params_and_estimated_none() {
     use deadreckon_core::timing::Which;
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path().join("drive");
-    let seed = 5;
-    let mut sc = CarFamily::draw(seed).drive(seed, 300.0);
-    let g = sc.sensors.gyro.as_mut().expect("family gyro");
-    g.tilt_deg = Some([3.0, -2.5]);
-    let sim = deadreckon_sim::simulate(&sc, seed).unwrap();
-    deadreckon_io::write_drive_whole(&dir, &sim.drive, |_| Ok(())).unwrap();
+    tilted_drive(&dir, 0.0);
     let d = dir.to_str().unwrap();
     let p = tmp.path().join("params.toml");
     run_ok(&["calibrate", d, "--out", p.to_str().unwrap()]);
