@@ -5,7 +5,9 @@
 //! (printed, and bounded above; the 5 % is not reached), and against
 //! the drift with the true corrections and the same RTS calibration, which
 //! separates what the estimated corrections cost from what the GNSS-based
-//! calibration itself leaves.
+//! calibration itself leaves. The same cars with white GNSS fixes show what
+//! that is: the receiver's slow wander (with white fixes the RTS calibration
+//! is within 5 % of the truth).
 //!
 //! The delays are against the wheel clock: a simulated wheel-speed row is the
 //! mean speed over the preceding wheel period, so the wheels themselves are
@@ -75,14 +77,28 @@ impl Install {
     }
 }
 
-#[test]
-fn delays_tilt_and_gyro_scale_are_recovered_on_the_car_family() {
+/// The mean drift per 100 m on a member's test drive, %: with our
+/// corrections and RTS parameters, with the true corrections and the RTS
+/// parameters calibrated on them, and with the truth.
+#[derive(Debug, Clone, Copy)]
+struct Drift {
+    ours: f64,
+    known: f64,
+    truth: f64,
+}
+
+/// Each member's corrections recovered within 3σ, and its drifts.
+/// `white_fixes` takes the receiver's Gauss–Markov wander out (the family
+/// draws 0–1.5 m over 20–120 s).
+fn family_drift(white_fixes: bool) -> Vec<Drift> {
     let copts = CalibrationOptions::default();
     let o = DelayOptions::default();
-    let mut drift_ratios = Vec::new();
-    let mut known_ratios = Vec::new();
+    let mut drifts = Vec::new();
     for seed in 1..=4u64 {
-        let car = CarFamily::draw(seed);
+        let mut car = CarFamily::draw(seed);
+        if white_fixes {
+            car.gnss_markov.0 = 0.0;
+        }
         let inst = Install::draw(seed);
         let half_wheel = 0.5 / car.wheel_rate_hz;
         let train = simulate(&inst.apply(car.drive(100 + seed, 600.0)), 100 + seed).unwrap();
@@ -189,21 +205,55 @@ fn delays_tilt_and_gyro_scale_are_recovered_on_the_car_family() {
         eprintln!(
             "  drift per 100 m: {d_ours:.4}% ours, {d_known:.4}% with the true corrections and RTS parameters, {d_truth:.4}% with the truth"
         );
-        drift_ratios.push(d_ours / d_truth);
-        known_ratios.push(d_ours / d_known);
+        drifts.push(Drift {
+            ours: d_ours,
+            known: d_known,
+            truth: d_truth,
+        });
     }
+    drifts
+}
+
+#[test]
+fn delays_tilt_and_gyro_scale_are_recovered_on_the_car_family() {
+    let drifts = family_drift(false);
+    let drift_ratios: Vec<f64> = drifts.iter().map(|d| d.ours / d.truth).collect();
+    let known_ratios: Vec<f64> = drifts.iter().map(|d| d.ours / d.known).collect();
     eprintln!("drift ours / truth: {drift_ratios:?}");
     eprintln!("drift ours / true corrections with RTS parameters: {known_ratios:?}");
     // What the estimated corrections cost against the true ones, the RTS
-    // calibration being the same: measured 1.054, 1.246, 1.042 and 1.018
+    // calibration being the same: measured 1.047, 0.996, 1.002 and 1.008
     // (seeds 1–4); most of the gap to the truth is the RTS calibration's
-    // own (true corrections: 1.06, 1.33, 1.02, 1.41 × the truth, and on
-    // the same cars without any installation effect 1.07, 1.36, 1.04,
-    // 1.62). Bound: 8 % above the worst.
-    assert!(known_ratios.iter().all(|&r| r <= 1.35), "{known_ratios:?}");
-    // Not the 5 %: measured 1.11, 1.66, 1.07 and 1.44 (seeds 1–4).
-    // This bound (8 % above the worst) only pins that result.
-    assert!(drift_ratios.iter().all(|&r| r <= 1.8), "{drift_ratios:?}");
+    // own, and that is the receiver's wander (see
+    // `with_white_fixes_the_rts_calibration_is_within_5_percent_of_the_truth`).
+    // Bound: 8 % above the worst.
+    assert!(known_ratios.iter().all(|&r| r <= 1.13), "{known_ratios:?}");
+    // Not the 5 %: measured 1.131, 1.186, 1.017 and 1.437 (seeds
+    // 1–4). This bound (8 % above the worst) only pins that result.
+    assert!(drift_ratios.iter().all(|&r| r <= 1.56), "{drift_ratios:?}");
+}
+
+/// What limits the drift above: the same cars with a receiver whose fixes
+/// are white noise about the antenna (no Gauss–Markov wander). The RTS
+/// calibration on truly corrected streams is then within the 5 % of
+/// the truth (measured 1.0055, 1.0434, 1.0016, 1.0015 on cars 1–4, against
+/// 1.06, 1.33, 1.02, 1.41 with the wander, whose metre-scale drift over a
+/// minute or two the white-noise filter reads as a scale error of every
+/// wheel: 1–5 mm of circumference, 50–250 times its claimed standard
+/// error). With our estimated corrections it is 1.06, 1.58, 1.02, 1.05 ×
+/// the truth: car 2's gyro scale error reads +0.85 % ± 0.30 % for +1.33 %,
+/// and that alone moves its drift by half.
+#[test]
+fn with_white_fixes_the_rts_calibration_is_within_5_percent_of_the_truth() {
+    let drifts = family_drift(true);
+    let known: Vec<f64> = drifts.iter().map(|d| d.known / d.truth).collect();
+    let ours: Vec<f64> = drifts.iter().map(|d| d.ours / d.truth).collect();
+    eprintln!(
+        "white fixes: true corrections, RTS parameters / truth {known:?}; ours / truth {ours:?}"
+    );
+    assert!(known.iter().all(|&r| r <= 1.05), "{known:?}");
+    // Pinned: the worst measured (car 2, 1.58) plus 8 %.
+    assert!(ours.iter().all(|&r| r <= 1.7), "{ours:?}");
 }
 
 /// Regression: interpolating the noisy wheel-derived signal at the gyro's
