@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pandas as pd
@@ -32,7 +33,6 @@ def test_calibrate_with_a_drive_object_equals_the_path(sim_drive):
     "method,extra",
     [
         ("rts", ["--state", "paper", "--iteration", "plain", "--max-iterations", "3"]),
-        ("rts", ["--timing", "each", "--min-speed", "3"]),
         ("zupt", []),
         ("truth", []),
     ],
@@ -47,6 +47,26 @@ def test_calibrate_options_equal_cli(sim_drive, cli_json, method, extra):
     ours = deadreckon.calibrate(sim_drive, method, **opts)
     theirs = cli_json("calibrate", sim_drive, "--method", method, "--json", *extra)
     assert ours == theirs
+
+
+def test_calibrate_per_reading_refused_then_equal_to_cli(drive_copy, cli, cli_json):
+    # Table I's process noise per reading lets the GNSS fixes set the speed:
+    # both refuse it, with the same message.
+    needle = "noise.process_speed_mps = 10 (at most 0.5)"
+    with pytest.raises(deadreckon.DeadreckonError, match=re.escape(needle)):
+        deadreckon.calibrate(drive_copy, timing="each")
+    p = cli("calibrate", drive_copy, "--timing", "each", "--json", check=False)
+    assert p.returncode != 0 and needle in p.stderr
+    # Within the bounds both calibrate, equally.
+    vt = drive_copy / "vehicle.toml"
+    text = vt.read_text()
+    text = text.replace("process_speed_mps = 10.0", "process_speed_mps = 0.5")
+    text = text.replace("process_yaw_rate_rps = 1.0", "process_yaw_rate_rps = 0.03")
+    vt.write_text(text)
+    ours = deadreckon.calibrate(drive_copy, timing="each", min_speed=3.0)
+    theirs = cli_json("calibrate", drive_copy, "--json", "--timing", "each", "--min-speed", "3")
+    assert ours == theirs
+    assert ours["converged"] is True
 
 
 @pytest.mark.parametrize(

@@ -42,7 +42,9 @@ impl From<WheelsArg> for deadreckon_io::WheelFile {
 pub enum TimingArg {
     /// One epoch per wheel row (the paper's).
     Wheel,
-    /// One epoch per reading.
+    /// One epoch per reading. Calibrating or learning the parameters this
+    /// way needs [noise] process_speed_mps <= 0.5 and process_yaw_rate_rps
+    /// <= 0.03 in vehicle.toml (table I's values are refused).
     Each,
 }
 

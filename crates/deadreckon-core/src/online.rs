@@ -128,7 +128,9 @@ impl Online {
     }
 
     /// A filter that learns the six parameters, starting from `params` with
-    /// standard deviations `prior_std` (circumferences in metres).
+    /// standard deviations `prior_std` (circumferences in metres). Refused
+    /// under per-reading timing with table I's loose process noise
+    /// ([`crate::calibrate::check_learning_noise`]).
     pub fn learning(
         vehicle: &Vehicle,
         params: &Params,
@@ -136,6 +138,7 @@ impl Online {
         opts: &FilterOptions,
         start: Start,
     ) -> Result<Self, Error> {
+        crate::calibrate::check_learning_noise(&vehicle.noise, opts.timing)?;
         Self::build(vehicle, params, Some(*prior_std), opts, start)
     }
 
