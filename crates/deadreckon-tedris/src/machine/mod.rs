@@ -124,6 +124,10 @@ pub struct MachineChecks {
     pub inconsistent_headings: u64,
     /// Courses not used while the car reversed.
     pub reversing_courses: u64,
+    /// Courses skipped as repeats of the one before (a receiver holding
+    /// its last course).
+    #[serde(default)]
+    pub repeated_courses: u64,
     /// Calibrations refused (worse out of sample, or at a physical bound).
     pub refused_calibrations: u64,
     /// Heading segments started.
@@ -138,9 +142,10 @@ impl MachineChecks {
     /// One line for a table: what was refused, and how often.
     pub fn line(&self) -> String {
         format!(
-            "TedriS checks: {} courses inconsistent with the wheels, {} while reversing, {} calibrations refused, {} heading segments, {} watchdog alarms, {} samples rejected",
+            "TedriS checks: {} courses inconsistent with the wheels, {} while reversing, {} repeated, {} calibrations refused, {} heading segments, {} watchdog alarms, {} samples rejected",
             self.inconsistent_headings,
             self.reversing_courses,
+            self.repeated_courses,
             self.refused_calibrations,
             self.heading_segments,
             self.model_alarms,
@@ -203,6 +208,9 @@ pub struct Tedris {
     /// GNSS courses not used because the car was reversing.
     #[serde(default)]
     reversing_courses: u64,
+    /// GNSS courses skipped as repeats of the course before.
+    #[serde(default)]
+    repeated_courses: u64,
     /// Calibrations refused: worse out of sample than the model they would
     /// replace, or at a physical bound.
     #[serde(default)]
@@ -272,6 +280,7 @@ impl Tedris {
             segment: 0,
             inconsistent_headings: 0,
             reversing_courses: 0,
+            repeated_courses: 0,
             refused_calibrations: 0,
             untrained_because: None,
             model_alarms: 0,
@@ -349,6 +358,7 @@ impl Tedris {
         MachineChecks {
             inconsistent_headings: self.inconsistent_headings,
             reversing_courses: self.reversing_courses,
+            repeated_courses: self.repeated_courses,
             refused_calibrations: self.refused_calibrations,
             heading_segments: self.segment,
             model_alarms: self.model_alarms,

@@ -81,6 +81,15 @@ impl Tedris {
 
     pub(super) fn process_heading(&mut self, hs: HeadingSample) {
         let prev = self.last_heading;
+        // A course identical to the one before is no new measurement: the
+        // receiver holds its last course (below its speed threshold), and a
+        // course held since the car reversed points backwards while the car
+        // pulls away, which the consistency check cannot see (a held course
+        // does not change, nor do the wheels turn much). It is skipped.
+        if self.geometry.heading_is_course && prev.is_some_and(|p| p.2 == hs.yaw_rad) {
+            self.repeated_courses += 1;
+            return;
+        }
         let gap_ok = |p: &(f64, f64, f64, f64, bool)| hs.t_s - p.0 <= self.config.max_heading_gap_s;
         // A GNSS course is the antenna's: the antenna moves at atan(l ψ̇ / v) from the
         // rear-axle heading. ψ̇ and v are the wheels' over the fix interval centred
