@@ -69,7 +69,12 @@
 //!   `course_consistency_rad`, not only above a speed; none is used while the
 //!   rear wheels roll backwards (receivers then report the direction of
 //!   motion, a frozen course or a random one;
-//!   [`Tedris::reversing_courses`] counts them).
+//!   [`Tedris::reversing_courses`] counts them). Below
+//!   [`tuning::HELD_COURSE_MAX_SPEED_MPS`] a course equal to the one before
+//!   is skipped as held by the receiver (a course held since reversing
+//!   points backwards while the car pulls away, and its change agrees with
+//!   the wheels'; `MachineChecks::repeated_courses` counts them); faster, a
+//!   repeat is a straight road in the course's resolution and kept.
 //! - **Physical form** (GNSS course, the extended variant): the straight-line
 //!   heading is per metre only, as unequal rear radii make it; the model turns
 //!   the car only when the wheels move ([`history::moving`]); the ARX kind,

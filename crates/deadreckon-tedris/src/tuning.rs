@@ -7,6 +7,14 @@
 /// sample) are at rest: the model turns the heading only when they move, m/s.
 pub const STANDSTILL_SPEED_MPS: f64 = 0.005;
 
+/// Below this speed a course equal to the one before is taken as held by
+/// the receiver and skipped; at and above it a repeat is a straight road in
+/// the course's resolution (NMEA gives 0.1° or 0.01°) and kept, m/s.
+/// Receivers hold their course below a threshold of their own (the
+/// simulator's family draws 0.3–1.5 m/s; a held course lasts until the car
+/// passes it, so the repeats seen come at or below it).
+pub const HELD_COURSE_MAX_SPEED_MPS: f64 = 3.0;
+
 /// Courses more than this older than the newest are processed with the wheel
 /// samples there are (their centred lever-arm window is incomplete), s.
 pub const COURSE_QUEUE_S: f64 = 1.0;

@@ -571,3 +571,56 @@ fn a_course_held_since_reversing_turned_the_anchored_heading() {
     assert!(off.abs() < 2f64.to_radians(), "{off} rad");
     assert!(e.mean_error_m() < 7.0, "{e:?}");
 }
+
+/// Regression (of the fix above, before it shipped): every course equal to
+/// the one before was skipped as held, also at speed, where a repeat is a
+/// straight road in the course's resolution (NMEA gives 0.1° or 0.01°).
+/// With car 8's test courses rounded to whole degrees, the repeats at speed
+/// are kept: only those below `tuning::HELD_COURSE_MAX_SPEED_MPS` are
+/// skipped, and the outage error stays near the unrounded one.
+#[test]
+fn a_quantised_course_on_a_fast_straight_was_skipped_as_held() {
+    let car = CarFamily::draw(8);
+    let train_drive = simulate(&car.drive(1008, 900.0), 1008)
+        .expect("train")
+        .drive;
+    let test = simulate(&car.drive(2008, 500.0), 2008).expect("test");
+    let (model, _) = train(&train_drive, TedrisConfig::default(), None).expect("trained");
+    let o = Outage {
+        start_s: 320.0,
+        end_s: 400.0,
+    };
+    let mut rounded = test.drive.clone();
+    for g in &mut rounded.gnss {
+        g.course_deg = g.course_deg.map(f64::round);
+    }
+    // Repeats at speed that the rounding made.
+    let mut fast_repeats = 0;
+    for w in rounded.gnss.windows(2) {
+        if w[1].speed_mps.is_some_and(|v| v > 5.0)
+            && w[1].course_deg.is_some()
+            && w[1].course_deg == w[0].course_deg
+        {
+            fast_repeats += 1;
+        }
+    }
+    let raw = run_outages(&test.drive, &model, &[o]).expect("run");
+    let round = run_outages(&rounded, &model, &[o]).expect("run rounded");
+    let (n_raw, n_round) = (
+        raw.machine.checks().repeated_courses,
+        round.machine.checks().repeated_courses,
+    );
+    let (e_raw, e_round) = (
+        raw.outages[0].mean_error_m(),
+        round.outages[0].mean_error_m(),
+    );
+    eprintln!(
+        "{fast_repeats} repeats above 5 m/s after rounding; skipped {n_raw} raw, {n_round} rounded; outage mean {e_raw:.2} m raw, {e_round:.2} m rounded"
+    );
+    assert!(fast_repeats > 200, "{fast_repeats}");
+    assert!(
+        n_round < n_raw + fast_repeats / 10,
+        "{n_round} of {fast_repeats}"
+    );
+    assert!((e_round - e_raw).abs() < 1.0, "{e_raw} → {e_round}");
+}

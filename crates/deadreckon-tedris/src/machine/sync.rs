@@ -81,15 +81,6 @@ impl Tedris {
 
     pub(super) fn process_heading(&mut self, hs: HeadingSample) {
         let prev = self.last_heading;
-        // A course identical to the one before is no new measurement: the
-        // receiver holds its last course (below its speed threshold), and a
-        // course held since the car reversed points backwards while the car
-        // pulls away, which the consistency check cannot see (a held course
-        // does not change, nor do the wheels turn much). It is skipped.
-        if self.geometry.heading_is_course && prev.is_some_and(|p| p.2 == hs.yaw_rad) {
-            self.repeated_courses += 1;
-            return;
-        }
         let gap_ok = |p: &(f64, f64, f64, f64, bool)| hs.t_s - p.0 <= self.config.max_heading_gap_s;
         // A GNSS course is the antenna's: the antenna moves at atan(l ψ̇ / v) from the
         // rear-axle heading. ψ̇ and v are the wheels' over the fix interval centred
@@ -115,6 +106,17 @@ impl Tedris {
                 }
             }
             let v = if st > 0.0 { sd / st } else { 0.0 };
+            // A course identical to the one before at low speed is no new
+            // measurement: the receiver holds its last course (below its
+            // speed threshold), and a course held since the car reversed
+            // points backwards while the car pulls away, which the
+            // consistency check cannot see (a held course does not change,
+            // nor do the wheels turn much). It is skipped. Faster, a repeat
+            // is a straight road in the course's resolution: kept.
+            if prev.is_some_and(|p| p.2 == hs.yaw_rad) && v.abs() < HELD_COURSE_MAX_SPEED_MPS {
+                self.repeated_courses += 1;
+                return;
+            }
             // Reversing (the rear wheels roll backwards), receivers differ: the
             // direction of motion (π from the heading), the last course at
             // speed frozen, or a random one. None is used; the consistency
