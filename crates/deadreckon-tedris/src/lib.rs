@@ -188,11 +188,11 @@
 //! with the exact gyro bias also gives 37/48.
 //!
 //! The real Husky bag (tests/husky_bag.rs, gyro reference, trained on the first
-//! half, lag −3 samples): 30 s outages 0.63–2.20 m mean error against the hidden
-//! SBAS fixes (largest 4.4 m; mean of the five 1.43 m), 60 s outages 0.77–2.50 m
-//! (largest 5.0 m; mean 1.52 m, 1.47 m before the changes above). The
-//! course from chords between the fixes is too noisy at 1 m/s for the block
-//! regression (cross-correlation peak 0.06): 0.9–6.0 m over 30 s.
+//! half, lag −3 samples): 30 s outages 0.63–2.10 m mean error against the hidden
+//! SBAS fixes (largest 4.4 m; mean of the five 1.41 m), 60 s outages 0.77–2.39 m
+//! (largest 4.7 m; mean 1.48 m). The course from chords between the fixes is
+//! too noisy at 1 m/s for the block regression (cross-correlation peak 0.06):
+//! 2.9–12.1 m over 30 s.
 //!
 //! ## Modules
 //!

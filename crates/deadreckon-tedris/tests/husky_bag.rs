@@ -87,10 +87,11 @@ fn husky_gyro_reference_30_and_60_s_outages() {
         mean(&e30),
         mean(&e60)
     );
-    // Measured (against fixes with 0.9 m noise): 30 s means 0.63–2.20 m (max 4.39 m),
-    // 60 s means 0.77–2.50 m (max 5.04 m); averages 1.43 m (30 s) and 1.52 m
-    // (60 s). Bounds: the largest measured + 20% (3.0 m mean, 6.0 m max) and
-    // the averages + 25% (1.9 m).
+    // Measured (against fixes with 0.9 m noise): 30 s means 0.63–2.10 m (max 4.38 m),
+    // 60 s means 0.77–2.39 m (max 4.70 m); averages 1.41 m (30 s) and 1.48 m
+    // (60 s). Bounds: the largest measured + 25% (3.0 m mean, 6.0 m max) and
+    // the averages + 25% (1.9 m). The 60 s target is 2.30 m per window:
+    // [125, 185) is above it.
     for e in e30.iter().chain(&e60) {
         assert!(
             e.result.points() > 50 && e.predicted_fraction > 0.95,
@@ -105,8 +106,11 @@ fn husky_gyro_reference_30_and_60_s_outages() {
 #[test]
 fn husky_fix_track_reference_runs() {
     // The course from chords between fixes is too noisy at 1 m/s for the block
-    // regression (cross-correlation peak about 0.06). Measured 3.68–5.26 m mean,
-    // 11.92 m largest, over the 30 s outages; bounds: + 25% (6.5 m mean, 15 m max).
+    // regression (cross-correlation peak about 0.06). Measured 2.91–12.13 m mean,
+    // 21.17 m largest, over the 30 s outages; bounds: + 25% (15.2 m mean, 26.5 m
+    // max). It read 3.68–5.26 m (11.92 m) while the run's blocks were numbered
+    // among the training drive's and its refits mixed the two drives' blocks
+    // (`a_model_run_on_a_new_drive_numbered_its_blocks_among_the_training_drives`).
     let cfg = TedrisConfig {
         min_course_speed_mps: 0.3,
         init_s: 60.0,
@@ -117,9 +121,9 @@ fn husky_fix_track_reference_runs() {
     let e = run(ReferenceSource::GnssTrack, cfg, &OUT_30);
     for o in &e {
         assert!(
-            o.mean_error_m().is_finite() && o.mean_error_m() < 6.5,
+            o.mean_error_m().is_finite() && o.mean_error_m() < 15.2,
             "{o:?}"
         );
-        assert!(o.max_error_m() < 15.0, "{o:?}");
+        assert!(o.max_error_m() < 26.5, "{o:?}");
     }
 }

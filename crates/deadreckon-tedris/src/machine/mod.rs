@@ -296,12 +296,21 @@ impl Tedris {
         model.validate()?;
         let mut m = Tedris::new(model.config.clone(), geometry)?;
         let c = &model.config;
+        // This drive's samples are numbered after the model's blocks, so a
+        // block's sequence number orders it in time across drives: numbered
+        // from 0, a refit sorted the two drives' blocks into one another, and
+        // the ARX kind's fit took blocks of different drives for neighbours.
+        let start = model.repositories.all_sorted().last().map_or(0, |t| {
+            t.seq + c.tau_samples as u64 + model.lag_samples.unsigned_abs() + 1
+        });
+        m.next_idx = start;
+        m.pending_from = start;
         let former = BlockFormer::new(
             c.tau_samples,
             model.lag_samples,
             1,
             c.slt_max_change_deg.to_radians(),
-            0,
+            start,
         );
         m.former = Some(former);
         m.convention = model.course_convention.map(|c| c.convention);
