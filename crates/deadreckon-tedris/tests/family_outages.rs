@@ -469,6 +469,18 @@ fn a_distance_scale_beyond_its_bound_is_refused_not_clamped() {
     assert!(r.machine.refused_calibrations() > 0);
 }
 
+/// Car 8 (its receiver holds its course below 1.4 m/s; shunts): the model
+/// trained on its 900 s training drive, and its 500 s test drive.
+fn car8() -> (deadreckon_tedris::TedrisModel, deadreckon_sim::SimOutput) {
+    let car = CarFamily::draw(8);
+    let train_drive = simulate(&car.drive(1008, 900.0), 1008)
+        .expect("train")
+        .drive;
+    let test = simulate(&car.drive(2008, 500.0), 2008).expect("test");
+    let (model, _) = train(&train_drive, TedrisConfig::default(), None).expect("trained");
+    (model, test)
+}
+
 /// Found while adding reversing to the family: courses taken while the car
 /// backed up (a receiver frozen on the last forward course, or the direction
 /// of motion, π from the heading) were anchored as the heading; an outage
@@ -476,12 +488,7 @@ fn a_distance_scale_beyond_its_bound_is_refused_not_clamped() {
 /// wheels roll backwards are now not used, and counted.
 #[test]
 fn courses_while_reversing_turned_the_anchored_heading() {
-    let car = CarFamily::draw(8);
-    let train_drive = simulate(&car.drive(1008, 900.0), 1008)
-        .expect("train")
-        .drive;
-    let test = simulate(&car.drive(2008, 500.0), 2008).expect("test");
-    let (model, _) = train(&train_drive, TedrisConfig::default(), None).expect("trained");
+    let (model, test) = car8();
     let o = Outage {
         start_s: 316.0,
         end_s: 396.0,
@@ -520,12 +527,7 @@ fn courses_while_reversing_turned_the_anchored_heading() {
 /// A course identical to the one before is now skipped, and counted.
 #[test]
 fn a_course_held_since_reversing_turned_the_anchored_heading() {
-    let car = CarFamily::draw(8);
-    let train_drive = simulate(&car.drive(1008, 900.0), 1008)
-        .expect("train")
-        .drive;
-    let test = simulate(&car.drive(2008, 500.0), 2008).expect("test");
-    let (model, _) = train(&train_drive, TedrisConfig::default(), None).expect("trained");
+    let (model, test) = car8();
     let o = Outage {
         start_s: 320.0,
         end_s: 400.0,
@@ -581,12 +583,7 @@ fn a_course_held_since_reversing_turned_the_anchored_heading() {
 /// skipped, and the outage error stays near the unrounded one.
 #[test]
 fn a_quantised_course_on_a_fast_straight_was_skipped_as_held() {
-    let car = CarFamily::draw(8);
-    let train_drive = simulate(&car.drive(1008, 900.0), 1008)
-        .expect("train")
-        .drive;
-    let test = simulate(&car.drive(2008, 500.0), 2008).expect("test");
-    let (model, _) = train(&train_drive, TedrisConfig::default(), None).expect("trained");
+    let (model, test) = car8();
     let o = Outage {
         start_s: 320.0,
         end_s: 400.0,
@@ -633,12 +630,7 @@ fn a_quantised_course_on_a_fast_straight_was_skipped_as_held() {
 /// drives for neighbours. The new drive's blocks now come after the model's.
 #[test]
 fn a_model_run_on_a_new_drive_numbered_its_blocks_among_the_training_drives() {
-    let car = CarFamily::draw(8);
-    let train_drive = simulate(&car.drive(1008, 900.0), 1008)
-        .expect("train")
-        .drive;
-    let test = simulate(&car.drive(2008, 500.0), 2008).expect("test");
-    let (model, _) = train(&train_drive, TedrisConfig::default(), None).expect("trained");
+    let (model, test) = car8();
     let trained: Vec<u64> = model
         .repositories
         .all_sorted()
