@@ -62,7 +62,8 @@ fn run_kinematic(a: &EvaluateArgs, load: &common::Loader, tricycle: bool) -> Res
             yaw,
             len,
             step,
-            a.align.unwrap_or(60.0),
+            a.align
+                .unwrap_or(deadreckon_core::kinematics::diff_drive::DEFAULT_WARMUP_S),
             &a.start.unwrap_or(StartArg::Filter).into(),
             a.from_s,
             a.until_s,

@@ -241,9 +241,16 @@ pub(crate) fn lag1(r: &[f64]) -> f64 {
     }
 }
 
-/// Least squares `y ≈ a + b·x`: `(a, b, residuals)`, `None` if `x` is constant.
 /// Blocks of consecutive points of the delay's jackknife.
 pub const JACKKNIFE_BLOCKS: usize = 20;
+
+/// The delete-a-group jackknife's standard error from the estimates made
+/// without each group in turn: `√((g − 1)/g · Σ (θᵢ − θ̄)²)`.
+fn jackknife_std(estimates: &[f64]) -> f64 {
+    let g = estimates.len() as f64;
+    let m = estimates.iter().sum::<f64>() / g;
+    ((g - 1.0) / g * estimates.iter().map(|v| (v - m).powi(2)).sum::<f64>()).sqrt()
+}
 
 /// The sums of a straight-line fit y = a + b x.
 #[derive(Debug, Clone, Copy, Default)]
@@ -297,6 +304,7 @@ impl LineSums {
     }
 }
 
+/// Least squares `y ≈ a + b·x`: `(a, b, residuals)`, `None` if `x` is constant.
 fn line_fit(x: &[f64], y: &[f64]) -> Option<(f64, f64, Vec<f64>)> {
     let n = x.len() as f64;
     let (mx, my) = (x.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
@@ -495,9 +503,7 @@ pub fn scalar_delay(
         })
         .collect();
     let jack_std = if jack.len() == blocks && blocks >= 5 {
-        let m = jack.iter().sum::<f64>() / blocks as f64;
-        let g = blocks as f64;
-        ((g - 1.0) / g * jack.iter().map(|v| (v - m).powi(2)).sum::<f64>()).sqrt()
+        jackknife_std(&jack)
     } else {
         f64::INFINITY
     };
@@ -644,7 +650,7 @@ pub fn gnss_delay(
     let mut last = None;
     let mut prev: Option<(f64, f64)> = None;
     for _ in 0..o.gnss_iterations.max(1) {
-        let shifted = shift(drive, [0.0, 0.0, 0.0, d]);
+        let mut shifted = shift(drive, [0.0, 0.0, 0.0, d]);
         let cal = calibrate::calibrate(&shifted, copts)?;
         let params = cal.estimate.params;
         let f = ekf::run(
@@ -666,10 +672,11 @@ pub fn gnss_delay(
         // Euler step its yaw lags half a step of yaw-rate change in every
         // turn, which the fixes read as time (family car 7, 25 Hz wheels,
         // 0.18 s true: 0.162 ± 0.003 s, −6σ; with the trapezoid 0.179 s).
-        let mut dr_drive = shifted.clone();
-        dr_drive.vehicle.noise.yaw_integration = crate::vehicle::YawIntegration::Trapezoidal;
+        // (The calibration and the smoothing above are done with `shifted`;
+        // only its fixes are read below.)
+        shifted.vehicle.noise.yaw_integration = crate::vehicle::YawIntegration::Trapezoidal;
         let dr = ekf::run(
-            &dr_drive,
+            &shifted,
             &params,
             &FilterOptions {
                 record_epochs: true,
@@ -862,9 +869,7 @@ pub fn regress_gnss(
             .filter(|(wvv, _)| svv - wvv > 0.0)
             .map(|(wvv, wvr)| -(svr - wvr) / (svv - wvv))
             .collect();
-        let m = d.iter().sum::<f64>() / d.len() as f64;
-        let g = d.len() as f64;
-        ((g - 1.0) / g * d.iter().map(|x| (x - m).powi(2)).sum::<f64>()).sqrt()
+        jackknife_std(&d)
     } else {
         0.0
     };

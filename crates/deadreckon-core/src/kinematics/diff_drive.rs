@@ -286,7 +286,7 @@ mod outages;
 
 pub use calibration::{calibrate_diff_drive, DiffDriveOptions};
 pub use filter::{DiffDriveFilter, FilterNoise};
-pub use outages::{evaluate_diff_drive, DiffDriveOutages, OutageStart};
+pub use outages::{evaluate_diff_drive, DiffDriveOutages, OutageStart, DEFAULT_WARMUP_S};
 
 #[cfg(test)]
 mod filter_tests;

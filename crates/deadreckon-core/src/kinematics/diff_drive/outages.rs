@@ -74,6 +74,10 @@ impl DiffDriveOutages {
     }
 }
 
+/// The default `warmup_s` of [`evaluate_diff_drive`] (`evaluate --align`):
+/// a minute of fixes before the first outage and aligned before each, s.
+pub const DEFAULT_WARMUP_S: f64 = 60.0;
+
 /// Dead reckons through outages of `outage_s` every `step_s`, the first
 /// starting `warmup_s` after the first sample, each started as `start`
 /// says (the alignment spans the `warmup_s` before the outage), and scores
