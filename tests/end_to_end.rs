@@ -160,6 +160,27 @@ fn simulate_calibrate_evaluate_run() {
             && fe["max"].as_f64().unwrap() >= fe["p95"].as_f64().unwrap(),
         "{o}"
     );
+    // Every window, with the error the aided run handed over at its start;
+    // the summaries are of these.
+    let per = o["outages"].as_array().unwrap();
+    assert_eq!(per.len() as u64, o["windows"].as_u64().unwrap());
+    let field = |k: &str| -> Vec<f64> { per.iter().map(|w| w[k].as_f64().unwrap()).collect() };
+    let (starts, finals) = (field("start_error_m"), field("final_error_m"));
+    let max = |v: &[f64]| v.iter().copied().fold(f64::NAN, f64::max);
+    assert_eq!(max(&starts), o["start_error_m"]["max"].as_f64().unwrap());
+    assert_eq!(max(&finals), fe["max"].as_f64().unwrap());
+    for w in per {
+        let (a, b) = (w["start_s"].as_f64().unwrap(), w["end_s"].as_f64().unwrap());
+        assert!((b - a - 20.0).abs() < 1e-9, "{w}");
+        assert!(
+            w["max_error_m"].as_f64() >= w["final_error_m"].as_f64(),
+            "{w}"
+        );
+        assert!(
+            w["max_error_m"].as_f64() >= w["start_error_m"].as_f64(),
+            "{w}"
+        );
+    }
 
     // run: tracks with covariances.
     let track = tmp.path().join("track.csv");
@@ -418,6 +439,17 @@ fn comma2k19_import_calibrate_evaluate_report() {
         assert!((d - 0.1).abs() < 0.02, "{c}");
         assert_eq!(c["imu"]["estimated"], true, "{c}");
         assert_eq!(c["traction"]["axle"], "front", "{c}");
+        if len == "20" {
+            // Issue 13's target (median final error 0.5 m) is under what
+            // the GNSS-aided start hands over: the u-blox fixes sit 0.39 m
+            // west of the reference for the whole segment (which heads
+            // north throughout), and the windows start a median 0.432 m
+            // off. Measured: start 0.432 m, final 0.621 m (medians).
+            let (s, f) = (&o["start_error_m"]["median"], &o["final_error_m"]["median"]);
+            let (s, f) = (s.as_f64().unwrap(), f.as_f64().unwrap());
+            assert!((0.40..0.47).contains(&s), "start {s}");
+            assert!((0.58..0.66).contains(&f), "final {f}");
+        }
     }
     // Bounds on the measured figures (see the closing note of the readers issue).
     assert!(

@@ -175,11 +175,18 @@ pub fn outage_json(outage_s: f64, params: &str, ev: &OutageEvaluation) -> Value 
         "windows": ev.windows.len(),
         "reference": ev.reference.name(),
         "params": params,
+        "start_error_m": summary_json(&ev.start_error()),
         "final_error_m": summary_json(&ev.final_error()),
         "drift_pct": summary_json(&ev.drift_pct()),
         "distance_to_1m_m": summary_json(&ev.distance_to_1m()),
         "windows_reaching_1m": ev.windows.iter().filter(|w| w.time_to(1.0).is_some()).count(),
         "gates": gates_json(&ev.gates),
+        "outages": ev.windows.iter().map(|w| json!({
+            "start_s": w.start_s, "end_s": w.end_s,
+            "start_error_m": w.start_m(), "mean_error_m": w.mean_m(),
+            "max_error_m": w.max_m(), "final_error_m": w.final_m(),
+            "distance_m": w.distance_m, "time_to_1m_s": w.time_to(1.0),
+        })).collect::<Vec<_>>(),
     })
 }
 

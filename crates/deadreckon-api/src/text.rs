@@ -245,6 +245,7 @@ pub fn outage_lines(
         ev.reference.name()
     )];
     out.extend(summary_table(&[
+        ("error at the start (m)", ev.start_error()),
         ("final error (m)", ev.final_error()),
         ("drift per 100 m (%)", ev.drift_pct()),
         ("distance before 1 m (m)", ev.distance_to_1m()),

@@ -195,6 +195,14 @@ impl OutageResult {
         self.errors.iter().map(|e| e.1).fold(f64::NAN, f64::max)
     }
 
+    /// The first error, m: the one the GNSS-aided run handed over at the
+    /// outage start (its first point, one epoch in; NaN without errors). It
+    /// is in every later error too, so the final error less this one is what
+    /// the dead reckoning itself added, at most.
+    pub fn start_m(&self) -> f64 {
+        self.errors.first().map_or(f64::NAN, |e| e.1)
+    }
+
     /// The last error, m (NaN without errors).
     pub fn final_m(&self) -> f64 {
         self.errors.last().map_or(f64::NAN, |e| e.1)
@@ -258,6 +266,7 @@ mod tests {
         assert_eq!(r.mean_m(), 1.25);
         assert_eq!(r.max_m(), 2.0);
         assert_eq!(r.final_m(), 1.5);
+        assert_eq!(r.start_m(), 0.5);
         // Both the time and the distance to a threshold, from the same error.
         assert_eq!(r.time_to(1.0), Some(2.0));
         assert_eq!(r.distance_to(1.0), Some(20.0));
@@ -266,6 +275,7 @@ mod tests {
         let empty =
             OutageResult::new::<RearAxle>(0.0, 1.0, Against::Truth, vec![], vec![], f64::NAN);
         assert!(empty.mean_m().is_nan() && empty.max_m().is_nan() && empty.final_m().is_nan());
+        assert!(empty.start_m().is_nan());
         assert_eq!(empty.point, ComparedPoint::RearAxle);
     }
 }

@@ -37,6 +37,12 @@ pub struct OutageEvaluation {
 }
 
 impl OutageEvaluation {
+    /// Summary of the errors at the windows' starts, m: what the GNSS-aided
+    /// run handed over ([`OutageResult::start_m`]). A receiver's bias against
+    /// the truth is in it, and no dead reckoning removes it.
+    pub fn start_error(&self) -> Summary {
+        Summary::of(&self.windows.iter().map(|w| w.start_m()).collect::<Vec<_>>())
+    }
     /// Summary of the final errors, m.
     pub fn final_error(&self) -> Summary {
         Summary::of(&self.windows.iter().map(|w| w.final_m()).collect::<Vec<_>>())
