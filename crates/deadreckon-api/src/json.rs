@@ -43,6 +43,13 @@ pub fn calibration_json(method: &str, c: &Calibration) -> Value {
         m.insert("wheel_gaps".into(), st.wheel_gaps.into());
         m.insert("gates".into(), gates_json(&st.gates));
     }
+    if let Some(ch) = &c.gnss_chords {
+        m.insert(
+            "gnss_chords".into(),
+            json!({"mean_pct": 100.0 * ch.mean, "std_pct": 100.0 * ch.std,
+                "blocks": ch.blocks, "block_s": deadreckon_core::chords::BLOCK_S}),
+        );
+    }
     if let Some(h) = &c.wheel_health {
         m.insert("wheel_health".into(), wheel_health_json(h));
     }

@@ -561,3 +561,15 @@ pub fn known_corrections_text(c: &deadreckon_core::timing::KnownCorrections) -> 
     }
     parts.join(", ")
 }
+
+/// The RTS calibration's distance scale against GNSS chords, one line.
+pub fn chords_line(c: &deadreckon_core::chords::ChordScale) -> String {
+    format!(
+        "distance scale against GNSS chords: {:+.3}% ± {:.3}% ({} blocks of {} s); \
+         the speed scale's and circumferences' standard errors include it",
+        100.0 * c.mean,
+        100.0 * c.std,
+        c.blocks,
+        deadreckon_core::chords::BLOCK_S
+    )
+}

@@ -17,6 +17,12 @@
 //! speed-dependent parameters. Standard errors are the least-squares ones,
 //! inflated for the lag-1 autocorrelation of the residuals (effective sample
 //! size `n·(1−ρ₁)/(1+ρ₁)`), because consecutive residuals are not independent.
+//! The RTS calibration's speed scale and circumferences then take the GNSS
+//! chords' distance-scale error as well ([`crate::chords`]): the least
+//! squares see how well the wheels follow the smoothed speed, which they
+//! themselves set, and not how well a wandering receiver fixed the scale
+//! (on the simulator's car family they claimed 0.02–0.1 mm for errors of
+//! 1–5 mm).
 //!
 //! The parameters are learnt (RTS passes, and the online learner) only with
 //! process noise that does not let one reading set the speed or the yaw rate:
@@ -24,6 +30,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
+use crate::chords::{chord_scale, ChordScale};
 use crate::drive::{Drive, Wheels};
 use crate::ekf::{self, FilterOptions, Init, Timing};
 use crate::model::{State, V, YAW_RATE};
@@ -223,6 +230,41 @@ pub struct Calibration {
     /// threshold), from which [`crate::observability::Manoeuvres::lacking`]
     /// says what it lacked.
     pub manoeuvres: Option<crate::observability::Manoeuvres>,
+    /// The distance scale against GNSS chords (RTS only): its residual and
+    /// the relative standard error folded into the speed scale's and the
+    /// circumferences' standard errors ([`crate::chords`]). `None` for the
+    /// other methods, or when the drive has fewer than
+    /// [`crate::chords::MIN_BLOCKS`] usable blocks.
+    pub gnss_chords: Option<ChordScale>,
+}
+
+/// One smoothing pass's result ([`smoothing_pass`]).
+#[derive(Debug, Clone)]
+pub struct Pass {
+    /// The least squares on the smoothed states, their standard errors
+    /// widened by the GNSS chords' scale error.
+    pub estimate: ParamsWithStd,
+    /// Samples used per parameter.
+    pub samples: [usize; 6],
+    /// The filter's counters.
+    pub stats: ekf::FilterStats,
+    /// The distance scale against GNSS chords.
+    pub chords: Option<ChordScale>,
+}
+
+/// Folds a relative distance-scale standard error `rel` (from the GNSS
+/// chords) into the standard errors of the parameters that set distance:
+/// the CAN speed scale (when estimated) and the four circumferences (each
+/// `√(σ_LS² + (rel·ρ)²)`). The gyro bias does not depend on it.
+fn widen_for_chords(est: &mut ParamsWithStd, rel: f64) {
+    let (p, s) = (est.params.to_array(), est.std.to_array());
+    let mut out = s;
+    for i in 1..6 {
+        if s[i] > 0.0 {
+            out[i] = s[i].hypot(rel * p[i]);
+        }
+    }
+    est.std = Params::from_array(out);
 }
 
 /// Tolerance units of the parameters, in [`Params::to_array`] order.
@@ -267,6 +309,7 @@ pub fn calibrate(drive: &Drive, opts: &CalibrationOptions) -> Result<Calibration
                 filter_stats: None,
                 wheel_health: None,
                 manoeuvres: None,
+                gnss_chords: None,
             })
         }
         Method::Rts => rts_calibration(drive, opts, start),
@@ -289,12 +332,9 @@ pub fn calibrate(drive: &Drive, opts: &CalibrationOptions) -> Result<Calibration
     })
 }
 
-/// One pass: filter with `p`, smooth, least squares on the smoothed states.
-pub fn smoothing_pass(
-    drive: &Drive,
-    p: &Params,
-    opts: &CalibrationOptions,
-) -> Result<(ParamsWithStd, [usize; 6], ekf::FilterStats), Error> {
+/// One pass: filter with `p`, smooth, least squares on the smoothed states,
+/// their distance-scale errors widened by the GNSS chords.
+pub fn smoothing_pass(drive: &Drive, p: &Params, opts: &CalibrationOptions) -> Result<Pass, Error> {
     let mut fopts = opts.filter.clone();
     fopts.record_epochs = true;
     if matches!(fopts.init, Init::Truth) {
@@ -314,8 +354,17 @@ pub fn smoothing_pass(
     };
     let (t, x): (Vec<f64>, Vec<State>) = sm.into_iter().unzip();
     let reference = Reference::from_states(t, x);
-    let (est, samples) = least_squares(drive, &reference, opts.min_speed_mps, false)?;
-    Ok((est, samples, stats))
+    let (mut est, samples) = least_squares(drive, &reference, opts.min_speed_mps, false)?;
+    let chords = chord_scale(drive, &reference);
+    if let Some(c) = chords {
+        widen_for_chords(&mut est, c.std);
+    }
+    Ok(Pass {
+        estimate: est,
+        samples,
+        stats,
+        chords,
+    })
 }
 
 fn rts_calibration(
@@ -347,12 +396,13 @@ fn rts_calibration(
     let mut converged = false;
     let memory = 3;
     for _ in 0..opts.max_iterations.max(1) {
-        let (g, samples, stats) = smoothing_pass(drive, &p, opts)?;
+        let pass = smoothing_pass(drive, &p, opts)?;
+        let g = pass.estimate;
         history.push(g.params);
         let x = scale(&p);
         let gx = scale(&g.params);
         let change = (&gx - &x).amax();
-        last = Some((g, samples, stats));
+        last = Some(pass);
         if change < opts.tolerance {
             converged = true;
             break;
@@ -374,17 +424,17 @@ fn rts_calibration(
             g.params
         };
     }
-    let (estimate, samples, stats) =
-        last.ok_or_else(|| Error::Insufficient("no calibration pass ran".into()))?;
+    let last = last.ok_or_else(|| Error::Insufficient("no calibration pass ran".into()))?;
     Ok(Calibration {
-        estimate,
+        estimate: last.estimate,
         iterations: history.len(),
         history,
         converged,
-        samples,
-        filter_stats: Some(stats),
+        samples: last.samples,
+        filter_stats: Some(last.stats),
         wheel_health: None,
         manoeuvres: None,
+        gnss_chords: last.chords,
     })
 }
 
@@ -660,5 +710,6 @@ pub fn zupt(drive: &Drive, nominal: &Params) -> Result<Calibration, Error> {
         filter_stats: None,
         wheel_health: None,
         manoeuvres: None,
+        gnss_chords: None,
     })
 }

@@ -25,6 +25,7 @@
 pub mod angle;
 pub mod calibrate;
 pub mod checkpoint;
+pub mod chords;
 pub mod compared;
 pub mod consistency;
 pub mod drive;
