@@ -425,6 +425,37 @@ fn rts_calibration(
         };
     }
     let last = last.ok_or_else(|| Error::Insufficient("no calibration pass ran".into()))?;
+    if let Some(c) = last.chords.filter(|c| c.disagrees()) {
+        let st = &last.stats;
+        return Err(Error::Rejected(format!(
+            "the calibrated distance scale disagrees with the GNSS chords by {:+.2}% ± {:.2}% \
+             ({:+.1} standard errors over {} blocks of {} s, more than {}): the smoothing \
+             filter did not follow the fixes ({} of {} rejected by its gate, {} recoveries; \
+             circumferences {:.4}–{:.4} m after {} passes)",
+            100.0 * c.mean,
+            100.0 * c.std,
+            c.sigmas(),
+            c.blocks,
+            crate::chords::BLOCK_S,
+            crate::chords::REJECT_SIGMA,
+            st.gnss_rejected,
+            st.gnss_updates + st.gnss_rejected,
+            st.gnss_recoveries,
+            last.estimate
+                .params
+                .circumferences()
+                .iter()
+                .copied()
+                .fold(f64::INFINITY, f64::min),
+            last.estimate
+                .params
+                .circumferences()
+                .iter()
+                .copied()
+                .fold(f64::NEG_INFINITY, f64::max),
+            history.len(),
+        )));
+    }
     Ok(Calibration {
         estimate: last.estimate,
         iterations: history.len(),

@@ -82,4 +82,8 @@ pub enum Error {
     /// The data cannot support the requested computation (e.g. no GNSS for RTS calibration).
     #[error("insufficient data: {0}")]
     Insufficient(String),
+    /// An estimate the data contradict, refused rather than kept (a
+    /// calibrated distance scale the GNSS chords disagree with).
+    #[error("estimate rejected: {0}")]
+    Rejected(String),
 }
