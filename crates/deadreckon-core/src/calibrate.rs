@@ -429,7 +429,7 @@ fn rts_calibration(
         let st = &last.stats;
         return Err(Error::Rejected(format!(
             "the calibrated distance scale disagrees with the GNSS chords by {:+.2}% ± {:.2}% \
-             ({:+.1} standard errors over {} blocks of {} s, more than {}): the smoothing \
+             ({:+.1} standard errors over {} blocks of {} s, p = {:.1e}): the smoothing \
              filter did not follow the fixes ({} of {} rejected by its gate, {} recoveries; \
              circumferences {:.4}–{:.4} m after {} passes)",
             100.0 * c.mean,
@@ -437,7 +437,7 @@ fn rts_calibration(
             c.sigmas(),
             c.blocks,
             crate::chords::BLOCK_S,
-            crate::chords::REJECT_SIGMA,
+            c.p_value(),
             st.gnss_rejected,
             st.gnss_updates + st.gnss_rejected,
             st.gnss_recoveries,

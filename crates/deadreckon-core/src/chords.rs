@@ -20,6 +20,8 @@
 //! (sandwich form). White fixes scatter little; a wandering receiver
 //! scatters by its wander over a block.
 
+use statrs::distribution::{ContinuousCDF, StudentsT};
+
 use crate::drive::Drive;
 use crate::model::{V, YAW};
 use crate::reference::Reference;
@@ -35,17 +37,17 @@ pub const END_S: f64 = 1.0;
 pub const MIN_CHORD_M: f64 = 100.0;
 /// Fewest blocks that give a scale error.
 pub const MIN_BLOCKS: usize = 3;
-/// A calibration whose chords' mean residual is more than this many of its
-/// standard errors from 0 is rejected: the distance scale it found is not
-/// the GNSS's. With about ten blocks the ratio is t-distributed with nine
-/// degrees of freedom, and 4 is exceeded by chance with probability 0.003.
-/// On the simulator's car family (cars 1–32, 600 s drives, with and without
-/// the receiver's wander) the 62 calibrations within 3 standard errors of
-/// the truth read at most 2.76, and the three whose smoothing filter lost
-/// the fixes (car 30, "converged" with its circumferences 12 % off, and car
-/// 22, 15 m off) read 5.1, 5.5 and 30.3 (`deadreckon-sim`'s
-/// `calibration_errors` test).
-pub const REJECT_SIGMA: f64 = 4.0;
+/// A calibration is rejected when its chords' mean residual is both
+/// significant at this level (two-sided, Student's t with one degree of
+/// freedom fewer than the blocks) and larger than [`REJECT_MIN_REL`]: the
+/// distance scale it found is not the GNSS's.
+pub const REJECT_LEVEL: f64 = 0.001;
+/// The smallest relative disagreement with the chords that rejects a
+/// calibration: 1 %, what a tyre's pressure or wear moves its rolling
+/// radius by. Below it the disagreement is in the widened standard errors.
+/// (A 300 s drive of the built-in calibration scenario, its front-left tyre
+/// new, read +0.08 % ± 0.02 % over 4 blocks: real, and harmless.)
+pub const REJECT_MIN_REL: f64 = 0.01;
 
 /// The GNSS chords' verdict on a distance scale.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -148,9 +150,18 @@ impl ChordScale {
             0.0
         }
     }
-    /// True when the scale disagrees with the chords by more than
-    /// [`REJECT_SIGMA`].
+    /// The two-sided p-value of the mean residual against 0 (Student's t
+    /// with `blocks − 1` degrees of freedom).
+    pub fn p_value(&self) -> f64 {
+        let dof = self.blocks.saturating_sub(1).max(1) as f64;
+        match StudentsT::new(0.0, 1.0, dof) {
+            Ok(t) => 2.0 * (1.0 - t.cdf(self.sigmas().abs())),
+            Err(_) => 1.0,
+        }
+    }
+    /// True when the scale disagrees with the chords: by more than
+    /// [`REJECT_MIN_REL`], at the level [`REJECT_LEVEL`].
     pub fn disagrees(&self) -> bool {
-        self.sigmas().abs() > REJECT_SIGMA
+        self.mean.abs() > REJECT_MIN_REL && self.p_value() < REJECT_LEVEL
     }
 }
