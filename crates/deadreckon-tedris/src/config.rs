@@ -159,7 +159,10 @@ pub struct TedrisConfig {
     pub update_window_s: f64,
     /// Interval between DCF updates, s (default 10).
     pub update_interval_s: f64,
-    /// Interval between regression refits once trained, s (default 60).
+    /// Interval between regression refits once trained, s (default 60). In
+    /// the extended variant a refit is refused when significantly worse on
+    /// held-back data than the regressions it would replace (see the crate
+    /// docs).
     pub refit_interval_s: f64,
     /// Weight of each new DCF estimate against the previous DCF, in (0, 1]
     /// (default 0.2; 1 is eq. (6) as in the paper, whose 30 s estimates are noisy).

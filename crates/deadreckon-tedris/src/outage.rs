@@ -202,9 +202,12 @@ pub fn train(
         f.course_convention = model.course_convention;
         f.settle_kind();
         f
-    })
-    .unwrap_or(model);
-    let mut refit = refit;
+    });
+    // The closing refit is guarded like every refit once trained.
+    let mut refit = match refit {
+        Ok(f) if m.closing_refit_accepted(&f) => f,
+        _ => model,
+    };
     if input.source == ReferenceSource::Gyro {
         let (b, n) = standstill_gyro_stats(drive);
         refit.gyro_bias = (n > 0).then_some((b, n));

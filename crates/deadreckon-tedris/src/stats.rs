@@ -212,6 +212,85 @@ pub fn invert(a: &[Vec<f64>]) -> Option<Vec<Vec<f64>>> {
     Some(inv)
 }
 
+/// A one-sided paired test of two losses over the same rows (see
+/// [`paired_batch_test`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PairedTest {
+    /// The mean loss difference `a − b` over the rows.
+    pub mean_difference: f64,
+    /// Student's t of the batch means of `a − b`.
+    pub t_value: f64,
+    /// Degrees of freedom (batches − 1).
+    pub dof: usize,
+    /// One-sided p value of "`a` has the larger mean loss": the probability
+    /// of a t value at least this large if the mean losses were equal.
+    pub p_a_larger: f64,
+}
+
+/// A paired t test of the mean of `a − b` by batch means: the rows (in
+/// time order) are cut into `batches` runs of equal count, and the run
+/// means of `a − b` are taken as independent (the batch-means estimate of
+/// the variance of a mean of autocorrelated values; Diebold and Mariano's
+/// comparison of predictive accuracy with a loss differential, its long-run
+/// variance from batches instead of a kernel). `None` with different
+/// lengths, fewer than two batches, fewer rows than batches, a non-finite
+/// loss, or batch means without spread.
+pub fn paired_batch_test(a: &[f64], b: &[f64], batches: usize) -> Option<PairedTest> {
+    if a.len() != b.len() || batches < 2 || a.len() < batches {
+        return None;
+    }
+    let d: Vec<f64> = a.iter().zip(b).map(|(x, y)| x - y).collect();
+    if !d.iter().all(|v| v.is_finite()) {
+        return None;
+    }
+    let n = d.len();
+    let means: Vec<f64> = (0..batches)
+        .map(|k| {
+            let run = &d[k * n / batches..(k + 1) * n / batches];
+            run.iter().sum::<f64>() / run.len() as f64
+        })
+        .collect();
+    let m = means.iter().sum::<f64>() / batches as f64;
+    let var = means.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (batches - 1) as f64;
+    if var.is_nan() || var <= 0.0 {
+        return None;
+    }
+    let t_value = m / (var / batches as f64).sqrt();
+    let dof = batches - 1;
+    let dist = StudentsT::new(0.0, 1.0, dof as f64).ok()?;
+    Some(PairedTest {
+        mean_difference: d.iter().sum::<f64>() / n as f64,
+        t_value,
+        dof,
+        p_a_larger: dist.sf(t_value),
+    })
+}
+
+/// The correlation time of `values` sampled at `times`: the time from the
+/// first sample to the first lag at which the autocorrelation falls below
+/// 1/e, s. `None` with fewer than four values, without spread, with
+/// lengths that differ, or when it does not fall that far within half the
+/// series.
+pub fn correlation_time(values: &[f64], times: &[f64]) -> Option<f64> {
+    let n = values.len();
+    if n < 4 || times.len() != n {
+        return None;
+    }
+    let m = values.iter().sum::<f64>() / n as f64;
+    let c0: f64 = values.iter().map(|v| (v - m).powi(2)).sum();
+    if !(c0 > 0.0 && c0.is_finite()) {
+        return None;
+    }
+    (1..=n / 2)
+        .find(|&lag| {
+            let c: f64 = (0..n - lag)
+                .map(|i| (values[i] - m) * (values[i + lag] - m))
+                .sum();
+            c / c0 < (-1.0f64).exp()
+        })
+        .map(|lag| times[lag] - times[0])
+}
+
 /// The summary statistics live in one place, `deadreckon_core::metrics`.
 pub use deadreckon_core::metrics::{mean, median};
 
@@ -279,6 +358,61 @@ mod tests {
         let x = vec![vec![1.0, 2.0], vec![2.0, 4.0], vec![3.0, 6.0]];
         assert!(ols(&x, &[1.0, 2.0, 3.0], &["a", "b"]).is_err());
         assert!(ols(&x[..1], &[1.0], &["a", "b"]).is_err());
+    }
+
+    /// Batches of (a − b) = 1, 2, 3, 4 (one row each): mean 2.5, variance
+    /// 5/3, t = 2.5 / sqrt(5/12) = 3.872983; one-sided p with 3 dof from the
+    /// closed form 1 − F(t), F(t) = 1/2 + (u/(1 + u²) + atan u)/π, u = t/√3:
+    /// 0.015219.
+    #[test]
+    fn paired_batch_test_matches_closed_form() {
+        let a = [1.5, 2.0, 3.5, 4.25];
+        let b = [0.5, 0.0, 0.5, 0.25];
+        let p = paired_batch_test(&a, &b, 4).unwrap();
+        assert!((p.mean_difference - 2.5).abs() < 1e-12);
+        assert!((p.t_value - 3.872983346207417).abs() < 1e-9);
+        assert_eq!(p.dof, 3);
+        let u = p.t_value / 3f64.sqrt();
+        let cdf = 0.5 + (u / (1.0 + u * u) + u.atan()) / std::f64::consts::PI;
+        assert!(
+            (p.p_a_larger - (1.0 - cdf)).abs() < 1e-9,
+            "{}",
+            p.p_a_larger
+        );
+        // Swapped, the same t with the other sign.
+        let q = paired_batch_test(&b, &a, 4).unwrap();
+        assert!((q.t_value + p.t_value).abs() < 1e-12);
+        assert!((q.p_a_larger - cdf).abs() < 1e-9);
+        // Batches of two rows: the means are 1.5 and 3.5.
+        let r = paired_batch_test(&a, &b, 2).unwrap();
+        assert!((r.t_value - 2.5).abs() < 1e-12);
+        assert!(paired_batch_test(&a, &b[..3], 2).is_none());
+        assert!(paired_batch_test(&a, &b, 5).is_none());
+        assert!(paired_batch_test(&a, &a, 2).is_none());
+    }
+
+    /// An AR(1) series x_k = 0.9·x_(k−1) + u_k at 10 Hz: its autocorrelation
+    /// 0.9^k falls below 1/e at k = 10 (0.9^9 = 0.387, 0.9^10 = 0.349), 1 s.
+    #[test]
+    fn correlation_time_of_an_ar1_series() {
+        let mut seed = 11u64;
+        let mut x = 0.0;
+        let v: Vec<f64> = (0..20000)
+            .map(|_| {
+                seed = seed
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                x = 0.9 * x + ((seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5);
+                x
+            })
+            .collect();
+        let t: Vec<f64> = (0..v.len()).map(|k| 0.1 * k as f64).collect();
+        let tc = correlation_time(&v, &t).expect("correlated");
+        assert!((tc - 1.0).abs() < 0.15, "{tc}");
+        // White values decorrelate at the first lag.
+        let w: Vec<f64> = (0..v.len()).map(|k| v[k] - 0.9 * v[k.max(1) - 1]).collect();
+        assert!((correlation_time(&w[1..], &t[1..]).expect("white") - 0.1).abs() < 1e-9);
+        assert!(correlation_time(&[1.0; 10], &t[..10]).is_none());
     }
 
     #[test]

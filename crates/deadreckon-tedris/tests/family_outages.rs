@@ -20,6 +20,8 @@ use deadreckon_tedris::{run_outages, train, Outage, TedrisConfig};
 #[derive(Debug, Clone)]
 struct PairResult {
     alarms: u64,
+    /// Refits accepted and refused by the guard over the test drive.
+    refits: (u64, u64),
     outage: Outage,
     tedris_m: f64,
     tedris_max_m: f64,
@@ -104,6 +106,7 @@ fn run_car(car_seed: u64) -> (Vec<PairResult>, ConventionCheck) {
         let b = base.run_outage(&test_out.drive, &o).expect("baseline run");
         out.push(PairResult {
             alarms: r.machine.model_alarms(),
+            refits: (r.machine.accepted_refits(), r.machine.refused_refits()),
             outage: o,
             tedris_m: r.outages[0].mean_error_m(),
             tedris_max_m: r.outages[0].max_error_m(),
@@ -210,6 +213,10 @@ fn family_train_test_80s_outages() {
     // the errors above are the same with and without it.
     let alarms: u64 = all.iter().map(|r| r.alarms).sum();
     eprintln!("watchdog alarms over the test drives: {alarms}");
+    let (accepted, refused) = all
+        .iter()
+        .fold((0, 0), |(a, r), p| (a + p.refits.0, r + p.refits.1));
+    eprintln!("refits over the test drives: {accepted} accepted, {refused} refused");
     assert!(alarms <= 5, "{alarms} watchdog alarms on trained models");
     assert!(count(ConventionCheck::Right) >= 8);
     assert!(t < 0.6 * b, "TedriS {t} m against the baseline's {b} m");

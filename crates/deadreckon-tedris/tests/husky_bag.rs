@@ -48,14 +48,16 @@ fn run(source: ReferenceSource, cfg: TedrisConfig, rel_outages: &[(f64, f64)]) -
         assert_eq!(r.reference.name(), "gnss");
         let e = r.outages[0].clone();
         eprintln!(
-            "husky {source:?} (lag {}): outage [{:.0}, {:.0}) s after the half: mean {:.2} m, max {:.2} m, final {:.2} m ({} fixes)",
+            "husky {source:?} (lag {}): outage [{:.0}, {:.0}) s after the half: mean {:.2} m, max {:.2} m, final {:.2} m ({} fixes; refits {} accepted, {} refused)",
             model.lag_samples,
             o.start_s - half,
             o.end_s - half,
             e.mean_error_m(),
             e.max_error_m(),
             e.final_error_m(),
-            e.result.points()
+            e.result.points(),
+            r.machine.accepted_refits(),
+            r.machine.refused_refits()
         );
         errs.push(e);
     }

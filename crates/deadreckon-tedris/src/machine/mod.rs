@@ -130,6 +130,13 @@ pub struct MachineChecks {
     pub repeated_courses: u64,
     /// Calibrations refused (worse out of sample, or at a physical bound).
     pub refused_calibrations: u64,
+    /// Refits of the regressions installed once trained.
+    #[serde(default)]
+    pub accepted_refits: u64,
+    /// Refits refused: significantly worse out of sample than the
+    /// regressions they would replace.
+    #[serde(default)]
+    pub refused_refits: u64,
     /// Heading segments started.
     pub heading_segments: u32,
     /// Times the watchdog found the model off.
@@ -142,11 +149,13 @@ impl MachineChecks {
     /// One line for a table: what was refused, and how often.
     pub fn line(&self) -> String {
         format!(
-            "TedriS checks: {} courses inconsistent with the wheels, {} while reversing, {} repeated, {} calibrations refused, {} heading segments, {} watchdog alarms, {} samples rejected",
+            "TedriS checks: {} courses inconsistent with the wheels, {} while reversing, {} repeated, {} calibrations refused, {} refits accepted, {} refused, {} heading segments, {} watchdog alarms, {} samples rejected",
             self.inconsistent_headings,
             self.reversing_courses,
             self.repeated_courses,
             self.refused_calibrations,
+            self.accepted_refits,
+            self.refused_refits,
             self.heading_segments,
             self.model_alarms,
             self.rejected_samples
@@ -215,6 +224,14 @@ pub struct Tedris {
     /// replace, or at a physical bound.
     #[serde(default)]
     refused_calibrations: u64,
+    /// Refits of the regressions installed once trained (with the joint
+    /// calibration: not significantly worse out of sample, or untestable).
+    #[serde(default)]
+    accepted_refits: u64,
+    /// Refits refused: significantly worse out of sample than the current
+    /// regressions (see `Tedris::refit_verdict`).
+    #[serde(default)]
+    refused_refits: u64,
     /// Why no model exists yet: the requirement that failed last, with numbers.
     #[serde(default)]
     untrained_because: Option<String>,
@@ -282,6 +299,8 @@ impl Tedris {
             reversing_courses: 0,
             repeated_courses: 0,
             refused_calibrations: 0,
+            accepted_refits: 0,
+            refused_refits: 0,
             untrained_because: None,
             model_alarms: 0,
             alarm_active: false,
@@ -369,6 +388,8 @@ impl Tedris {
             reversing_courses: self.reversing_courses,
             repeated_courses: self.repeated_courses,
             refused_calibrations: self.refused_calibrations,
+            accepted_refits: self.accepted_refits,
+            refused_refits: self.refused_refits,
             heading_segments: self.segment,
             model_alarms: self.model_alarms,
             rejected_samples: self.rejected,
@@ -386,6 +407,21 @@ impl Tedris {
     /// or reaching a physical bound).
     pub fn refused_calibrations(&self) -> u64 {
         self.refused_calibrations
+    }
+
+    /// Refits of the regressions installed once trained: with the joint
+    /// calibration, those not significantly worse on held-back data than
+    /// the regressions they replaced (or that could not be tested).
+    pub fn accepted_refits(&self) -> u64 {
+        self.accepted_refits
+    }
+
+    /// Refits refused: significantly worse on held-back data than the
+    /// current regressions, or not calibratable within the physical bounds
+    /// where they are (see the crate docs, "Nothing replaces a model unless
+    /// it is better out of sample").
+    pub fn refused_refits(&self) -> u64 {
+        self.refused_refits
     }
 
     /// Without a model: the training requirement that failed last, with its

@@ -227,6 +227,7 @@ impl Tedris {
             }
         }
         let Some(old) = &self.model else { return };
+        let guarded = old.complete && old.config.joint_calibration();
         let convention = old.course_convention;
         let scale = old.distance_scale;
         let (gain, per_metre, dist, dcf, joint) = (
@@ -253,9 +254,43 @@ impl Tedris {
                 m.dcf_distance_rad_per_m = dist;
                 m.dcf_rad = dcf;
             }
-            self.model = Some(m);
+            if self.guard_refit(&m, guarded, t) {
+                self.model = Some(m);
+            }
         }
         self.update_dcf(t);
+    }
+}
+
+impl Tedris {
+    /// The refit at the end of a training drive ([`crate::train`]), guarded
+    /// like every refit once trained: false when refused (counted).
+    pub(crate) fn closing_refit_accepted(&mut self, refit: &TedrisModel) -> bool {
+        let (Some(t), Some(m)) = (self.last_t, self.model.as_ref()) else {
+            return true;
+        };
+        let guarded = m.complete && m.config.joint_calibration();
+        self.guard_refit(refit, guarded, t)
+    }
+
+    /// Whether the refit `m` may replace the current model: unguarded
+    /// (before training completes, or without the joint calibration, as in
+    /// the paper) always; guarded, unless [`Tedris::refit_verdict`] refuses
+    /// it. Counts the verdict.
+    pub(super) fn guard_refit(&mut self, m: &TedrisModel, guarded: bool, t: f64) -> bool {
+        let Some(current) = self.model.as_ref().filter(|_| guarded) else {
+            return true;
+        };
+        let accept = !matches!(
+            self.refit_verdict(current, m, t),
+            super::calibration::RefitVerdict::Refused(_)
+        );
+        if accept {
+            self.accepted_refits += 1;
+        } else {
+            self.refused_refits += 1;
+        }
+        accept
     }
 }
 
