@@ -155,19 +155,8 @@ impl CarCalibration {
         if let Some(st) = &c.filter_stats {
             out.push(crate::text::stats_line(st));
         }
-        match &c.gnss_chords {
-            Some(ch) => out.push(crate::text::chords_line(ch)),
-            None if self.options.method == deadreckon_core::calibrate::Method::Rts => {
-                out.push(format!(
-                    "distance scale against GNSS chords: not checked (fewer than {} blocks of \
-                     {} s with {} m of travel): the standard errors leave out the receiver's \
-                     slow error",
-                    deadreckon_core::chords::MIN_BLOCKS,
-                    deadreckon_core::chords::BLOCK_S,
-                    deadreckon_core::chords::MIN_CHORD_M
-                ))
-            }
-            None => {}
+        if self.options.method == deadreckon_core::calibrate::Method::Rts {
+            out.push(crate::text::chords_line(c.gnss_chords.as_ref()));
         }
         if self.which != Which::None {
             out.extend(crate::text::corrections_lines(&self.corrections));

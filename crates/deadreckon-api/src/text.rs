@@ -562,14 +562,22 @@ pub fn known_corrections_text(c: &deadreckon_core::timing::KnownCorrections) -> 
     parts.join(", ")
 }
 
-/// The RTS calibration's distance scale against GNSS chords, one line.
-pub fn chords_line(c: &deadreckon_core::chords::ChordScale) -> String {
-    format!(
-        "distance scale against GNSS chords: {:+.3}% ± {:.3}% ({} blocks of {} s); \
-         the speed scale's and circumferences' standard errors include it",
-        100.0 * c.mean,
-        100.0 * c.std,
-        c.blocks,
-        deadreckon_core::chords::BLOCK_S
-    )
+/// The RTS calibration's distance scale against GNSS chords, one line (or
+/// that the drive was too short to check it).
+pub fn chords_line(c: Option<&deadreckon_core::chords::ChordScale>) -> String {
+    use deadreckon_core::chords::{BLOCK_S, MIN_BLOCKS, MIN_CHORD_M};
+    match c {
+        Some(c) => format!(
+            "distance scale against GNSS chords: {:+.3}% ± {:.3}% ({} blocks of {BLOCK_S} s); \
+             the speed scale's and circumferences' standard errors include it",
+            100.0 * c.mean,
+            100.0 * c.std,
+            c.blocks,
+        ),
+        None => format!(
+            "distance scale against GNSS chords: not checked (fewer than {MIN_BLOCKS} blocks \
+             of {BLOCK_S} s with {MIN_CHORD_M} m of travel): the standard errors leave out \
+             the receiver's slow error"
+        ),
+    }
 }

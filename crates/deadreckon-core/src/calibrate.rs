@@ -427,6 +427,12 @@ fn rts_calibration(
     let last = last.ok_or_else(|| Error::Insufficient("no calibration pass ran".into()))?;
     if let Some(c) = last.chords.filter(|c| c.disagrees()) {
         let st = &last.stats;
+        let circ = last.estimate.params.circumferences();
+        let (lo, hi) = circ
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+                (a.min(x), b.max(x))
+            });
         return Err(Error::Rejected(format!(
             "the calibrated distance scale disagrees with the GNSS chords by {:+.2}% ± {:.2}% \
              ({:+.1} standard errors over {} blocks of {} s, p = {:.1e}): the smoothing \
@@ -441,18 +447,8 @@ fn rts_calibration(
             st.gnss_rejected,
             st.gnss_updates + st.gnss_rejected,
             st.gnss_recoveries,
-            last.estimate
-                .params
-                .circumferences()
-                .iter()
-                .copied()
-                .fold(f64::INFINITY, f64::min),
-            last.estimate
-                .params
-                .circumferences()
-                .iter()
-                .copied()
-                .fold(f64::NEG_INFINITY, f64::max),
+            lo,
+            hi,
             history.len(),
         )));
     }

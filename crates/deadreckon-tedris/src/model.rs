@@ -349,6 +349,19 @@ fn one() -> f64 {
 }
 
 impl TedrisModel {
+    /// [`TedrisModel::fit`] again on this model's own settings, lag,
+    /// cross-correlation and repositories: the regressions fitted anew, the
+    /// calibrated values (turn gain, DCF, distance scale) not carried over.
+    pub fn refit(&self) -> Result<Self, Error> {
+        TedrisModel::fit(
+            self.config.clone(),
+            self.sample_period_s,
+            self.lag_samples,
+            self.ccf.clone(),
+            self.repositories.clone(),
+        )
+    }
+
     /// Fits every kind on the repositories and chooses one.
     pub fn fit(
         config: TedrisConfig,

@@ -182,14 +182,7 @@ pub fn train(
                 .unwrap_or("no reference heading reached the machine")
         ))
     })?;
-    let refit = TedrisModel::fit(
-        model.config.clone(),
-        model.sample_period_s,
-        model.lag_samples,
-        model.ccf.clone(),
-        model.repositories.clone(),
-    )
-    .map(|mut f| {
+    let refit = model.refit().map(|mut f| {
         if f.fits.iter().any(|k| k.kind == model.chosen) {
             // The machine's choice (by the calibrated heading when automatic).
             f.chosen = model.chosen;

@@ -609,14 +609,7 @@ mod tests {
         for tu in &tuples[..tuples.len() * 3 / 4] {
             fewer.repositories.insert(*tu);
         }
-        let fitted = TedrisModel::fit(
-            fewer.config.clone(),
-            fewer.sample_period_s,
-            fewer.lag_samples,
-            fewer.ccf.clone(),
-            fewer.repositories.clone(),
-        )
-        .expect("fit");
+        let fitted = fewer.refit().expect("fit");
         m.model = Some(TedrisModel {
             dcf_rad: before.dcf_rad,
             dcf_distance_rad_per_m: before.dcf_distance_rad_per_m,

@@ -237,13 +237,7 @@ impl Tedris {
             old.dcf_rad,
             old.config.joint_calibration(),
         );
-        if let Ok(mut m) = TedrisModel::fit(
-            old.config.clone(),
-            old.sample_period_s,
-            old.lag_samples,
-            old.ccf.clone(),
-            old.repositories.clone(),
-        ) {
+        if let Ok(mut m) = old.refit() {
             m.turn_gain = gain;
             m.distance_scale = scale;
             m.per_metre_straight = per_metre;
