@@ -779,25 +779,43 @@ fn an_origin_at_95_degrees_wrote_geojson_at_85_north() {
 
 /// A calibration whose smoothing filter lost the fixes (family car 30 with
 /// white fixes: its circumferences 12 % off, "converged") is refused with the
-/// reason and writes no params file; it used to be written. With the default
+/// reason and writes no params file; it used to be written. The filter lost
+/// them by learning the circumferences while its heading was unknown, which
+/// `[noise] scale_hold_yaw_std_rad` (2°) now prevents: the drive calibrates,
+/// and with the hold off (`inf`) it is refused as before. With the default
 /// corrections the delay estimate's own calibration is the one refused.
 #[test]
 fn a_calibration_that_lost_the_fixes_was_written_as_converged() {
     let tmp = tempfile::tempdir().unwrap();
     let mut car = deadreckon_sim::family::CarFamily::draw(30);
     car.gnss_markov = (0.0, 60.0);
-    let sim = deadreckon_sim::simulate(&car.drive(130, 600.0), 130).unwrap();
+    let mut sim = deadreckon_sim::simulate(&car.drive(130, 600.0), 130).unwrap();
     let dir = tmp.path().join("car30");
     deadreckon_io::write_drive(&dir, &sim.drive).unwrap();
     let params = tmp.path().join("params.toml");
-    for (corrections, chords) in [("none", "-8.56%"), ("gnss", "-6.67%")] {
-        let out = bin()
+    let calibrate = |corrections: &str| {
+        bin()
             .arg("calibrate")
             .arg(&dir)
             .args(["--corrections", corrections, "--out"])
             .arg(&params)
             .output()
-            .unwrap();
+            .unwrap()
+    };
+    for corrections in ["none", "gnss"] {
+        let out = calibrate(corrections);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{corrections}: {err}");
+        std::fs::remove_file(&params).unwrap();
+    }
+    sim.drive.vehicle.noise.scale_hold_yaw_std_rad = f64::INFINITY;
+    std::fs::remove_dir_all(&dir).unwrap();
+    deadreckon_io::write_drive(&dir, &sim.drive).unwrap();
+    assert!(std::fs::read_to_string(dir.join("vehicle.toml"))
+        .unwrap()
+        .contains("scale_hold_yaw_std_rad = inf"));
+    for (corrections, chords) in [("none", "-8.56%"), ("gnss", "-6.67%")] {
+        let out = calibrate(corrections);
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(!out.status.success(), "{err}");
         assert!(

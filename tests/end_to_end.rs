@@ -444,11 +444,13 @@ fn comma2k19_import_calibrate_evaluate_report() {
             // the GNSS-aided start hands over: the u-blox fixes sit 0.39 m
             // west of the reference for the whole segment (which heads
             // north throughout), and the windows start a median 0.432 m
-            // off. Measured: start 0.432 m, final 0.621 m (medians).
+            // off. Measured: start 0.431 m, final 0.559 m (medians; 0.621
+            // before the augmented pass held the scale and circumferences
+            // while the heading was unknown).
             let (s, f) = (&o["start_error_m"]["median"], &o["final_error_m"]["median"]);
             let (s, f) = (s.as_f64().unwrap(), f.as_f64().unwrap());
             assert!((0.40..0.47).contains(&s), "start {s}");
-            assert!((0.58..0.66).contains(&f), "final {f}");
+            assert!((0.52..0.60).contains(&f), "final {f}");
         }
     }
     // Bounds on the measured figures (see the closing note of the readers issue).

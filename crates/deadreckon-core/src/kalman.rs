@@ -167,6 +167,50 @@ impl<const N: usize> ScalarInnovation<N> {
             }
         }
     }
+
+    /// The Schmidt ("consider") update: as [`ScalarInnovation::apply`] but the
+    /// states where `hold` is true are not corrected; their covariance with
+    /// the others follows, so P stays the covariance of the held states' error
+    /// (`P − Kₛ h P − P hᵀ Kₛᵀ + Kₛ S Kₛᵀ`, Kₛ the gain with the held rows 0).
+    pub fn apply_holding(
+        &self,
+        x: &mut SVector<f64, N>,
+        p: &mut SMatrix<f64, N, N>,
+        hold: &[bool; N],
+    ) {
+        let (ph, s, y) = (&self.ph, self.s, self.y);
+        let ks: SVector<f64, N> = SVector::from_fn(|i, _| if hold[i] { 0.0 } else { ph[i] / s });
+        x.axpy(y, &ks, 1.0);
+        let d = ks * ph.transpose();
+        let out = *p - d - d.transpose() + ks * ks.transpose() * s;
+        *p = (out + out.transpose()) * 0.5;
+    }
+}
+
+/// [`update_vector`] holding the states where `hold` is true (the Schmidt
+/// update of [`ScalarInnovation::apply_holding`]).
+pub fn update_vector_holding<const N: usize, const M: usize>(
+    x: &mut SVector<f64, N>,
+    p: &mut SMatrix<f64, N, N>,
+    y: &SVector<f64, M>,
+    h: &SMatrix<f64, M, N>,
+    r: &SMatrix<f64, M, M>,
+    hold: &[bool; N],
+    t_s: f64,
+) -> Result<(), Error> {
+    let (s, s_inv, _) = innovation_stats(p, y, h, r, t_s)?;
+    let hp = h * *p;
+    let mut k = hp.transpose() * s_inv;
+    for (i, &held) in hold.iter().enumerate() {
+        if held {
+            k.row_mut(i).fill(0.0);
+        }
+    }
+    *x += k * y;
+    let d = k * hp;
+    let out = *p - d - d.transpose() + k * s * k.transpose();
+    *p = (out + out.transpose()) * 0.5;
+    Ok(())
 }
 
 /// Innovation statistics of an `M`-dimensional measurement without updating:

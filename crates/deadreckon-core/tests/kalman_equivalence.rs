@@ -102,6 +102,83 @@ fn vector_update_equals_textbook_in_both_covariance_forms() {
     }
 }
 
+/// The Schmidt ("consider") update the augmented filter makes while its
+/// heading is unknown: the held states keep their value, and P is the
+/// covariance of the estimator with the held rows of the gain zeroed,
+/// `(I − Kₛ H) P (I − Kₛ H)ᵀ + Kₛ R Kₛᵀ`, for the scalar and the vector
+/// update; with nothing held it is the ordinary update.
+#[test]
+fn schmidt_updates_equal_the_textbook_consider_update() {
+    let mut rng = Pcg64::seed_from_u64(19);
+    let a = M4::from_fn(|_, _| randn(&mut rng));
+    let p0 = a * a.transpose() + M4::identity();
+    let x0 = V4::from_fn(|_, _| randn(&mut rng));
+    let textbook =
+        |h: &SMatrix<f64, 3, 4>, r: &SMatrix<f64, 3, 3>, y: &SVector<f64, 3>, hold: &[bool; 4]| {
+            let s = h * p0 * h.transpose() + r;
+            let mut k = p0 * h.transpose() * s.try_inverse().unwrap();
+            for (i, &held) in hold.iter().enumerate() {
+                if held {
+                    k.row_mut(i).fill(0.0);
+                }
+            }
+            let ikh = M4::identity() - k * h;
+            (
+                x0 + k * y,
+                ikh * p0 * ikh.transpose() + k * r * k.transpose(),
+            )
+        };
+    let h = SMatrix::<f64, 3, 4>::from_fn(|_, _| randn(&mut rng));
+    let r = SMatrix::<f64, 3, 3>::from_diagonal(&SVector::<f64, 3>::new(0.5, 0.2, 0.9));
+    let y = SVector::<f64, 3>::from_fn(|_, _| randn(&mut rng));
+    for hold in [
+        [false, false, true, true],
+        [true, false, false, false],
+        [false; 4],
+    ] {
+        let (xr, pr) = textbook(&h, &r, &y, &hold);
+        let (mut x, mut p) = (x0, p0);
+        kalman::update_vector_holding(&mut x, &mut p, &y, &h, &r, &hold, 0.0).unwrap();
+        assert!(
+            (x - xr).amax() < 1e-12 && (p - pr).amax() < 1e-12,
+            "vector {hold:?}"
+        );
+        for (i, &held) in hold.iter().enumerate() {
+            if held {
+                assert_eq!(x[i], x0[i], "held state {i} moved");
+            }
+        }
+        // One row of the vector measurement as a scalar update.
+        let h1 = SMatrix::<f64, 1, 4>::from_fn(|_, j| h[(0, j)]);
+        let r1 = SMatrix::<f64, 1, 1>::new(r[(0, 0)]);
+        let s = (h1 * p0 * h1.transpose())[(0, 0)] + r1[(0, 0)];
+        let mut k = p0 * h1.transpose() / s;
+        for (i, &held) in hold.iter().enumerate() {
+            if held {
+                k[i] = 0.0;
+            }
+        }
+        let ikh = M4::identity() - k * h1;
+        let (xs, ps) = (
+            x0 + k * y[0],
+            ikh * p0 * ikh.transpose() + k * r1 * k.transpose(),
+        );
+        let inn =
+            kalman::ScalarInnovation::new(&p0, &h1.transpose(), r1[(0, 0)], y[0], 0.0).unwrap();
+        let (mut x, mut p) = (x0, p0);
+        inn.apply_holding(&mut x, &mut p, &hold);
+        assert!(
+            (x - xs).amax() < 1e-12 && (p - ps).amax() < 1e-12,
+            "scalar {hold:?}"
+        );
+        if !hold.contains(&true) {
+            let (mut xo, mut po) = (x0, p0);
+            inn.apply(&mut xo, &mut po, CovarianceForm::Joseph);
+            assert!((x - xo).amax() < 1e-12 && (p - po).amax() < 1e-12);
+        }
+    }
+}
+
 /// The EKF's (v, ψ̇) block with only the gyro and the CAN speed is a linear
 /// Kalman filter on a 2-state random walk: the whole `ekf::run` must match one.
 #[test]

@@ -14,6 +14,13 @@
 //!   and car 22's ended 15 m off (not converged, but written). Their
 //!   distance scales disagree with the GNSS chords by 5.1 and 30 standard
 //!   errors; a calibration that does is now rejected.
+//!
+//! And the cause of those two: the augmented pass learnt the circumferences
+//! while the heading from the first fixes was still unknown (car 30:
+//! 13–20° off, standard deviation 17°, +107 mm at pull-away, +450 mm by
+//! 50 s). It now holds them while the yaw standard deviation is above
+//! `noise.scale_hold_yaw_std_rad` (2°), and every car calibrates; with the
+//! hold off (`inf`) the rejection still catches car 30.
 
 use deadreckon_core::calibrate::{self, CalibrationOptions};
 use deadreckon_core::Error;
@@ -34,14 +41,19 @@ struct Figures {
 
 /// Family car `seed`'s 600 s training drive (no installation effects), with
 /// its receiver's wander or, when `white`, without it, calibrated with RTS:
-/// its figures, or the rejection's message.
-fn calibrate(seed: u64, white: bool) -> Result<Figures, String> {
+/// its figures, or the rejection's message. `hold` off learns the scale and
+/// circumferences whatever the heading's uncertainty (`scale_hold_yaw_std_rad
+/// = inf`).
+fn calibrate(seed: u64, white: bool, hold: bool) -> Result<Figures, String> {
     let mut car = CarFamily::draw(seed);
     if white {
         car.gnss_markov = (0.0, 60.0);
     }
     let sc = car.drive(100 + seed, 600.0);
-    let sim = simulate(&sc, 100 + seed).unwrap();
+    let mut sim = simulate(&sc, 100 + seed).unwrap();
+    if !hold {
+        sim.drive.vehicle.noise.scale_hold_yaw_std_rad = f64::INFINITY;
+    }
     let c = match calibrate::calibrate(&sim.drive, &CalibrationOptions::default()) {
         Ok(c) => c,
         Err(e @ Error::Rejected(_)) => return Err(e.to_string()),
@@ -66,14 +78,16 @@ fn calibrate(seed: u64, white: bool) -> Result<Figures, String> {
 }
 
 /// Every car: accepted within 3 standard errors, or rejected; returns the
-/// rejected cars and the largest |error| / least-squares error.
-fn every_car(white: bool) -> (Vec<u64>, f64) {
-    let (mut rejected, mut worst_ls) = (Vec::new(), 0.0f64);
+/// rejected cars, the largest |error| / least-squares error and the largest
+/// |error| / standard error.
+fn every_car(white: bool) -> (Vec<u64>, f64, f64) {
+    let (mut rejected, mut worst_ls, mut worst) = (Vec::new(), 0.0f64, 0.0f64);
     for seed in 1..=32 {
-        match calibrate(seed, white) {
+        match calibrate(seed, white, true) {
             Ok(f) => {
                 let (z, z_ls) = (f.err / f.std, f.err / f.ls);
                 worst_ls = worst_ls.max(z_ls.abs());
+                worst = worst.max(z.abs());
                 println!(
                     "car {seed} (white fixes: {white}): circumference error {:+.2} mm, standard \
                      error {:.2} mm (z {z:+.2}); least squares alone {:.3} mm (z {z_ls:+.1}); \
@@ -85,7 +99,7 @@ fn every_car(white: bool) -> (Vec<u64>, f64) {
                 );
                 assert!(z.abs() < 3.0, "car {seed}: z {z}");
                 if white {
-                    // Measured 0.18–1.80 mm for errors of 0.00–0.79 mm.
+                    // Measured 0.18–1.80 mm for errors of 0.00–1.83 mm.
                     assert!(f.std < 2.0e-3, "car {seed}: {}", f.std);
                 }
             }
@@ -95,26 +109,43 @@ fn every_car(white: bool) -> (Vec<u64>, f64) {
             }
         }
     }
-    (rejected, worst_ls)
+    (rejected, worst_ls, worst)
 }
 
 #[test]
 fn the_rts_standard_errors_left_out_the_receivers_wander() {
-    let (rejected, worst_ls) = every_car(false);
-    // Measured: the 30 accepted cars within 2.27 standard errors (RMS 0.91;
-    // standard errors 0.51–4.24 mm for errors up to 4.84 mm); without the
-    // chords up to 194 standard errors, and under 4 on 6 cars only. Their
-    // chords read at most 2.76 standard errors (all 62 accepted
-    // calibrations, white fixes included); the rejected ones 5.1 to 30.3.
+    let (rejected, worst_ls, worst) = every_car(false);
+    // Measured: the 32 cars within 2.28 standard errors (standard errors
+    // 0.51–4.24 mm for errors up to 4.81 mm); without the chords up to 194
+    // standard errors. Bounds: 2.5, and 20 for the least squares alone.
     assert!(worst_ls > 20.0, "{worst_ls}");
-    assert_eq!(rejected, [22, 30]);
+    assert!(worst < 2.5, "{worst}");
+    assert_eq!(rejected, [] as [u64; 0]);
 }
 
 #[test]
 fn a_calibration_whose_filter_lost_the_fixes_was_kept_as_converged() {
-    // Measured: the 31 accepted cars within 1.0 standard error (RMS 0.33:
-    // the chords are cautious with white fixes); car 30 rejected (its
-    // circumferences 225 mm off, "converged" before).
-    let (rejected, _) = every_car(true);
-    assert_eq!(rejected, [30]);
+    // Measured: the 32 cars within 1.45 standard errors (car 30, +1.83 mm;
+    // the others within 1.0, RMS error 0.28 mm: the chords are cautious with
+    // white fixes). Bound 1.6.
+    let (rejected, _, worst) = every_car(true);
+    assert!(worst < 1.6, "{worst}");
+    assert_eq!(rejected, [] as [u64; 0]);
+    // The rejection still catches the filter that loses the fixes: car 30
+    // with the scale learnt while the heading is unknown (its circumferences
+    // 225 mm off, "converged" before the rejection).
+    let e = calibrate(30, true, false).expect_err("car 30 without the hold");
+    assert!(e.contains("disagrees with the GNSS chords"), "{e}");
+}
+
+#[test]
+fn the_circumferences_were_learnt_while_the_heading_was_unknown() {
+    // Car 30 pulls away with its heading from the first fixes 13–20° off.
+    // Measured with the hold: +1.83 mm (white fixes) and +1.99 mm (its
+    // wander), 1.45 and 1.76 standard errors. Bound 2.5 mm; without the hold
+    // it is rejected (above), and was 225 mm off.
+    for white in [true, false] {
+        let f = calibrate(30, white, true).unwrap_or_else(|e| panic!("white {white}: {e}"));
+        assert!(f.err.abs() < 2.5e-3, "white {white}: {f:?}");
+    }
 }
