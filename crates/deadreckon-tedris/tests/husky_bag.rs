@@ -93,7 +93,9 @@ fn husky_gyro_reference_30_and_60_s_outages() {
     // 60 s means 0.77–2.39 m (max 4.70 m); averages 1.41 m (30 s) and 1.48 m
     // (60 s). Bounds: the largest measured + 25% (3.0 m mean, 6.0 m max) and
     // the averages + 25% (1.9 m). The issue's 60 s target is 2.30 m per window:
-    // [125, 185) is above it.
+    // [125, 185) is above it, by the DCF it starts with (crate docs, "Measured
+    // on the simulator": 2.34 m before the held-back calibration, a difference
+    // not significant against the fixes' noise).
     for e in e30.iter().chain(&e60) {
         assert!(
             e.result.points() > 50 && e.predicted_fraction > 0.95,
