@@ -226,7 +226,7 @@
 //! is not significant (paired per-fix errors, 10 s batch means: +0.047 m,
 //! t = 1.3 on 5 degrees of freedom). The course from chords between the fixes
 //! is too noisy at 1 m/s for the block regression (cross-correlation peak
-//! 0.06): 2.9–12.1 m over 30 s.
+//! 0.06): 2.8–12.1 m over 30 s.
 //!
 //! ## Modules
 //!

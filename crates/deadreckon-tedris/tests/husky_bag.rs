@@ -110,7 +110,7 @@ fn husky_gyro_reference_30_and_60_s_outages() {
 #[test]
 fn husky_fix_track_reference_runs() {
     // The course from chords between fixes is too noisy at 1 m/s for the block
-    // regression (cross-correlation peak about 0.06). Measured 2.91–12.13 m mean,
+    // regression (cross-correlation peak about 0.06). Measured 2.84–12.13 m mean,
     // 21.17 m largest, over the 30 s outages; bounds: + 25% (15.2 m mean, 26.5 m
     // max). It read 3.68–5.26 m (11.92 m) while the run's blocks were numbered
     // among the training drive's and its refits mixed the two drives' blocks
