@@ -188,7 +188,10 @@ impl<const N: usize> ScalarInnovation<N> {
 }
 
 /// [`update_vector`] holding the states where `hold` is true (the Schmidt
-/// update of [`ScalarInnovation::apply_holding`]).
+/// update of [`ScalarInnovation::apply_holding`]). The covariance is always
+/// the Joseph form's, `P − K H P − P Hᵀ Kᵀ + K S Kᵀ`, which holds for any
+/// gain: [`CovarianceForm::Simple`], `(I − K H) P`, is right only for the
+/// optimal one.
 pub fn update_vector_holding<const N: usize, const M: usize>(
     x: &mut SVector<f64, N>,
     p: &mut SMatrix<f64, N, N>,
