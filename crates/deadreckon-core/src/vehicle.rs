@@ -36,8 +36,10 @@ impl Origin {
 }
 
 /// Noise standard deviations: the paper's tables I (evolution, per 20 ms step) and
-/// II (observations). Every field has the paper's value as its default but
-/// `process_yaw_rad` ([`PROCESS_YAW_RAD`]).
+/// II (observations), with the filter's gates and the augmented filter's hold
+/// ([`SCALE_HOLD_YAW_STD_RAD`]), which the paper does not have. Every field
+/// the paper has takes its value as default but `process_yaw_rad`
+/// ([`PROCESS_YAW_RAD`]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Noise {
