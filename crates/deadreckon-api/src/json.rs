@@ -252,7 +252,7 @@ pub fn evo_json(q: &EvoQuery<'_>, r: &TrajectoryError) -> Value {
 /// `tedris train --json`: the trained model's summary.
 pub fn tedris_train_json(m: &TedrisModel, source: ReferenceSource) -> Value {
     let s = m.straight();
-    json!({
+    let mut v = json!({
         "source": source,
         "chosen": m.chosen.name(),
         "lag_samples": m.lag_samples,
@@ -264,12 +264,7 @@ pub fn tedris_train_json(m: &TedrisModel, source: ReferenceSource) -> Value {
         "epsilon_m": s.epsilon_m,
         "dcf0_rad": m.dcf0_rad,
         // Not a parameter of the per-metre form (no heading per sample).
-        "dcf_rad": (!m.per_metre_straight).then_some(m.dcf_rad),
-        // Estimated by the joint calibration only (the extended variant):
-        // otherwise not estimated, not a nominal value.
-        "dcf_distance_rad_per_m": m.config.joint_calibration().then_some(m.dcf_distance_rad_per_m),
         "gyro_bias": m.gyro_bias,
-        "turn_gain": m.config.turn_gain().then_some(m.turn_gain),
         // From GNSS chords; null while not estimated.
         "distance_scale": m.distance_scale.estimated(),
         "distance_scale_chords": m.distance_scale.chords,
@@ -280,6 +275,30 @@ pub fn tedris_train_json(m: &TedrisModel, source: ReferenceSource) -> Value {
         "complete": m.complete,
         "fill": m.repositories.fill(m.config.required_bins),
         "fits": m.fits,
+    });
+    if let (Some(o), Value::Object(c)) = (v.as_object_mut(), tedris_calibrated_json(m)) {
+        o.extend(c);
+    }
+    v
+}
+
+/// The calibrated values of a TedriS model with their standard errors
+/// (autocorrelation-robust, from the joint calibration that installed
+/// them): `dcf_rad`, `dcf_distance_rad_per_m`, `turn_gain` and their
+/// `*_std*`. Null: not estimated (not a parameter of the form, not
+/// estimated by the variant, or no standard error), never 0.
+pub fn tedris_calibrated_json(m: &TedrisModel) -> Value {
+    let joint = m.config.joint_calibration();
+    json!({
+        // Not a parameter of the per-metre form (no heading per sample).
+        "dcf_rad": (!m.per_metre_straight).then_some(m.dcf_rad),
+        "dcf_std_rad": m.dcf_std_rad.filter(|_| !m.per_metre_straight),
+        // Estimated by the joint calibration only (the extended variant):
+        // otherwise not estimated, not a nominal value.
+        "dcf_distance_rad_per_m": joint.then_some(m.dcf_distance_rad_per_m),
+        "dcf_distance_std_rad_per_m": m.dcf_distance_std_rad_per_m.filter(|_| joint),
+        "turn_gain": m.config.turn_gain().then_some(m.turn_gain),
+        "turn_gain_std": m.turn_gain_std.filter(|_| m.config.turn_gain()),
     })
 }
 

@@ -157,6 +157,10 @@ pub fn run_json(
         "reference": r.reference,
         "source": r.source,
         "model": model.chosen.name(),
+        // The values the machine holds at the end of the run (it keeps
+        // calibrating while the reference is good), with their standard
+        // errors; null without a model.
+        "calibrated": r.machine.model().map(crate::json::tedris_calibrated_json),
         // Not "checks": that key holds the plausibility checks of every --json object.
         "tedris_checks": r.machine.checks(),
         "track": track.map(|p| p.display().to_string()),

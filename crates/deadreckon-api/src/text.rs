@@ -227,6 +227,12 @@ pub fn tedris_outage_lines(r: &deadreckon_tedris::OutageReport, threshold_m: f64
             ))
         ));
     }
+    if let Some(m) = r.machine.model() {
+        out.push(format!(
+            "at the end of the run: {}",
+            tedris_calibrated_line(m)
+        ));
+    }
     out.push(r.machine.checks().line());
     out
 }
@@ -316,6 +322,46 @@ pub fn wheel_health_lines(h: &deadreckon_core::wheel_health::WheelHealth) -> Vec
     out
 }
 
+/// ` ± s` after a calibrated value (`s` its standard error), or
+/// ` (std not estimated)`: never a 0 standing in for unknown.
+fn plus_minus(std: Option<f64>) -> String {
+    std.map_or(" (std not estimated)".to_string(), |s| {
+        format!(" ± {s:.2e}")
+    })
+}
+
+/// The calibrated heading values of a TedriS model with their standard
+/// errors (`tedris train`, and `tedris run` for the values at the end).
+pub fn tedris_calibrated_line(m: &deadreckon_tedris::TedrisModel) -> String {
+    if m.per_metre_straight {
+        // Heading per metre as the rear radius mismatch it is.
+        format!(
+            "straight-line heading {:.3e}{} rad/m (per metre only: none at rest), turn gain = {:.4}{}",
+            m.dcf_distance_rad_per_m,
+            plus_minus(m.dcf_distance_std_rad_per_m),
+            m.turn_gain,
+            plus_minus(m.turn_gain_std)
+        )
+    } else if m.config.joint_calibration() {
+        format!(
+            "DCF0 = {:.3e} rad/sample, DCF = {:.3e}{} rad/sample + {:.3e}{} rad/m, turn gain = {:.4}{}",
+            m.dcf0_rad,
+            m.dcf_rad,
+            plus_minus(m.dcf_std_rad),
+            m.dcf_distance_rad_per_m,
+            plus_minus(m.dcf_distance_std_rad_per_m),
+            m.turn_gain,
+            plus_minus(m.turn_gain_std)
+        )
+    } else {
+        // The paper's method: eq. (6) only; no distance term, no turn gain.
+        format!(
+            "DCF0 = {:.3e} rad/sample, DCF = {:.3e} rad/sample (eq. 6, std not estimated; heading per metre and turn gain not estimated)",
+            m.dcf0_rad, m.dcf_rad
+        )
+    }
+}
+
 /// The summary `tedris train` prints: the reference, τ and the lag, the
 /// straight line, the drift corrections, the course convention, every
 /// model kind with its coefficients and residual tests, the repositories.
@@ -354,24 +400,7 @@ pub fn tedris_train_lines(
         s.w_high_m,
         eps
     ));
-    if m.per_metre_straight {
-        // Heading per metre as the rear radius mismatch it is.
-        out.push(format!(
-            "straight-line heading {:.3e} rad/m (per metre only: none at rest), turn gain = {:.4}",
-            m.dcf_distance_rad_per_m, m.turn_gain
-        ));
-    } else if m.config.joint_calibration() {
-        out.push(format!(
-            "DCF0 = {:.3e} rad/sample, DCF = {:.3e} rad/sample + {:.3e} rad/m, turn gain = {:.4}",
-            m.dcf0_rad, m.dcf_rad, m.dcf_distance_rad_per_m, m.turn_gain
-        ));
-    } else {
-        // The paper's method: eq. (6) only; no distance term, no turn gain.
-        out.push(format!(
-            "DCF0 = {:.3e} rad/sample, DCF = {:.3e} rad/sample (eq. 6; heading per metre and turn gain not estimated)",
-            m.dcf0_rad, m.dcf_rad
-        ));
-    }
+    out.push(tedris_calibrated_line(m));
     if m.config.distance_scale() {
         out.push(match m.distance_scale.estimated() {
             Some(k) => format!(

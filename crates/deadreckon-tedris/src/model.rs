@@ -305,6 +305,21 @@ pub struct TedrisModel {
     /// paper variant, where it is not estimated).
     #[serde(default = "one")]
     pub turn_gain: f64,
+    /// Standard error of the installed `dcf_rad`, rad per sample, from the
+    /// joint calibration that set it (autocorrelation-robust:
+    /// [`crate::stats::increment_block_std`]). `None`: not estimated (never
+    /// calibrated jointly, the per-metre form which has no DCF, the paper's
+    /// eq. (6), or too little reference heading to tell).
+    #[serde(default)]
+    pub dcf_std_rad: Option<f64>,
+    /// Standard error of the installed `dcf_distance_rad_per_m`, rad per
+    /// metre (as `dcf_std_rad`; `None` also while the term was never fitted).
+    #[serde(default)]
+    pub dcf_distance_std_rad_per_m: Option<f64>,
+    /// Standard error of the installed `turn_gain` (as `dcf_std_rad`; `None`
+    /// also while the gain was never fitted).
+    #[serde(default)]
+    pub turn_gain_std: Option<f64>,
     /// The rear wheels' distance scale (see [`DistanceScale`]).
     #[serde(default)]
     pub distance_scale: DistanceScale,
@@ -421,6 +436,9 @@ impl TedrisModel {
             straight_omega,
             straight_sigma_m,
             turn_gain: 1.0,
+            dcf_std_rad: None,
+            dcf_distance_std_rad_per_m: None,
+            turn_gain_std: None,
             distance_scale: DistanceScale::default(),
             corrections: None,
         };
@@ -457,6 +475,7 @@ impl TedrisModel {
         self.dcf_bound_rad =
             (self.config.dcf_bound_factor * slope * (s.w_high_m - s.w_low_m)).max(1e-6);
         self.dcf_rad = self.dcf0_rad;
+        self.dcf_std_rad = None;
     }
 
     /// The expected ω on a straight line at `dist_m` per sample, m per sample
@@ -544,6 +563,21 @@ impl TedrisModel {
             self.straight_omega.0,
             self.straight_omega.1,
         ];
+        // A standard error is finite and non-negative, or not estimated (null).
+        for (name, s) in [
+            ("dcf_std_rad", self.dcf_std_rad),
+            (
+                "dcf_distance_std_rad_per_m",
+                self.dcf_distance_std_rad_per_m,
+            ),
+            ("turn_gain_std", self.turn_gain_std),
+        ] {
+            if let Some(s) = s.filter(|s| !(s.is_finite() && *s >= 0.0)) {
+                return Err(Error::Model(format!(
+                    "{name} = {s} is not a standard error (finite, not negative; null when not estimated)"
+                )));
+            }
+        }
         let ok = consistent
             && scalars.iter().all(|v| v.is_finite())
             && self.sample_period_s.is_finite()

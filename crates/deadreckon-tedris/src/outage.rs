@@ -190,6 +190,9 @@ pub fn train(
         f.dcf_rad = model.dcf_rad;
         f.dcf_distance_rad_per_m = model.dcf_distance_rad_per_m;
         f.turn_gain = model.turn_gain;
+        f.dcf_std_rad = model.dcf_std_rad;
+        f.dcf_distance_std_rad_per_m = model.dcf_distance_std_rad_per_m;
+        f.turn_gain_std = model.turn_gain_std;
         f.distance_scale = model.distance_scale;
         f.per_metre_straight = model.per_metre_straight;
         f.course_convention = model.course_convention;

@@ -291,6 +291,159 @@ pub fn correlation_time(values: &[f64], times: &[f64]) -> Option<f64> {
         .map(|lag| times[lag] - times[0])
 }
 
+/// Standard errors of a least-squares fit of a *cumulative* quantity
+/// (see [`increment_block_std`]), with what they rest on.
+#[derive(Debug, Clone, PartialEq)]
+pub struct IncrementBlockStd {
+    /// One standard error per column, in column order.
+    pub std_error: Vec<f64>,
+    /// Blocks of contiguous rows the scores were summed over.
+    pub blocks: usize,
+    /// Correlation time of the residual increments ([`correlation_time`]), s.
+    pub correlation_time_s: f64,
+}
+
+/// Standard errors of `β̂ = (XᵀX)⁻¹Xᵀy` when the errors of `y` are
+/// random-walk-like (a cumulative heading against cumulative columns):
+/// `x` and `residuals` are the fit's design and residuals, centred per run
+/// of equal `segments` (an intercept per run), rows in time order.
+///
+/// Why not the OLS formula, nor blocks of the rows: the OLS formula takes
+/// the errors as independent, and a cumulative error stays of one sign for
+/// most of a window, so the scores `x̃ₖeₖ` of rows far apart are correlated
+/// and no block of rows is independent of the others. Summation by parts
+/// moves the sum onto the error *increments* `uₘ = eₘ − eₘ₋₁`, which
+/// decorrelate within seconds (wheel noise, reference noise, a turn's
+/// misfit): within a run, as `Σₖ x̃ₖ = 0`,
+///
+/// `Σₖ x̃ₖ eₖ = Σₘ uₘ Sₘ`, `Sₘ = Σ_{k≥m} x̃ₖ` (the run's tail sums),
+///
+/// an identity. The scores `zₘ = ûₘ Sₘ` are cut into `blocks` contiguous
+/// blocks of equal row count and their block sums taken as independent
+/// (batch means of the scores; the delete-a-block jackknife's linearised
+/// form): `Ω = g/(g − 1) Σ_b z_b z_bᵀ`, `V = (XᵀX)⁻¹ Ω (XᵀX)⁻¹`. White
+/// reference noise adds to `ûₘ` a difference that telescopes within a block,
+/// as it should: it does not accumulate.
+///
+/// Errors (naming why) with lengths that differ, a non-finite value, fewer
+/// than two blocks or fewer increments than blocks, a singular `XᵀX`,
+/// increments that do not decorrelate within half the window, or blocks
+/// shorter than `decorrelations` correlation times of the increments (the
+/// block sums would not be independent).
+pub fn increment_block_std(
+    x: &[Vec<f64>],
+    residuals: &[f64],
+    segments: &[u32],
+    times: &[f64],
+    blocks: usize,
+    decorrelations: f64,
+) -> Result<IncrementBlockStd, Error> {
+    let n = residuals.len();
+    let p = x.first().map_or(0, Vec::len);
+    if x.len() != n || segments.len() != n || times.len() != n || x.iter().any(|r| r.len() != p) {
+        return Err(Error::Regression(
+            "block standard errors: design, residuals, segments and times differ in length".into(),
+        ));
+    }
+    if p == 0 || blocks < 2 {
+        return Err(Error::Regression(format!(
+            "block standard errors: {p} columns and {blocks} blocks"
+        )));
+    }
+    if x.iter()
+        .flatten()
+        .chain(residuals)
+        .chain(times)
+        .any(|v| !v.is_finite())
+    {
+        return Err(Error::Regression(
+            "block standard errors: non-finite value".into(),
+        ));
+    }
+    let mut xtx = vec![vec![0.0; p]; p];
+    for r in x {
+        for i in 0..p {
+            for j in 0..p {
+                xtx[i][j] += r[i] * r[j];
+            }
+        }
+    }
+    let a = invert(&xtx)
+        .ok_or_else(|| Error::Regression("block standard errors: the design is singular".into()))?;
+    // The tail sums S_m of each run, from its end backwards.
+    let mut tail = vec![vec![0.0; p]; n];
+    let mut acc = vec![0.0; p];
+    for k in (0..n).rev() {
+        if k + 1 < n && segments[k + 1] != segments[k] {
+            acc.iter_mut().for_each(|v| *v = 0.0);
+        }
+        for (s, v) in acc.iter_mut().zip(&x[k]) {
+            *s += v;
+        }
+        tail[k].clone_from(&acc);
+    }
+    // Increments within a run and their scores u_m·S_m.
+    let (mut u, mut t, mut z) = (Vec::new(), Vec::new(), Vec::new());
+    for k in 1..n {
+        if segments[k] != segments[k - 1] {
+            continue;
+        }
+        let du = residuals[k] - residuals[k - 1];
+        u.push(du);
+        t.push(times[k]);
+        z.push(tail[k].iter().map(|s| du * s).collect::<Vec<f64>>());
+    }
+    let m = u.len();
+    if m < blocks {
+        return Err(Error::Regression(format!(
+            "block standard errors: {m} increments cannot fill {blocks} blocks"
+        )));
+    }
+    let tc = correlation_time(&u, &t).ok_or_else(|| {
+        Error::Regression(
+            "block standard errors: the heading increments do not decorrelate within half the window"
+                .into(),
+        )
+    })?;
+    let span = t[m - 1] - t[0];
+    if span < blocks as f64 * decorrelations * tc {
+        return Err(Error::Regression(format!(
+            "block standard errors: {blocks} blocks of {:.1} s are shorter than {decorrelations} correlation times of {tc:.2} s",
+            span / blocks as f64
+        )));
+    }
+    let mut omega = vec![vec![0.0; p]; p];
+    for b in 0..blocks {
+        let mut zb = vec![0.0; p];
+        for zk in &z[b * m / blocks..(b + 1) * m / blocks] {
+            for (s, v) in zb.iter_mut().zip(zk) {
+                *s += v;
+            }
+        }
+        for i in 0..p {
+            for j in 0..p {
+                omega[i][j] += zb[i] * zb[j];
+            }
+        }
+    }
+    let g = blocks as f64;
+    let std_error = (0..p)
+        .map(|j| {
+            // V_jj = Σ_ik A_ji Ω_ik A_kj, with Ω grown by g/(g − 1).
+            let v: f64 = (0..p)
+                .flat_map(|i| (0..p).map(move |k| (i, k)))
+                .map(|(i, k)| a[j][i] * omega[i][k] * a[k][j])
+                .sum();
+            (g / (g - 1.0) * v).max(0.0).sqrt()
+        })
+        .collect();
+    Ok(IncrementBlockStd {
+        std_error,
+        blocks,
+        correlation_time_s: tc,
+    })
+}
+
 /// The summary statistics live in one place, `deadreckon_core::metrics`.
 pub use deadreckon_core::metrics::{mean, median};
 
@@ -413,6 +566,63 @@ mod tests {
         let w: Vec<f64> = (0..v.len()).map(|k| v[k] - 0.9 * v[k.max(1) - 1]).collect();
         assert!((correlation_time(&w[1..], &t[1..]).expect("white") - 0.1).abs() < 1e-9);
         assert!(correlation_time(&[1.0; 10], &t[..10]).is_none());
+    }
+
+    /// A cumulative regression with random-walk errors, as the joint
+    /// calibration's: `y = c_s + β·Σd + W + v`, Σd the cumulative distance
+    /// at a speed that varies, W a random walk, v white noise, two runs with
+    /// their own intercepts. Over 300 seeded replications the block standard
+    /// error's root mean square is within 20 % of the spread of β̂ (measured
+    /// 1.05× the spread), while the OLS one is 35 times too small (0.028×).
+    #[test]
+    fn block_std_of_a_cumulative_regression_matches_the_spread() {
+        let mut seed = 7u64;
+        let mut uniform = move || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let (n, reps) = (2000, 300);
+        let (mut betas, mut block_var, mut ols_var) = (Vec::new(), 0.0, 0.0);
+        for _ in 0..reps {
+            let (mut d, mut w) = (0.0, 0.0);
+            let mut x = Vec::with_capacity(n);
+            let mut y = Vec::with_capacity(n);
+            let segments: Vec<u32> = (0..n).map(|k| u32::from(k >= n / 3)).collect();
+            let times: Vec<f64> = (0..n).map(|k| 0.1 * k as f64).collect();
+            for (k, &segment) in segments.iter().enumerate() {
+                let speed = 1.0 + (0.01 * k as f64).sin() + 0.5 * uniform();
+                d += 0.1 * speed;
+                w += 0.01 * uniform();
+                y.push(2.0e-3 * d + w + 0.02 * uniform() + f64::from(segment));
+                x.push(vec![d]);
+            }
+            let mut rows: Vec<Vec<f64>> = x.iter().zip(&y).map(|(a, b)| vec![a[0], *b]).collect();
+            crate::history::centre_per_segment(&mut rows, &segments);
+            let (xc, yc): (Vec<Vec<f64>>, Vec<f64>) =
+                rows.into_iter().map(|r| (vec![r[0]], r[1])).unzip();
+            let fit = ols(&xc, &yc, &["distance"]).expect("fit");
+            let e = fit.residuals(&xc, &yc);
+            let b = increment_block_std(&xc, &e, &segments, &times, 10, 2.0).expect("std");
+            assert_eq!(b.blocks, 10);
+            betas.push(fit.coefficients[0].estimate);
+            block_var += b.std_error[0].powi(2) / reps as f64;
+            ols_var += fit.coefficients[0].std_error.powi(2) / reps as f64;
+        }
+        let m = mean(&betas);
+        let spread =
+            (betas.iter().map(|b| (b - m).powi(2)).sum::<f64>() / (reps - 1) as f64).sqrt();
+        let (block, plain) = (block_var.sqrt() / spread, ols_var.sqrt() / spread);
+        eprintln!("block {block:.3}, OLS {plain:.3} of the spread {spread:.3e}");
+        assert!((block - 1.0).abs() < 0.2, "{block}");
+        assert!(plain < 0.5, "{plain}");
+        // Bad input is an error naming why.
+        let x = vec![vec![1.0], vec![2.0], vec![3.0]];
+        let err = increment_block_std(&x, &[0.0; 3], &[0; 3], &[0.0, 1.0], 2, 2.0);
+        assert!(err.is_err());
+        let err = increment_block_std(&x, &[0.1, -0.1, 0.0], &[0; 3], &[0.0, 1.0, 2.0], 4, 2.0);
+        assert!(format!("{:?}", err).contains("cannot fill"), "{err:?}");
     }
 
     #[test]

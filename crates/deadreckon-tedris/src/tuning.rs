@@ -138,3 +138,18 @@ pub const REFIT_TEST_MIN_BATCHES: usize = 4;
 /// 1–12, 3–5 s on the simulated robot), so that the batch means are close to
 /// independent, as the t test takes them.
 pub const REFIT_TEST_DECORRELATIONS: f64 = 2.0;
+
+/// Blocks of the fit rows over which the joint calibration's standard errors
+/// are taken (`stats::increment_block_std`: block sums of the scores of the
+/// heading residual *increments*, taken as independent). Ten, as the batch
+/// means literature's usual 10–30 batches at the low end: the blocks of a
+/// 450 s fit (the default 600 s calibration window's first three quarters)
+/// are then 45 s long, far beyond the seconds within which the increments
+/// decorrelate (a turn's misfit, the reference's noise), at the price of a
+/// variance estimated with 9 degrees of freedom (about ±24 % on the
+/// standard error). Set from that argument, not tuned on any drive.
+pub const CALIBRATION_STD_BLOCKS: usize = 10;
+/// ... each at least this many correlation times of the residual increments
+/// long (else the standard errors are not estimated): as the refit guard's
+/// batches, [`REFIT_TEST_DECORRELATIONS`].
+pub const CALIBRATION_STD_DECORRELATIONS: f64 = REFIT_TEST_DECORRELATIONS;

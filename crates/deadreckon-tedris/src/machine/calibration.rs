@@ -4,7 +4,7 @@
 //! on held-back data; the heading lag.
 
 use super::*;
-use crate::stats::{correlation_time, paired_batch_test, PairedTest};
+use crate::stats::{correlation_time, increment_block_std, paired_batch_test, PairedTest};
 use crate::tuning::*;
 
 impl Tedris {
@@ -91,6 +91,8 @@ impl Tedris {
             // estimate is blended into the previous one.
             let w = model.config.dcf_smoothing;
             model.dcf_rad = w * x + (1.0 - w) * model.dcf_rad;
+            // Eq. (6) gives no standard error.
+            model.dcf_std_rad = None;
         }
     }
 
@@ -200,6 +202,9 @@ impl Tedris {
             dcf_rad: if per_metre { 0.0 } else { beta[0] },
             distance_rad_per_m: None,
             gain: None,
+            residuals: fit.residuals(&x, &y),
+            x,
+            fit,
         };
         let mut k = usize::from(!per_metre);
         if use_d {
@@ -243,7 +248,7 @@ impl Tedris {
         };
         let kinds = calibration_kinds(model);
         let mut current_rms = f64::INFINITY;
-        let mut best: Option<(crate::config::ModelKind, Calibration, f64)> = None;
+        let mut best: Option<(crate::config::ModelKind, Calibration, f64, CalibrationRows)> = None;
         let mut refused = false;
         for kind in kinds {
             let mut m = model.clone();
@@ -260,6 +265,7 @@ impl Tedris {
                 .partition_point(|&x| x < first + FIT_SHARE * (last - first));
             let (fit_rows, held) = rows.rows.split_at(split);
             let (fit_segs, held_segs) = rows.segments.split_at(split);
+            let fit_times = &rows.times[..split];
             if kind == model.chosen {
                 current_rms = held_rms(
                     held,
@@ -279,13 +285,18 @@ impl Tedris {
                         c.gain.unwrap_or(model.turn_gain),
                     );
                     if rms.is_finite() && best.as_ref().is_none_or(|b| rms < b.2) {
-                        best = Some((kind, c, rms));
+                        let fit_part = CalibrationRows {
+                            rows: Vec::new(),
+                            segments: fit_segs.to_vec(),
+                            times: fit_times.to_vec(),
+                        };
+                        best = Some((kind, c, rms, fit_part));
                     }
                 }
                 None => refused = true,
             }
         }
-        let Some((kind, c, rms)) = best else {
+        let Some((kind, c, rms, fit_part)) = best else {
             if refused {
                 self.refused_calibrations += 1;
             }
@@ -295,17 +306,29 @@ impl Tedris {
             self.refused_calibrations += 1;
             return;
         }
+        let installed = InstalledCalibration::new(&c, &fit_part, t);
         let Some(model) = self.model.as_mut() else {
             return;
         };
+        // The standard errors of the values installed; a term left out keeps
+        // its value and the standard error it came with.
+        let std = installed.std_error.as_ref();
+        let se = |name: &str| {
+            let j = installed.names.iter().position(|n| n == name)?;
+            std.map(|s| s[j])
+        };
         model.chosen = kind;
         model.dcf_rad = c.dcf_rad;
+        model.dcf_std_rad = se("dcf");
         if let Some(d) = c.distance_rad_per_m {
             model.dcf_distance_rad_per_m = d;
+            model.dcf_distance_std_rad_per_m = se("dcf_distance");
         }
         if let Some(g) = c.gain {
             model.turn_gain = g;
+            model.turn_gain_std = se("gain");
         }
+        self.last_calibration = Some(installed);
     }
 }
 
@@ -480,11 +503,84 @@ pub(super) fn held_rms(rows: &[[f64; 4]], segments: &[u32], dcf: f64, dist: f64,
 }
 
 /// The result of one joint calibration.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 struct Calibration {
     dcf_rad: f64,
     distance_rad_per_m: Option<f64>,
     gain: Option<f64>,
+    /// The design (centred per heading segment), its fit and residuals,
+    /// for the standard errors of the values it installs.
+    x: Vec<Vec<f64>>,
+    fit: crate::stats::OlsFit,
+    residuals: Vec<f64>,
+}
+
+/// The joint calibration last installed ([`Tedris::last_calibration`]):
+/// what its values rest on and their standard errors, with the OLS ones for
+/// comparison.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct InstalledCalibration {
+    /// When it was made (the machine's time), s.
+    pub t_s: f64,
+    /// Rows of the fit (samples with a reference heading on the first
+    /// `FIT_SHARE` of the calibration window).
+    pub rows: usize,
+    /// The fitted columns: `dcf` (rad per moving sample), `dcf_distance`
+    /// (rad per metre), `gain` (turn gain − 1, whose standard error is the
+    /// gain's).
+    pub names: Vec<String>,
+    /// The estimates, in `names` order.
+    pub estimates: Vec<f64>,
+    /// The autocorrelation-robust standard errors
+    /// ([`crate::stats::increment_block_std`]), in `names` order; `None`:
+    /// not estimated, for the reason in `not_estimated_because`.
+    pub std_error: Option<Vec<f64>>,
+    /// Why `std_error` is `None`.
+    pub not_estimated_because: Option<String>,
+    /// Blocks of the robust standard errors (0 when not estimated).
+    pub blocks: usize,
+    /// Correlation time of the heading residual increments, s (`None`
+    /// when not estimated).
+    pub correlation_time_s: Option<f64>,
+    /// The ordinary least-squares standard errors, in `names` order: they
+    /// take the cumulative heading's residuals as independent, which they
+    /// are not (random-walk-like), and come out several times too small.
+    /// Kept for comparison only; never installed.
+    pub ols_std_error: Vec<f64>,
+}
+
+impl InstalledCalibration {
+    fn new(c: &Calibration, fit_part: &CalibrationRows, t: f64) -> Self {
+        let robust = increment_block_std(
+            &c.x,
+            &c.residuals,
+            &fit_part.segments,
+            &fit_part.times,
+            CALIBRATION_STD_BLOCKS,
+            CALIBRATION_STD_DECORRELATIONS,
+        );
+        let (std_error, not_estimated_because, blocks, correlation_time_s) = match robust {
+            Ok(b) => (
+                Some(b.std_error),
+                None,
+                b.blocks,
+                Some(b.correlation_time_s),
+            ),
+            Err(e) => (None, Some(e.to_string()), 0, None),
+        };
+        let co = &c.fit.coefficients;
+        InstalledCalibration {
+            t_s: t,
+            rows: c.x.len(),
+            names: co.iter().map(|k| k.name.clone()).collect(),
+            estimates: co.iter().map(|k| k.estimate).collect(),
+            std_error,
+            not_estimated_because,
+            blocks,
+            correlation_time_s,
+            ols_std_error: co.iter().map(|k| k.std_error).collect(),
+        }
+    }
 }
 
 /// The lag h ∈ ±`max_lag` for which the reference heading is best explained

@@ -37,7 +37,7 @@ mod scale;
 mod sync;
 mod training;
 
-pub use calibration::heading_lag;
+pub use calibration::{heading_lag, InstalledCalibration};
 pub use sync::{course_convention, ConventionFit, CourseConvention};
 pub use training::straight_line;
 
@@ -232,6 +232,9 @@ pub struct Tedris {
     /// regressions (see `Tedris::refit_verdict`).
     #[serde(default)]
     refused_refits: u64,
+    /// The joint calibration last installed, with its standard errors.
+    #[serde(default)]
+    last_calibration: Option<InstalledCalibration>,
     /// Why no model exists yet: the requirement that failed last, with numbers.
     #[serde(default)]
     untrained_because: Option<String>,
@@ -301,6 +304,7 @@ impl Tedris {
             refused_calibrations: 0,
             accepted_refits: 0,
             refused_refits: 0,
+            last_calibration: None,
             untrained_because: None,
             model_alarms: 0,
             alarm_active: false,
@@ -407,6 +411,13 @@ impl Tedris {
     /// or reaching a physical bound).
     pub fn refused_calibrations(&self) -> u64 {
         self.refused_calibrations
+    }
+
+    /// The joint calibration last installed: its rows, estimates and
+    /// standard errors (the robust ones the model carries, and the OLS ones
+    /// for comparison); `None` before the first.
+    pub fn last_calibration(&self) -> Option<&InstalledCalibration> {
+        self.last_calibration.as_ref()
     }
 
     /// Refits of the regressions installed once trained: with the joint

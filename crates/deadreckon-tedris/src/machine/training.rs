@@ -237,8 +237,14 @@ impl Tedris {
             old.dcf_rad,
             old.config.joint_calibration(),
         );
+        let (gain_std, dist_std, dcf_std) = (
+            old.turn_gain_std,
+            old.dcf_distance_std_rad_per_m,
+            old.dcf_std_rad,
+        );
         if let Ok(mut m) = old.refit() {
             m.turn_gain = gain;
+            m.turn_gain_std = gain_std;
             m.distance_scale = scale;
             m.per_metre_straight = per_metre;
             m.course_convention = convention;
@@ -247,6 +253,8 @@ impl Tedris {
                 // The calibrated values stand until a calibration beats them.
                 m.dcf_distance_rad_per_m = dist;
                 m.dcf_rad = dcf;
+                m.dcf_distance_std_rad_per_m = dist_std;
+                m.dcf_std_rad = dcf_std;
             }
             if self.guard_refit(&m, guarded, t) {
                 self.model = Some(m);
