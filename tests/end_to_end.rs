@@ -579,6 +579,18 @@ fn tedris_train_variant_paper_and_extended() {
         p["dcf_distance_rad_per_m"].is_null() && p["turn_gain"].is_null(),
         "{p}"
     );
+    // Standard errors: none from eq. (6) nor for what is not estimated
+    // (null, never 0); the joint calibration's distance term has one.
+    for k in ["dcf_std_rad", "dcf_distance_std_rad_per_m", "turn_gain_std"] {
+        assert!(p[k].is_null(), "{k}: {p}");
+    }
+    assert!(e["dcf_std_rad"].is_null(), "{e}");
+    let per_m_std = e["dcf_distance_std_rad_per_m"].as_f64().unwrap();
+    assert!(per_m_std > 0.0, "{e}");
+    eprintln!(
+        "tedris-car: heading per metre {} ± {per_m_std:.2e} rad/m, turn gain {} ± {}",
+        e["dcf_distance_rad_per_m"], e["turn_gain"], e["turn_gain_std"]
+    );
     // The simulated receiver's course is the antenna's velocity.
     assert_eq!(
         e["course_convention"]["convention"], "antenna_velocity",
@@ -720,10 +732,21 @@ fn tedris_ignored_the_stored_corrections_and_its_json_lost_its_checks() {
         "{r}"
     );
     assert_eq!(r["checks"]["skipped"], false, "{r}");
+    // The values the machine holds at the end of the run, with their
+    // standard errors (null when not estimated).
+    let cal = &r["calibrated"];
+    assert!(cal["turn_gain"].as_f64().is_some(), "{r}");
+    for k in ["dcf_std_rad", "dcf_distance_std_rad_per_m", "turn_gain_std"] {
+        assert!(
+            cal[k].is_null() || cal[k].as_f64().is_some_and(|s| s > 0.0),
+            "{k}: {r}"
+        );
+    }
     let r = json(&run_ok(&[
         "tedris", "run", d, "--model", m, "--outage", &window, "--params", ps, "--json",
     ]));
     assert_eq!(r["corrections"], format!("stored in {ps}"), "{r}");
     let text = run_ok(&["tedris", "run", d, "--model", m, "--outage", &window]);
     assert!(text.contains("corrections applied: the model's"), "{text}");
+    assert!(text.contains("at the end of the run: "), "{text}");
 }

@@ -356,7 +356,11 @@ def tedris_train(
     (``skip_checks``); the summary's ``checks`` holds the warnings.
     ``params``: a params.toml whose stored corrections (delays, IMU tilt,
     gyro scale) are applied to the drive first; the model keeps them
-    (``corrections``) and :func:`tedris_run` applies them too.
+    (``corrections``) and :func:`tedris_run` applies them too. The
+    summary's calibrated values (``dcf_rad``, ``dcf_distance_rad_per_m``,
+    ``turn_gain``) come with their standard errors (``dcf_std_rad``,
+    ``dcf_distance_std_rad_per_m``, ``turn_gain_std``; ``None``: not
+    estimated), as in ``tedris train --json``.
     """
     text, summary = _native.tedris_train(
         _source(drive),
@@ -386,7 +390,8 @@ def tedris_run(
 ) -> Dict[str, Any]:
     """Runs TedriS with GNSS blanked in ``outages`` ((start_s, end_s), drive
     clock); returns ``tedris run --json``'s object (``outages``,
-    ``reference``, ``source``, ``model``, ``corrections``,
+    ``reference``, ``source``, ``model``, ``calibrated``: the values the
+    machine holds at the end with their standard errors, ``corrections``,
     ``tedris_checks``, ``checks``) with ``track``: the predicted track as a
     DataFrame (instead of the CSV's path). The drive gets the corrections
     stored in ``params`` (a params.toml), or else those the model was

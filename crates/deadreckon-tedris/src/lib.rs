@@ -154,7 +154,13 @@
 //!   (to about 10⁻⁶ rad per sample on the car) and the scale of turns; block
 //!   increments of a noisy course, or 30 s windows, give these 10–100 times less
 //!   precisely than the heading over minutes. This is the largest gain (car,
-//!   seeds 7–12: 3.6 m → 1.4 m).
+//!   seeds 7–12: 3.6 m → 1.4 m). Each installed value carries its standard
+//!   error (`TedrisModel::dcf_std_rad`, `dcf_distance_std_rad_per_m`,
+//!   `turn_gain_std`; `None`: not estimated): the residuals of a cumulative
+//!   heading are random-walk-like and the OLS formula reads 18–153 times
+//!   smaller on the car family, so they are taken over blocks of the residual increments
+//!   ([`stats::increment_block_std`]; docs/tedris.md, "Calibrated values and
+//!   their standard errors").
 //! - Lag from the heading: h minimises the
 //!   residual of the reference heading fitted on the wheels' cumulative sums
 //!   h samples earlier ([`machine::heading_lag`]); the per-sample
@@ -232,7 +238,7 @@
 //!
 //! | module | concept |
 //! |---|---|
-//! | [`stats`] | OLS, coefficient table (estimate, standard error, t, p), median, the paired batch-means t test of the refit guard |
+//! | [`stats`] | OLS, coefficient table (estimate, standard error, t, p), median, the paired batch-means t test of the refit guard, the block standard errors of a cumulative regression (the joint calibration's) |
 //! | [`baseline`] | the plain least-squares baseline TedriS is compared with |
 //! | [`residuals`] | autocorrelation, Box–Pierce, Ljung–Box, AR/MA correction |
 //! | [`ccf`] | cross-correlation ω/γ, lag at the peak |

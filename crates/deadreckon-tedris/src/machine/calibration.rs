@@ -248,7 +248,9 @@ impl Tedris {
         };
         let kinds = calibration_kinds(model);
         let mut current_rms = f64::INFINITY;
-        let mut best: Option<(crate::config::ModelKind, Calibration, f64, CalibrationRows)> = None;
+        // The best kind, its calibration, held-back RMS, and its fit rows'
+        // segments and times (for the standard errors).
+        let mut best: Option<(crate::config::ModelKind, Calibration, f64, FitRows)> = None;
         let mut refused = false;
         for kind in kinds {
             let mut m = model.clone();
@@ -285,11 +287,7 @@ impl Tedris {
                         c.gain.unwrap_or(model.turn_gain),
                     );
                     if rms.is_finite() && best.as_ref().is_none_or(|b| rms < b.2) {
-                        let fit_part = CalibrationRows {
-                            rows: Vec::new(),
-                            segments: fit_segs.to_vec(),
-                            times: fit_times.to_vec(),
-                        };
+                        let fit_part = (fit_segs.to_vec(), fit_times.to_vec());
                         best = Some((kind, c, rms, fit_part));
                     }
                 }
@@ -502,6 +500,9 @@ pub(super) fn held_rms(rows: &[[f64; 4]], segments: &[u32], dcf: f64, dist: f64,
     rms_about_segment_means(&e, segments)
 }
 
+/// The heading segments and times of a calibration's fit rows.
+type FitRows = (Vec<u32>, Vec<f64>);
+
 /// The result of one joint calibration.
 #[derive(Debug, Clone)]
 struct Calibration {
@@ -550,12 +551,12 @@ pub struct InstalledCalibration {
 }
 
 impl InstalledCalibration {
-    fn new(c: &Calibration, fit_part: &CalibrationRows, t: f64) -> Self {
+    fn new(c: &Calibration, (segments, times): &FitRows, t: f64) -> Self {
         let robust = increment_block_std(
             &c.x,
             &c.residuals,
-            &fit_part.segments,
-            &fit_part.times,
+            segments,
+            times,
             CALIBRATION_STD_BLOCKS,
             CALIBRATION_STD_DECORRELATIONS,
         );
@@ -659,6 +660,43 @@ mod tests {
 
     fn betas(m: &TedrisModel) -> Vec<Vec<f64>> {
         m.fits.iter().map(|f| f.global_beta.clone()).collect()
+    }
+
+    /// The installed values carry the last calibration's robust standard
+    /// errors; a model file written before they existed loads them as not
+    /// estimated; a negative one is an error naming the key.
+    #[test]
+    fn model_files_carry_the_calibrations_standard_errors() {
+        let m = trained();
+        let model = m.model.as_ref().expect("model");
+        let last = m.last_calibration().expect("a calibration was installed");
+        let std = last.std_error.as_ref().expect("estimated");
+        let j = last
+            .names
+            .iter()
+            .position(|n| n == "dcf_distance")
+            .expect("fitted");
+        assert_eq!(model.dcf_distance_std_rad_per_m, Some(std[j]));
+        assert!(std[j] > 0.0 && std[j] > last.ols_std_error[j], "{last:?}");
+        let mut v = serde_json::to_value(model).expect("serialises");
+        let o = v.as_object_mut().expect("an object");
+        for k in ["dcf_std_rad", "dcf_distance_std_rad_per_m", "turn_gain_std"] {
+            o.remove(k).expect("written");
+        }
+        let old = TedrisModel::from_json(&v.to_string()).expect("loads");
+        assert_eq!(
+            (
+                old.dcf_std_rad,
+                old.dcf_distance_std_rad_per_m,
+                old.turn_gain_std
+            ),
+            (None, None, None)
+        );
+        let mut bad = model.clone();
+        bad.turn_gain_std = Some(-1e-3);
+        let text = serde_json::to_string(&bad).expect("serialises");
+        let e = TedrisModel::from_json(&text).expect_err("refused");
+        assert!(e.to_string().contains("turn_gain_std"), "{e}");
     }
 
     #[test]
