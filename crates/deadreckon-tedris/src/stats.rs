@@ -370,35 +370,32 @@ pub fn increment_block_std(
     }
     let a = invert(&xtx)
         .ok_or_else(|| Error::Regression("block standard errors: the design is singular".into()))?;
-    // The tail sums S_m of each run, from its end backwards.
-    let mut tail = vec![vec![0.0; p]; n];
-    let mut acc = vec![0.0; p];
+    // The tail sums S_m of each run, from its end backwards (row-major).
+    let mut tail = vec![0.0; n * p];
     for k in (0..n).rev() {
-        if k + 1 < n && segments[k + 1] != segments[k] {
-            acc.iter_mut().for_each(|v| *v = 0.0);
+        let continues = k + 1 < n && segments[k + 1] == segments[k];
+        for j in 0..p {
+            let after = if continues {
+                tail[(k + 1) * p + j]
+            } else {
+                0.0
+            };
+            tail[k * p + j] = after + x[k][j];
         }
-        for (s, v) in acc.iter_mut().zip(&x[k]) {
-            *s += v;
-        }
-        tail[k].clone_from(&acc);
     }
-    // Increments within a run and their scores u_m·S_m.
-    let (mut u, mut t, mut z) = (Vec::new(), Vec::new(), Vec::new());
-    for k in 1..n {
-        if segments[k] != segments[k - 1] {
-            continue;
-        }
-        let du = residuals[k] - residuals[k - 1];
-        u.push(du);
-        t.push(times[k]);
-        z.push(tail[k].iter().map(|s| du * s).collect::<Vec<f64>>());
-    }
-    let m = u.len();
+    // Increments within a run (the first row of a run has none).
+    let rows: Vec<usize> = (1..n).filter(|&k| segments[k] == segments[k - 1]).collect();
+    let m = rows.len();
     if m < blocks {
         return Err(Error::Regression(format!(
             "block standard errors: {m} increments cannot fill {blocks} blocks"
         )));
     }
+    let u: Vec<f64> = rows
+        .iter()
+        .map(|&k| residuals[k] - residuals[k - 1])
+        .collect();
+    let t: Vec<f64> = rows.iter().map(|&k| times[k]).collect();
     let tc = correlation_time(&u, &t).ok_or_else(|| {
         Error::Regression(
             "block standard errors: the heading increments do not decorrelate within half the window"
@@ -412,12 +409,15 @@ pub fn increment_block_std(
             span / blocks as f64
         )));
     }
+    // Ω = Σ_b z_b z_bᵀ, z_b the block's sum of the scores u_m·S_m.
     let mut omega = vec![vec![0.0; p]; p];
+    let mut zb = vec![0.0; p];
     for b in 0..blocks {
-        let mut zb = vec![0.0; p];
-        for zk in &z[b * m / blocks..(b + 1) * m / blocks] {
-            for (s, v) in zb.iter_mut().zip(zk) {
-                *s += v;
+        zb.iter_mut().for_each(|v| *v = 0.0);
+        for i in b * m / blocks..(b + 1) * m / blocks {
+            let k = rows[i];
+            for (j, z) in zb.iter_mut().enumerate() {
+                *z += u[i] * tail[k * p + j];
             }
         }
         for i in 0..p {

@@ -202,8 +202,8 @@ impl Tedris {
             dcf_rad: if per_metre { 0.0 } else { beta[0] },
             distance_rad_per_m: None,
             gain: None,
-            residuals: fit.residuals(&x, &y),
             x,
+            y,
             fit,
         };
         let mut k = usize::from(!per_metre);
@@ -509,11 +509,11 @@ struct Calibration {
     dcf_rad: f64,
     distance_rad_per_m: Option<f64>,
     gain: Option<f64>,
-    /// The design (centred per heading segment), its fit and residuals,
+    /// The design and response (centred per heading segment) and the fit,
     /// for the standard errors of the values it installs.
     x: Vec<Vec<f64>>,
+    y: Vec<f64>,
     fit: crate::stats::OlsFit,
-    residuals: Vec<f64>,
 }
 
 /// The joint calibration last installed ([`Tedris::last_calibration`]):
@@ -554,7 +554,7 @@ impl InstalledCalibration {
     fn new(c: &Calibration, (segments, times): &FitRows, t: f64) -> Self {
         let robust = increment_block_std(
             &c.x,
-            &c.residuals,
+            &c.fit.residuals(&c.x, &c.y),
             segments,
             times,
             CALIBRATION_STD_BLOCKS,
