@@ -6,9 +6,15 @@
 //!   predicted to the wheel timestamp and updated with the wheels and the most
 //!   recent *unused* reading of each other sensor (older readings between two
 //!   wheel epochs are discarded, as in the paper) and with a GNSS fix if one
-//!   arrived since the previous epoch.
+//!   arrived since the previous epoch. While the gyro is live, an epoch
+//!   without a gyro reading of its own leaves the steering reading waiting
+//!   for the next epoch that has one ([`crate::gyro_hold`]: a gyro on its own
+//!   clock is often a few milliseconds late, and the steering must not stand
+//!   in for it).
 //! - [`Timing::EachMeasurement`]: every reading is processed at its own
-//!   timestamp, one epoch per reading.
+//!   timestamp, one epoch per reading; a steering reading that arrives while
+//!   the gyro's latest reading is live is applied right after the next gyro
+//!   reading ([`crate::gyro_hold`]).
 //!
 //! Any sensor may be absent: the filter uses the streams the drive has. The
 //! per-epoch predicted and updated states, covariances and Jacobians are kept
@@ -24,6 +30,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::drive::{Drive, GnssFix, Wheels};
 use crate::filter::{AugmentedLayout, CarLayout, Filter, Layout, Prediction};
+use crate::gyro_hold::GyroHold;
 use crate::kalman::CovarianceForm;
 use crate::model::{Mat, State};
 use crate::vehicle::Params;
@@ -220,6 +227,11 @@ pub struct FilterStats {
     /// Readings of the other sensors not used because a newer one arrived before the
     /// next wheel epoch (the paper's scheme).
     pub readings_superseded: usize,
+    /// Steering readings held back for a later epoch with a gyro reading,
+    /// because the gyro was live but had no reading at the steering's epoch
+    /// ([`crate::gyro_hold`]).
+    #[serde(default)]
+    pub steering_deferred: usize,
     /// GNSS fixes used.
     pub gnss_updates: usize,
     /// GNSS fixes rejected by the Mahalanobis gate.
@@ -313,6 +325,9 @@ pub struct Feeder {
     pending_speed: Option<f64>,
     pending_steering: Option<f64>,
     pending_gnss: Option<GnssFix>,
+    /// The gyro's latest reading, live for a while ([`crate::gyro_hold`]).
+    #[serde(default)]
+    gyro: GyroHold,
     stats: FilterStats,
     #[serde(skip)]
     updates: Vec<Update>,
@@ -363,6 +378,7 @@ impl Feeder {
             pending_speed: None,
             pending_steering: None,
             pending_gnss: None,
+            gyro: GyroHold::default(),
             stats: FilterStats::default(),
             updates: Vec::new(),
             gated_fix_t_s: None,
@@ -623,11 +639,14 @@ impl Feeder {
         };
         match self.timing {
             Timing::WheelEpochs => match ev.measurement {
-                Measurement::YawRate { yaw_rate_rps } if use_.gyro => supersede(
-                    &mut self.pending_gyro,
-                    yaw_rate_rps,
-                    &mut self.stats.readings_superseded,
-                ),
+                Measurement::YawRate { yaw_rate_rps } if use_.gyro => {
+                    supersede(
+                        &mut self.pending_gyro,
+                        yaw_rate_rps,
+                        &mut self.stats.readings_superseded,
+                    );
+                    self.gyro.push(t, yaw_rate_rps);
+                }
                 Measurement::Speed { speed_mps } if use_.speed => supersede(
                     &mut self.pending_speed,
                     speed_mps,
@@ -657,14 +676,21 @@ impl Feeder {
                             self.wheel_updates(f, &ev.measurement, interval)?;
                         }
                     }
+                    let fresh_gyro = self.pending_gyro.is_some();
                     if let Some(v) = self.pending_gyro.take() {
                         self.updates.push(f.update_gyro(v)?);
                     }
                     if let Some(v) = self.pending_speed.take() {
                         self.updates.push(f.update_speed(v)?);
                     }
-                    if let Some(v) = self.pending_steering.take() {
-                        self.updates.push(f.update_steering(v)?);
+                    // While the gyro is live, the steering waits for an
+                    // epoch with a gyro reading of its own (crate::gyro_hold).
+                    if fresh_gyro || !(use_.gyro && self.gyro.is_live(t)) {
+                        if let Some(v) = self.pending_steering.take() {
+                            self.updates.push(f.update_steering(v)?);
+                        }
+                    } else if self.pending_steering.is_some() {
+                        self.stats.steering_deferred += 1;
                     }
                     if let Some(fix) = self.pending_gnss.take() {
                         self.gnss_update(f, &fix)?;
@@ -711,6 +737,22 @@ impl Feeder {
                 if !used {
                     return Ok(());
                 }
+                if let Measurement::Steering { steering_wheel_rad } = ev.measurement {
+                    if use_.gyro && self.gyro.is_live(t) {
+                        // Waits for the next gyro reading (a newer steering
+                        // reading supersedes it).
+                        if self.pending_steering.replace(steering_wheel_rad).is_some() {
+                            self.stats.readings_superseded += 1;
+                        }
+                        self.stats.steering_deferred += 1;
+                        return Ok(());
+                    }
+                    // The gyro has stopped: the steering stands in, and a
+                    // reading still waiting is superseded by this one.
+                    if self.pending_steering.take().is_some() {
+                        self.stats.readings_superseded += 1;
+                    }
+                }
                 let prediction = self.predict(f, t);
                 match ev.measurement {
                     Measurement::WheelTicks { .. } | Measurement::WheelSpeeds { .. } => {
@@ -724,7 +766,11 @@ impl Feeder {
                         }
                     }
                     Measurement::YawRate { yaw_rate_rps } => {
-                        self.updates.push(f.update_gyro(yaw_rate_rps)?)
+                        self.gyro.push(t, yaw_rate_rps);
+                        self.updates.push(f.update_gyro(yaw_rate_rps)?);
+                        if let Some(v) = self.pending_steering.take() {
+                            self.updates.push(f.update_steering(v)?);
+                        }
                     }
                     Measurement::Speed { speed_mps } => {
                         self.updates.push(f.update_speed(speed_mps)?)

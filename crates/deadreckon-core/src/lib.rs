@@ -34,6 +34,7 @@ pub mod event;
 pub mod evo;
 pub mod filter;
 pub mod geo;
+pub mod gyro_hold;
 pub mod gyro_scale;
 pub mod imu;
 pub mod init;
