@@ -444,13 +444,20 @@ fn comma2k19_import_calibrate_evaluate_report() {
             // the GNSS-aided start hands over: the u-blox fixes sit 0.39 m
             // west of the reference for the whole segment (which heads
             // north throughout), and the windows start a median 0.432 m
-            // off. Measured: start 0.431 m, final 0.559 m (medians; 0.621
+            // off. Measured: start 0.434 m, final 0.613 m (medians; 0.621
             // before the augmented pass held the scale and circumferences
-            // while the heading was unknown).
+            // while the heading was unknown, 0.559 m before the steering
+            // waited for the gyro (issue 28), which took the held-out
+            // halves from 0.908 / 0.744 m to 0.807 / 0.691 m: this figure
+            // is in-sample, and a gyro bias 2.4e-5 rad/s off moves it by
+            // 0.1 m).
             let (s, f) = (&o["start_error_m"]["median"], &o["final_error_m"]["median"]);
             let (s, f) = (s.as_f64().unwrap(), f.as_f64().unwrap());
             assert!((0.40..0.47).contains(&s), "start {s}");
-            assert!((0.52..0.60).contains(&f), "final {f}");
+            assert!((0.57..0.65).contains(&f), "final {f}");
+            // Every window starts with the heading known (yaw standard
+            // deviation 0.14-0.48 deg measured).
+            assert_eq!(o["unsettled"].as_array().unwrap().len(), 0, "{o}");
         }
     }
     // Bounds on the measured figures (see the closing note of the readers issue).

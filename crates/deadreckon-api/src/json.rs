@@ -188,12 +188,20 @@ pub fn outage_json(outage_s: f64, params: &str, ev: &OutageEvaluation) -> Value 
         "distance_to_1m_m": summary_json(&ev.distance_to_1m()),
         "windows_reaching_1m": ev.windows.iter().filter(|w| w.time_to(1.0).is_some()).count(),
         "gates": gates_json(&ev.gates),
-        "outages": ev.windows.iter().map(|w| json!({
-            "start_s": w.start_s, "end_s": w.end_s,
-            "start_error_m": w.start_m(), "mean_error_m": w.mean_m(),
-            "max_error_m": w.max_m(), "final_error_m": w.final_m(),
-            "distance_m": w.distance_m, "time_to_1m_s": w.time_to(1.0),
-        })).collect::<Vec<_>>(),
+        "outages": ev.windows.iter().map(outage_window_json).collect::<Vec<_>>(),
+        "heading_limit_deg": ev.heading_limit_rad.is_finite().then(|| ev.heading_limit_rad.to_degrees()),
+        "unsettled": ev.unsettled.iter().map(outage_window_json).collect::<Vec<_>>(),
+    })
+}
+
+/// One outage window of `evaluate --outage --json` (`outages[]`, `unsettled[]`).
+fn outage_window_json(w: &deadreckon_core::outage::OutageResult) -> Value {
+    json!({
+        "start_s": w.start_s, "end_s": w.end_s,
+        "start_error_m": w.start_m(), "mean_error_m": w.mean_m(),
+        "max_error_m": w.max_m(), "final_error_m": w.final_m(),
+        "distance_m": w.distance_m, "time_to_1m_s": w.time_to(1.0),
+        "start_yaw_std_deg": w.start_yaw_std_rad.map(f64::to_degrees),
     })
 }
 

@@ -256,6 +256,9 @@ pub fn outage_lines(
         ("drift per 100 m (%)", ev.drift_pct()),
         ("distance before 1 m (m)", ev.distance_to_1m()),
     ]));
+    if let Some(line) = unsettled_line(ev) {
+        out.push(line);
+    }
     out.push(format!(
         "rejected by the χ² gates: {}",
         gated_text(&ev.gates)
@@ -264,6 +267,37 @@ pub fn outage_lines(
         out.extend(corrections_lines(c));
     }
     out
+}
+
+/// The windows left out of the summaries because the heading was not yet
+/// known at their start, with their final errors (`None` when there are none).
+pub fn unsettled_line(ev: &deadreckon_core::outage::OutageEvaluation) -> Option<String> {
+    if ev.unsettled.is_empty() {
+        return None;
+    }
+    let stds: Vec<f64> = ev
+        .unsettled
+        .iter()
+        .filter_map(|w| w.start_yaw_std_rad.map(f64::to_degrees))
+        .collect();
+    let (lo, hi) = stds
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
+    let finals: Vec<String> = ev
+        .unsettled
+        .iter()
+        .map(|w| format!("{:.2}", w.final_m()))
+        .collect();
+    Some(format!(
+        "left out: {} window{} starting before the heading was known (the aided filter's yaw \
+         standard deviation {lo:.1}–{hi:.1}° at the start, above {:.1}°), final errors {} m",
+        ev.unsettled.len(),
+        if ev.unsettled.len() == 1 { "" } else { "s" },
+        ev.heading_limit_rad.to_degrees(),
+        finals.join(", ")
+    ))
 }
 
 /// `evaluate --metric rpe|ape`'s two lines: what was measured, and the

@@ -157,6 +157,9 @@ pub struct OutageResult {
     pub travelled_m: Vec<f64>,
     /// The distance travelled over the window, m (NaN when unknown).
     pub distance_m: f64,
+    /// The filter's yaw standard deviation where the dead reckoning started,
+    /// rad (`None` when the estimator has none).
+    pub start_yaw_std_rad: Option<f64>,
 }
 
 impl OutageResult {
@@ -179,6 +182,7 @@ impl OutageResult {
             errors,
             travelled_m,
             distance_m,
+            start_yaw_std_rad: None,
         }
     }
 

@@ -8,6 +8,15 @@
 //! 100 m (end error over the distance travelled in the window), and the distance
 //! travelled before the error first reaches 1 m (the window's distance when it
 //! never does, flagged as censored).
+//!
+//! A window counts only once the heading is known: where the aided filter's
+//! yaw standard deviation at the window's start is above
+//! [`HEADING_KNOWN_YAW_STD_RAD`], the window is **unsettled**: evaluated and
+//! reported on its own ([`OutageEvaluation::unsettled`]), not in the
+//! summaries. Dead reckoning from a heading nobody knows measures the
+//! initialisation, not the dead reckoning: on a dynamic-world family the
+//! first window at pull-away, with the yaw standard deviation still 14–17°,
+//! ended 31–66 m off and doubled every mean (issue 28).
 
 use crate::compared::{Antenna, Position, RearAxle};
 use crate::drive::Drive;
@@ -34,6 +43,13 @@ pub struct OutageEvaluation {
     /// The χ² gate counters summed over every filter run of the evaluation:
     /// the GNSS-aided run and the dead reckoning through every window.
     pub gates: GateCounts,
+    /// Windows whose start had the aided filter's yaw standard deviation above
+    /// `heading_limit_rad` (typically at pull-away, before the fixes told
+    /// the heading): evaluated, reported on their own, and left out of
+    /// `windows` and the summaries.
+    pub unsettled: Vec<OutageResult>,
+    /// The yaw standard deviation above which a window is unsettled, rad.
+    pub heading_limit_rad: f64,
 }
 
 impl OutageEvaluation {
@@ -73,6 +89,12 @@ impl OutageEvaluation {
 /// The speed above which the vehicle counts as moving for the sliding windows, m/s.
 pub const MOVING_MPS: f64 = 0.5;
 
+/// The aided filter's yaw standard deviation above which the heading is not
+/// yet known and an outage window starting there is unsettled, rad: 0.035
+/// (2°, the level at which the augmented filter starts learning the
+/// distance scale, [`crate::vehicle::SCALE_HOLD_YAW_STD_RAD`]).
+pub const HEADING_KNOWN_YAW_STD_RAD: f64 = 0.035;
+
 /// Refuses outage windows that are empty or not inside the drive's wheel time
 /// span, naming the span: a window after the end gave a four-wheel error and
 /// "NaN … never" for TedriS.
@@ -103,6 +125,25 @@ struct Collect(Vec<(f64, State)>);
 impl EpochHook for Collect {
     fn after_epoch(&mut self, t: f64, x: &mut State, _p: &mut Mat) {
         self.0.push((t, *x));
+    }
+}
+
+/// The speeds of the aided run, and its first epoch and time.
+struct Aided {
+    first_t: f64,
+    last_t: f64,
+    moving_t: Option<f64>,
+}
+
+impl EpochHook for Aided {
+    fn after_epoch(&mut self, t: f64, x: &mut State, _p: &mut Mat) {
+        if self.first_t.is_nan() {
+            self.first_t = t;
+        }
+        self.last_t = t;
+        if self.moving_t.is_none() && x[V].abs() > MOVING_MPS {
+            self.moving_t = Some(t);
+        }
     }
 }
 
@@ -143,30 +184,33 @@ pub fn evaluate(
         record_innovations: false,
         ..base.clone()
     };
-    let mut epochs = Collect(Vec::new());
-    ekf::run(drive, params, &aided_opts, &mut epochs)?;
-    let (Some(first), Some(last_epoch)) = (epochs.0.first(), epochs.0.last()) else {
-        return Err(Error::Insufficient("the filter produced no epochs".into()));
+    let mut aided = Aided {
+        first_t: f64::NAN,
+        last_t: f64::NAN,
+        moving_t: None,
     };
-    let mut end_limit = last_epoch.0;
+    ekf::run(drive, params, &aided_opts, &mut aided)?;
+    if aided.first_t.is_nan() {
+        return Err(Error::Insufficient("the filter produced no epochs".into()));
+    }
+    let mut end_limit = aided.last_t;
     if let Some(t) = &truth {
         end_limit = end_limit.min(t.span().map(|s| s.1).unwrap_or(f64::NEG_INFINITY));
     } else if let Some(g) = drive.gnss.last() {
         end_limit = end_limit.min(g.t_s);
     }
-    let Some(moving) = epochs.0.iter().find(|e| e.1[V].abs() > MOVING_MPS) else {
+    let Some(moving_t) = aided.moving_t else {
         return Err(Error::Insufficient(format!(
             "the vehicle never moves faster than {MOVING_MPS} m/s: no outage to evaluate"
         )));
     };
-    let (first_t, moving_t) = (first.0, moving.0);
+    let first_t = aided.first_t;
     let mut starts = Vec::new();
     let mut start = (first_t + warmup_s).max(moving_t);
     while start + outage_s <= end_limit {
         starts.push(start);
         start += step_s;
     }
-    drop(epochs);
 
     // The second pass steps the same filter; at each window start a clone of
     // it (filter, feeder and the events still to come) goes on without GNSS
@@ -178,6 +222,7 @@ pub fn evaluate(
     let mut upcoming = events.next();
     let mut noop = |_: &mut Filter<CarLayout, 5>, _: EpochOut<'_, 5>| {};
     let mut windows = Vec::new();
+    let mut unsettled = Vec::new();
     let mut gates = GateCounts::default();
     for &start in &starts {
         let end = start + outage_s;
@@ -188,6 +233,7 @@ pub fn evaluate(
         }
         feeder.finish(&mut f, &mut noop)?;
         let t0 = f.time_s();
+        let yaw_std = f.covariance()[(YAW, YAW)].max(0.0).sqrt();
         let before = *f.gates();
         let (mut g, mut fd, mut evs, mut next) =
             (f.clone(), feeder.clone(), events.clone(), upcoming);
@@ -202,8 +248,13 @@ pub fn evaluate(
         }
         fd.finish(&mut g, &mut keep)?;
         gates.add(&g.gates().since(&before));
-        if let Some(w) = window_errors(drive, truth.as_ref(), &states, t0, start, end) {
-            windows.push(w);
+        if let Some(mut w) = window_errors(drive, truth.as_ref(), &states, t0, start, end) {
+            w.start_yaw_std_rad = Some(yaw_std);
+            if yaw_std > HEADING_KNOWN_YAW_STD_RAD {
+                unsettled.push(w);
+            } else {
+                windows.push(w);
+            }
         }
     }
     // The aided run's own counts, through the end of the drive.
@@ -213,11 +264,25 @@ pub fn evaluate(
     }
     feeder.finish(&mut f, &mut noop)?;
     gates.add(f.gates());
-    if windows.is_empty() {
+    if windows.is_empty() && unsettled.is_empty() {
         return Err(Error::Insufficient(format!(
             "the drive ({:.1}–{:.1} s, moving from {:.1} s) is too short for a {outage_s} s \
              outage after {warmup_s} s of warm-up",
             first_t, end_limit, moving_t
+        )));
+    }
+    if windows.is_empty() {
+        let least = unsettled
+            .iter()
+            .filter_map(|w| w.start_yaw_std_rad)
+            .fold(f64::INFINITY, f64::min);
+        return Err(Error::Insufficient(format!(
+            "no outage window starts with the heading known: the aided filter's yaw standard \
+             deviation is at least {:.1}° at the {} window starts (above {:.1}°); the drive \
+             does not tell the heading (too few GNSS fixes while moving?)",
+            least.to_degrees(),
+            unsettled.len(),
+            HEADING_KNOWN_YAW_STD_RAD.to_degrees()
         )));
     }
     Ok(OutageEvaluation {
@@ -225,6 +290,8 @@ pub fn evaluate(
         reference,
         windows,
         gates,
+        unsettled,
+        heading_limit_rad: HEADING_KNOWN_YAW_STD_RAD,
     })
 }
 
@@ -333,6 +400,8 @@ pub fn through_windows(
         reference,
         windows: out,
         gates: run.stats.gates,
+        unsettled: Vec::new(),
+        heading_limit_rad: f64::INFINITY,
     })
 }
 
