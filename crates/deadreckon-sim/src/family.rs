@@ -248,6 +248,7 @@ impl CarFamily {
                 truth_rate_hz: 50.0,
                 wheel_faults: None,
             },
+            dynamics: None,
         }
     }
 }

@@ -23,6 +23,7 @@
 //! | steering wheel | r_s · atan(l_RF · κ + β), β white: the noise of eq. 7 on tan(δ/r_s) |
 //! | wheel faults (optional) | spin bursts under traction on one wheel, one wheel smaller from some time on ([`faults`]) |
 //! | GNSS | antenna position (lever arm forward of M) + white noise; course and speed from the antenna velocity + white noise |
+//! | vehicle dynamics (optional `[dynamics]`) | a quasi-steady single-track model with load-sensitive tyre cornering stiffness and load transfer ([`dynamics`]): the body yaw is M's course less the rear side slip β_r ≈ −g·a_y; gyro, wheels (each along its own axis), antenna and truth yaw follow the body; the steering reads the understeer δ ≈ L·κ + K_us·a_y |
 //!
 //! Other vehicle shapes: [`tricycle`] simulates a steered, driven front
 //! wheel with steering and traction encoders and an external tracker, through
@@ -42,6 +43,7 @@
 //! ```
 #![deny(missing_docs)]
 
+pub mod dynamics;
 pub mod family;
 pub mod faults;
 pub mod profile;
@@ -53,6 +55,7 @@ mod truth;
 
 use deadreckon_core::{Drive, Params};
 
+pub use dynamics::DynamicsSpec;
 pub use faults::{ShrinkSpec, SpinSpec, WheelFaultsSpec};
 pub use profile::SpeedSpec;
 pub use route::{RouteSpec, Segment};
@@ -173,9 +176,20 @@ pub fn simulate(scenario: &Scenario, seed: u64) -> Result<SimOutput, SimError> {
         ));
     }
     let params = scenario.true_params();
-    let kin = truth::Kinematics::new(&route, &profile, &scenario.vehicle);
+    let model = scenario
+        .dynamics
+        .as_ref()
+        .map(|d| dynamics::Model::new(d, &scenario.vehicle));
+    let kin = truth::Kinematics::new(&route, &profile, &scenario.vehicle, model);
     let mut integrator = truth::Integrator::new(&kin, scenario.integration_rate_hz, t_end);
-    let mut suite = sensors::Suite::new(&scenario.sensors, &scenario.vehicle, &params, seed, t_end);
+    let mut suite = sensors::Suite::new(
+        &scenario.sensors,
+        &scenario.vehicle,
+        &params,
+        seed,
+        t_end,
+        kin.is_dynamic(),
+    );
 
     let first = *integrator.state();
     suite.sample(&kin, &first, &first);

@@ -416,6 +416,8 @@ pub(crate) struct Suite {
     imu_gyro: Vec<Axes>,
     imu_accel: Vec<Axes>,
     faults: Option<(WheelFaults, Noise)>,
+    /// Whether the truth has side slip (`[dynamics]`).
+    dynamic: bool,
 }
 
 const WHEELS: usize = 0;
@@ -432,6 +434,7 @@ impl Suite {
         params: &Params,
         seed: u64,
         t_end: f64,
+        dynamic: bool,
     ) -> Self {
         let clocks = [
             Some(Clock::new(spec.wheels.rate_hz, spec.wheels.offset_s)),
@@ -491,6 +494,7 @@ impl Suite {
                 .wheel_faults
                 .clone()
                 .map(|f| (WheelFaults::new(f), Noise::new(seed, 6))),
+            dynamic,
         }
     }
 
@@ -534,7 +538,19 @@ impl Suite {
                                 + if i == 2 { bias } else { 0.0 }
                                 + n.gauss(g.noise_std)
                         });
-                        let f_v = [st.a, st.v * st.yaw_rate, deadreckon_core::imu::GRAVITY_MPS2];
+                        let f_v = if self.dynamic {
+                            // M's acceleration (a along the course, v·χ̇
+                            // across it) in the body frame, turned by β_r.
+                            let (sb, cb) = st.beta.sin_cos();
+                            let across = st.v * st.v * st.kappa;
+                            [
+                                st.a * cb - across * sb,
+                                st.a * sb + across * cb,
+                                deadreckon_core::imu::GRAVITY_MPS2,
+                            ]
+                        } else {
+                            [st.a, st.v * st.yaw_rate, deadreckon_core::imu::GRAVITY_MPS2]
+                        };
                         let f = [0, 1, 2].map(|i| {
                             (0..3).map(|j| m[i][j] * f_v[j]).sum::<f64>()
                                 + n.gauss(ACCEL_NOISE_STD_MPS2)
@@ -571,7 +587,14 @@ impl Suite {
                 let (std, offset, lat) = self.spec.steering.as_ref().map_or((0.0, 0.0, 0.0), |g| {
                     (g.noise_std, g.wheel_offset_rad, g.latency_s)
                 });
-                let tan = self.wheelbase * st.kappa + self.noise[STEERING].gauss(std);
+                // The road-wheel angle's tangent: L·κ kinematically, with
+                // the understeer under dynamics.
+                let exact = if self.dynamic {
+                    st.road_wheel_rad.tan()
+                } else {
+                    self.wheelbase * st.kappa
+                };
+                let tan = exact + self.noise[STEERING].gauss(std);
                 self.steering.push(Scalar {
                     t_s: t_s + lat,
                     value: self.steering_ratio * tan.atan() + offset,
@@ -689,6 +712,10 @@ impl Suite {
             // A body-yaw course is the direction the car faces: it does not
             // turn round when the car reverses.
             let (lat, fwd) = match spec.course_convention {
+                CourseConvention::AntennaVelocity if self.dynamic => {
+                    let (sb, cb) = st.beta.sin_cos();
+                    (st.v * sb + l * st.yaw_rate, st.v * cb)
+                }
                 CourseConvention::AntennaVelocity => (l * st.yaw_rate, st.v),
                 CourseConvention::BodyYaw => (0.0, st.v.abs()),
             };
