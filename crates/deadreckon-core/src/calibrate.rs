@@ -31,13 +31,13 @@
 use nalgebra::{DMatrix, DVector};
 
 use crate::chords::{chord_scale, ChordScale};
-use crate::kinematics::steering::{calibrate_steering_understeer, SteeringCalibration};
-use crate::side_slip::SideSlip;
 use crate::drive::{Drive, Wheels};
 use crate::ekf::{self, FilterOptions, Init, Timing};
+use crate::kinematics::steering::{calibrate_steering_understeer, SteeringCalibration};
 use crate::model::{State, V, YAW_RATE};
 use crate::observation::Sensors;
 use crate::reference::Reference;
+use crate::side_slip::SideSlip;
 
 use crate::vehicle::{Noise, Params, ParamsWithStd};
 use crate::Error;
@@ -377,7 +377,7 @@ pub fn smoothing_pass(drive: &Drive, p: &Params, opts: &CalibrationOptions) -> R
     if let Some(c) = chords {
         widen_for_chords(&mut est, c.std);
     }
-    let side_slip = crate::side_slip::estimate(drive, &reference);
+    let side_slip = crate::side_slip::estimate(drive, &reference, est.params.gyro_bias_rps);
     let steering = if drive.steering.is_empty() {
         None
     } else {

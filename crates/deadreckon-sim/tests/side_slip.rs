@@ -1,0 +1,178 @@
+//! Tyre side slip and the steering's understeer (issue 28), measured on
+//! family cars driven with the simulator's `[dynamics]` (a quasi-steady
+//! single-track model; `deadreckon_sim::dynamics`).
+//!
+//! Each car gets its own tyres (rear cornering stiffness 90–170 kN/rad,
+//! front 75–125 kN/rad: side-slip gradients g of 0.0037–0.0070 rad per
+//! m/s²), corners at up to 3.5 m/s² (0.36 g) and carries a steering stream
+//! with a 0.02 rad offset. The RTS calibration of a 1200 s drive estimates g
+//! ([`deadreckon_core::side_slip`]) and the steering (ratio, offset,
+//! understeer); a 300 s drive of the same car is then dead-reckoned through
+//! sliding 30 s outages with the calibrated parameters: the paper's model
+//! against the model with the side slip (and the steering) calibrated.
+//!
+//! Two receivers per car: the family's as drawn (white noise 0.3–1.5 m and a
+//! Gauss–Markov wander of up to 1.5 m, 20–120 s), and the same without the
+//! wander. Neither has latency: the GNSS delay is not what is measured here.
+
+use deadreckon_core::calibrate::{self, Calibration, CalibrationOptions};
+use deadreckon_core::ekf::FilterOptions;
+use deadreckon_core::outage::evaluate;
+use deadreckon_core::{Drive, Params};
+use deadreckon_sim::family::CarFamily;
+use deadreckon_sim::sensors::SteeringSpec;
+use deadreckon_sim::{simulate, DynamicsSpec, Scenario};
+
+/// Family cars measured.
+const CARS: std::ops::RangeInclusive<u64> = 1..=10;
+
+/// The dynamics of car `seed`: its tyres' cornering stiffnesses spread
+/// over their range by the seed (golden-ratio sequences, reproducible).
+fn dynamics(seed: u64) -> DynamicsSpec {
+    let u = (seed as f64 * 0.618_033_988_75).fract();
+    let w = (seed as f64 * 0.414_213_562_37).fract();
+    DynamicsSpec {
+        cornering_stiffness_rear_n_per_rad: 90_000.0 + 80_000.0 * u,
+        cornering_stiffness_front_n_per_rad: 75_000.0 + 50_000.0 * w,
+        ..DynamicsSpec::default()
+    }
+}
+
+/// A forward-only drive of `car` drawn from `drive_seed`, at least
+/// `duration_s` long, with the car's dynamics, lateral acceleration up to
+/// 3.5 m/s², a steering stream with a 0.02 rad offset, and the receiver
+/// without latency (and without its wander unless `wander`).
+fn scenario(car: &CarFamily, drive_seed: u64, duration_s: f64, wander: bool) -> Scenario {
+    let mut sc = car
+        .drive_forward(drive_seed, duration_s)
+        .with_dynamics(Some(dynamics(car.seed)));
+    sc.speed.max_lateral_accel_mps2 = 3.5;
+    let g = sc.sensors.gnss.as_mut().expect("family GNSS");
+    g.latency_s = 0.0;
+    if !wander {
+        g.markov_std_m = 0.0;
+    }
+    sc.sensors.steering = Some(SteeringSpec {
+        rate_hz: 50.0,
+        offset_s: 0.0,
+        noise_std: 0.02,
+        latency_s: 0.0,
+        true_ratio: None,
+        wheel_offset_rad: 0.02,
+    });
+    sc
+}
+
+/// One car with one receiver: the calibration and the evaluation drive.
+struct Car {
+    seed: u64,
+    g_true: f64,
+    calibration: Calibration,
+    evaluation: Drive,
+}
+
+fn car(seed: u64, wander: bool) -> Car {
+    let car = CarFamily::draw(seed);
+    let cal = simulate(&scenario(&car, 1000 + seed, 1200.0, wander), 1000 + seed).unwrap();
+    let calibration = calibrate::calibrate(&cal.drive, &CalibrationOptions::default()).unwrap();
+    let ev = simulate(&scenario(&car, 2000 + seed, 300.0, wander), 2000 + seed).unwrap();
+    Car {
+        seed,
+        g_true: dynamics(seed).rear_slip_gradient_rad_per_mps2(&car.vehicle),
+        calibration,
+        evaluation: ev.drive,
+    }
+}
+
+/// Mean final error of sliding 30 s outages (every 15 s) on `drive` with
+/// `params`, m.
+fn outage_error(drive: &Drive, params: &Params) -> f64 {
+    evaluate(drive, params, 30.0, 15.0, 5.0, &FilterOptions::default())
+        .unwrap()
+        .final_error()
+        .mean
+}
+
+/// The mean 30 s outage errors of `c`'s evaluation drive with its
+/// calibrated parameters: the paper's model, with the calibrated g, and
+/// with g and the calibrated steering.
+fn outages(c: &Car) -> [f64; 3] {
+    let slip = c.calibration.side_slip.as_ref().expect("RTS: side slip");
+    let st = c.calibration.steering.as_ref().expect("steering");
+    let params = c.calibration.estimate.params;
+    let paper = outage_error(&c.evaluation, &params);
+    let mut slipping = c.evaluation.clone();
+    slipping.vehicle.rear_slip_gradient_rad_per_mps2 = slip.fitted;
+    let with_slip = outage_error(&slipping, &params);
+    let mut steered = slipping;
+    steered.vehicle.steering_ratio = st.ratio.value;
+    steered.vehicle.steering_offset_rad = st.offset.value;
+    if let Some(u) = st.understeer.as_ref().filter(|u| u.estimated) {
+        steered.vehicle.understeer_gradient_rad_per_mps2 = u.value;
+    }
+    [paper, with_slip, outage_error(&steered, &params)]
+}
+
+#[test]
+fn the_side_slip_gradient_is_within_3_sigma_and_modelling_it_shortens_outages() {
+    for wander in [true, false] {
+        let (mut within, mut estimated) = (0, 0);
+        let mut errors = Vec::new();
+        for seed in CARS {
+            let c = car(seed, wander);
+            let slip = c.calibration.side_slip.as_ref().expect("RTS: side slip");
+            let (g, sd) = (slip.fitted, slip.fitted_std);
+            let z = (g - c.g_true) / sd;
+            within += usize::from(z.abs() <= 3.0);
+            estimated += usize::from(slip.gradient.estimated);
+            let e = outages(&c);
+            let st = c.calibration.steering.as_ref().expect("steering");
+            println!(
+                "car {} (wander {wander}): g {g:.5} ± {sd:.5} (truth {:.5}, {z:+.2} σ, {}, {} \
+                 blocks, RMS a_y {:.2} m/s²); steering ratio {:.3} ± {:.3}, offset {:.4} ± \
+                 {:.4} rad, K_us {}; 30 s outages: paper {:.3} m, slip {:.3} m, slip + steering \
+                 {:.3} m",
+                c.seed,
+                c.g_true,
+                if slip.gradient.estimated {
+                    "estimated"
+                } else {
+                    "NOT estimated"
+                },
+                slip.blocks,
+                slip.rms_lateral_accel_mps2,
+                st.ratio.value,
+                st.ratio.std.unwrap_or(f64::NAN),
+                st.offset.value,
+                st.offset.std.unwrap_or(f64::NAN),
+                st.understeer.as_ref().map_or("-".into(), |u| match u.std {
+                    Some(s) => format!("{:.5} ± {s:.5}", u.value),
+                    None => "not estimated".into(),
+                }),
+                e[0],
+                e[1],
+                e[2],
+            );
+            errors.push(e);
+        }
+        let n = errors.len() as f64;
+        let mean = |k: usize| errors.iter().map(|e| e[k]).sum::<f64>() / n;
+        let (paper, slip, steer) = (mean(0), mean(1), mean(2));
+        println!(
+            "wander {wander}: {within} of {n} within 3σ, {estimated} estimated; mean 30 s outage \
+             error: paper {paper:.3} m, slip {slip:.3} m, slip + steering {steer:.3} m"
+        );
+        // Measured (cars 1–10, 1200 s calibration drives, 300 s evaluation
+        // drives): with the wander 10 of 10 within 3σ (z −1.88..+1.91), 1
+        // estimated (σ 0.00095–0.00355), outages 3.678 → 3.569 m (−3.0 %);
+        // without it 10 of 10 within 3σ (z −2.44..+2.23, mean +0.77: the
+        // load transfer makes the slip grow faster than a_y), 9 estimated
+        // (σ 0.00021–0.00077, car 9's 0.00142 not), outages 1.740 →
+        // 1.551 m (−10.9 %), 1.543 m with the steering calibrated too.
+        assert!(within as f64 >= 0.9 * n, "{within} of {n} within 3σ");
+        let (most_estimated, gain) = if wander { (0, 0.99) } else { (8, 0.93) };
+        assert!(estimated >= most_estimated, "{estimated} estimated");
+        assert!(slip < gain * paper, "{slip} vs {paper}");
+        assert!(steer < gain * paper, "{steer} vs {paper}");
+    }
+}
