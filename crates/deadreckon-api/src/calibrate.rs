@@ -206,7 +206,7 @@ impl CarCalibration {
 
 /// The steering calibration as a params.toml table: value, std (when
 /// estimated) and the reason when not.
-fn steering_toml(st: &SteeringCalibration) -> toml::Table {
+pub(crate) fn steering_toml(st: &SteeringCalibration) -> toml::Table {
     let mut t = toml::Table::new();
     for p in [&st.ratio, &st.offset]
         .into_iter()
@@ -235,7 +235,7 @@ fn estimate_toml(p: &deadreckon_core::kinematics::ParamEstimate) -> toml::Table 
 
 /// The side-slip gradient as the params.toml table `[side_slip]`: the
 /// estimate (`rear_slip_gradient_rad_per_mps2`) and the blocks used.
-fn side_slip_toml(s: &deadreckon_core::side_slip::SideSlip) -> toml::Table {
+pub(crate) fn side_slip_toml(s: &deadreckon_core::side_slip::SideSlip) -> toml::Table {
     let mut t = toml::Table::new();
     t.insert(s.gradient.name.clone(), estimate_toml(&s.gradient).into());
     t.insert("blocks".into(), (s.blocks as i64).into());
