@@ -67,6 +67,8 @@ fn scenario(car: &CarFamily, drive_seed: u64, duration_s: f64, wander: bool) -> 
 struct Car {
     seed: u64,
     g_true: f64,
+    k_us_true: f64,
+    ratio_true: f64,
     calibration: Calibration,
     evaluation: Drive,
 }
@@ -79,6 +81,8 @@ fn car(seed: u64, wander: bool) -> Car {
     Car {
         seed,
         g_true: dynamics(seed).rear_slip_gradient_rad_per_mps2(&car.vehicle),
+        k_us_true: dynamics(seed).understeer_gradient_rad_per_mps2(&car.vehicle),
+        ratio_true: car.vehicle.steering_ratio,
         calibration,
         evaluation: ev.drive,
     }
@@ -117,6 +121,9 @@ fn outages(c: &Car) -> [f64; 3] {
 fn the_side_slip_gradient_is_within_3_sigma_and_modelling_it_shortens_outages() {
     for wander in [true, false] {
         let (mut within, mut estimated) = (0, 0);
+        // Steering: (ratio, offset, K_us) each within 3σ, on the cars whose
+        // K_us was estimated; and how many those were.
+        let (mut steering_within, mut steering_cars) = ([0; 3], 0);
         let mut errors = Vec::new();
         for seed in CARS {
             let c = car(seed, wander);
@@ -127,10 +134,24 @@ fn the_side_slip_gradient_is_within_3_sigma_and_modelling_it_shortens_outages() 
             estimated += usize::from(slip.gradient.estimated);
             let e = outages(&c);
             let st = c.calibration.steering.as_ref().expect("steering");
+            if let Some(u) = st.understeer.as_ref().filter(|u| u.estimated) {
+                steering_cars += 1;
+                for (k, (p, truth)) in [
+                    (&st.ratio, c.ratio_true),
+                    (&st.offset, 0.02),
+                    (u, c.k_us_true),
+                ]
+                .into_iter()
+                .enumerate()
+                {
+                    let z = (p.value - truth) / p.std.unwrap();
+                    steering_within[k] += usize::from(z.abs() <= 3.0);
+                }
+            }
             println!(
                 "car {} (wander {wander}): g {g:.5} ± {sd:.5} (truth {:.5}, {z:+.2} σ, {}, {} \
                  blocks, RMS a_y {:.2} m/s²); steering ratio {:.3} ± {:.3}, offset {:.4} ± \
-                 {:.4} rad, K_us {}; 30 s outages: paper {:.3} m, slip {:.3} m, slip + steering \
+                 {:.4} rad, K_us {} (truth {:.5}); 30 s outages: paper {:.3} m, slip {:.3} m, slip + steering \
                  {:.3} m",
                 c.seed,
                 c.g_true,
@@ -149,6 +170,7 @@ fn the_side_slip_gradient_is_within_3_sigma_and_modelling_it_shortens_outages() 
                     Some(s) => format!("{:.5} ± {s:.5}", u.value),
                     None => "not estimated".into(),
                 }),
+                c.k_us_true,
                 e[0],
                 e[1],
                 e[2],
@@ -160,7 +182,9 @@ fn the_side_slip_gradient_is_within_3_sigma_and_modelling_it_shortens_outages() 
         let (paper, slip, steer) = (mean(0), mean(1), mean(2));
         println!(
             "wander {wander}: {within} of {n} within 3σ, {estimated} estimated; mean 30 s outage \
-             error: paper {paper:.3} m, slip {slip:.3} m, slip + steering {steer:.3} m"
+             error: paper {paper:.3} m, slip {slip:.3} m, slip + steering {steer:.3} m; steering \
+             with K_us on {steering_cars} cars, within 3σ: ratio {}, offset {}, K_us {}",
+            steering_within[0], steering_within[1], steering_within[2]
         );
         // Measured (cars 1–10, 1200 s calibration drives, 300 s evaluation
         // drives): with the wander 10 of 10 within 3σ (z −1.88..+1.91), 1
@@ -174,5 +198,19 @@ fn the_side_slip_gradient_is_within_3_sigma_and_modelling_it_shortens_outages() 
         assert!(estimated >= most_estimated, "{estimated} estimated");
         assert!(slip < gain * paper, "{slip} vs {paper}");
         assert!(steer < gain * paper, "{steer} vs {paper}");
+        // The steering against the smoothed states: K_us estimated on 9 of
+        // 10 cars (car 9, RMS a_y 0.56 m/s², took its turns at too few
+        // speeds: its two-parameter ratio, 17.22 for 16, holds the
+        // understeer), and there ratio, offset and K_us each within 3σ on
+        // all 9 (K_us: z −2.8..+1.8, car 4 the worst), with and without the
+        // wander.
+        assert!(steering_cars >= 8, "K_us on {steering_cars} cars");
+        for (k, name) in ["ratio", "offset", "K_us"].iter().enumerate() {
+            assert!(
+                steering_within[k] as f64 >= 0.9 * steering_cars as f64,
+                "{name}: {} of {steering_cars} within 3σ",
+                steering_within[k]
+            );
+        }
     }
 }
