@@ -122,7 +122,6 @@ fn calibrated_model(c: &Car, drive: &Drive) -> Drive {
 /// with g and the calibrated steering.
 fn outages(c: &Car) -> [f64; 3] {
     let slip = c.calibration.side_slip.as_ref().expect("RTS: side slip");
-    let st = c.calibration.steering.as_ref().expect("steering");
     let params = c.calibration.estimate.params;
     let paper = outage_error(&c.evaluation, &params);
     let mut slipping = c.evaluation.clone();
