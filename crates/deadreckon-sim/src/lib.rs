@@ -46,6 +46,7 @@
 pub mod dynamics;
 pub mod family;
 pub mod faults;
+pub mod imperfections;
 pub mod profile;
 pub mod route;
 pub mod scenario;
@@ -57,6 +58,7 @@ use deadreckon_core::{Drive, Params};
 
 pub use dynamics::DynamicsSpec;
 pub use faults::{ShrinkSpec, SpinSpec, WheelFaultsSpec};
+pub use imperfections::{ClockSpec, MultipathSpec};
 pub use profile::SpeedSpec;
 pub use route::{RouteSpec, Segment};
 pub use scenario::Scenario;
@@ -145,6 +147,12 @@ pub struct SimStats {
     pub heading_change_rad: f64,
     /// Wheel-spin bursts simulated (`[sensors.wheel_faults.spin]`), `(start, end)` in s.
     pub spin_bursts: Vec<(f64, f64)>,
+    /// GNSS multipath bursts simulated (`[sensors.gnss.multipath]`), `(start,
+    /// end, east offset, north offset)` in s (true time) and m.
+    pub multipath_bursts: Vec<(f64, f64, f64, f64)>,
+    /// The tone rings' tooth position errors per wheel FL, FR, RL, RR, in
+    /// tooth pitches (`sensors.wheels.tooth_error_std`; `None` without).
+    pub tooth_errors: Option<[Vec<f64>; 4]>,
 }
 
 /// Simulates `scenario` with the noise drawn from `seed` (a PCG-64 generator
@@ -221,6 +229,8 @@ pub fn simulate(scenario: &Scenario, seed: u64) -> Result<SimOutput, SimError> {
         wheel_distance_m: prev.wheel_m,
         heading_change_rad: prev.psi - first.psi,
         spin_bursts: suite.spin_bursts(),
+        multipath_bursts: suite.multipath_bursts(),
+        tooth_errors: suite.tooth_errors(),
     };
     let drive = suite.finish(scenario.vehicle.clone());
     drive.validate()?;

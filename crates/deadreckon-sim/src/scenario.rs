@@ -374,6 +374,35 @@ impl Scenario {
                 ));
             }
         }
+        for (key, r, clock) in self.sensors.ecu_clocks() {
+            if let Some(c) = clock {
+                c.check(key, r).map_err(|(k, m)| invalid(&k, m))?;
+            }
+        }
+        let tooth = self.sensors.wheels.tooth_error_std;
+        if !(tooth.is_finite() && (0.0..=0.1).contains(&tooth)) {
+            return Err(invalid(
+                "sensors.wheels.tooth_error_std",
+                format!("must be within 0..=0.1 tooth pitches, got {tooth}"),
+            ));
+        }
+        if let Some(g) = &self.sensors.gyro {
+            let tau = g.bias_drift_tau_s;
+            if !(tau.is_finite() && tau > 0.0) {
+                return Err(invalid(
+                    "sensors.gyro.bias_drift_tau_s",
+                    format!("must be a positive number of seconds, got {tau}"),
+                ));
+            }
+        }
+        if let Some(m) = self
+            .sensors
+            .gnss
+            .as_ref()
+            .and_then(|g| g.multipath.as_ref())
+        {
+            m.check().map_err(|(k, m)| invalid(&k, m))?;
+        }
         for (key, v) in self.sensors.noises() {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(invalid(
