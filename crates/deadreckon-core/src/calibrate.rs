@@ -384,7 +384,8 @@ pub fn smoothing_pass(drive: &Drive, p: &Params, opts: &CalibrationOptions) -> R
         Some(calibrate_steering_understeer(
             drive,
             &reference,
-            opts.min_speed_mps,
+            opts.min_speed_mps
+                .max(crate::kinematics::steering::SMOOTHED_MIN_SPEED_MPS),
         )?)
     };
     Ok(Pass {

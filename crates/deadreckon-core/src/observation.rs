@@ -14,10 +14,11 @@
 //!   course of M is `ψ + β_r` ([`Sensors::yaw`]). The GNSS antenna's
 //!   position is rigid geometry (eq. 10), unchanged;
 //! - the steering's offset `s₀` and understeer gradient `K_us`: the wheel
-//!   angle of eq. (7) is `δ = (s − s₀)/r_s − K_us·v·ψ̇` at the prior state
+//!   angle of eq. (7) is `δ = (s − s₀)/r_s − K_us·|v|·ψ̇` at the prior state
 //!   ([`Sensors::wheel_angle`]), so that `l_RF·ψ̇ = v·tan δ` stays the
 //!   kinematic relation `atan(l_RF·κ)` of the convention
-//!   `s = r_s·(atan(l_RF·κ) + K_us·a_y) + s₀`.
+//!   `s = r_s·(atan(l_RF·κ) + K_us·a_y) + s₀` (`|v|·ψ̇ = a_y` forwards;
+//!   reversing, the front tyre's slip angle turns round with the velocity).
 
 use crate::model::{Row, State, V, X, Y, YAW, YAW_RATE};
 use crate::vehicle::{Params, Vehicle};
@@ -173,7 +174,7 @@ impl Sensors {
     }
 
     /// The virtual front-wheel angle of a steering-wheel reading `s` at the
-    /// prior state `x_prior`, rad: `δ = (s − s₀)/r_s − K_us·v·ψ̇` (`s/r_s`
+    /// prior state `x_prior`, rad: `δ = (s − s₀)/r_s − K_us·|v|·ψ̇` (`s/r_s`
     /// with the paper's model, offset and understeer 0). The lateral
     /// acceleration is the prior's, as eq. (7) takes the prior speed.
     pub fn wheel_angle(&self, steering_wheel_rad: f64, x_prior: &State) -> f64 {
@@ -181,7 +182,7 @@ impl Sensors {
         if self.understeer_gradient_rad_per_mps2 == 0.0 {
             d
         } else {
-            d - self.understeer_gradient_rad_per_mps2 * x_prior[V] * x_prior[YAW_RATE]
+            d - self.understeer_gradient_rad_per_mps2 * x_prior[V].abs() * x_prior[YAW_RATE]
         }
     }
 

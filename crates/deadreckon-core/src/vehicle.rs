@@ -238,7 +238,8 @@ pub struct Vehicle {
     pub steering_offset_rad: f64,
     /// K_us: understeer gradient, rad of road-wheel angle per m/s² of lateral
     /// acceleration (default 0, the paper's kinematic steering; not written
-    /// when 0): the road-wheel angle is `atan(l_RF·ψ̇/v) + K_us·v·ψ̇`.
+    /// when 0): the road-wheel angle is `atan(l_RF·ψ̇/v) + K_us·|v|·ψ̇`
+    /// (`K_us·a_y` forwards).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub understeer_gradient_rad_per_mps2: f64,
     /// g: rear-axle side-slip gradient, rad per m/s² of lateral acceleration

@@ -1,72 +1,48 @@
-//! Tyre side slip and the steering's understeer (issue 28), measured on
-//! family cars driven with the simulator's `[dynamics]` (a quasi-steady
-//! single-track model; `deadreckon_sim::dynamics`).
-//!
-//! Each car gets its own tyres (rear cornering stiffness 90–170 kN/rad,
-//! front 75–125 kN/rad: side-slip gradients g of 0.0037–0.0070 rad per
-//! m/s²), corners at up to 3.5 m/s² (0.36 g) and carries a steering stream
-//! with a 0.02 rad offset. The RTS calibration of a 1200 s drive estimates g
+//! Tyre side slip and the steering's understeer (issue 28), measured on the
+//! dynamic family's cars (`deadreckon_sim::family::DynamicCar`, cars 1–10)
+//! with two of its effects: the side slip (a quasi-steady single-track
+//! model, `deadreckon_sim::dynamics`: side-slip gradients g of 0.003–0.007
+//! rad per m/s², understeer 0.001–0.004) and the steering-wheel offset
+//! (1–3°). The RTS calibration of a 1200 s drive estimates g
 //! ([`deadreckon_core::side_slip`]) and the steering (ratio, offset,
 //! understeer); a 300 s drive of the same car is then dead-reckoned through
 //! sliding 30 s outages with the calibrated parameters: the paper's model
-//! against the model with the side slip (and the steering) calibrated.
+//! against the model with the side slip (and the steering) calibrated, and
+//! the same without the gyro, where the steering sets the yaw rate.
 //!
-//! On the same cars and drives without the dynamics (the kinematic world),
-//! the paper's model gave 1.541 m (one-off run); with them 1.740 m, and
-//! with the calibrated g 1.551 m: the slip's cost is recovered. Without
-//! the gyro, the steering sets the yaw rate, and its calibration is what
-//! matters (4.967 → 2.769 m).
+//! One-off runs on the same cars and drives without the wander: with no
+//! effect (the kinematic world) the paper's model gives 1.611 m and g reads
+//! 0 within its standard error on all ten (z −1.6..+1.0); with the
+//! steering offset alone 1.634 m; with the side slip too 1.747 m, and with
+//! the calibrated g 1.637 m: the slip's cost is recovered.
 //!
 //! Two receivers per car: the family's as drawn (white noise 0.3–1.5 m and a
 //! Gauss–Markov wander of up to 1.5 m, 20–120 s), and the same without the
 //! wander. Neither has latency: the GNSS delay is not what is measured here.
+//!
+//! ```text
+//! cargo test --profile ci -p deadreckon-sim --test side_slip -- --nocapture
+//! ```
 
 use deadreckon_core::calibrate::{self, Calibration, CalibrationOptions};
 use deadreckon_core::ekf::FilterOptions;
 use deadreckon_core::outage::evaluate;
 use deadreckon_core::{Drive, Params};
-use deadreckon_sim::family::CarFamily;
-use deadreckon_sim::sensors::SteeringSpec;
-use deadreckon_sim::{simulate, DynamicsSpec, Scenario};
+use deadreckon_sim::family::{DynamicCar, Effects};
+use deadreckon_sim::simulate;
 
-/// Family cars measured.
+/// Dynamic family cars measured (`DynamicCar::draw`).
 const CARS: std::ops::RangeInclusive<u64> = 1..=10;
 
-/// The dynamics of car `seed`: its tyres' cornering stiffnesses spread
-/// over their range by the seed (golden-ratio sequences, reproducible).
-fn dynamics(seed: u64) -> DynamicsSpec {
-    let u = (seed as f64 * 0.618_033_988_75).fract();
-    let w = (seed as f64 * 0.414_213_562_37).fract();
-    DynamicsSpec {
-        cornering_stiffness_rear_n_per_rad: 90_000.0 + 80_000.0 * u,
-        cornering_stiffness_front_n_per_rad: 75_000.0 + 50_000.0 * w,
-        ..DynamicsSpec::default()
+/// The effects of the drives: the side slip (and understeer) and the
+/// steering offset, with the receiver's wander or without.
+fn effects(wander: bool) -> Effects {
+    Effects {
+        side_slip: true,
+        steering_offset: true,
+        wander,
+        ..Effects::none()
     }
-}
-
-/// A forward-only drive of `car` drawn from `drive_seed`, at least
-/// `duration_s` long, with the car's dynamics, lateral acceleration up to
-/// 3.5 m/s², a steering stream with a 0.02 rad offset, and the receiver
-/// without latency (and without its wander unless `wander`).
-fn scenario(car: &CarFamily, drive_seed: u64, duration_s: f64, wander: bool) -> Scenario {
-    let mut sc = car
-        .drive_forward(drive_seed, duration_s)
-        .with_dynamics(Some(dynamics(car.seed)));
-    sc.speed.max_lateral_accel_mps2 = 3.5;
-    let g = sc.sensors.gnss.as_mut().expect("family GNSS");
-    g.latency_s = 0.0;
-    if !wander {
-        g.markov_std_m = 0.0;
-    }
-    sc.sensors.steering = Some(SteeringSpec {
-        rate_hz: 50.0,
-        offset_s: 0.0,
-        noise_std: 0.02,
-        latency_s: 0.0,
-        true_ratio: None,
-        wheel_offset_rad: 0.02,
-    });
-    sc
 }
 
 /// One car with one receiver: the calibration and the evaluation drive.
@@ -75,20 +51,24 @@ struct Car {
     g_true: f64,
     k_us_true: f64,
     ratio_true: f64,
+    offset_true: f64,
     calibration: Calibration,
     evaluation: Drive,
 }
 
 fn car(seed: u64, wander: bool) -> Car {
-    let car = CarFamily::draw(seed);
-    let cal = simulate(&scenario(&car, 1000 + seed, 1200.0, wander), 1000 + seed).unwrap();
+    let car = DynamicCar::draw(seed);
+    let e = effects(wander);
+    let cal = simulate(&car.drive(1000 + seed, 1200.0, &e), 1000 + seed).unwrap();
     let calibration = calibrate::calibrate(&cal.drive, &CalibrationOptions::default()).unwrap();
-    let ev = simulate(&scenario(&car, 2000 + seed, 300.0, wander), 2000 + seed).unwrap();
+    let ev = simulate(&car.drive(2000 + seed, 300.0, &e), 2000 + seed).unwrap();
+    let vehicle = &car.base.vehicle;
     Car {
         seed,
-        g_true: dynamics(seed).rear_slip_gradient_rad_per_mps2(&car.vehicle),
-        k_us_true: dynamics(seed).understeer_gradient_rad_per_mps2(&car.vehicle),
-        ratio_true: car.vehicle.steering_ratio,
+        g_true: car.dynamics.rear_slip_gradient_rad_per_mps2(vehicle),
+        k_us_true: car.dynamics.understeer_gradient_rad_per_mps2(vehicle),
+        ratio_true: vehicle.steering_ratio,
+        offset_true: car.steering_offset_rad,
         calibration,
         evaluation: ev.drive,
     }
@@ -154,7 +134,7 @@ fn the_side_slip_gradient_is_within_3_sigma_and_modelling_it_shortens_outages() 
                 steering_cars += 1;
                 for (k, (p, truth)) in [
                     (&st.ratio, c.ratio_true),
-                    (&st.offset, 0.02),
+                    (&st.offset, c.offset_true),
                     (u, c.k_us_true),
                 ]
                 .into_iter()
@@ -167,7 +147,7 @@ fn the_side_slip_gradient_is_within_3_sigma_and_modelling_it_shortens_outages() 
             println!(
                 "car {} (wander {wander}): g {g:.5} ± {sd:.5} (truth {:.5}, {z:+.2} σ, {}, {} \
                  blocks, RMS a_y {:.2} m/s²); steering ratio {:.3} ± {:.3}, offset {:.4} ± \
-                 {:.4} rad, K_us {} (truth {:.5}); 30 s outages: paper {:.3} m, slip {:.3} m, slip + steering \
+                 {:.4} rad (truth {:.4}), K_us {} (truth {:.5}); 30 s outages: paper {:.3} m, slip {:.3} m, slip + steering \
                  {:.3} m",
                 c.seed,
                 c.g_true,
@@ -182,6 +162,7 @@ fn the_side_slip_gradient_is_within_3_sigma_and_modelling_it_shortens_outages() 
                 st.ratio.std.unwrap_or(f64::NAN),
                 st.offset.value,
                 st.offset.std.unwrap_or(f64::NAN),
+                c.offset_true,
                 st.understeer.as_ref().map_or("-".into(), |u| match u.std {
                     Some(s) => format!("{:.5} ± {s:.5}", u.value),
                     None => "not estimated".into(),
@@ -210,33 +191,33 @@ fn the_side_slip_gradient_is_within_3_sigma_and_modelling_it_shortens_outages() 
              with K_us on {steering_cars} cars, within 3σ: ratio {}, offset {}, K_us {}",
             steering_within[0], steering_within[1], steering_within[2]
         );
-        // Measured (cars 1–10, 1200 s calibration drives, 300 s evaluation
-        // drives): with the wander 10 of 10 within 3σ (z −1.88..+1.91), 1
-        // estimated (σ 0.00095–0.00355), outages 3.678 → 3.569 m (−3.0 %);
-        // without it 10 of 10 within 3σ (z −2.44..+2.23, mean +0.77: the
-        // load transfer makes the slip grow faster than a_y), 9 estimated
-        // (σ 0.00021–0.00077, car 9's 0.00142 not), outages 1.740 →
-        // 1.551 m (−10.9 %), 1.543 m with the steering calibrated too.
+        // Measured (dynamic family cars 1–10, 1200 s calibration drives,
+        // 300 s evaluation drives): with the wander 10 of 10 within 3σ,
+        // none estimated (σ 0.0013–0.0047), outages 3.548 → 3.484 m
+        // (−1.8 %), 3.480 m with the steering too; without it 10 of 10
+        // within 3σ (z −1.94..+0.87), 8 estimated (σ 0.00036–0.00089; cars
+        // 6 and 9, RMS a_y 0.51 and 0.38 m/s², not), outages 1.747 →
+        // 1.637 m (−6.3 %), 1.621 m with the steering too.
         assert!(within as f64 >= 0.9 * n, "{within} of {n} within 3σ");
-        let (most_estimated, gain) = if wander { (0, 0.99) } else { (8, 0.93) };
+        let (most_estimated, gain) = if wander { (0, 0.99) } else { (7, 0.96) };
         assert!(estimated >= most_estimated, "{estimated} estimated");
         assert!(slip < gain * paper, "{slip} vs {paper}");
         assert!(steer < gain * paper, "{steer} vs {paper}");
-        // The steering against the smoothed states: K_us estimated on 9 of
-        // 10 cars (car 9, RMS a_y 0.56 m/s², took its turns at too few
-        // speeds: its two-parameter ratio, 17.22 for 16, holds the
-        // understeer), and there ratio, offset and K_us each within 3σ on
-        // all 9 (K_us: z −2.8..+1.8, car 4 the worst), with and without the
-        // wander.
+        // The steering against the smoothed states (above 5 m/s): K_us
+        // estimated on 9 of 10 cars (car 9, RMS a_y 0.38 m/s², not: its
+        // two-parameter ratio, 17.07 for 16, holds the understeer), and
+        // there ratio, offset and K_us each within 3σ on all 9, with and
+        // without the wander.
         assert!(steering_cars >= 8, "K_us on {steering_cars} cars");
         if !wander {
             // Without the gyro the steering sets the yaw rate, and its
-            // calibration (with g) matters: measured 4.967 → 2.769 m.
+            // calibration (with g) matters: measured 13.790 → 4.366 m (the
+            // offsets of 1–3° uncalibrated).
             println!(
                 "without the gyro: paper {:.3} m, calibrated steering and slip {:.3} m",
                 no_gyro[0], no_gyro[1]
             );
-            assert!(no_gyro[1] < 0.65 * no_gyro[0], "{no_gyro:?}");
+            assert!(no_gyro[1] < 0.4 * no_gyro[0], "{no_gyro:?}");
         }
         for (k, name) in ["ratio", "offset", "K_us"].iter().enumerate() {
             assert!(

@@ -30,8 +30,12 @@
 //! K_us and the lateral acceleration `a_y = v·ψ̇`, so the reading is
 //!
 //! ```text
-//! s = s₀ + r_s·atan(l·ψ̇/v) + k·v·ψ̇,   k = r_s·K_us
+//! s = s₀ + r_s·atan(l·ψ̇/v) + k·|v|·ψ̇,   k = r_s·K_us
 //! ```
+//!
+//! (`|v|·ψ̇` is a_y forwards; reversing, the front tyre's slip angle turns
+//! round with the velocity, as in the simulator's single-track model, so
+//! the term keeps the sign of the turn's curvature).
 //!
 //! linear in `(r_s, s₀, k)`: [`calibrate_steering_understeer`] solves it by
 //! linear least squares. Without the `k` column the understeer goes into the
@@ -252,6 +256,15 @@ pub const MIN_LATERAL_ACCEL_SPREAD_MPS2: f64 = 0.1;
 /// The largest standard error with which K_us is reported as estimated,
 /// rad per m/s²: 0.0005, a fifth of a car's typical 0.0025.
 pub const MAX_UNDERSTEER_STD_RAD_PER_MPS2: f64 = 0.0005;
+/// The lowest speed of the smoothed states the RTS calibration fits the
+/// steering at, m/s (above its own threshold of 2 m/s): below it the
+/// smoothed `ψ̇/v` is noisy, and noise in the regressor pulls the ratio
+/// down and pushes K_us up. On the dynamic family's cars 1–10 (side slip
+/// and steering offset, 1200 s drives), at 2 m/s car 9 (RMS a_y 0.38
+/// m/s²) read a ratio of 14.65 ± 0.09 for 16 and K_us 0.0068 ± 0.0005 for
+/// 0.0015, and car 1 15.96 and 0.00331 for 0.00303; at 5 m/s car 9's K_us
+/// is not estimated and car 1 reads 16.02 and 0.00303.
+pub const SMOOTHED_MIN_SPEED_MPS: f64 = 5.0;
 /// The key of K_us (vehicle.toml, params.toml `[steering]`).
 pub const UNDERSTEER_NAME: &str = "understeer_gradient_rad_per_mps2";
 
@@ -284,7 +297,13 @@ pub fn calibrate_steering_understeer(
         };
         if x[V].abs() >= min_speed_mps && x[V].abs() > 0.0 {
             s.push(m.value);
-            rows.push([(l * x[YAW_RATE] / x[V]).atan(), 1.0, x[V] * x[YAW_RATE]]);
+            // |v|·ψ̇: a_y forwards; reversing, the front slip angle turns
+            // round with the velocity (the simulator's single-track model).
+            rows.push([
+                (l * x[YAW_RATE] / x[V]).atan(),
+                1.0,
+                x[V].abs() * x[YAW_RATE],
+            ]);
         }
     }
     let n = s.len();
