@@ -385,3 +385,54 @@ impl DynamicCar {
         sc
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn switching_one_effect_changes_only_its_part_of_the_scenario() {
+        let car = DynamicCar::draw(3);
+        assert_eq!(car, DynamicCar::draw(3));
+        let none = car.drive(5, 200.0, &Effects::none());
+        assert!(none.dynamics.is_none());
+        assert_eq!(none.sensors.gnss.as_ref().unwrap().markov_std_m, 0.0);
+        for name in Effects::NAMES {
+            let with = car.drive(5, 200.0, &Effects::only(name).unwrap());
+            assert_ne!(with, none, "{name} changed nothing");
+            assert_eq!(with.route, none.route, "{name}");
+            assert_eq!(with.speed, none.speed, "{name}");
+            assert_eq!(with.sensors.wheels.offset_s, none.sensors.wheels.offset_s);
+        }
+        // All on is each on; unknown names are refused.
+        let all = Effects::all();
+        for name in Effects::NAMES {
+            assert_eq!(Effects::all_but(name).unwrap(), {
+                let mut e = all;
+                *e.flag(name).unwrap() = false;
+                e
+            });
+        }
+        assert!(Effects::only("tyre_pressure").is_none());
+        // The side slip's draws are the same whether the longitudinal ones
+        // exist or not: each effect has its own generator.
+        let g = car
+            .dynamics
+            .rear_slip_gradient_rad_per_mps2(&car.base.vehicle);
+        assert!((0.003..=0.007).contains(&g), "{g}");
+    }
+
+    #[test]
+    fn wheel_ticks_are_among_the_drawn_kinds_at_50_or_100_hz() {
+        let cars: Vec<DynamicCar> = (1..=20).map(DynamicCar::draw).collect();
+        assert!(cars.iter().any(|c| c.wheel_kind == WheelKind::Ticks));
+        assert!(cars.iter().any(|c| c.wheel_kind == WheelKind::Speeds));
+        assert!(cars
+            .iter()
+            .all(|c| [50.0, 100.0].contains(&c.wheel_rate_hz)));
+        let sc = cars[0].drive(1, 100.0, &Effects::all());
+        assert_eq!(sc.sensors.gyro.as_ref().unwrap().rate_hz, 100.0);
+        assert!(sc.sensors.gyro.as_ref().unwrap().clock.is_some());
+        sc.validate().unwrap();
+    }
+}
