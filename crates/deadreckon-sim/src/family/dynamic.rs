@@ -434,5 +434,8 @@ mod tests {
         assert_eq!(sc.sensors.gyro.as_ref().unwrap().rate_hz, 100.0);
         assert!(sc.sensors.gyro.as_ref().unwrap().clock.is_some());
         sc.validate().unwrap();
+        // Every effect is written to, and read back from, the scenario file.
+        let text = sc.to_toml_string().unwrap();
+        assert_eq!(Scenario::from_toml_str(&text).unwrap(), sc, "{text}");
     }
 }
