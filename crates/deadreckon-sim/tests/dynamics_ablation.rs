@@ -17,9 +17,38 @@
 //! cargo test --profile ci -p deadreckon-sim --test dynamics_ablation -- --ignored --nocapture
 //! ```
 //!
-//! The first runs the development cars on short drives (under two minutes
-//! on two cores); the second, ignored, the development and held-out cars on
-//! longer drives.
+//! The first runs the development cars on short drives (about 75 s of CPU
+//! for the ablation); the second, ignored, the development and held-out
+//! cars on 600 s drives (10 min 15 s of CPU, 24 min on the shared two
+//! cores). Measured with the second (mean final error, m; ×: of "none"):
+//!
+//! | effects | dev cars 1–6 | × | held-out 101–110 (104 apart) | × |
+//! |---|---|---|---|---|
+//! | kinematic family | 0.883 | 1.11 | 0.858 | 1.05 |
+//! | none | 0.799 | 1.00 | 0.815 | 1.00 |
+//! | side_slip | 0.940 | 1.18 | 0.861 | 1.06 |
+//! | longitudinal | 0.822 | 1.03 | 0.815 | 1.00 |
+//! | terrain | 0.798 | 1.00 | 0.813 | 1.00 |
+//! | clocks | 1.578 | 1.98 | 1.682 | 2.06 |
+//! | tooth_error | 0.798 | 1.00 | 0.816 | 1.00 |
+//! | gyro_drift | 1.288 | 1.61 | 1.366 | 1.68 |
+//! | gyro_scale | 1.172 | 1.47 | 1.264 | 1.55 |
+//! | multipath | 1.238 | 1.55 | 0.880 | 1.08 |
+//! | wander | 2.844 | 3.56 | 1.363 | 1.67 |
+//! | latency | 1.171 | 1.47 | 1.055 | 1.30 |
+//! | steering_offset | 0.829 | 1.04 | 0.857 | 1.05 |
+//! | all | 4.489 | 5.62 | 2.993 | 3.67 |
+//!
+//! Car 104's calibration drive is rejected by the RTS calibration (the
+//! smoothing filter loses the fixes: circumferences of about 4 m for 2 m
+//! tyres) in every configuration but "kinematic family" and "clocks"; the
+//! held-out means are over the nine other cars in every row (the test
+//! prints "kinematic family" 0.897 and "clocks" 1.671 with car 104 in).
+//! Car 104 is the only one of the sixteen with wheel speeds at 100 Hz from
+//! tone-ring edge jitter (0.8 mm: about 0.1 m/s per reading); the same drive
+//! with its wheels at 50 Hz calibrates (rear-left 1.9977 m, truth 1.9974 m),
+//! without steering or CAN speed it is still rejected. An estimator
+//! finding, left as drawn (held-out members are not tuned on).
 
 use std::collections::HashMap;
 use std::sync::{Mutex, OnceLock};
@@ -197,7 +226,7 @@ fn ablation_on_the_development_cars() {
 const DEV_DRIVE_S: f64 = 300.0;
 
 /// The bigger run: the development cars and the held-out ones (printed on
-/// their own), on 600 s drives. About 15 minutes on two cores.
+/// their own), on 600 s drives (10 min of CPU).
 #[test]
 #[ignore]
 fn ablation_on_the_development_and_held_out_cars() {
