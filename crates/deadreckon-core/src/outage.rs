@@ -11,7 +11,9 @@
 //!
 //! Windows count once the heading is known: a window that starts before the
 //! aided filter's yaw standard deviation first falls to
-//! [`HEADING_KNOWN_YAW_STD_RAD`] is **unsettled** (the pull-away): evaluated
+//! [`HEADING_KNOWN_YAW_STD_RAD`] (or to twice its median over the drive,
+//! where that is higher: a filter without a gyro may never reach 2°) is
+//! **unsettled** (the pull-away): evaluated
 //! and reported on its own ([`OutageEvaluation::unsettled`]), not in the
 //! summaries. Dead reckoning from a heading nobody knows yet measures the
 //! initialisation, not the dead reckoning: on a dynamic-world family the
@@ -138,7 +140,32 @@ struct Aided {
     first_t: f64,
     last_t: f64,
     moving_t: Option<f64>,
-    heading_known_t: Option<f64>,
+    /// Every epoch's time and yaw variance.
+    yaw_var: Vec<(f64, f64)>,
+}
+
+impl Aided {
+    /// The yaw standard deviation at which the heading counts as known, rad:
+    /// [`HEADING_KNOWN_YAW_STD_RAD`], or twice the run's median where that
+    /// is higher (a filter without a gyro may never reach 2°: its pull-away
+    /// is the time before it settles at its own level).
+    fn heading_limit(&self) -> f64 {
+        let mut v: Vec<f64> = self.yaw_var.iter().map(|e| e.1).collect();
+        if v.is_empty() {
+            return HEADING_KNOWN_YAW_STD_RAD;
+        }
+        let mid = v.len() / 2;
+        let median = *v.select_nth_unstable_by(mid, |a, b| a.total_cmp(b)).1;
+        HEADING_KNOWN_YAW_STD_RAD.max(2.0 * median.max(0.0).sqrt())
+    }
+
+    /// When the yaw standard deviation first falls to `limit`.
+    fn heading_known_t(&self, limit: f64) -> Option<f64> {
+        self.yaw_var
+            .iter()
+            .find(|e| e.1 <= limit * limit)
+            .map(|e| e.0)
+    }
 }
 
 impl EpochHook for Aided {
@@ -150,9 +177,7 @@ impl EpochHook for Aided {
         if self.moving_t.is_none() && x[V].abs() > MOVING_MPS {
             self.moving_t = Some(t);
         }
-        if self.heading_known_t.is_none() && p[(YAW, YAW)] <= HEADING_KNOWN_YAW_STD_RAD.powi(2) {
-            self.heading_known_t = Some(t);
-        }
+        self.yaw_var.push((t, p[(YAW, YAW)]));
     }
 }
 
@@ -197,7 +222,7 @@ pub fn evaluate(
         first_t: f64::NAN,
         last_t: f64::NAN,
         moving_t: None,
-        heading_known_t: None,
+        yaw_var: Vec::new(),
     };
     ekf::run(drive, params, &aided_opts, &mut aided)?;
     if aided.first_t.is_nan() {
@@ -215,6 +240,9 @@ pub fn evaluate(
         )));
     };
     let first_t = aided.first_t;
+    let heading_limit = aided.heading_limit();
+    let heading_known_t = aided.heading_known_t(heading_limit);
+    drop(aided.yaw_var);
     let mut starts = Vec::new();
     let mut start = (first_t + warmup_s).max(moving_t);
     while start + outage_s <= end_limit {
@@ -260,7 +288,7 @@ pub fn evaluate(
         gates.add(&g.gates().since(&before));
         if let Some(mut w) = window_errors(drive, truth.as_ref(), &states, t0, start, end) {
             w.start_yaw_std_rad = Some(yaw_std);
-            if aided.heading_known_t.is_none_or(|k| start < k) {
+            if heading_known_t.is_none_or(|k| start < k) {
                 unsettled.push(w);
             } else {
                 windows.push(w);
@@ -282,15 +310,12 @@ pub fn evaluate(
         )));
     }
     if windows.is_empty() {
-        let known = match aided.heading_known_t {
+        let known = match heading_known_t {
             Some(k) => format!(
                 "first falls to {:.1}° at {k:.1} s",
-                HEADING_KNOWN_YAW_STD_RAD.to_degrees()
+                heading_limit.to_degrees()
             ),
-            None => format!(
-                "never falls to {:.1}°",
-                HEADING_KNOWN_YAW_STD_RAD.to_degrees()
-            ),
+            None => format!("never falls to {:.1}°", heading_limit.to_degrees()),
         };
         return Err(Error::Insufficient(format!(
             "no {outage_s} s outage window starts with the heading known: the aided filter's \
@@ -305,7 +330,7 @@ pub fn evaluate(
         windows,
         gates,
         unsettled,
-        heading_limit_rad: HEADING_KNOWN_YAW_STD_RAD,
+        heading_limit_rad: heading_limit,
     })
 }
 

@@ -201,9 +201,10 @@ fn ablation_on_the_development_cars() {
     let none = mean("none");
     // With every effect off the dynamic family is a kinematic world: its
     // error is the kinematic family's (white fixes, no latency; wheel
-    // speeds only, no CAN speed or steering). Measured: none 1.225 m,
-    // kinematic family 1.204 m (cars 1–6, 300 s drives).
-    assert!((none - 1.225).abs() < 0.05, "none {none}");
+    // speeds only, no CAN speed or steering). Measured: none 0.405 m,
+    // kinematic family 0.436 m (cars 1–6, 300 s drives; 1.225 and 1.204 m
+    // before the pull-away windows were reported on their own).
+    assert!((none - 0.405).abs() < 0.03, "none {none}");
     assert!((none / mean("kinematic family") - 1.0).abs() < 0.1);
     // Every effect changes the drives, and so the errors of some cars.
     for (k, (name, _)) in configs.iter().enumerate().skip(NONE + 1) {
