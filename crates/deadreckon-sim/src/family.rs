@@ -25,6 +25,16 @@
 //! does not). What the family does not cover: other reversing manoeuvres
 //! (three-point turns, parking), unsigned wheel speeds, wheel ticks (wheel
 //! speeds only), slopes and slip.
+//!
+//! The **dynamic family** ([`DynamicCar`], [`Effects`]) adds a real car's
+//! physics and sensors to these cars: tyre side slip and understeer, each
+//! stream on its own clock, tone-ring tooth errors, gyro bias drift and
+//! scale error, GNSS multipath, wander and latency, a steering offset —
+//! each drawn per car and switchable, wheel ticks among the wheel kinds.
+
+mod dynamic;
+
+pub use dynamic::{Clocks, DynamicCar, Effects};
 
 use deadreckon_core::{Params, Vehicle};
 use rand::{RngExt, SeedableRng};
@@ -209,6 +219,8 @@ impl CarFamily {
             noise_std_mps: self.wheel_noise_mps,
             resolution_mps: 0.01,
             edge_jitter_m: self.edge_jitter_m,
+            tooth_error_std: 0.0,
+            clock: None,
         };
         let gnss = GnssSpec {
             rate_hz: self.gnss_rate_hz,
@@ -221,6 +233,8 @@ impl CarFamily {
             markov_std_m: self.gnss_markov.0,
             markov_tau_s: self.gnss_markov.1,
             latency_s: self.gnss_latency_s,
+            multipath: None,
+            clock: None,
         };
         Scenario {
             name: format!("car-family-{}-drive-{seed}", self.seed),
@@ -241,6 +255,9 @@ impl CarFamily {
                     latency_s: 0.0,
                     scale_error: 0.0,
                     tilt_deg: None,
+                    bias_drift_std_rps: 0.0,
+                    bias_drift_tau_s: 300.0,
+                    clock: None,
                 }),
                 speed: None,
                 steering: None,
@@ -248,6 +265,7 @@ impl CarFamily {
                 truth_rate_hz: 50.0,
                 wheel_faults: None,
             },
+            dynamics: None,
         }
     }
 }

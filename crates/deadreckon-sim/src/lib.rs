@@ -23,6 +23,7 @@
 //! | steering wheel | r_s · atan(l_RF · κ + β), β white: the noise of eq. 7 on tan(δ/r_s) |
 //! | wheel faults (optional) | spin bursts under traction on one wheel, one wheel smaller from some time on ([`faults`]) |
 //! | GNSS | antenna position (lever arm forward of M) + white noise; course and speed from the antenna velocity + white noise |
+//! | vehicle dynamics (optional `[dynamics]`) | a quasi-steady single-track model with load-sensitive tyre cornering stiffness and load transfer ([`dynamics`]): the body yaw is M's course less the rear side slip β_r ≈ −g·a_y; gyro, wheels (each along its own axis), antenna and truth yaw follow the body; the steering reads the understeer δ ≈ L·κ + K_us·a_y |
 //!
 //! Other vehicle shapes: [`tricycle`] simulates a steered, driven front
 //! wheel with steering and traction encoders and an external tracker, through
@@ -42,8 +43,10 @@
 //! ```
 #![deny(missing_docs)]
 
+pub mod dynamics;
 pub mod family;
 pub mod faults;
+pub mod imperfections;
 pub mod profile;
 pub mod route;
 pub mod scenario;
@@ -53,7 +56,9 @@ mod truth;
 
 use deadreckon_core::{Drive, Params};
 
+pub use dynamics::DynamicsSpec;
 pub use faults::{ShrinkSpec, SpinSpec, WheelFaultsSpec};
+pub use imperfections::{ClockSpec, MultipathSpec};
 pub use profile::SpeedSpec;
 pub use route::{RouteSpec, Segment};
 pub use scenario::Scenario;
@@ -142,6 +147,12 @@ pub struct SimStats {
     pub heading_change_rad: f64,
     /// Wheel-spin bursts simulated (`[sensors.wheel_faults.spin]`), `(start, end)` in s.
     pub spin_bursts: Vec<(f64, f64)>,
+    /// GNSS multipath bursts simulated (`[sensors.gnss.multipath]`), `(start,
+    /// end, east offset, north offset)` in s (true time) and m.
+    pub multipath_bursts: Vec<(f64, f64, f64, f64)>,
+    /// The tone rings' tooth position errors per wheel FL, FR, RL, RR, in
+    /// tooth pitches (`sensors.wheels.tooth_error_std`; `None` without).
+    pub tooth_errors: Option<[Vec<f64>; 4]>,
 }
 
 /// Simulates `scenario` with the noise drawn from `seed` (a PCG-64 generator
@@ -173,9 +184,20 @@ pub fn simulate(scenario: &Scenario, seed: u64) -> Result<SimOutput, SimError> {
         ));
     }
     let params = scenario.true_params();
-    let kin = truth::Kinematics::new(&route, &profile, &scenario.vehicle);
+    let model = scenario
+        .dynamics
+        .as_ref()
+        .map(|d| dynamics::Model::new(d, &scenario.vehicle));
+    let kin = truth::Kinematics::new(&route, &profile, &scenario.vehicle, model);
     let mut integrator = truth::Integrator::new(&kin, scenario.integration_rate_hz, t_end);
-    let mut suite = sensors::Suite::new(&scenario.sensors, &scenario.vehicle, &params, seed, t_end);
+    let mut suite = sensors::Suite::new(
+        &scenario.sensors,
+        &scenario.vehicle,
+        &params,
+        seed,
+        t_end,
+        kin.is_dynamic(),
+    );
 
     let first = *integrator.state();
     suite.sample(&kin, &first, &first);
@@ -207,6 +229,8 @@ pub fn simulate(scenario: &Scenario, seed: u64) -> Result<SimOutput, SimError> {
         wheel_distance_m: prev.wheel_m,
         heading_change_rad: prev.psi - first.psi,
         spin_bursts: suite.spin_bursts(),
+        multipath_bursts: suite.multipath_bursts(),
+        tooth_errors: suite.tooth_errors(),
     };
     let drive = suite.finish(scenario.vehicle.clone());
     drive.validate()?;

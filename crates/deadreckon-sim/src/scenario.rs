@@ -45,6 +45,7 @@ use deadreckon_core::{Params, Vehicle};
 use serde::de::{self, Deserializer, MapAccess, Visitor};
 use serde::{Deserialize, Serialize};
 
+use crate::dynamics::DynamicsSpec;
 use crate::profile::SpeedSpec;
 use crate::route::RouteSpec;
 use crate::sensors::{GnssSpec, SensorsSpec};
@@ -84,6 +85,10 @@ pub struct Scenario {
     pub speed: SpeedSpec,
     /// The sensors.
     pub sensors: SensorsSpec,
+    /// Vehicle dynamics: tyre side slip and understeer (default none: the
+    /// exact kinematic bicycle model). See [`crate::dynamics`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dynamics: Option<DynamicsSpec>,
 }
 
 /// Longest drive simulated, s (about 11.6 days).
@@ -300,6 +305,12 @@ impl Scenario {
         self
     }
 
+    /// Sets (or, with `None`, removes) the vehicle dynamics.
+    pub fn with_dynamics(mut self, dynamics: Option<DynamicsSpec>) -> Self {
+        self.dynamics = dynamics;
+        self
+    }
+
     /// Replaces the sensors.
     pub fn with_sensors(mut self, sensors: SensorsSpec) -> Self {
         self.sensors = sensors;
@@ -363,6 +374,35 @@ impl Scenario {
                 ));
             }
         }
+        for (key, r, clock) in self.sensors.ecu_clocks() {
+            if let Some(c) = clock {
+                c.check(key, r).map_err(|(k, m)| invalid(&k, m))?;
+            }
+        }
+        let tooth = self.sensors.wheels.tooth_error_std;
+        if !(tooth.is_finite() && (0.0..=0.1).contains(&tooth)) {
+            return Err(invalid(
+                "sensors.wheels.tooth_error_std",
+                format!("must be within 0..=0.1 tooth pitches, got {tooth}"),
+            ));
+        }
+        if let Some(g) = &self.sensors.gyro {
+            let tau = g.bias_drift_tau_s;
+            if !(tau.is_finite() && tau > 0.0) {
+                return Err(invalid(
+                    "sensors.gyro.bias_drift_tau_s",
+                    format!("must be a positive number of seconds, got {tau}"),
+                ));
+            }
+        }
+        if let Some(m) = self
+            .sensors
+            .gnss
+            .as_ref()
+            .and_then(|g| g.multipath.as_ref())
+        {
+            m.check().map_err(|(k, m)| invalid(&k, m))?;
+        }
         for (key, v) in self.sensors.noises() {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(invalid(
@@ -399,6 +439,9 @@ impl Scenario {
             f.check().map_err(|(k, m)| invalid(&k, m))?;
         }
         self.speed.check().map_err(|(k, m)| invalid(&k, m))?;
+        if let Some(d) = &self.dynamics {
+            d.check().map_err(|(k, m)| invalid(&k, m))?;
+        }
         Ok(())
     }
 }

@@ -15,6 +15,7 @@ use rand_pcg::Pcg64;
 use serde::{Deserialize, Serialize};
 
 use crate::faults::WheelFaults;
+use crate::imperfections::{ClockSpec, EcuClock, GaussMarkov, Multipath, MultipathSpec, ToneRings};
 use crate::truth::{Kinematics, State};
 
 /// What the wheel stream reports.
@@ -53,6 +54,16 @@ pub struct WheelsSpec {
     /// noise measured on the comma2k19 RAV4's wheel speeds (0.038 m/s).
     #[serde(default)]
     pub edge_jitter_m: f64,
+    /// Tone-ring tooth-spacing error: standard deviation of each tooth's
+    /// position, as a fraction of the tooth pitch (default 0; 0.002–0.01 is
+    /// typical), fixed per wheel and tooth. Ticks count the misplaced edges,
+    /// speeds are the rotation inferred from them
+    /// ([`crate::imperfections`]).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub tooth_error_std: f64,
+    /// The wheel ECU's clock (default: true time).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub clock: Option<ClockSpec>,
 }
 
 fn default_wheel_speed_noise() -> f64 {
@@ -89,6 +100,26 @@ pub struct ScalarSpec {
     /// [`ACCEL_NOISE_STD_MPS2`]) at the gyro's times.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tilt_deg: Option<[f64; 2]>,
+    /// Gyro only: standard deviation of a slowly drifting bias (first-order
+    /// Gauss–Markov, stationary) added to the constant one, rad/s (default 0).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub bias_drift_std_rps: f64,
+    /// Gyro only: correlation time of the drifting bias, s (default 300).
+    #[serde(
+        default = "default_bias_drift_tau",
+        skip_serializing_if = "is_default_bias_drift_tau"
+    )]
+    pub bias_drift_tau_s: f64,
+    /// The stream's own clock (default: true time).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub clock: Option<ClockSpec>,
+}
+
+fn default_bias_drift_tau() -> f64 {
+    300.0
+}
+fn is_default_bias_drift_tau(x: &f64) -> bool {
+    *x == default_bias_drift_tau()
 }
 
 /// White noise of the simulated accelerometer, m/s².
@@ -145,6 +176,9 @@ pub struct SteeringSpec {
     /// (default 0): the reading is r_s · atan(l_RF·κ + β) + this.
     #[serde(default)]
     pub wheel_offset_rad: f64,
+    /// The steering ECU's clock (default: true time).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub clock: Option<ClockSpec>,
 }
 
 /// The GNSS receiver (`[sensors.gnss]`).
@@ -186,6 +220,14 @@ pub struct GnssSpec {
     /// stamp, s (default 0; u-blox receivers are about 0.1 s late).
     #[serde(default)]
     pub latency_s: f64,
+    /// Multipath bursts: position offsets of a few metres for a few seconds
+    /// (default none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub multipath: Option<MultipathSpec>,
+    /// The receiver's clock (default: true time; GNSS time is usually good,
+    /// but the stamps a logger puts on the fixes need not be).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub clock: Option<ClockSpec>,
 }
 
 impl GnssSpec {
@@ -202,6 +244,8 @@ impl GnssSpec {
             markov_std_m: 0.0,
             markov_tau_s: default_markov_tau(),
             latency_s: 0.0,
+            multipath: None,
+            clock: None,
         }
     }
 }
@@ -290,16 +334,43 @@ impl SensorsSpec {
         v
     }
 
+    /// Each stream's own clock, with its table's key and rate, for validation.
+    pub(crate) fn ecu_clocks(&self) -> Vec<(&'static str, f64, Option<&ClockSpec>)> {
+        let mut v = vec![(
+            "sensors.wheels",
+            self.wheels.rate_hz,
+            self.wheels.clock.as_ref(),
+        )];
+        if let Some(g) = &self.gyro {
+            v.push(("sensors.gyro", g.rate_hz, g.clock.as_ref()));
+        }
+        if let Some(g) = &self.speed {
+            v.push(("sensors.speed", g.rate_hz, g.clock.as_ref()));
+        }
+        if let Some(g) = &self.steering {
+            v.push(("sensors.steering", g.rate_hz, g.clock.as_ref()));
+        }
+        if let Some(g) = &self.gnss {
+            v.push(("sensors.gnss", g.rate_hz, g.clock.as_ref()));
+        }
+        v
+    }
+
     /// The noise values with their keys, for validation (all must be ≥ 0).
     pub(crate) fn noises(&self) -> Vec<(&'static str, f64)> {
         let mut v = vec![
             ("sensors.wheels.noise_std_mps", self.wheels.noise_std_mps),
             ("sensors.wheels.resolution_mps", self.wheels.resolution_mps),
             ("sensors.wheels.edge_jitter_m", self.wheels.edge_jitter_m),
+            (
+                "sensors.wheels.tooth_error_std",
+                self.wheels.tooth_error_std,
+            ),
         ];
         if let Some(g) = &self.gyro {
             v.push(("sensors.gyro.noise_std", g.noise_std));
             v.push(("sensors.gyro.latency_s", g.latency_s));
+            v.push(("sensors.gyro.bias_drift_std_rps", g.bias_drift_std_rps));
         }
         if let Some(g) = &self.speed {
             v.push(("sensors.speed.noise_std", g.noise_std));
@@ -351,18 +422,18 @@ fn mix(mut z: u64) -> u64 {
 
 /// A seeded Gaussian source for one stream.
 #[derive(Debug)]
-struct Noise(Pcg64);
+pub(crate) struct Noise(Pcg64);
 
 impl Noise {
-    fn new(seed: u64, stream: u64) -> Self {
+    pub(crate) fn new(seed: u64, stream: u64) -> Self {
         Noise(Pcg64::seed_from_u64(mix(seed ^ mix(stream))))
     }
-    fn gauss(&mut self, std: f64) -> f64 {
+    pub(crate) fn gauss(&mut self, std: f64) -> f64 {
         let z: f64 = StandardNormal.sample(&mut self.0);
         std * z
     }
     /// Uniform in [0, 1).
-    fn uniform(&mut self) -> f64 {
+    pub(crate) fn uniform(&mut self) -> f64 {
         rand::RngExt::random::<f64>(&mut self.0)
     }
 }
@@ -416,6 +487,16 @@ pub(crate) struct Suite {
     imu_gyro: Vec<Axes>,
     imu_accel: Vec<Axes>,
     faults: Option<(WheelFaults, Noise)>,
+    /// Whether the truth has side slip (`[dynamics]`).
+    dynamic: bool,
+    /// Each stream's own clock, by stream index (wheels to GNSS).
+    stamps: [Option<EcuClock>; 5],
+    /// Tone rings with tooth-spacing errors.
+    rings: Option<ToneRings>,
+    /// The gyro's drifting bias.
+    gyro_drift: Option<GaussMarkov>,
+    /// The receiver's multipath bursts.
+    multipath: Option<Multipath>,
 }
 
 const WHEELS: usize = 0;
@@ -432,6 +513,7 @@ impl Suite {
         params: &Params,
         seed: u64,
         t_end: f64,
+        dynamic: bool,
     ) -> Self {
         let clocks = [
             Some(Clock::new(spec.wheels.rate_hz, spec.wheels.offset_s)),
@@ -491,6 +573,50 @@ impl Suite {
                 .wheel_faults
                 .clone()
                 .map(|f| (WheelFaults::new(f), Noise::new(seed, 6))),
+            dynamic,
+            stamps: {
+                let ecu = spec.ecu_clocks();
+                let mut k = 0u64;
+                [WHEELS, GYRO, SPEED, STEERING, GNSS].map(|stream| {
+                    k += 1;
+                    // Only streams present are in `ecu`; match them by key.
+                    let key = [
+                        "sensors.wheels",
+                        "sensors.gyro",
+                        "sensors.speed",
+                        "sensors.steering",
+                        "sensors.gnss",
+                    ][stream];
+                    ecu.iter()
+                        .find(|(name, _, _)| *name == key)
+                        .and_then(|(_, rate, c)| {
+                            c.map(|c| EcuClock::new(*c, *rate, Noise::new(seed, 6 + k)))
+                        })
+                })
+            },
+            rings: (spec.wheels.tooth_error_std > 0.0).then(|| {
+                ToneRings::draw(
+                    vehicle.ticks_per_rev,
+                    spec.wheels.tooth_error_std,
+                    &mut Noise::new(seed, 12),
+                )
+            }),
+            gyro_drift: spec
+                .gyro
+                .as_ref()
+                .filter(|g| g.bias_drift_std_rps > 0.0)
+                .map(|g| {
+                    GaussMarkov::new(
+                        g.bias_drift_std_rps,
+                        g.bias_drift_tau_s,
+                        Noise::new(seed, 13),
+                    )
+                }),
+            multipath: spec
+                .gnss
+                .as_ref()
+                .and_then(|g| g.multipath.clone())
+                .map(|m| Multipath::new(m, Noise::new(seed, 14))),
         }
     }
 
@@ -510,6 +636,14 @@ impl Suite {
         }
     }
 
+    /// The stamp `stream` puts on the sample describing true time `t`.
+    fn stamp(&mut self, stream: usize, t: f64) -> f64 {
+        match self.stamps.get_mut(stream) {
+            Some(Some(c)) => c.stamp(t),
+            _ => t,
+        }
+    }
+
     fn emit(&mut self, stream: usize, st: &State) {
         let t_s = st.t;
         match stream {
@@ -518,9 +652,12 @@ impl Suite {
                 let Some(g) = self.spec.gyro.clone() else {
                     return;
                 };
-                let t_s = t_s + g.latency_s;
+                let t_s = self.stamp(GYRO, t_s) + g.latency_s;
                 let k = 1.0 + g.scale_error;
-                let bias = self.params.gyro_bias_rps;
+                let bias = match &mut self.gyro_drift {
+                    Some(d) => self.params.gyro_bias_rps + d.at(st.t),
+                    None => self.params.gyro_bias_rps,
+                };
                 match g.tilt_deg {
                     None => {
                         let value = k * st.yaw_rate + bias + self.noise[GYRO].gauss(g.noise_std);
@@ -534,7 +671,19 @@ impl Suite {
                                 + if i == 2 { bias } else { 0.0 }
                                 + n.gauss(g.noise_std)
                         });
-                        let f_v = [st.a, st.v * st.yaw_rate, deadreckon_core::imu::GRAVITY_MPS2];
+                        let f_v = if self.dynamic {
+                            // M's acceleration (a along the course, v·χ̇
+                            // across it) in the body frame, turned by β_r.
+                            let (sb, cb) = st.beta.sin_cos();
+                            let across = st.v * st.v * st.kappa;
+                            [
+                                st.a * cb - across * sb,
+                                st.a * sb + across * cb,
+                                deadreckon_core::imu::GRAVITY_MPS2,
+                            ]
+                        } else {
+                            [st.a, st.v * st.yaw_rate, deadreckon_core::imu::GRAVITY_MPS2]
+                        };
                         let f = [0, 1, 2].map(|i| {
                             (0..3).map(|j| m[i][j] * f_v[j]).sum::<f64>()
                                 + n.gauss(ACCEL_NOISE_STD_MPS2)
@@ -562,18 +711,24 @@ impl Suite {
                     .as_ref()
                     .map_or((0.0, 0.0), |g| (g.noise_std, g.latency_s));
                 let value = self.params.speed_scale * st.v + self.noise[SPEED].gauss(std);
-                self.speed.push(Scalar {
-                    t_s: t_s + lat,
-                    value,
-                });
+                let t_s = self.stamp(SPEED, t_s) + lat;
+                self.speed.push(Scalar { t_s, value });
             }
             STEERING => {
                 let (std, offset, lat) = self.spec.steering.as_ref().map_or((0.0, 0.0, 0.0), |g| {
                     (g.noise_std, g.wheel_offset_rad, g.latency_s)
                 });
-                let tan = self.wheelbase * st.kappa + self.noise[STEERING].gauss(std);
+                // The road-wheel angle's tangent: L·κ kinematically, with
+                // the understeer under dynamics.
+                let exact = if self.dynamic {
+                    st.road_wheel_rad.tan()
+                } else {
+                    self.wheelbase * st.kappa
+                };
+                let tan = exact + self.noise[STEERING].gauss(std);
+                let t_s = self.stamp(STEERING, t_s) + lat;
                 self.steering.push(Scalar {
-                    t_s: t_s + lat,
+                    t_s,
                     value: self.steering_ratio * tan.atan() + offset,
                 });
             }
@@ -594,18 +749,24 @@ impl Suite {
             Some((f, n)) => f.counted(st.t, st.a, st.wheel_m, || n.uniform()),
             None => st.wheel_m,
         };
-        let rot = [0, 1, 2, 3].map(|i| counted[i] / self.circ[i]);
+        let mut rot = [0, 1, 2, 3].map(|i| counted[i] / self.circ[i]);
+        let stamp = self.stamp(WHEELS, st.t);
+        let n = self.ticks_per_rev;
         match &mut self.wheels {
             WheelState::Ticks { out, emitted } => {
                 let mut d = [0i64; 4];
                 for i in 0..4 {
-                    // Cumulative ticks, floored: fractions of a tick carry over.
-                    let cum = (rot[i] * self.ticks_per_rev).floor() as i64;
+                    // Cumulative ticks, floored: fractions of a tick carry
+                    // over (the edges passed, on rings with tooth errors).
+                    let cum = match &self.rings {
+                        None => (rot[i] * n).floor() as i64,
+                        Some(r) => r.edges(i, rot[i] * n),
+                    };
                     d[i] = cum - emitted[i];
                     emitted[i] = cum;
                 }
                 out.push(WheelTicks {
-                    t_s: st.t,
+                    t_s: stamp,
                     fl: d[0],
                     fr: d[1],
                     rl: d[2],
@@ -618,6 +779,12 @@ impl Suite {
                 last_t,
                 last_jitter,
             } => {
+                if let Some(r) = &self.rings {
+                    // The rotation the ECU infers from misplaced edges.
+                    for (i, x) in rot.iter_mut().enumerate() {
+                        *x = r.inferred(i, *x * n) / n;
+                    }
+                }
                 let period = 1.0 / self.spec.wheels.rate_hz;
                 let dt = last_t.map_or(period, |t0| st.t - t0);
                 let (std, q) = (
@@ -648,7 +815,7 @@ impl Suite {
                 *last_rot = rot;
                 *last_t = Some(st.t);
                 out.push(WheelSpeeds {
-                    t_s: st.t,
+                    t_s: stamp,
                     fl_mps: v[0],
                     fr_mps: v[1],
                     rl_mps: v[2],
@@ -683,12 +850,21 @@ impl Suite {
             north_m += nn;
         }
         gs.last_t = Some(st.t);
+        if let Some(m) = &mut self.multipath {
+            let (e, nn) = m.at(st.t);
+            east_m += e;
+            north_m += nn;
+        }
         let (mut course_deg, mut speed_mps) = (None, None);
         if let Some(vstd) = spec.velocity_std_mps {
             // Antenna velocity: v·(cos ψ, sin ψ) + l·ψ̇·(−sin ψ, cos ψ).
             // A body-yaw course is the direction the car faces: it does not
             // turn round when the car reverses.
             let (lat, fwd) = match spec.course_convention {
+                CourseConvention::AntennaVelocity if self.dynamic => {
+                    let (sb, cb) = st.beta.sin_cos();
+                    (st.v * sb + l * st.yaw_rate, st.v * cb)
+                }
                 CourseConvention::AntennaVelocity => (l * st.yaw_rate, st.v),
                 CourseConvention::BodyYaw => (0.0, st.v.abs()),
             };
@@ -708,14 +884,33 @@ impl Suite {
                 };
             }
         }
+        let t_s = match &mut self.stamps[GNSS] {
+            Some(c) => c.stamp(st.t),
+            None => st.t,
+        } + spec.latency_s;
         self.gnss.push(GnssFix {
-            t_s: st.t + spec.latency_s,
+            t_s,
             east_m,
             north_m,
             std_m: spec.std_m,
             course_deg,
             speed_mps,
         });
+    }
+
+    /// The multipath bursts simulated, `(start, end, east, north)` in s and m.
+    pub fn multipath_bursts(&self) -> Vec<(f64, f64, f64, f64)> {
+        self.multipath
+            .as_ref()
+            .map(|m| m.bursts.clone())
+            .unwrap_or_default()
+    }
+
+    /// The tone rings' tooth errors per wheel (FL, FR, RL, RR), pitches.
+    pub fn tooth_errors(&self) -> Option<[Vec<f64>; 4]> {
+        self.rings
+            .as_ref()
+            .map(|r| [0, 1, 2, 3].map(|i| r.errors(i).to_vec()))
     }
 
     /// The spin bursts simulated, `(start, end)` in s.

@@ -56,6 +56,9 @@ impl Install {
             latency_s: self.latency_s[1],
             scale_error: 0.0,
             tilt_deg: None,
+            bias_drift_std_rps: 0.0,
+            bias_drift_tau_s: 300.0,
+            clock: None,
         });
         s.steering = Some(SteeringSpec {
             rate_hz: 50.0,
@@ -64,6 +67,7 @@ impl Install {
             latency_s: self.latency_s[2],
             true_ratio: None,
             wheel_offset_rad: 0.0,
+            clock: None,
         });
         s.gnss.as_mut().expect("family gnss").latency_s = self.latency_s[3];
         sc
@@ -306,6 +310,7 @@ fn the_steering_lags_standard_error_ignored_the_noise_of_its_derivative() {
             latency_s: 0.085,
             true_ratio: None,
             wheel_offset_rad: 0.0,
+            clock: None,
         });
         let truth = 0.085 - 0.5 / car.wheel_rate_hz;
         let (mut errors, mut stds) = (Vec::new(), Vec::new());
