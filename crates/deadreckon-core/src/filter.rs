@@ -288,6 +288,9 @@ pub struct Filter<L: Layout<N>, const N: usize> {
     wheels_excluded: [bool; 4],
     /// Consecutive rejections per sensor (same order as [`GateCounts`]).
     consecutive: [u32; 9],
+    /// When the current run of rejected GNSS fixes began, s.
+    #[serde(default)]
+    gnss_rejecting_since_s: Option<f64>,
     gates: GateCounts,
     #[serde(skip)]
     layout: PhantomData<L>,
@@ -355,6 +358,7 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
             wheels_present: vehicle.wheels_present,
             wheels_excluded: [false; 4],
             consecutive: [0; 9],
+            gnss_rejecting_since_s: None,
             gates: GateCounts::default(),
             layout: PhantomData,
         })
@@ -560,9 +564,22 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
             self.noise.max_rejections
         };
         let within = nis <= self.gate_chi2(sensor);
-        let recovery = !within && self.consecutive[k] >= max;
+        // A GNSS recovery also waits for the rejections to have lasted
+        // `gnss_recovery_after_s`: a multipath burst is a few seconds.
+        let patient = sensor != SensorKind::Gnss || {
+            let since = if within {
+                self.t_s
+            } else {
+                *self.gnss_rejecting_since_s.get_or_insert(self.t_s)
+            };
+            self.t_s - since >= self.noise.gnss_recovery_after_s
+        };
+        let recovery = !within && self.consecutive[k] >= max && patient;
         let accepted = within || recovery;
         self.consecutive[k] = if accepted { 0 } else { self.consecutive[k] + 1 };
+        if accepted && sensor == SensorKind::Gnss {
+            self.gnss_rejecting_since_s = None;
+        }
         if accepted {
             self.gates.accepted[k] += 1;
         } else {

@@ -78,6 +78,13 @@ pub struct Noise {
     /// after inflating the position covariance by the innovation, and counted
     /// as a recovery (default 10).
     pub gnss_max_rejections: u32,
+    /// A GNSS recovery (see `gnss_max_rejections`) also waits until the
+    /// rejections have lasted this long, s (default 0: the count alone).
+    /// A multipath burst moves the fixes by metres for a few seconds; a
+    /// recovery inside it takes the burst's fix with the position
+    /// covariance widened, and the filter follows the burst.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub gnss_recovery_after_s: f64,
     /// Standard deviation per axis of the receiver's slowly wandering
     /// position error, m (default 0: the fixes are white, the paper's
     /// model). Above 0 the outage evaluation's aided filter carries the
@@ -215,6 +222,7 @@ impl Default for Noise {
             steering: 0.02,
             gnss_gate_chi2: 13.815510557964274,
             gnss_max_rejections: 10,
+            gnss_recovery_after_s: 0.0,
             gnss_wander_std_m: 0.0,
             gnss_wander_tau_s: DEFAULT_GNSS_WANDER_TAU_S,
             wheel_gate_chi2: GROSS_FAULT_CHI2,
@@ -401,6 +409,12 @@ impl Vehicle {
                     "{k} must be positive (or inf to switch the gate off), got {v}"
                 )));
             }
+        }
+        if !(n.gnss_recovery_after_s.is_finite() && n.gnss_recovery_after_s >= 0.0) {
+            return Err(Error::InvalidVehicle(format!(
+                "noise.gnss_recovery_after_s must be a non-negative number, got {}",
+                n.gnss_recovery_after_s
+            )));
         }
         if !(n.gnss_wander_std_m.is_finite() && n.gnss_wander_std_m >= 0.0) {
             return Err(Error::InvalidVehicle(format!(
