@@ -49,7 +49,11 @@ struct CarResult {
 /// One car's result, or why there is none (a calibration refused).
 type Measured = Result<CarResult, String>;
 
-fn measure(car: &DynamicCar, effects: &Effects, model: Model, drive_s: f64) -> Measured {
+/// The aided filter's receiver model and `gnss_recovery_after_s`, s.
+type Setup = (Model, f64);
+
+fn measure(car: &DynamicCar, effects: &Effects, setup: Setup, drive_s: f64) -> Measured {
+    let (model, recovery_after_s) = setup;
     let seed = car.base.seed;
     let cal = simulate(&car.drive(1000 + seed, drive_s, effects), 1000 + seed).unwrap();
     let mut ev = simulate(&car.drive(2000 + seed, drive_s, effects), 2000 + seed).unwrap();
@@ -70,7 +74,7 @@ fn measure(car: &DynamicCar, effects: &Effects, model: Model, drive_s: f64) -> M
             car.base.gnss_markov, effects.wander
         );
     }
-    ev.drive.vehicle.noise.gnss_recovery_after_s = recovery_after_s();
+    ev.drive.vehicle.noise.gnss_recovery_after_s = recovery_after_s;
     if let Some((s, tau)) = wander {
         ev.drive.vehicle.noise.gnss_wander_std_m = s;
         ev.drive.vehicle.noise.gnss_wander_tau_s = tau;
@@ -83,7 +87,7 @@ fn measure(car: &DynamicCar, effects: &Effects, model: Model, drive_s: f64) -> M
         5.0,
         &FilterOptions::default(),
     )
-    .unwrap();
+    .map_err(|e| format!("evaluation: {e}"))?;
     let f = out.final_error();
     Ok(CarResult {
         mean_m: f.mean,
@@ -93,7 +97,7 @@ fn measure(car: &DynamicCar, effects: &Effects, model: Model, drive_s: f64) -> M
 }
 
 /// Every (car, model) pair on two threads; `rows[model][car]`.
-fn table(cars: &[u64], effects: &Effects, models: &[Model], drive_s: f64) -> Vec<Vec<Measured>> {
+fn table(cars: &[u64], effects: &Effects, models: &[Setup], drive_s: f64) -> Vec<Vec<Measured>> {
     let jobs: Vec<(usize, usize)> = (0..models.len())
         .flat_map(|m| (0..cars.len()).map(move |k| (m, k)))
         .collect();
@@ -128,19 +132,20 @@ fn mean(row: &[Measured]) -> f64 {
     ok.iter().sum::<f64>() / ok.len() as f64
 }
 
-fn name(m: &Model) -> String {
-    match m {
+fn name(setup: &Setup) -> String {
+    let m = match setup.0 {
         Model::White => "white fixes".into(),
         Model::Fixed(s, t) => format!("wander {s} m, {t} s"),
         Model::Drawn => "wander as drawn".into(),
         Model::Fitted => "wander fitted".into(),
-    }
+    };
+    format!("{m}, recovery after {} s", setup.1)
 }
 
-fn print(title: &str, cars: &[u64], models: &[Model], rows: &[Vec<Measured>]) {
+fn print(title: &str, cars: &[u64], models: &[Setup], rows: &[Vec<Measured>]) {
     println!("\n{title}: mean final error of 30 s outages (step 10 s), m");
     for (m, row) in models.iter().zip(rows) {
-        print!("{:<22} {:>7.3}", name(m), mean(row));
+        print!("{:<40} {:>7.3}", name(m), mean(row));
         for (c, r) in cars.iter().zip(row) {
             let Ok(r) = r else {
                 print!("  car {c}: {r:?}");
@@ -160,7 +165,8 @@ fn print(title: &str, cars: &[u64], models: &[Model], rows: &[Vec<Measured>]) {
     }
 }
 
-/// Exploration only: `RECOVERY_AFTER_S` in the environment.
+/// The explorations' `gnss_recovery_after_s`: `RECOVERY_AFTER_S` in the
+/// environment, 0 without.
 fn recovery_after_s() -> f64 {
     std::env::var("RECOVERY_AFTER_S")
         .ok()
@@ -171,11 +177,98 @@ fn recovery_after_s() -> f64 {
 const DEV: [u64; 6] = [1, 2, 3, 4, 5, 6];
 const DRIVE_S: f64 = 300.0;
 
+/// The GNSS recoveries counted over the cars' evaluations.
+fn recoveries(row: &[Measured]) -> u64 {
+    row.iter()
+        .flatten()
+        .map(|r| r.gates.recovered(SensorKind::Gnss))
+        .sum()
+}
+
+/// Issue 28: on the family's multipath bursts (2–9 s, offsets of 1–4 m per
+/// axis) the GNSS recovery — after 10 consecutive rejections, 1–2.5 s at
+/// 4–10 Hz — fired inside bursts: the burst's fix was taken with the
+/// position covariance widened and the filter followed the burst (car 1:
+/// 0.368 m without multipath, 0.807 m with). Waiting for the rejections to
+/// last 10 s (`gnss_recovery_after_s`, longer than any burst) removes the
+/// cost.
+#[test]
+fn multipath_bursts_pulled_the_filter_through_gnss_recoveries() {
+    let effects = Effects::only("multipath").unwrap();
+    let setups = [(Model::White, 0.0), (Model::White, 10.0)];
+    let rows = table(&DEV, &effects, &setups, DRIVE_S);
+    print("multipath only, cars 1–6", &DEV, &setups, &rows);
+    // Measured (cars 1–6, 300 s): 8 recoveries, mean 0.496 m; with 10 s
+    // none and 0.400 m (every effect off: 0.405 m).
+    assert!(recoveries(&rows[0]) >= 4, "{}", recoveries(&rows[0]));
+    assert_eq!(recoveries(&rows[1]), 0);
+    let (before, after) = (mean(&rows[0]), mean(&rows[1]));
+    assert!((before - 0.496).abs() < 0.02, "{before}");
+    assert!((after - 0.400).abs() < 0.02, "{after}");
+}
+
+/// The wander as states, fitted on the evaluation drive's own fixes, against
+/// white fixes on the family's wandering receivers (0–1.5 m, 20–120 s).
+#[test]
+fn the_wander_states_cut_the_outage_error_of_a_wandering_receiver() {
+    let effects = Effects::only("wander").unwrap();
+    let setups = [(Model::White, 0.0), (Model::Fitted, 0.0)];
+    let rows = table(&DEV, &effects, &setups, DRIVE_S);
+    print("wander only, cars 1–6", &DEV, &setups, &rows);
+    // Measured (cars 1–6, 300 s): white 1.995 m, fitted 1.669 m (every car
+    // better; the drawn σ and τ give 1.574 m).
+    let (white, fitted) = (mean(&rows[0]), mean(&rows[1]));
+    assert!((white - 1.995).abs() < 0.05, "{white}");
+    assert!((fitted - 1.669).abs() < 0.05, "{fitted}");
+    for (w, f) in rows[0].iter().zip(&rows[1]) {
+        let (w, f) = (w.as_ref().unwrap(), f.as_ref().unwrap());
+        assert!(f.mean_m < w.mean_m, "{} vs {}", f.mean_m, w.mean_m);
+    }
+}
+
+/// The fit on a white receiver chooses white fixes, and on a wandering one a
+/// σ near the drawn one (truth parameters, the evaluation drives).
+#[test]
+fn the_fit_tells_a_white_receiver_from_a_wandering_one() {
+    for seed in DEV {
+        let car = DynamicCar::draw(seed);
+        for wander in [false, true] {
+            let effects = if wander {
+                Effects::only("wander").unwrap()
+            } else {
+                Effects::none()
+            };
+            let ev = simulate(&car.drive(2000 + seed, DRIVE_S, &effects), 2000 + seed).unwrap();
+            let best = fit(&ev.drive, &ev.truth_params, &FilterOptions::default())
+                .unwrap()
+                .best;
+            let drawn = car.base.gnss_markov;
+            println!("car {seed}, wander {wander}: fitted {best:?}, drawn {drawn:?}");
+            if !wander {
+                assert!(best.is_none(), "car {seed}: {best:?}");
+            } else {
+                let s = best.map_or(0.0, |w| w.std_m);
+                assert!(
+                    (s / drawn.0 - 1.0).abs() < 0.5,
+                    "car {seed}: {s} vs {drawn:?}"
+                );
+            }
+        }
+    }
+}
+
 #[test]
 #[ignore]
 fn explore_models_on_the_development_cars() {
-    let models = vec![Model::White, Model::Fitted];
+    let r = recovery_after_s();
+    let models = vec![
+        (Model::White, r),
+        (Model::Fixed(1.0, 60.0), r),
+        (Model::Drawn, r),
+        (Model::Fitted, r),
+    ];
     for (title, effects) in [
+        ("wander only, cars 1–6", Effects::only("wander").unwrap()),
         (
             "multipath only, cars 1–6",
             Effects::only("multipath").unwrap(),
@@ -191,7 +284,8 @@ fn explore_models_on_the_development_cars() {
 #[ignore]
 fn explore_models_on_the_held_out_cars() {
     let cars: Vec<u64> = (101..=110).collect();
-    let models = vec![Model::White, Model::Fitted];
+    let r = recovery_after_s();
+    let models = vec![(Model::White, r), (Model::Fitted, r)];
     for (title, effects) in [
         (
             "wander only, cars 101–110",
