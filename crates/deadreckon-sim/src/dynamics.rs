@@ -33,6 +33,17 @@
 //! Every wheel rolls the component of its ground velocity along its own axis
 //! (rigid body): the rear wheels v·cos β_r ∓ (l_R/2)·ψ̇, the front wheels their
 //! speed times cos α_f.
+//!
+//! Longitudinal effects (each off unless its key is set) change what a
+//! wheel's rotation measures: the driven axle's **longitudinal slip**
+//! F_x/C_x under the traction force F_x = m·a_x + m·g·sin θ + rolling
+//! resistance + drag (braking shared by the axles by their static loads);
+//! the **rolling circumference**, growing as 1 + k_v·v² and shrinking with
+//! the wheel's load (the same load transfer as above); the **grade** and
+//! **bumps**, sinusoidal elevations along the path whose slope lengthens the
+//! distance rolled by √(1 + z′²) and whose pitch θ tips gravity into the
+//! accelerometer's x axis. The truth stays the horizontal path of M.
+//! `side_slip = false` keeps only these.
 
 use deadreckon_core::Vehicle;
 use serde::{Deserialize, Serialize};
@@ -72,6 +83,110 @@ pub struct DynamicsSpec {
     /// (default 0.6: its share of the roll stiffness).
     #[serde(default = "default_roll_front_share")]
     pub roll_stiffness_front_share: f64,
+    /// Whether the tyres slip sideways (default true); false keeps the body
+    /// along the path and only the longitudinal effects below.
+    #[serde(default = "yes", skip_serializing_if = "is_true")]
+    pub side_slip: bool,
+    /// The driven axle (default front).
+    #[serde(default, skip_serializing_if = "is_front")]
+    pub driven_axle: DrivenAxle,
+    /// Longitudinal slip stiffness of an axle (both tyres), N per unit
+    /// slip (default 0: no longitudinal slip). The driven axle's wheels turn
+    /// 1 + F_x/this times the ground distance under a traction force F_x
+    /// (m·a_x + m·g·sin θ + rolling resistance + drag); braking is shared
+    /// by the axles in proportion to their static loads.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub longitudinal_stiffness_n: f64,
+    /// Rolling-resistance coefficient, unitless (default 0.012; with
+    /// longitudinal slip only).
+    #[serde(
+        default = "default_rolling",
+        skip_serializing_if = "is_default_rolling"
+    )]
+    pub rolling_resistance: f64,
+    /// Aerodynamic drag: force over speed squared, N per (m/s)² (default 0.4:
+    /// ½·ρ·c_d·A for 0.3 × 2.2 m²; with longitudinal slip only).
+    #[serde(default = "default_drag", skip_serializing_if = "is_default_drag")]
+    pub drag_n_per_mps2: f64,
+    /// Growth of the rolling circumference with speed: the circumference is
+    /// 1 + this·v² times the static one, per (m/s)² (default 0; 2e-6 gives
+    /// +0.18 % at 30 m/s).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub radius_growth_per_mps2: f64,
+    /// Change of a wheel's rolling circumference with its load: 1 − this·(F_z
+    /// / F_z0 − 1) times the static one (default 0; 0.01–0.02 from a tyre's
+    /// deflection).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub radius_load_sensitivity: f64,
+    /// Road elevation: a sinusoid of this amplitude along the path, m
+    /// (default 0: flat). The wheels roll the distance along the slope; an
+    /// accelerometer reads the pitch.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub grade_amplitude_m: f64,
+    /// Wavelength of the elevation sinusoid, m (default 500).
+    #[serde(
+        default = "default_grade_wavelength",
+        skip_serializing_if = "is_default_grade_wavelength"
+    )]
+    pub grade_wavelength_m: f64,
+    /// Bumps: a short sinusoid in the elevation, amplitude m (default 0),
+    /// which adds wheel distance but no mean slope.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub bump_amplitude_m: f64,
+    /// Wavelength of the bumps, m (default 3).
+    #[serde(
+        default = "default_bump_wavelength",
+        skip_serializing_if = "is_default_bump_wavelength"
+    )]
+    pub bump_wavelength_m: f64,
+}
+
+/// The driven axle.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DrivenAxle {
+    /// Front-wheel drive.
+    #[default]
+    Front,
+    /// Rear-wheel drive.
+    Rear,
+}
+
+fn yes() -> bool {
+    true
+}
+fn is_true(b: &bool) -> bool {
+    *b
+}
+fn is_front(a: &DrivenAxle) -> bool {
+    *a == DrivenAxle::Front
+}
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
+}
+fn default_rolling() -> f64 {
+    0.012
+}
+fn is_default_rolling(x: &f64) -> bool {
+    *x == default_rolling()
+}
+fn default_drag() -> f64 {
+    0.4
+}
+fn is_default_drag(x: &f64) -> bool {
+    *x == default_drag()
+}
+fn default_grade_wavelength() -> f64 {
+    500.0
+}
+fn is_default_grade_wavelength(x: &f64) -> bool {
+    *x == default_grade_wavelength()
+}
+fn default_bump_wavelength() -> f64 {
+    3.0
+}
+fn is_default_bump_wavelength(x: &f64) -> bool {
+    *x == default_bump_wavelength()
 }
 
 fn default_mass() -> f64 {
@@ -106,6 +221,17 @@ impl Default for DynamicsSpec {
             cornering_stiffness_rear_n_per_rad: default_c_rear(),
             load_sensitivity: default_load_sensitivity(),
             roll_stiffness_front_share: default_roll_front_share(),
+            side_slip: true,
+            driven_axle: DrivenAxle::Front,
+            longitudinal_stiffness_n: 0.0,
+            rolling_resistance: default_rolling(),
+            drag_n_per_mps2: default_drag(),
+            radius_growth_per_mps2: 0.0,
+            radius_load_sensitivity: 0.0,
+            grade_amplitude_m: 0.0,
+            grade_wavelength_m: default_grade_wavelength(),
+            bump_amplitude_m: 0.0,
+            bump_wavelength_m: default_bump_wavelength(),
         }
     }
 }
@@ -172,6 +298,46 @@ impl DynamicsSpec {
                 return Err((key(k), format!("{v} must be strictly between 0 and 1")));
             }
         }
+        for (k, v) in [
+            ("longitudinal_stiffness_n", self.longitudinal_stiffness_n),
+            ("rolling_resistance", self.rolling_resistance),
+            ("drag_n_per_mps2", self.drag_n_per_mps2),
+            ("radius_growth_per_mps2", self.radius_growth_per_mps2),
+            ("radius_load_sensitivity", self.radius_load_sensitivity),
+            ("grade_amplitude_m", self.grade_amplitude_m),
+            ("bump_amplitude_m", self.bump_amplitude_m),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err((key(k), format!("{v} must be a non-negative number")));
+            }
+        }
+        for (k, v) in [
+            ("grade_wavelength_m", self.grade_wavelength_m),
+            ("bump_wavelength_m", self.bump_wavelength_m),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err((key(k), format!("{v} must be positive")));
+            }
+        }
+        for (k, a, l) in [
+            (
+                "grade_amplitude_m",
+                self.grade_amplitude_m,
+                self.grade_wavelength_m,
+            ),
+            (
+                "bump_amplitude_m",
+                self.bump_amplitude_m,
+                self.bump_wavelength_m,
+            ),
+        ] {
+            if std::f64::consts::TAU * a / l > 0.3 {
+                return Err((
+                    key(k),
+                    format!("{a} m over a wavelength of {l} m is a slope steeper than 30 %"),
+                ));
+            }
+        }
         if !(self.load_sensitivity.is_finite() && (0.0..=1.0).contains(&self.load_sensitivity)) {
             return Err((
                 key("load_sensitivity"),
@@ -196,6 +362,25 @@ pub(crate) struct Model {
     c_front: f64,
     c_rear: f64,
     eps: f64,
+    side_slip: bool,
+    rear_driven: bool,
+    c_long: f64,
+    rolling: f64,
+    drag: f64,
+    growth: f64,
+    load_radius: f64,
+    /// Elevation sinusoids: (amplitude m, wavenumber rad/m), grade and bumps.
+    waves: [(f64, f64); 2],
+}
+
+/// What the longitudinal effects make of one instant.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Rolling {
+    /// Per wheel FL, FR, RL, RR: distance counted in units of the static
+    /// circumference per metre of ground along the wheel's axis in the plane.
+    pub factors: [f64; 4],
+    /// Road pitch, rad (nose up positive).
+    pub pitch_rad: f64,
 }
 
 impl Model {
@@ -211,7 +396,86 @@ impl Model {
             c_front: spec.cornering_stiffness_front_n_per_rad,
             c_rear: spec.cornering_stiffness_rear_n_per_rad,
             eps: spec.load_sensitivity,
+            side_slip: spec.side_slip,
+            rear_driven: spec.driven_axle == DrivenAxle::Rear,
+            c_long: spec.longitudinal_stiffness_n,
+            rolling: spec.rolling_resistance,
+            drag: spec.drag_n_per_mps2,
+            growth: spec.radius_growth_per_mps2,
+            load_radius: spec.radius_load_sensitivity,
+            waves: [
+                (
+                    spec.grade_amplitude_m,
+                    std::f64::consts::TAU / spec.grade_wavelength_m,
+                ),
+                (
+                    spec.bump_amplitude_m,
+                    std::f64::consts::TAU / spec.bump_wavelength_m,
+                ),
+            ],
         }
+    }
+
+    /// Whether anything longitudinal is on (else every factor is 1).
+    pub(crate) fn rolls(&self) -> bool {
+        self.c_long > 0.0
+            || self.growth > 0.0
+            || self.load_radius > 0.0
+            || self.waves.iter().any(|w| w.0 > 0.0)
+    }
+
+    /// dz/ds of the road at path distance `s`, and of its grade part alone.
+    fn slopes(&self, s: f64) -> (f64, f64) {
+        let d = |(a, k): (f64, f64)| a * k * (k * s).cos();
+        let grade = d(self.waves[0]);
+        (grade + d(self.waves[1]), grade)
+    }
+
+    /// The longitudinal effects at path distance `s`, speed `v`, and
+    /// accelerations `a_x`, `a_y`.
+    pub(crate) fn rolling(&self, s: f64, v: f64, a_x: f64, a_y: f64) -> Rolling {
+        let (dz, grade) = self.slopes(s);
+        let pitch_rad = grade.atan();
+        // Distance along the road per metre in the plane (bumps included).
+        let along = dz.hypot(1.0);
+        let w = self.mass * G_MPS2;
+        let (fz0_f, fz0_r) = (w * self.front_share, w * (1.0 - self.front_share));
+        let shift = self.mass * a_x * self.h_over_l;
+        let (fz_f, fz_r) = (fz0_f - shift, fz0_r + shift);
+        let roll = self.mass * a_y * self.h;
+        // a_y > 0 (left turn): load moves to the right wheels.
+        let d_f = self.roll_front * roll / self.track_front;
+        let d_r = (1.0 - self.roll_front) * roll / self.track_rear;
+        let loads = [
+            0.5 * fz_f - d_f,
+            0.5 * fz_f + d_f,
+            0.5 * fz_r - d_r,
+            0.5 * fz_r + d_r,
+        ];
+        let static_loads = [0.5 * fz0_f, 0.5 * fz0_f, 0.5 * fz0_r, 0.5 * fz0_r];
+        // Longitudinal slip per axle (front, rear).
+        let mut slip = [0.0, 0.0];
+        if self.c_long > 0.0 && v != 0.0 {
+            let resist = v.signum() * (self.rolling * w + self.drag * v * v);
+            let f_x = self.mass * (a_x + G_MPS2 * pitch_rad.sin()) + resist;
+            // Slip as a wheel's extra turning relative to the ground, signed
+            // by the force along the direction of travel.
+            let f = f_x * v.signum();
+            if f > 0.0 {
+                slip[usize::from(self.rear_driven)] = f / self.c_long;
+            } else {
+                slip = [
+                    f * self.front_share / self.c_long,
+                    f * (1.0 - self.front_share) / self.c_long,
+                ];
+            }
+        }
+        let growth = 1.0 + self.growth * v * v;
+        let factors = [0, 1, 2, 3].map(|i| {
+            let load = 1.0 - self.load_radius * (loads[i] / static_loads[i] - 1.0);
+            along * (1.0 + slip[i / 2]) / (growth * load)
+        });
+        Rolling { factors, pitch_rad }
     }
 
     /// An axle's stiffness, N/rad: `c0` at static axle load `fz0` (both
@@ -227,7 +491,7 @@ impl Model {
 
     /// The rear side slip β_r and the front slip angle α_f, rad.
     pub(crate) fn slip(&self, v: f64, a_x: f64, a_y: f64) -> (f64, f64) {
-        if a_y == 0.0 || v == 0.0 {
+        if !self.side_slip || a_y == 0.0 || v == 0.0 {
             return (0.0, 0.0);
         }
         let w = self.mass * G_MPS2;

@@ -23,7 +23,16 @@
 //! | steering wheel | r_s · atan(l_RF · κ + β), β white: the noise of eq. 7 on tan(δ/r_s) |
 //! | wheel faults (optional) | spin bursts under traction on one wheel, one wheel smaller from some time on ([`faults`]) |
 //! | GNSS | antenna position (lever arm forward of M) + white noise; course and speed from the antenna velocity + white noise |
-//! | vehicle dynamics (optional `[dynamics]`) | a quasi-steady single-track model with load-sensitive tyre cornering stiffness and load transfer ([`dynamics`]): the body yaw is M's course less the rear side slip β_r ≈ −g·a_y; gyro, wheels (each along its own axis), antenna and truth yaw follow the body; the steering reads the understeer δ ≈ L·κ + K_us·a_y |
+//! | vehicle dynamics (optional `[dynamics]`) | a quasi-steady single-track model with load-sensitive tyre cornering stiffness and load transfer ([`dynamics`]): the body yaw is M's course less the rear side slip β_r ≈ −g·a_y; gyro, wheels (each along its own axis), antenna and truth yaw follow the body; the steering reads the understeer δ ≈ L·κ + K_us·a_y. Optional longitudinal effects on what the wheels count: the driven axle's slip under the traction force, rolling circumferences growing with speed and shrinking with load, grade and bumps (sinusoidal elevations; the accelerometer reads the pitch) |
+//! | stream clocks (optional `clock = {…}` in any stream) | the sample describes the true time, its stamp is the stream's clock: offset + drift (ppm) + white jitter ([`imperfections`]); wheel ticks are counted over the true intervals |
+//! | tone-ring tooth error (optional `sensors.wheels.tooth_error_std`) | each tooth of each wheel's ring misplaced by a fixed fraction of the pitch: ticks count the misplaced edges, speeds are the rotation inferred from them |
+//! | gyro bias drift (optional `sensors.gyro.bias_drift_std_rps`) | a Gauss–Markov bias on top of the constant one |
+//! | GNSS multipath (optional `[sensors.gnss.multipath]`) | Poisson bursts of a few seconds, each with one position offset of a few metres, on top of the wander (`markov_std_m`), the white noise and the latency |
+//!
+//! Every optional effect is off by default: a scenario without them
+//! simulates exactly as before they existed. The dynamic family
+//! ([`family::DynamicCar`], [`family::Effects`]) draws each at random per
+//! car and switches each on or off.
 //!
 //! Other vehicle shapes: [`tricycle`] simulates a steered, driven front
 //! wheel with steering and traction encoders and an external tracker, through

@@ -674,12 +674,15 @@ impl Suite {
                         let f_v = if self.dynamic {
                             // M's acceleration (a along the course, v·χ̇
                             // across it) in the body frame, turned by β_r.
+                            // The road's pitch tips gravity into x.
                             let (sb, cb) = st.beta.sin_cos();
                             let across = st.v * st.v * st.kappa;
+                            let (sp, cp) = st.pitch_rad.sin_cos();
+                            let g = deadreckon_core::imu::GRAVITY_MPS2;
                             [
-                                st.a * cb - across * sb,
+                                st.a * cb - across * sb + g * sp,
                                 st.a * sb + across * cb,
-                                deadreckon_core::imu::GRAVITY_MPS2,
+                                g * cp,
                             ]
                         } else {
                             [st.a, st.v * st.yaw_rate, deadreckon_core::imu::GRAVITY_MPS2]

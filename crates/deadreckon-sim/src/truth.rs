@@ -51,11 +51,15 @@ pub struct State {
     /// Road-wheel angle of the single-track model, rad: atan(L·κ) without
     /// dynamics, the front axle's velocity direction plus its slip angle with.
     pub road_wheel_rad: f64,
+    /// Road pitch, rad, nose up (0 without a grade).
+    pub pitch_rad: f64,
     /// East of the origin, m.
     pub x: f64,
     /// North of the origin, m.
     pub y: f64,
-    /// Ground distance rolled by each wheel, FL, FR, RL, RR, m.
+    /// Ground distance rolled by each wheel, FL, FR, RL, RR, m; with the
+    /// longitudinal effects of `[dynamics]` (slip, radii, slopes) the
+    /// distance its rotation measures in static circumferences.
     pub wheel_m: [f64; 4],
 }
 
@@ -86,6 +90,10 @@ struct Exact {
     beta: f64,
     alpha_front: f64,
     road_wheel_rad: f64,
+    /// Per wheel: distance counted per metre rolled in the plane (1
+    /// without longitudinal effects).
+    roll_factors: [f64; 4],
+    pitch_rad: f64,
 }
 
 impl<'a> Kinematics<'a> {
@@ -132,7 +140,15 @@ impl<'a> Kinematics<'a> {
                 beta: 0.0,
                 alpha_front: 0.0,
                 road_wheel_rad: (self.wheelbase * kappa).atan(),
+                roll_factors: [1.0; 4],
+                pitch_rad: 0.0,
             };
+        };
+        let (roll_factors, pitch_rad) = if model.rolls() {
+            let r = model.rolling(m.s, m.v, m.a, m.v * m.v * kappa);
+            (r.factors, r.pitch_rad)
+        } else {
+            ([1.0; 4], 0.0)
         };
         let (beta, alpha_front) = model.slip(m.v, m.a, m.v * m.v * kappa);
         let h = SLIP_RATE_STEP_S;
@@ -158,6 +174,8 @@ impl<'a> Kinematics<'a> {
             beta,
             alpha_front,
             road_wheel_rad,
+            roll_factors,
+            pitch_rad,
         }
     }
 
@@ -172,11 +190,12 @@ impl<'a> Kinematics<'a> {
         let (vx, vy) = (e.v * cb, e.v * sb + self.wheelbase * w);
         let sign = if e.v < 0.0 { -1.0 } else { 1.0 };
         let front = e.alpha_front.cos();
+        let f = e.roll_factors;
         [
-            sign * front * vy.hypot(vx - self.half_front * w),
-            sign * front * vy.hypot(vx + self.half_front * w),
-            vx - self.half_rear * w,
-            vx + self.half_rear * w,
+            f[0] * sign * front * vy.hypot(vx - self.half_front * w),
+            f[1] * sign * front * vy.hypot(vx + self.half_front * w),
+            f[2] * (vx - self.half_rear * w),
+            f[3] * (vx + self.half_rear * w),
         ]
     }
 
@@ -219,6 +238,7 @@ impl<'a> Kinematics<'a> {
             course: e.course,
             beta: e.beta,
             road_wheel_rad: e.road_wheel_rad,
+            pitch_rad: e.pitch_rad,
             x: lerp(a.x, b.x),
             y: lerp(a.y, b.y),
             wheel_m,
@@ -254,6 +274,7 @@ impl<'a> Integrator<'a> {
             course: e.course,
             beta: e.beta,
             road_wheel_rad: e.road_wheel_rad,
+            pitch_rad: e.pitch_rad,
             x: 0.0,
             y: 0.0,
             wheel_m: [0.0; 4],
@@ -320,6 +341,7 @@ impl<'a> Integrator<'a> {
             course: e.course,
             beta: e.beta,
             road_wheel_rad: e.road_wheel_rad,
+            pitch_rad: e.pitch_rad,
             x,
             y,
             wheel_m,

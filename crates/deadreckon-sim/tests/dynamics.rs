@@ -186,3 +186,146 @@ fn without_dynamics_the_scenario_and_its_file_are_unchanged() {
     let worst = rows.iter().map(|r| r.1.abs()).fold(0.0, f64::max);
     assert!(worst < 1e-3, "{worst}");
 }
+
+/// Straights with speed changes (the traction test's), noise-free wheel
+/// speeds at 100 Hz and a level IMU, with `dynamics` (TOML keys).
+fn straights(dynamics: &str) -> SimOutput {
+    let text = format!(
+        r#"
+name = "speed-changes"
+vehicle = "paper-car"
+
+[route]
+segments = [
+  {{ kind = "straight", length_m = 400, speed_limit_kmh = 50 }},
+  {{ kind = "straight", length_m = 1200, speed_limit_kmh = 100 }},
+  {{ kind = "straight", length_m = 300, speed_limit_kmh = 40 }},
+  {{ kind = "straight", length_m = 700, speed_limit_kmh = 80 }},
+]
+
+[speed]
+max_accel_mps2 = 2.0
+max_decel_mps2 = 2.5
+start_stop_s = 0
+end_stop_s = 0
+
+[sensors]
+truth_rate_hz = 100
+
+[sensors.wheels]
+kind = "speeds"
+rate_hz = 100
+noise_std_mps = 0.0
+resolution_mps = 0.0
+
+[sensors.gyro]
+rate_hz = 100
+noise_std = 0.0
+tilt_deg = [0.0, 0.0]
+
+[dynamics]
+side_slip = false
+{dynamics}
+"#
+    );
+    simulate(&Scenario::from_toml_str(&text).unwrap(), 5).unwrap()
+}
+
+/// Per wheel row: (time, truth speed and acceleration at that time, the
+/// wheel speeds FL, FR, RL, RR).
+fn rows(out: &SimOutput) -> Vec<(f64, f64, f64, [f64; 4])> {
+    let Wheels::Speeds(ws) = &out.drive.wheels else {
+        panic!("speeds")
+    };
+    let tr = &out.drive.truth;
+    let mut v = Vec::new();
+    for w in ws.iter().skip(1) {
+        // The reading is the mean over the last 10 ms: the truth at its middle.
+        let t = w.t_s - 0.005;
+        let i = tr.partition_point(|p| p.t_s < t);
+        if i < 2 || i + 1 >= tr.len() {
+            continue;
+        }
+        let (a, b) = (&tr[i - 1], &tr[i]);
+        let l = (t - a.t_s) / (b.t_s - a.t_s);
+        let (va, vb) = (a.speed_mps.unwrap(), b.speed_mps.unwrap());
+        let speed = va + l * (vb - va);
+        let accel = (tr[i + 1].speed_mps.unwrap() - tr[i - 2].speed_mps.unwrap())
+            / (tr[i + 1].t_s - tr[i - 2].t_s);
+        v.push((
+            w.t_s,
+            speed,
+            accel,
+            [w.fl_mps, w.fr_mps, w.rl_mps, w.rr_mps],
+        ));
+    }
+    v
+}
+
+#[test]
+fn the_driven_axle_slips_with_the_traction_force() {
+    let c_x = 150_000.0;
+    let out = straights(&format!("longitudinal_stiffness_n = {c_x}"));
+    let spec = DynamicsSpec::default();
+    let (m, g) = (spec.mass_kg, 9.806_65);
+    let mut xy = Vec::new();
+    for (_, v, a, w) in rows(&out) {
+        let force = m * a + spec.rolling_resistance * m * g + spec.drag_n_per_mps2 * v * v;
+        if v > 5.0 && force > 0.0 {
+            // Front-wheel drive: the front wheels turn 1 + F/C_x times, the
+            // rear ones roll.
+            xy.push((
+                force / c_x,
+                0.5 * (w[0] + w[1]) / (0.5 * (w[2] + w[3])) - 1.0,
+            ));
+        }
+    }
+    let fit = slope(&xy);
+    let largest = xy.iter().map(|p| p.1).fold(0.0, f64::max);
+    println!("front/rear − 1 against F/C_x: slope {fit:.4}, largest slip {largest:.4}");
+    // Measured: slope 1.0000 (the truth's speed difference quotient), slip
+    // up to 2 %.
+    assert!((fit - 1.0).abs() < 0.02, "{fit}");
+    assert!(largest > 0.015, "{largest}");
+    // Without the key, the axles agree.
+    let flat = straights("");
+    for (_, v, _, w) in rows(&flat) {
+        if v > 5.0 {
+            assert!((w[0] / w[2] - 1.0).abs() < 1e-9);
+        }
+    }
+}
+
+#[test]
+fn rolling_radii_grow_with_speed_and_slopes_add_distance() {
+    let k = 2e-6;
+    let out = straights(&format!("radius_growth_per_mps2 = {k}"));
+    let mut worst: f64 = 0.0;
+    for (_, v, _, w) in rows(&out) {
+        if v > 5.0 {
+            worst = worst.max((w[2] / v * (1.0 + k * v * v) - 1.0).abs());
+        }
+    }
+    println!("rear-left speed against v/(1 + k·v²): worst relative error {worst:.2e}");
+    // Measured 5.6e-7 (the truth's speed interpolated to the reading's middle).
+    assert!(worst < 1e-5, "{worst}");
+    // A grade of 2π·5/500 = 6.3 % at most: the wheels roll the length of the
+    // slope, 1 + (2πA/λ)²/4 on average, and the accelerometer reads g·sin θ.
+    let out = straights("grade_amplitude_m = 5.0\ngrade_wavelength_m = 500.0");
+    let ratio = out.stats.wheel_distance_m[2] / out.stats.distance_m;
+    let expected = 1.0 + (std::f64::consts::TAU * 5.0 / 500.0).powi(2) / 4.0;
+    println!("rear-left distance over the path's: {ratio:.6} (expected about {expected:.6})");
+    assert!((ratio - expected).abs() < 2e-4, "{ratio}");
+    let largest = out
+        .drive
+        .imu
+        .accel
+        .iter()
+        .map(|f| f.x.abs())
+        .fold(0.0, f64::max);
+    // g·0.0628 = 0.62 m/s² from the slope, plus up to 2.5 from the speed changes.
+    assert!(largest > 0.6, "{largest}");
+    let flat = straights("");
+    let level = flat.stats.wheel_distance_m[2] / flat.stats.distance_m;
+    assert!((level - 1.0).abs() < 1e-9, "{level}");
+}

@@ -17,9 +17,38 @@
 //! cargo test --profile ci -p deadreckon-sim --test dynamics_ablation -- --ignored --nocapture
 //! ```
 //!
-//! The first runs the development cars on short drives (under two minutes
-//! on two cores); the second, ignored, the development and held-out cars on
-//! longer drives.
+//! The first runs the development cars on short drives (about 75 s of CPU
+//! for the ablation); the second, ignored, the development and held-out
+//! cars on 600 s drives (10 min 15 s of CPU, 24 min on the shared two
+//! cores). Measured with the second (mean final error, m; ×: of "none"):
+//!
+//! | effects | dev cars 1–6 | × | held-out 101–110 (104 apart) | × |
+//! |---|---|---|---|---|
+//! | kinematic family | 0.883 | 1.11 | 0.858 | 1.05 |
+//! | none | 0.799 | 1.00 | 0.815 | 1.00 |
+//! | side_slip | 0.940 | 1.18 | 0.861 | 1.06 |
+//! | longitudinal | 0.822 | 1.03 | 0.815 | 1.00 |
+//! | terrain | 0.798 | 1.00 | 0.813 | 1.00 |
+//! | clocks | 1.578 | 1.98 | 1.682 | 2.06 |
+//! | tooth_error | 0.798 | 1.00 | 0.816 | 1.00 |
+//! | gyro_drift | 1.288 | 1.61 | 1.366 | 1.68 |
+//! | gyro_scale | 1.172 | 1.47 | 1.264 | 1.55 |
+//! | multipath | 1.238 | 1.55 | 0.880 | 1.08 |
+//! | wander | 2.844 | 3.56 | 1.363 | 1.67 |
+//! | latency | 1.171 | 1.47 | 1.055 | 1.30 |
+//! | steering_offset | 0.829 | 1.04 | 0.857 | 1.05 |
+//! | all | 4.489 | 5.62 | 2.993 | 3.67 |
+//!
+//! Car 104's calibration drive is rejected by the RTS calibration (the
+//! smoothing filter loses the fixes: circumferences of about 4 m for 2 m
+//! tyres) in every configuration but "kinematic family" and "clocks"; the
+//! held-out means are over the nine other cars in every row (the test
+//! prints "kinematic family" 0.897 and "clocks" 1.671 with car 104 in).
+//! Car 104 is the only one of the sixteen with wheel speeds at 100 Hz from
+//! tone-ring edge jitter (0.8 mm: about 0.1 m/s per reading); the same drive
+//! with its wheels at 50 Hz calibrates (rear-left 1.9977 m, truth 1.9974 m),
+//! without steering or CAN speed it is still rejected. An estimator
+//! finding, left as drawn (held-out members are not tuned on).
 
 use std::collections::HashMap;
 use std::sync::{Mutex, OnceLock};
@@ -31,6 +60,7 @@ use deadreckon_core::ekf::FilterOptions;
 use deadreckon_core::model::{X, Y, YAW};
 use deadreckon_core::outage::evaluate;
 use deadreckon_core::reference::Reference;
+use deadreckon_sim::dynamics::DrivenAxle;
 use deadreckon_sim::family::{DynamicCar, Effects};
 use deadreckon_sim::{simulate, SimOutput, WheelKind};
 
@@ -196,7 +226,7 @@ fn ablation_on_the_development_cars() {
 const DEV_DRIVE_S: f64 = 300.0;
 
 /// The bigger run: the development cars and the held-out ones (printed on
-/// their own), on 600 s drives. About 15 minutes on two cores.
+/// their own), on 600 s drives (10 min of CPU).
 #[test]
 #[ignore]
 fn ablation_on_the_development_and_held_out_cars() {
@@ -300,6 +330,39 @@ fn side_slip_turns_the_body_by_the_drawn_gradient() {
         );
         // Measured on cars 1–6: within 0.6 % of −g (load transfer adds to it).
         assert!((fit + g).abs() < 0.03 * g, "car {seed}: {fit} vs {g}");
+    }
+}
+
+#[test]
+fn terrain_and_longitudinal_slip_change_what_the_wheels_count() {
+    for seed in CARS {
+        let car = DynamicCar::draw(seed);
+        let d = &car.dynamics;
+        let (none, with) = pair(&car, "terrain");
+        // The wheels roll the length of the road: on average
+        // 1 + (2πA/λ)²/4 for each sinusoid (grade and bumps).
+        let wave = |a: f64, l: f64| (std::f64::consts::TAU * a / l).powi(2) / 4.0;
+        let expected = wave(d.grade_amplitude_m, d.grade_wavelength_m)
+            + wave(d.bump_amplitude_m, d.bump_wavelength_m);
+        let extra = with.stats.wheel_distance_m[2] / none.stats.wheel_distance_m[2] - 1.0;
+        println!("car {seed}: terrain adds {extra:.6} to the rear-left distance (expected {expected:.6})");
+        // Measured on cars 1–6: within 1.5 % (the rest: the drive's end is
+        // not at a whole wavelength).
+        assert!((extra / expected - 1.0).abs() < 0.05, "car {seed}: {extra}");
+        // Longitudinal slip and radii: the driven axle counts more than the
+        // other (traction beats the braking share on these drives).
+        let (none, with) = pair(&car, "longitudinal");
+        let axle = |s: &SimOutput, k: usize| {
+            s.stats.wheel_distance_m[2 * k] + s.stats.wheel_distance_m[2 * k + 1]
+        };
+        let driven = usize::from(d.driven_axle == DrivenAxle::Rear);
+        let gain = |s: &SimOutput| axle(s, driven) / axle(s, 1 - driven);
+        println!(
+            "car {seed}: driven over free axle distance {:.5} (without {:.5})",
+            gain(&with),
+            gain(none)
+        );
+        assert!(gain(&with) > gain(none), "car {seed}");
     }
 }
 

@@ -10,6 +10,8 @@
 //! | effect ([`Effects`] field) | what is drawn per car |
 //! |---|---|
 //! | `side_slip` | a [`DynamicsSpec`]: mass 1200–2000 kg, front weight share 0.52–0.64, centre of gravity 0.45–0.65 m high, the rear stiffness from a side-slip gradient of 0.003–0.007 rad per m/s², the front one from an understeer gradient of 0.001–0.004 rad per m/s², load sensitivity 0.2–0.4, front roll share 0.5–0.7 |
+//! | `longitudinal` | the driven axle (front 70 % of cars) slipping by the traction force over a stiffness of 15–25 times its static load, rolling resistance 0.008–0.015, drag 0.3–0.5 N/(m/s)²; rolling circumference +0.1–0.3 % at 30 m/s and −(0.01–0.02) per unit of relative load change |
+//! | `terrain` | a sinusoidal elevation of 300–1000 m wavelength and 2–6 % largest grade, bumps of 5–15 mm amplitude and 2–5 m wavelength |
 //! | `clocks` | each stream's own clock ([`ClockSpec`]): wheels, gyro, CAN speed and steering offset 0–10 ms (late), drift ±100 ppm, jitter 0.2–1 ms (wheels at 50 Hz up to 2 ms); the receiver's stamps jitter 0–5 ms |
 //! | `tooth_error` | tone-ring tooth position error 0.2–1 % of the pitch (48 teeth, fixed per wheel and tooth) |
 //! | `gyro_drift` | a Gauss–Markov gyro bias of 0.00005–0.0002 rad/s (10–40 °/h, an automotive MEMS gyro's in-run instability), correlation time 100–600 s, on top of the constant bias |
@@ -28,7 +30,7 @@ use rand::RngExt;
 use serde::{Deserialize, Serialize};
 
 use super::{between, rng, CarFamily};
-use crate::dynamics::DynamicsSpec;
+use crate::dynamics::{DrivenAxle, DynamicsSpec};
 use crate::imperfections::{ClockSpec, MultipathSpec};
 use crate::scenario::Scenario;
 use crate::sensors::{ScalarSpec, SteeringSpec, WheelKind};
@@ -38,6 +40,11 @@ use crate::sensors::{ScalarSpec, SteeringSpec, WheelKind};
 pub struct Effects {
     /// Tyre side slip and understeer ([`crate::dynamics`]).
     pub side_slip: bool,
+    /// The driven axle's longitudinal slip, rolling radii growing with
+    /// speed and shrinking with load.
+    pub longitudinal: bool,
+    /// Grade (a sinusoidal elevation) and bumps.
+    pub terrain: bool,
     /// Each stream on its own clock: offset, drift, jitter.
     pub clocks: bool,
     /// Tone-ring tooth-spacing error.
@@ -58,8 +65,10 @@ pub struct Effects {
 
 impl Effects {
     /// The names of the effects, in the order of [`Effects::only`].
-    pub const NAMES: [&'static str; 9] = [
+    pub const NAMES: [&'static str; 11] = [
         "side_slip",
+        "longitudinal",
+        "terrain",
         "clocks",
         "tooth_error",
         "gyro_drift",
@@ -101,6 +110,8 @@ impl Effects {
     fn flag(&mut self, name: &str) -> Option<&mut bool> {
         Some(match name {
             "side_slip" => &mut self.side_slip,
+            "longitudinal" => &mut self.longitudinal,
+            "terrain" => &mut self.terrain,
             "clocks" => &mut self.clocks,
             "tooth_error" => &mut self.tooth_error,
             "gyro_drift" => &mut self.gyro_drift,
@@ -139,7 +150,8 @@ pub struct DynamicCar {
     pub wheel_kind: WheelKind,
     /// Wheel rate, Hz (50 or 100).
     pub wheel_rate_hz: f64,
-    /// Tyre side slip and understeer.
+    /// Tyre side slip and understeer, longitudinal slip, rolling radii,
+    /// grade and bumps (each part used when its effect is on).
     pub dynamics: DynamicsSpec,
     /// The streams' clocks.
     pub clocks: Clocks,
@@ -167,6 +179,8 @@ const LATENCY: u64 = 106;
 const STEERING: u64 = 107;
 const STREAMS: u64 = 108;
 const PHASES: u64 = 109;
+const LONGITUDINAL: u64 = 110;
+const TERRAIN: u64 = 111;
 
 fn signed(r: &mut rand_pcg::Pcg64, lo: f64, hi: f64) -> f64 {
     let m = between(r, lo, hi);
@@ -196,6 +210,38 @@ impl DynamicCar {
                 / (understeer + slip_gradient),
             load_sensitivity: between(r, 0.2, 0.4),
             roll_stiffness_front_share: between(r, 0.5, 0.7),
+            ..DynamicsSpec::default()
+        };
+        // Drawn after the side slip's values, from their own generators.
+        let r = &mut rng(seed, LONGITUDINAL);
+        let rear_driven = r.random::<f64>() < 0.3;
+        let driven_share = if rear_driven {
+            1.0 - front_load_share
+        } else {
+            front_load_share
+        };
+        let dynamics = DynamicsSpec {
+            driven_axle: if rear_driven {
+                DrivenAxle::Rear
+            } else {
+                DrivenAxle::Front
+            },
+            longitudinal_stiffness_n: between(r, 15.0, 25.0) * mass_kg * 9.81 * driven_share,
+            rolling_resistance: between(r, 0.008, 0.015),
+            drag_n_per_mps2: between(r, 0.3, 0.5),
+            radius_growth_per_mps2: between(r, 0.001, 0.003) / 900.0,
+            radius_load_sensitivity: between(r, 0.01, 0.02),
+            ..dynamics
+        };
+        let r = &mut rng(seed, TERRAIN);
+        let grade_wavelength_m = between(r, 300.0, 1000.0);
+        let grade_amplitude_m = between(r, 0.02, 0.06) * grade_wavelength_m / std::f64::consts::TAU;
+        let dynamics = DynamicsSpec {
+            grade_amplitude_m,
+            grade_wavelength_m,
+            bump_amplitude_m: between(r, 0.005, 0.015),
+            bump_wavelength_m: between(r, 2.0, 5.0),
+            ..dynamics
         };
         let s = &mut rng(seed, STREAMS);
         let wheel_kind = if s.random::<bool>() {
@@ -321,9 +367,75 @@ impl DynamicCar {
         if effects.multipath {
             g.multipath = Some(self.multipath.clone());
         }
-        if effects.side_slip {
-            sc.dynamics = Some(self.dynamics.clone());
+        if effects.side_slip || effects.longitudinal || effects.terrain {
+            let mut d = self.dynamics.clone();
+            let flat = DynamicsSpec::default();
+            d.side_slip = effects.side_slip;
+            if !effects.longitudinal {
+                d.longitudinal_stiffness_n = 0.0;
+                d.radius_growth_per_mps2 = 0.0;
+                d.radius_load_sensitivity = 0.0;
+            }
+            if !effects.terrain {
+                d.grade_amplitude_m = flat.grade_amplitude_m;
+                d.bump_amplitude_m = flat.bump_amplitude_m;
+            }
+            sc.dynamics = Some(d);
         }
         sc
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn switching_one_effect_changes_only_its_part_of_the_scenario() {
+        let car = DynamicCar::draw(3);
+        assert_eq!(car, DynamicCar::draw(3));
+        let none = car.drive(5, 200.0, &Effects::none());
+        assert!(none.dynamics.is_none());
+        assert_eq!(none.sensors.gnss.as_ref().unwrap().markov_std_m, 0.0);
+        for name in Effects::NAMES {
+            let with = car.drive(5, 200.0, &Effects::only(name).unwrap());
+            assert_ne!(with, none, "{name} changed nothing");
+            assert_eq!(with.route, none.route, "{name}");
+            assert_eq!(with.speed, none.speed, "{name}");
+            assert_eq!(with.sensors.wheels.offset_s, none.sensors.wheels.offset_s);
+        }
+        // All on is each on; unknown names are refused.
+        let all = Effects::all();
+        for name in Effects::NAMES {
+            assert_eq!(Effects::all_but(name).unwrap(), {
+                let mut e = all;
+                *e.flag(name).unwrap() = false;
+                e
+            });
+        }
+        assert!(Effects::only("tyre_pressure").is_none());
+        // The side slip's draws are the same whether the longitudinal ones
+        // exist or not: each effect has its own generator.
+        let g = car
+            .dynamics
+            .rear_slip_gradient_rad_per_mps2(&car.base.vehicle);
+        assert!((0.003..=0.007).contains(&g), "{g}");
+    }
+
+    #[test]
+    fn wheel_ticks_are_among_the_drawn_kinds_at_50_or_100_hz() {
+        let cars: Vec<DynamicCar> = (1..=20).map(DynamicCar::draw).collect();
+        assert!(cars.iter().any(|c| c.wheel_kind == WheelKind::Ticks));
+        assert!(cars.iter().any(|c| c.wheel_kind == WheelKind::Speeds));
+        assert!(cars
+            .iter()
+            .all(|c| [50.0, 100.0].contains(&c.wheel_rate_hz)));
+        let sc = cars[0].drive(1, 100.0, &Effects::all());
+        assert_eq!(sc.sensors.gyro.as_ref().unwrap().rate_hz, 100.0);
+        assert!(sc.sensors.gyro.as_ref().unwrap().clock.is_some());
+        sc.validate().unwrap();
+        // Every effect is written to, and read back from, the scenario file.
+        let text = sc.to_toml_string().unwrap();
+        assert_eq!(Scenario::from_toml_str(&text).unwrap(), sc, "{text}");
     }
 }
