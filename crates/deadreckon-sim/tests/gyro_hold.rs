@@ -35,6 +35,7 @@ fn drive(seed: u64, jitter_s: f64) -> SimOutput {
         latency_s: 0.0,
         true_ratio: None,
         wheel_offset_rad: 5f64.to_radians(),
+        clock: None,
     });
     let mut sim = simulate(&sc, 700 + seed).unwrap();
     if jitter_s > 0.0 {
