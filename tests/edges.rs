@@ -691,7 +691,25 @@ fn evaluate_used_nominal_for_metrics_but_rts_for_outages() {
     };
     // One rule, whatever the metric: the RTS calibration on the drive.
     let (ape, _) = eval(&["--metric", "ape", "--json"]);
-    let (outage, _) = eval(&["--outage", "10", "--step", "10", "--json"]);
+    let (outage, _) = eval(&["--outage", "10", "--step", "5", "--json"]);
+    // The window at pull-away (11.6 s, yaw standard deviation 13.9°) is
+    // reported on its own; the heading is known from 16.1 s.
+    assert_eq!(outage["windows"], 1, "{outage}");
+    assert_eq!(outage["unsettled"].as_array().unwrap().len(), 1, "{outage}");
+    // With only the pull-away window, nothing is measured, and the error says why.
+    let st = bin()
+        .arg("evaluate")
+        .arg(&d)
+        .args(["--outage", "10", "--step", "10"])
+        .output()
+        .unwrap();
+    assert!(!st.status.success());
+    let err = String::from_utf8_lossy(&st.stderr);
+    assert!(
+        err.contains("no 10 s outage window starts with the heading known")
+            && err.contains("first falls to 2.0° at 16.1 s"),
+        "{err}"
+    );
     let label = ape["params"].as_str().unwrap().to_string();
     assert!(label.starts_with("rts ("), "{ape}");
     assert_eq!(outage["params"], label.as_str());

@@ -26,7 +26,9 @@ pub struct CarCalibration {
     pub corrections: Corrections,
     /// Which corrections were applied.
     pub which: Which,
-    /// The steering ratio and offset (with the truth method).
+    /// The steering ratio and offset (against the truth with the truth
+    /// method; with the understeer gradient against the smoothed states with
+    /// the RTS method).
     pub steering: Option<SteeringCalibration>,
 }
 
@@ -48,7 +50,9 @@ pub fn calibrate_car(
         .map_err(|source| Error::Step {
             step: "calibrating the steering".into(),
             source,
-        })?;
+        })?
+        // The RTS calibration's fit against its smoothed states.
+        .or_else(|| calibration.steering.clone());
     Ok(CarCalibration {
         method_name: method_name.to_string(),
         options,
@@ -98,6 +102,9 @@ impl CarCalibration {
         if let Some(st) = &self.steering {
             extra.insert("steering".into(), steering_toml(st).into());
         }
+        if let Some(slip) = &self.calibration.side_slip {
+            extra.insert("side_slip".into(), side_slip_toml(slip).into());
+        }
         if self.which != Which::None {
             extra.extend(crate::corrections::corrections_toml(&self.corrections));
         }
@@ -132,14 +139,18 @@ impl CarCalibration {
         for (k, why) in self.not_estimated() {
             out.push(format!("{k}: NOT ESTIMATED ({why})"));
         }
-        if let Some(st) = &self.steering {
-            for p in [&st.ratio, &st.offset] {
-                out.push(match (&p.reason, p.std) {
-                    (None, Some(s)) => format!("{}: {:.5} ± {s:.5}", p.name, p.value),
-                    (Some(r), _) => format!("{}: NOT ESTIMATED ({r}), {} kept", p.name, p.value),
-                    (None, None) => format!("{}: {:.5}", p.name, p.value),
-                });
-            }
+        let slip = self.calibration.side_slip.as_ref().map(|s| &s.gradient);
+        let steering = self.steering.iter().flat_map(|st| {
+            [&st.ratio, &st.offset]
+                .into_iter()
+                .chain(st.understeer.as_ref())
+        });
+        for p in steering.chain(slip) {
+            out.push(match (&p.reason, p.std) {
+                (None, Some(s)) => format!("{}: {:.5} ± {s:.5}", p.name, p.value),
+                (Some(r), _) => format!("{}: NOT ESTIMATED ({r}), {} kept", p.name, p.value),
+                (None, None) => format!("{}: {:.5}", p.name, p.value),
+            });
         }
         if self.options.method == Method::Rts {
             out.push(format!(
@@ -195,21 +206,39 @@ impl CarCalibration {
 
 /// The steering calibration as a params.toml table: value, std (when
 /// estimated) and the reason when not.
-fn steering_toml(st: &SteeringCalibration) -> toml::Table {
+pub(crate) fn steering_toml(st: &SteeringCalibration) -> toml::Table {
     let mut t = toml::Table::new();
-    for p in [&st.ratio, &st.offset] {
-        let mut e = toml::Table::new();
-        e.insert("value".into(), p.value.into());
-        e.insert("estimated".into(), p.estimated.into());
-        if let Some(s) = p.std {
-            e.insert("std".into(), s.into());
-        }
-        if let Some(r) = &p.reason {
-            e.insert("reason".into(), r.clone().into());
-        }
-        t.insert(p.name.clone(), e.into());
+    for p in [&st.ratio, &st.offset]
+        .into_iter()
+        .chain(st.understeer.as_ref())
+    {
+        t.insert(p.name.clone(), estimate_toml(p).into());
     }
     t.insert("samples".into(), (st.samples as i64).into());
+    t
+}
+
+/// One estimate as a params.toml table: value, estimated, std (when
+/// estimated) and the reason when not.
+fn estimate_toml(p: &deadreckon_core::kinematics::ParamEstimate) -> toml::Table {
+    let mut e = toml::Table::new();
+    e.insert("value".into(), p.value.into());
+    e.insert("estimated".into(), p.estimated.into());
+    if let Some(s) = p.std {
+        e.insert("std".into(), s.into());
+    }
+    if let Some(r) = &p.reason {
+        e.insert("reason".into(), r.clone().into());
+    }
+    e
+}
+
+/// The side-slip gradient as the params.toml table `[side_slip]`: the
+/// estimate (`rear_slip_gradient_rad_per_mps2`) and the blocks used.
+pub(crate) fn side_slip_toml(s: &deadreckon_core::side_slip::SideSlip) -> toml::Table {
+    let mut t = toml::Table::new();
+    t.insert(s.gradient.name.clone(), estimate_toml(&s.gradient).into());
+    t.insert("blocks".into(), (s.blocks as i64).into());
     t
 }
 

@@ -97,7 +97,11 @@ pub fn not_estimated(c: &Calibration, min_speed_mps: f64) -> Vec<(&'static str, 
 
 /// The steering calibration of a car, as `calibrate --json` reports it.
 pub fn steering_json(st: &deadreckon_core::kinematics::steering::SteeringCalibration) -> Value {
-    json!({"ratio": st.ratio, "offset_rad": st.offset, "samples": st.samples, "rms_rad": st.rms_rad})
+    let mut v = json!({"ratio": st.ratio, "offset_rad": st.offset, "samples": st.samples, "rms_rad": st.rms_rad});
+    if let Some(u) = &st.understeer {
+        v["understeer_gradient_rad_per_mps2"] = json!(u);
+    }
+    v
 }
 
 /// The car's steering ratio and offset against the truth, as `calibrate
@@ -139,7 +143,28 @@ pub fn calibrate_json(
     if let Some(st) = steering {
         v["steering"] = steering_json(st);
     }
+    if let Some(s) = &c.side_slip {
+        v["side_slip"] = side_slip_json(s);
+    }
     v
+}
+
+/// The rear-axle side-slip gradient of an RTS calibration, as `calibrate
+/// --json` reports it: the estimate (value, std, estimated, reason), the
+/// fitted value even when not reported as estimated (null without a fit),
+/// the nuisance scale and yaw offset, the blocks and their RMS lateral
+/// acceleration.
+pub fn side_slip_json(s: &deadreckon_core::side_slip::SideSlip) -> Value {
+    let num = |x: f64| if x.is_finite() { json!(x) } else { Value::Null };
+    json!({
+        "rear_slip_gradient_rad_per_mps2": s.gradient,
+        "fitted": num(s.fitted),
+        "fitted_std": num(s.fitted_std),
+        "scale_residual": num(s.scale_residual),
+        "yaw_offset_rad": num(s.yaw_offset_rad),
+        "blocks": s.blocks,
+        "rms_lateral_accel_mps2": num(s.rms_lateral_accel_mps2),
+    })
 }
 
 /// The wheel-health monitor's report: per wheel (`fl`, `fr`, `rl`, `rr`)

@@ -51,6 +51,7 @@ pub mod import;
 pub mod json;
 pub mod kinematic;
 pub mod load;
+pub mod model_keys;
 pub mod options;
 pub mod report;
 pub mod source;

@@ -33,9 +33,11 @@ use nalgebra::{DMatrix, DVector};
 use crate::chords::{chord_scale, ChordScale};
 use crate::drive::{Drive, Wheels};
 use crate::ekf::{self, FilterOptions, Init, Timing};
+use crate::kinematics::steering::{calibrate_steering_understeer, SteeringCalibration};
 use crate::model::{State, V, YAW_RATE};
 use crate::observation::Sensors;
 use crate::reference::Reference;
+use crate::side_slip::SideSlip;
 
 use crate::vehicle::{Noise, Params, ParamsWithStd};
 use crate::Error;
@@ -236,6 +238,16 @@ pub struct Calibration {
     /// other methods, or when the drive has fewer than
     /// [`crate::chords::MIN_BLOCKS`] usable blocks.
     pub gnss_chords: Option<ChordScale>,
+    /// The rear-axle side-slip gradient against the GNSS blocks of the last
+    /// pass's smoothed states (RTS only; [`crate::side_slip`]). Reported,
+    /// not applied: the filter uses the vehicle's
+    /// `rear_slip_gradient_rad_per_mps2`.
+    pub side_slip: Option<SideSlip>,
+    /// The steering's ratio, offset and understeer gradient against the last
+    /// pass's smoothed states (RTS with steering readings only;
+    /// [`crate::kinematics::steering::calibrate_steering_understeer`]).
+    /// Reported, not applied.
+    pub steering: Option<SteeringCalibration>,
 }
 
 /// One smoothing pass's result ([`smoothing_pass`]).
@@ -250,6 +262,10 @@ pub struct Pass {
     pub stats: ekf::FilterStats,
     /// The distance scale against GNSS chords.
     pub chords: Option<ChordScale>,
+    /// The side-slip gradient against the GNSS blocks.
+    pub side_slip: SideSlip,
+    /// The steering against the smoothed states (with steering readings).
+    pub steering: Option<SteeringCalibration>,
 }
 
 /// Folds a relative distance-scale standard error `rel` (from the GNSS
@@ -310,6 +326,8 @@ pub fn calibrate(drive: &Drive, opts: &CalibrationOptions) -> Result<Calibration
                 wheel_health: None,
                 manoeuvres: None,
                 gnss_chords: None,
+                side_slip: None,
+                steering: None,
             })
         }
         Method::Rts => rts_calibration(drive, opts, start),
@@ -359,11 +377,24 @@ pub fn smoothing_pass(drive: &Drive, p: &Params, opts: &CalibrationOptions) -> R
     if let Some(c) = chords {
         widen_for_chords(&mut est, c.std);
     }
+    let side_slip = crate::side_slip::estimate(drive, &reference, est.params.gyro_bias_rps);
+    let steering = if drive.steering.is_empty() {
+        None
+    } else {
+        Some(calibrate_steering_understeer(
+            drive,
+            &reference,
+            opts.min_speed_mps
+                .max(crate::kinematics::steering::SMOOTHED_MIN_SPEED_MPS),
+        )?)
+    };
     Ok(Pass {
         estimate: est,
         samples,
         stats,
         chords,
+        side_slip,
+        steering,
     })
 }
 
@@ -462,6 +493,8 @@ fn rts_calibration(
         wheel_health: None,
         manoeuvres: None,
         gnss_chords: last.chords,
+        side_slip: Some(last.side_slip),
+        steering: last.steering,
     })
 }
 
@@ -738,5 +771,7 @@ pub fn zupt(drive: &Drive, nominal: &Params) -> Result<Calibration, Error> {
         wheel_health: None,
         manoeuvres: None,
         gnss_chords: None,
+        side_slip: None,
+        steering: None,
     })
 }

@@ -509,11 +509,12 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
     pub fn advance_to(&mut self, t_s: f64) -> Mat {
         let dt = (t_s - self.t_s).max(0.0);
         let car = self.car_state();
-        let f5 = model::jacobian(&car, dt);
+        let g = self.sensors.rear_slip_gradient_rad_per_mps2;
+        let f5 = model::jacobian_slipping(&car, dt, g);
         let q5 = model::process_noise(&self.noise, dt);
         self.x
             .fixed_rows_mut::<5>(0)
-            .copy_from(&model::evolve(&car, dt));
+            .copy_from(&model::evolve_slipping(&car, dt, g));
         // P11 ← F P11 Fᵀ + Q (symmetrised), P12 ← F P12.
         let p11 = self.p.fixed_view::<5, 5>(0, 0).into_owned();
         let n11 = model::propagate_covariance(&p11, &f5, &q5);
@@ -703,21 +704,22 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
         self.scalar(SensorKind::Speed, speed_mps, pred, r, Some((1, d_scale)))
     }
 
-    /// Eq. (7): one steering-wheel reading, rad, with the prior speed.
+    /// Eq. (7): one steering-wheel reading, rad, with the prior speed (the
+    /// wheel angle with the vehicle's steering offset and understeer at the
+    /// prior state: [`Sensors::wheel_angle`]).
     pub fn update_steering(&mut self, steering_wheel_rad: f64) -> Result<Update, Error> {
-        let wheel_angle = steering_wheel_rad / self.sensors.steering_ratio;
+        let car = self.car_state();
+        let wheel_angle = self.sensors.wheel_angle(steering_wheel_rad, &car);
         if wheel_angle.abs() > crate::observation::STEERING_CONSTRAINT_ABOVE_RAD {
             // Large wheel angles: the constraint form, stable up to ±90°.
-            let (h, row, r) = self.sensors.steering_constraint(
-                &self.car_state(),
-                steering_wheel_rad,
-                self.noise.steering,
-            );
+            let (h, row, r) =
+                self.sensors
+                    .steering_constraint(&car, wheel_angle, self.noise.steering);
             return self.scalar(SensorKind::Steering, 0.0, (h, row), r, None);
         }
-        let (z, r) =
-            self.sensors
-                .steering_measurement(steering_wheel_rad, self.x[V], self.noise.steering);
+        let (z, r) = self
+            .sensors
+            .steering_measurement(wheel_angle, self.x[V], self.noise.steering);
         let pred = self.sensors.steering(&self.car_state());
         self.scalar(SensorKind::Steering, z, pred, r, None)
     }

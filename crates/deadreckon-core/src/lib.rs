@@ -50,6 +50,7 @@ pub mod outage;
 pub mod plausibility;
 pub mod reference;
 pub mod rts;
+pub mod side_slip;
 pub mod timing;
 pub mod track;
 pub mod traction;

@@ -3,6 +3,22 @@
 //! the Jacobian row `H = ∂h/∂x`.
 //!
 //! Wheel order everywhere is FL, FR, RL, RR (the order of [`Params::circumferences`]).
+//!
+//! Not in the paper, each off (0) by default and then the paper's models to
+//! the last bit:
+//!
+//! - the rear-axle side slip `β_r = −g·v·ψ̇` ([`crate::model`]): M's lateral
+//!   velocity `v·tan β_r` reaches the front wheels, whose ground speed is
+//!   that of the front-axle point `[v ∓ (l_F/2)ψ̇, l_RF·ψ̇ + v·tan β_r]`
+//!   (the rear wheels roll at the longitudinal speed, unchanged), and the
+//!   course of M is `ψ + β_r` ([`Sensors::yaw`]). The GNSS antenna's
+//!   position is rigid geometry (eq. 10), unchanged;
+//! - the steering's offset `s₀` and understeer gradient `K_us`: the wheel
+//!   angle of eq. (7) is `δ = (s − s₀)/r_s − K_us·|v|·ψ̇` at the prior state
+//!   ([`Sensors::wheel_angle`]), so that `l_RF·ψ̇ = v·tan δ` stays the
+//!   kinematic relation `atan(l_RF·κ)` of the convention
+//!   `s = r_s·(atan(l_RF·κ) + K_us·a_y) + s₀` (`|v|·ψ̇ = a_y` forwards;
+//!   reversing, the front tyre's slip angle turns round with the velocity).
 
 use crate::model::{Row, State, V, X, Y, YAW, YAW_RATE};
 use crate::vehicle::{Params, Vehicle};
@@ -34,6 +50,15 @@ pub struct Sensors {
     pub nominal_circumference_m: f64,
     /// r_s.
     pub steering_ratio: f64,
+    /// s₀: the steering-wheel reading when driving straight, rad.
+    #[serde(default)]
+    pub steering_offset_rad: f64,
+    /// K_us: understeer gradient, rad of wheel angle per m/s².
+    #[serde(default)]
+    pub understeer_gradient_rad_per_mps2: f64,
+    /// g: rear-axle side-slip gradient, rad per m/s² ([`crate::model`]).
+    #[serde(default)]
+    pub rear_slip_gradient_rad_per_mps2: f64,
     /// The calibration parameters p.
     pub params: Params,
     /// 1/ρ for FL, FR, RL, RR, 1/m.
@@ -58,6 +83,9 @@ impl Sensors {
             ticks_per_rev: vehicle.ticks_per_rev as f64,
             nominal_circumference_m: vehicle.wheel_circumference_m,
             steering_ratio: vehicle.steering_ratio,
+            steering_offset_rad: vehicle.steering_offset_rad,
+            understeer_gradient_rad_per_mps2: vehicle.understeer_gradient_rad_per_mps2,
+            rear_slip_gradient_rad_per_mps2: vehicle.rear_slip_gradient_rad_per_mps2,
             params: *params,
             inv_circumference: [1.0 / c[0], 1.0 / c[1], 1.0 / c[2], 1.0 / c[3]],
         }
@@ -67,7 +95,9 @@ impl Sensors {
     /// factor) and its partial derivatives with respect to v and ψ̇.
     ///
     /// Rear wheels: `v ∓ (l_R/2)·ψ̇`; front wheels: `sqrt((l_RF·ψ̇)² + (v ∓ (l_F/2)·ψ̇)²)`,
-    /// signed like `v` so reversing gives negative speeds.
+    /// signed like `v` so reversing gives negative speeds. With a rear side-slip
+    /// gradient g the front wheels' lateral component is `l_RF·ψ̇ + v·tan β_r`,
+    /// `β_r = −g·|v|·ψ̇` (see the module doc).
     pub fn wheel_ground_speed(&self, i: usize, v: f64, yaw_rate: f64) -> (f64, f64, f64) {
         match i {
             RL => (
@@ -89,6 +119,18 @@ impl Sensors {
                 let l = self.wheelbase_m;
                 let u = v + c * yaw_rate;
                 let s = v.signum();
+                let g = self.rear_slip_gradient_rad_per_mps2;
+                if g != 0.0 {
+                    // Lateral w = l·ψ̇ + v·tan β, β = −g·|v|·ψ̇.
+                    let (beta, db_dv, db_dr) = crate::model::rear_slip_angle(v, yaw_rate, g);
+                    let tau = beta.tan();
+                    let sec2 = 1.0 + tau * tau;
+                    let w = l * yaw_rate + v * tau;
+                    let dw_dv = tau + v * sec2 * db_dv;
+                    let dw_dr = l + v * sec2 * db_dr;
+                    let a = (w * w + u * u + 1e-12).sqrt();
+                    return (s * a, s * (u + w * dw_dv) / a, s * (w * dw_dr + c * u) / a);
+                }
                 // A tiny floor keeps the derivative defined at standstill (bias < 1e-6 m/s).
                 let a = (l * l * yaw_rate * yaw_rate + u * u + 1e-12).sqrt();
                 (s * a, s * u / a, s * (l * l * yaw_rate + c * u) / a)
@@ -131,8 +173,21 @@ impl Sensors {
         (self.params.speed_scale * x[V], h)
     }
 
+    /// The virtual front-wheel angle of a steering-wheel reading `s` at the
+    /// prior state `x_prior`, rad: `δ = (s − s₀)/r_s − K_us·|v|·ψ̇` (`s/r_s`
+    /// with the paper's model, offset and understeer 0). The lateral
+    /// acceleration is the prior's, as eq. (7) takes the prior speed.
+    pub fn wheel_angle(&self, steering_wheel_rad: f64, x_prior: &State) -> f64 {
+        let d = (steering_wheel_rad - self.steering_offset_rad) / self.steering_ratio;
+        if self.understeer_gradient_rad_per_mps2 == 0.0 {
+            d
+        } else {
+            d - self.understeer_gradient_rad_per_mps2 * x_prior[V].abs() * x_prior[YAW_RATE]
+        }
+    }
+
     /// Eq. (7): the steering pseudo-measurement. The measurement is
-    /// `z = v_{k-1}·tan(δ/r_s)` (built with [`Sensors::steering_measurement`]) and its
+    /// `z = v_{k-1}·tan δ` (built with [`Sensors::steering_measurement`]) and its
     /// model is `h = l_RF·ψ̇`.
     pub fn steering(&self, x: &State) -> (f64, Row) {
         let mut h = Row::zeros();
@@ -140,22 +195,23 @@ impl Sensors {
         (self.wheelbase_m * x[YAW_RATE], h)
     }
 
-    /// The steering pseudo-measurement `z = v·tan(δ/r_s)` and its variance
-    /// `(v·β_δ)²` for the prior speed `v` (floored at 0.1 m/s so the variance never
-    /// vanishes).
+    /// The steering pseudo-measurement `z = v·tan δ` for the wheel angle δ
+    /// ([`Sensors::wheel_angle`]) and its variance `(v·β_δ)²` for the prior
+    /// speed `v` (floored at 0.1 m/s so the variance never vanishes).
     pub fn steering_measurement(
         &self,
-        steering_wheel_rad: f64,
+        wheel_angle_rad: f64,
         v_prior: f64,
         beta: f64,
     ) -> (f64, f64) {
-        let z = v_prior * (steering_wheel_rad / self.steering_ratio).tan();
+        let z = v_prior * wheel_angle_rad.tan();
         let r = (v_prior.abs().max(0.1) * beta).powi(2);
         (z, r)
     }
 
     /// The steering as a constraint, for large wheel angles: the rear-axle
-    /// velocity and the turn agree with the wheel angle `δ = s / r_s`,
+    /// velocity and the turn agree with the wheel angle δ
+    /// ([`Sensors::wheel_angle`]),
     /// `h = l_RF·ψ̇·cos δ − v·sin δ = 0`, bounded at every angle (at ±90° it
     /// says that the rear axle centre stands still). Eq. (7)'s
     /// pseudo-measurement `v_{k-1}·tan δ` feeds the prior speed back with a
@@ -169,10 +225,10 @@ impl Sensors {
     pub fn steering_constraint(
         &self,
         x: &State,
-        steering_wheel_rad: f64,
+        wheel_angle_rad: f64,
         beta: f64,
     ) -> (f64, Row, f64) {
-        let (sd, cd) = (steering_wheel_rad / self.steering_ratio).sin_cos();
+        let (sd, cd) = wheel_angle_rad.sin_cos();
         let l = self.wheelbase_m;
         let mut h = Row::zeros();
         h[YAW_RATE] = l * cd;
@@ -195,11 +251,19 @@ impl Sensors {
         (h, j)
     }
 
-    /// A direct yaw observation (GNSS course, optional, not in the paper).
+    /// A direct yaw observation (GNSS course, optional, not in the paper):
+    /// the course of M, `ψ + β_r` (ψ without side slip).
     pub fn yaw(&self, x: &State) -> (f64, Row) {
         let mut h = Row::zeros();
         h[YAW] = 1.0;
-        (x[YAW], h)
+        let g = self.rear_slip_gradient_rad_per_mps2;
+        if g == 0.0 {
+            return (x[YAW], h);
+        }
+        let (beta, db_dv, db_dr) = crate::model::rear_slip_angle(x[V], x[YAW_RATE], g);
+        h[V] = db_dv;
+        h[YAW_RATE] = db_dr;
+        (x[YAW] + beta, h)
     }
 }
 
@@ -231,12 +295,25 @@ mod tests {
         p.gyro_bias_rps = -0.003;
         p.speed_scale = 0.987;
         p.set_circumferences([1.9134, 1.9129, 1.9166, 1.9164]);
-        let s = Sensors::new(&v, &p);
-        for x in [
-            State::from([1.0, 2.0, 0.3, 8.0, 0.2]),
-            State::from([-5.0, 7.0, -2.0, 2.5, -0.6]),
-            State::from([0.0, 0.0, 1.0, -1.5, 0.1]),
-        ] {
+        let plain = Sensors::new(&v, &p);
+        let slipping = Sensors::new(
+            &Vehicle {
+                rear_slip_gradient_rad_per_mps2: 0.006,
+                understeer_gradient_rad_per_mps2: 0.003,
+                steering_offset_rad: 0.02,
+                ..v.clone()
+            },
+            &p,
+        );
+        for (s, x) in [plain, slipping].into_iter().flat_map(|s| {
+            [
+                State::from([1.0, 2.0, 0.3, 8.0, 0.2]),
+                State::from([-5.0, 7.0, -2.0, 2.5, -0.6]),
+                State::from([0.0, 0.0, 1.0, -1.5, 0.1]),
+                State::from([0.0, 0.0, 1.0, 25.0, 0.3]),
+            ]
+            .map(|x| (s, x))
+        }) {
             for i in 0..4 {
                 fd_check(|x| s.wheel_ticks(x, i, 0.02), &x);
                 fd_check(|x| s.wheel_speed(x, i), &x);
@@ -252,7 +329,7 @@ mod tests {
             ] {
                 fd_check(
                     |x| {
-                        let (h, row, _) = s.steering_constraint(x, sw, 0.02);
+                        let (h, row, _) = s.steering_constraint(x, sw / s.steering_ratio, 0.02);
                         (h, row)
                     },
                     &x,

@@ -262,6 +262,25 @@ pub struct Vehicle {
     pub wheel_circumference_m: f64,
     /// r_s: steering wheel angle / virtual front wheel angle.
     pub steering_ratio: f64,
+    /// s₀: the steering-wheel reading when driving straight, rad (default 0,
+    /// not written when 0). The filter's steering update takes the wheel
+    /// angle as `(s − s₀)/r_s` ([`crate::observation::Sensors::wheel_angle`]).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub steering_offset_rad: f64,
+    /// K_us: understeer gradient, rad of road-wheel angle per m/s² of lateral
+    /// acceleration (default 0, the paper's kinematic steering; not written
+    /// when 0): the road-wheel angle is `atan(l_RF·ψ̇/v) + K_us·|v|·ψ̇`
+    /// (`K_us·a_y` forwards).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub understeer_gradient_rad_per_mps2: f64,
+    /// g: rear-axle side-slip gradient, rad per m/s² of lateral acceleration
+    /// (default 0, the paper's model: the rear-axle centre M moves along the
+    /// body axis; not written when 0). With g > 0 the velocity of M makes
+    /// the angle `β_r = −g·v·ψ̇` with the body axis (left positive; a left
+    /// turn slides the rear outwards, to the right), typically g =
+    /// 0.003–0.007 for a car on dry asphalt. See [`crate::model`].
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub rear_slip_gradient_rad_per_mps2: f64,
     /// Which wheels carry a sensor, FL, FR, RL, RR (default: all four). The
     /// columns of an absent wheel are ignored by the filter and the calibration
     /// (e.g. a tricycle's single traction encoder, written as FL).
@@ -296,6 +315,9 @@ impl Vehicle {
             ticks_per_rev: 48,
             wheel_circumference_m: 1.92,
             steering_ratio: 15.9,
+            steering_offset_rad: 0.0,
+            understeer_gradient_rad_per_mps2: 0.0,
+            rear_slip_gradient_rad_per_mps2: 0.0,
             wheels_present: [true; 4],
             origin: None,
             noise: Noise::default(),
@@ -337,6 +359,25 @@ impl Vehicle {
             if !(v.is_finite() && v > 0.0) {
                 return Err(Error::InvalidVehicle(format!(
                     "{k} must be a positive number, got {v}"
+                )));
+            }
+        }
+        for (k, v, max) in [
+            ("steering_offset_rad", self.steering_offset_rad, 1.0),
+            (
+                "understeer_gradient_rad_per_mps2",
+                self.understeer_gradient_rad_per_mps2,
+                MAX_UNDERSTEER_GRADIENT_RAD_PER_MPS2,
+            ),
+            (
+                "rear_slip_gradient_rad_per_mps2",
+                self.rear_slip_gradient_rad_per_mps2,
+                MAX_REAR_SLIP_GRADIENT_RAD_PER_MPS2,
+            ),
+        ] {
+            if !(v.is_finite() && v.abs() <= max) {
+                return Err(Error::InvalidVehicle(format!(
+                    "{k} must be a number within ±{max}, got {v}"
                 )));
             }
         }
@@ -437,6 +478,14 @@ impl Vehicle {
         Ok(())
     }
 }
+
+/// The largest |rear-axle side-slip gradient| a vehicle may state, rad per
+/// m/s²: 0.05, ten times a car's on dry asphalt (0.003–0.007), where 0.5 g
+/// would slide the rear axle by 14°.
+pub const MAX_REAR_SLIP_GRADIENT_RAD_PER_MPS2: f64 = 0.05;
+/// The largest |understeer gradient| a vehicle may state, rad per m/s²:
+/// 0.05 (a car's is 0.001–0.005).
+pub const MAX_UNDERSTEER_GRADIENT_RAD_PER_MPS2: f64 = 0.05;
 
 /// The sort key of a `recorded_at` value (`YYYY-MM-DD` or
 /// `YYYY-MM-DDTHH:MM:SS[.fff][Z]`, UTC): the date-time with a missing time

@@ -52,8 +52,24 @@ proptest! {
     }
 
     #[test]
-    fn wheel_jacobians_match_finite_differences(x in state(), wheel in 0usize..4) {
-        let v = Vehicle::paper_car();
+    fn slipping_evolution_jacobian_matches_finite_differences(
+        x in state(), dt in 0.001..0.2f64, g in 0.0..0.02f64,
+    ) {
+        let f = model::jacobian_slipping(&x, dt, g);
+        for j in 0..5 {
+            let h = 1e-6 * (1.0 + x[j].abs());
+            let mut xp = x; let mut xm = x;
+            xp[j] += h; xm[j] -= h;
+            let d = (model::evolve_slipping(&xp, dt, g) - model::evolve_slipping(&xm, dt, g)) / (2.0 * h);
+            for i in 0..5 {
+                prop_assert!((d[i] - f[(i, j)]).abs() < 1e-6 * (1.0 + f[(i, j)].abs()), "F[{},{}]", i, j);
+            }
+        }
+    }
+
+    #[test]
+    fn wheel_jacobians_match_finite_differences(x in state(), wheel in 0usize..4, g in 0.0..0.02f64) {
+        let v = Vehicle { rear_slip_gradient_rad_per_mps2: g, ..Vehicle::paper_car() };
         let s = Sensors::new(&v, &Params::nominal(&v));
         let (_, h) = s.wheel_ticks(&x, wheel, 0.02);
         for j in 0..5 {
@@ -87,4 +103,29 @@ proptest! {
         let min_eig = (before - pp).symmetric_eigen().eigenvalues.min();
         prop_assert!(min_eig > -1e-9 * before.amax());
     }
+}
+
+/// The filter predicts with the vehicle's side slip: state and recorded F
+/// (what the RTS smoother uses) are the model's, in both layouts.
+#[test]
+fn the_filter_predicts_with_the_vehicles_side_slip() {
+    use deadreckon_core::filter::{AugmentedFilter, CarFilter};
+    let v = Vehicle {
+        rear_slip_gradient_rad_per_mps2: 0.005,
+        ..Vehicle::paper_car()
+    };
+    let p = Params::nominal(&v);
+    let x0 = State::from([1.0, 2.0, 0.4, 20.0, 0.2]);
+    let p0 = Mat::from_diagonal(&State::from([1.0, 1.0, 0.01, 1.0, 0.01]));
+    let mut car = CarFilter::new(&v, &p, None, 0.0, x0, p0).unwrap();
+    let pred = car.predict_to(0.02);
+    assert_eq!(pred.x, model::evolve_slipping(&x0, 0.02, 0.005));
+    assert_eq!(pred.f, model::jacobian_slipping(&x0, 0.02, 0.005));
+    assert_ne!(pred.x, model::evolve(&x0, 0.02));
+    let sd = Params::from_array([0.01, 0.05, 0.05, 0.05, 0.05, 0.05]);
+    let mut aug = AugmentedFilter::new(&v, &p, Some(&sd), 0.0, x0, p0).unwrap();
+    let pa = aug.predict_to(0.02);
+    assert_eq!(pa.x.fixed_rows::<5>(0).into_owned(), pred.x);
+    assert_eq!(pa.f, pred.f);
+    assert_eq!(pa.p.fixed_view::<5, 5>(0, 0).into_owned(), pred.p);
 }

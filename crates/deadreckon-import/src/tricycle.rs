@@ -417,6 +417,9 @@ pub fn vehicle_from_header(h: &TricycleHeader) -> Vehicle {
         noise: Noise::default(),
         vehicle_id: None,
         recorded_at: None,
+        steering_offset_rad: 0.0,
+        understeer_gradient_rad_per_mps2: 0.0,
+        rear_slip_gradient_rad_per_mps2: 0.0,
     }
 }
 

@@ -244,6 +244,9 @@ pub fn differential_vehicle(track_m: f64, wheel_radius_m: f64) -> Vehicle {
         noise: Noise::default(),
         vehicle_id: None,
         recorded_at: None,
+        steering_offset_rad: 0.0,
+        understeer_gradient_rad_per_mps2: 0.0,
+        rear_slip_gradient_rad_per_mps2: 0.0,
     }
 }
 

@@ -222,6 +222,9 @@ fn car_filter_on_simulated_tricycle(seed: u64) {
         origin: None,
         vehicle_id: None,
         recorded_at: None,
+        steering_offset_rad: 0.0,
+        understeer_gradient_rad_per_mps2: 0.0,
+        rear_slip_gradient_rad_per_mps2: 0.0,
         noise: Noise::default(),
     };
     let mut drive = Drive::empty(vehicle.clone());
