@@ -835,6 +835,22 @@ pub fn car_filter(
     )
 }
 
+/// A filter of a layout without parameter states (the car's five states,
+/// or with the receiver's wander: [`crate::gnss_error::CarWanderLayout`])
+/// at the start `opts.init` gives on `drive`; the wander (when the layout
+/// has it) starts at zero with the variance `noise.gnss_wander_std_m²`.
+pub fn fixed_filter<L: Layout<N>, const N: usize>(
+    drive: &Drive,
+    params: &Params,
+    opts: &FilterOptions,
+) -> Result<Filter<L, N>, Error> {
+    let (t0, x0, p0) = start(drive, opts)?;
+    Ok(
+        Filter::<L, N>::new(&drive.vehicle, params, None, t0, x0, p0)?
+            .with_covariance_form(opts.covariance_form),
+    )
+}
+
 /// The 11-state filter (parameters as states, starting at `params` with
 /// standard deviations `prior_std`) at the start `opts.init` gives on `drive`.
 pub fn augmented_filter(

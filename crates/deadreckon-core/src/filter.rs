@@ -41,6 +41,7 @@ use nalgebra::{Matrix2, SMatrix, SVector, Vector2};
 use serde::{Deserialize, Serialize};
 
 use crate::drive::GnssFix;
+use crate::gnss_error::{add_wander, Wander};
 use crate::kalman::{self, CovarianceForm};
 use crate::model::{self, Mat, State, V};
 use crate::observation::Sensors;
@@ -63,6 +64,11 @@ pub trait Layout<const N: usize>: Copy + std::fmt::Debug + Default + PartialEq {
     /// Index in the state of parameter `j` (0 gyro bias, 1 speed scale, 2..6 the
     /// inverse circumferences FL..RR), or `None` when the parameters are fixed.
     fn param_index(j: usize) -> Option<usize>;
+    /// Index in the state of the receiver's wander east (north follows), or
+    /// `None` when the fixes are taken as white ([`crate::gnss_error`]).
+    fn wander_index() -> Option<usize> {
+        None
+    }
 }
 
 /// The five car states; the parameters are fixed.
@@ -182,6 +188,10 @@ pub struct Update {
     pub s: f64,
     /// Normalised innovation squared `ỹᵀ S⁻¹ ỹ`.
     pub nis: f64,
+    /// `ln det S` of the innovation covariance the gate decided with (`ln s`
+    /// for a scalar): with `nis`, the measurement's Gaussian log-likelihood
+    /// (what [`crate::wander_fit`] compares receiver models by).
+    pub ln_det_s: f64,
     /// False when the χ² gate rejected the measurement (the state is unchanged).
     pub accepted: bool,
 }
@@ -278,6 +288,9 @@ pub struct Filter<L: Layout<N>, const N: usize> {
     wheels_excluded: [bool; 4],
     /// Consecutive rejections per sensor (same order as [`GateCounts`]).
     consecutive: [u32; 9],
+    /// When the current run of rejected GNSS fixes began, s.
+    #[serde(default)]
+    gnss_rejecting_since_s: Option<f64>,
     gates: GateCounts,
     #[serde(skip)]
     layout: PhantomData<L>,
@@ -325,6 +338,16 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
                 ));
             }
         }
+        if let Some(w) = L::wander_index() {
+            let sd = vehicle.noise.gnss_wander_std_m;
+            if !(sd.is_finite() && sd > 0.0) {
+                return Err(Error::InvalidParams(
+                    "a filter with the receiver's wander needs noise.gnss_wander_std_m > 0".into(),
+                ));
+            }
+            p[(w, w)] = sd * sd;
+            p[(w + 1, w + 1)] = sd * sd;
+        }
         Ok(Filter {
             sensors: Sensors::new(vehicle, params),
             noise: vehicle.noise,
@@ -335,6 +358,7 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
             wheels_present: vehicle.wheels_present,
             wheels_excluded: [false; 4],
             consecutive: [0; 9],
+            gnss_rejecting_since_s: None,
             gates: GateCounts::default(),
             layout: PhantomData,
         })
@@ -505,8 +529,26 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
                 car_col[5 + j] = v;
             }
         }
+        // The receiver's wander: F = diag(F_car, I, φ·I₂) (crate::gnss_error).
+        if let Some(w) = L::wander_index() {
+            self.wander().propagate(w, dt, &mut self.x, &mut self.p);
+        }
         self.t_s = t_s.max(self.t_s);
         f5
+    }
+
+    /// The receiver's wander model of the noise settings.
+    fn wander(&self) -> Wander {
+        Wander {
+            std_m: self.noise.gnss_wander_std_m,
+            tau_s: self.noise.gnss_wander_tau_s,
+        }
+    }
+
+    /// The receiver's wander estimate `[east, north]`, m (zeros when the
+    /// layout has none).
+    pub fn wander_m(&self) -> [f64; 2] {
+        L::wander_index().map_or([0.0; 2], |w| [self.x[w], self.x[w + 1]])
     }
 
     fn gate_chi2(&self, sensor: SensorKind) -> f64 {
@@ -523,9 +565,22 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
             self.noise.max_rejections
         };
         let within = nis <= self.gate_chi2(sensor);
-        let recovery = !within && self.consecutive[k] >= max;
+        // A GNSS recovery also waits for the rejections to have lasted
+        // `gnss_recovery_after_s`: a multipath burst is a few seconds.
+        let patient = sensor != SensorKind::Gnss || {
+            let since = if within {
+                self.t_s
+            } else {
+                *self.gnss_rejecting_since_s.get_or_insert(self.t_s)
+            };
+            self.t_s - since >= self.noise.gnss_recovery_after_s
+        };
+        let recovery = !within && self.consecutive[k] >= max && patient;
         let accepted = within || recovery;
         self.consecutive[k] = if accepted { 0 } else { self.consecutive[k] + 1 };
+        if accepted && sensor == SensorKind::Gnss {
+            self.gnss_rejecting_since_s = None;
+        }
         if accepted {
             self.gates.accepted[k] += 1;
         } else {
@@ -586,6 +641,7 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
             y,
             s,
             nis,
+            ln_det_s: s.ln(),
             accepted,
         })
     }
@@ -673,12 +729,16 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
     /// the filter takes itself to be lost: it widens its position (and yaw)
     /// covariance to cover the innovation and takes the fix (a recovery).
     pub fn update_gnss(&mut self, fix: &GnssFix) -> Result<Update, Error> {
-        let (h, jac5) = self.sensors.gnss(&self.car_state());
+        let (mut h, jac5) = self.sensors.gnss(&self.car_state());
         let mut jac = SMatrix::<f64, 2, N>::zeros();
         jac.fixed_view_mut::<2, 5>(0, 0).copy_from(&jac5);
+        if let Some(w) = L::wander_index() {
+            add_wander(w, &self.x, &mut h, &mut jac);
+        }
         let y = Vector2::new(fix.east_m, fix.north_m) - h;
         let r = Matrix2::identity() * fix.std_m.powi(2);
         let (mut s, _, mut nis) = kalman::innovation_stats(&self.p, &y, &jac, &r, self.t_s)?;
+        let ln_det_s = s.determinant().ln();
         let (accepted, recovery) = self.decide(SensorKind::Gnss, nis);
         if recovery {
             let d2 = y.norm_squared();
@@ -720,6 +780,7 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
             y: y[0],
             s: s[(0, 0)],
             nis,
+            ln_det_s,
             accepted,
         })
     }

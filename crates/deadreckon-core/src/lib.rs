@@ -34,6 +34,7 @@ pub mod event;
 pub mod evo;
 pub mod filter;
 pub mod geo;
+pub mod gnss_error;
 pub mod gyro_hold;
 pub mod gyro_scale;
 pub mod imu;
@@ -54,6 +55,7 @@ pub mod timing;
 pub mod track;
 pub mod traction;
 pub mod vehicle;
+pub mod wander_fit;
 pub mod wheel_health;
 
 pub use drive::Drive;

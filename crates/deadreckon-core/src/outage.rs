@@ -26,12 +26,14 @@
 use crate::compared::{Antenna, Position, RearAxle};
 use crate::drive::Drive;
 use crate::ekf::{self, EpochHook, EpochOut, FilterOptions};
-use crate::filter::{CarLayout, Filter, GateCounts};
+use crate::filter::{CarLayout, Filter, GateCounts, Layout};
+use crate::gnss_error::{CarWanderLayout, N_WANDER};
 use crate::metrics::Summary;
 use crate::model::{Mat, State, V, X, Y, YAW};
 use crate::reference::Reference;
 use crate::vehicle::Params;
 use crate::Error;
+use nalgebra::{SMatrix, SVector};
 
 pub use crate::compared::{Against, OutageResult};
 
@@ -168,8 +170,8 @@ impl Aided {
     }
 }
 
-impl EpochHook for Aided {
-    fn after_epoch(&mut self, t: f64, x: &mut State, p: &mut Mat) {
+impl<const N: usize> EpochHook<N> for Aided {
+    fn after_epoch(&mut self, t: f64, x: &mut SVector<f64, N>, p: &mut SMatrix<f64, N, N>) {
         if self.first_t.is_nan() {
             self.first_t = t;
         }
@@ -188,7 +190,28 @@ impl EpochHook for Aided {
 /// parked at the start measured a standing filter converging, 20 m where the
 /// moving ones gave 1.5 m); windows start every `step_s` and must end before
 /// the last GNSS fix (and the truth's end).
+///
+/// With the vehicle's `noise.gnss_wander_std_m` above 0 the aided filter
+/// carries the receiver's wander as states ([`crate::gnss_error`]); through
+/// a window its estimate decays, and against hidden fixes (no truth) the
+/// dead-reckoned antenna is compared with the wander still expected added.
 pub fn evaluate(
+    drive: &Drive,
+    params: &Params,
+    outage_s: f64,
+    step_s: f64,
+    warmup_s: f64,
+    base: &FilterOptions,
+) -> Result<OutageEvaluation, Error> {
+    if drive.vehicle.noise.gnss_wander_std_m > 0.0 {
+        evaluate_in::<CarWanderLayout, N_WANDER>(drive, params, outage_s, step_s, warmup_s, base)
+    } else {
+        evaluate_in::<CarLayout, 5>(drive, params, outage_s, step_s, warmup_s, base)
+    }
+}
+
+/// [`evaluate`] with the aided filter of layout `L`.
+fn evaluate_in<L: Layout<N>, const N: usize>(
     drive: &Drive,
     params: &Params,
     outage_s: f64,
@@ -224,7 +247,12 @@ pub fn evaluate(
         moving_t: None,
         yaw_var: Vec::new(),
     };
-    ekf::run(drive, params, &aided_opts, &mut aided)?;
+    ekf::run_filter(
+        drive,
+        ekf::fixed_filter::<L, N>(drive, params, &aided_opts)?,
+        &aided_opts,
+        &mut aided,
+    )?;
     if aided.first_t.is_nan() {
         return Err(Error::Insufficient("the filter produced no epochs".into()));
     }
@@ -255,10 +283,10 @@ pub fn evaluate(
     // to the window's end. The clone keeps what the aided run had learnt, the
     // wheel monitor's verdicts included (a fresh filter started from the
     // aided state forgot that a wheel was out).
-    let mut f = ekf::car_filter(drive, params, &aided_opts)?;
+    let mut f = ekf::fixed_filter::<L, N>(drive, params, &aided_opts)?;
     let (mut feeder, mut events) = ekf::feed(drive, &aided_opts, f.time_s());
     let mut upcoming = events.next();
-    let mut noop = |_: &mut Filter<CarLayout, 5>, _: EpochOut<'_, 5>| {};
+    let mut noop = |_: &mut Filter<L, N>, _: EpochOut<'_, N>| {};
     let mut windows = Vec::new();
     let mut unsettled = Vec::new();
     let mut gates = GateCounts::default();
@@ -277,8 +305,10 @@ pub fn evaluate(
             (f.clone(), feeder.clone(), events.clone(), upcoming);
         fd.dead_reckon();
         let mut states: Vec<(f64, State)> = Vec::new();
-        let mut keep = |g: &mut Filter<CarLayout, 5>, _: EpochOut<'_, 5>| {
+        let mut wander: Vec<[f64; 2]> = Vec::new();
+        let mut keep = |g: &mut Filter<L, N>, _: EpochOut<'_, N>| {
             states.push((g.time_s(), g.car_state()));
+            wander.push(g.wander_m());
         };
         while let Some(ev) = next.filter(|e| e.t_s <= end) {
             fd.push(&mut g, ev, &mut keep)?;
@@ -286,7 +316,8 @@ pub fn evaluate(
         }
         fd.finish(&mut g, &mut keep)?;
         gates.add(&g.gates().since(&before));
-        if let Some(mut w) = window_errors(drive, truth.as_ref(), &states, t0, start, end) {
+        if let Some(mut w) = window_errors(drive, truth.as_ref(), &states, &wander, t0, start, end)
+        {
             w.start_yaw_std_rad = Some(yaw_std);
             if heading_known_t.is_none_or(|k| start < k) {
                 unsettled.push(w);
@@ -336,21 +367,35 @@ pub fn evaluate(
 
 /// The errors of dead-reckoned `states` (from `t0`, the start of dead reckoning)
 /// over the window `[start, end)`, against the truth or, without it, the GNSS
-/// fixes of the window (compared at the antenna). `None` when nothing compares.
+/// fixes of the window (compared at the antenna, plus the receiver's wander
+/// the filter still expects, `wander[k]` at `states[k]`, when given: the
+/// fixes carry it). `None` when nothing compares.
 fn window_errors(
     drive: &Drive,
     truth: Option<&Reference>,
     states: &[(f64, State)],
+    wander: &[[f64; 2]],
     t0: f64,
     start: f64,
     end: f64,
 ) -> Option<OutageResult> {
     let lever = drive.vehicle.gnss_lever_arm_m;
-    let states: Vec<(f64, State)> = states
+    let inside = |s: &(f64, State)| s.0 >= t0 && s.0 <= end;
+    // The antenna the fixes see: the car's plus the wander expected.
+    let seen: Vec<(f64, State)> = states
         .iter()
-        .filter(|s| s.0 >= t0 && s.0 <= end)
-        .copied()
+        .enumerate()
+        .filter(|(_, s)| inside(s))
+        .map(|(k, s)| {
+            let mut x = s.1;
+            if let Some(e) = wander.get(k) {
+                x[X] += e[0];
+                x[Y] += e[1];
+            }
+            (s.0, x)
+        })
         .collect();
+    let states: Vec<(f64, State)> = states.iter().filter(|s| inside(s)).copied().collect();
     let mut errors = Vec::new();
     match truth {
         Some(t) => {
@@ -366,8 +411,8 @@ fn window_errors(
         }
         None => {
             let traj = Reference::from_states(
-                states.iter().map(|s| s.0).collect(),
-                states.iter().map(|s| s.1).collect(),
+                seen.iter().map(|s| s.0).collect(),
+                seen.iter().map(|s| s.1).collect(),
             );
             let first = drive.gnss.partition_point(|g| g.t_s <= t0);
             for g in drive.gnss[first..].iter().take_while(|g| g.t_s <= end) {
@@ -430,7 +475,7 @@ pub fn through_windows(
         // Dead reckoning starts at the last epoch before the window.
         let i = hook.0.partition_point(|s| s.0 < a);
         let t0 = hook.0.get(i.saturating_sub(1)).map(|s| s.0).unwrap_or(a);
-        if let Some(w) = window_errors(drive, truth.as_ref(), &hook.0, t0, a, b) {
+        if let Some(w) = window_errors(drive, truth.as_ref(), &hook.0, &[], t0, a, b) {
             out.push(w);
         }
     }

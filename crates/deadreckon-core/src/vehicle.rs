@@ -78,6 +78,25 @@ pub struct Noise {
     /// after inflating the position covariance by the innovation, and counted
     /// as a recovery (default 10).
     pub gnss_max_rejections: u32,
+    /// A GNSS recovery (see `gnss_max_rejections`) also waits until the
+    /// rejections have lasted this long, s (default 0: the count alone).
+    /// A multipath burst moves the fixes by metres for a few seconds; a
+    /// recovery inside it takes the burst's fix with the position
+    /// covariance widened, and the filter follows the burst.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub gnss_recovery_after_s: f64,
+    /// Standard deviation per axis of the receiver's slowly wandering
+    /// position error, m (default 0: the fixes are white, the paper's
+    /// model). Above 0 the outage evaluation's aided filter carries the
+    /// wander as two first-order Gauss–Markov states
+    /// ([`crate::gnss_error`]), and a fix measures the antenna plus the
+    /// wander plus its own `std_m`.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub gnss_wander_std_m: f64,
+    /// Time constant of the receiver's wander, s (default 60; used only
+    /// with `gnss_wander_std_m` above 0).
+    #[serde(skip_serializing_if = "is_default_wander_tau")]
+    pub gnss_wander_tau_s: f64,
     /// χ² gate (1 degree of freedom) of each wheel reading, ticks or speed
     /// (default [`GROSS_FAULT_CHI2`]: only gross faults such as a spinning
     /// wheel or a counter glitch are rejected; `inf` switches the gate off).
@@ -118,6 +137,15 @@ pub struct Noise {
 /// (car 30 +1.8 mm, 1.5 standard errors) and the others' errors are
 /// unchanged (white fixes RMS 0.273 → 0.278 mm).
 pub const SCALE_HOLD_YAW_STD_RAD: f64 = 0.035;
+
+/// The default time constant of the receiver's wander, s: 60, the middle
+/// of the 20–120 s of the simulator's car family (standalone and SBAS
+/// receivers wander over a minute or two).
+pub const DEFAULT_GNSS_WANDER_TAU_S: f64 = 60.0;
+
+fn is_default_wander_tau(v: &f64) -> bool {
+    *v == DEFAULT_GNSS_WANDER_TAU_S
+}
 
 fn is_default_scale_hold(v: &f64) -> bool {
     *v == SCALE_HOLD_YAW_STD_RAD
@@ -194,6 +222,9 @@ impl Default for Noise {
             steering: 0.02,
             gnss_gate_chi2: 13.815510557964274,
             gnss_max_rejections: 10,
+            gnss_recovery_after_s: 0.0,
+            gnss_wander_std_m: 0.0,
+            gnss_wander_tau_s: DEFAULT_GNSS_WANDER_TAU_S,
             wheel_gate_chi2: GROSS_FAULT_CHI2,
             gyro_gate_chi2: GROSS_FAULT_CHI2,
             speed_gate_chi2: GROSS_FAULT_CHI2,
@@ -419,6 +450,24 @@ impl Vehicle {
                     "{k} must be positive (or inf to switch the gate off), got {v}"
                 )));
             }
+        }
+        if !(n.gnss_recovery_after_s.is_finite() && n.gnss_recovery_after_s >= 0.0) {
+            return Err(Error::InvalidVehicle(format!(
+                "noise.gnss_recovery_after_s must be a non-negative number, got {}",
+                n.gnss_recovery_after_s
+            )));
+        }
+        if !(n.gnss_wander_std_m.is_finite() && n.gnss_wander_std_m >= 0.0) {
+            return Err(Error::InvalidVehicle(format!(
+                "noise.gnss_wander_std_m must be a non-negative number (0: white fixes), got {}",
+                n.gnss_wander_std_m
+            )));
+        }
+        if !(n.gnss_wander_tau_s.is_finite() && n.gnss_wander_tau_s > 0.0) {
+            return Err(Error::InvalidVehicle(format!(
+                "noise.gnss_wander_tau_s must be a positive number, got {}",
+                n.gnss_wander_tau_s
+            )));
         }
         let v = n.scale_hold_yaw_std_rad;
         if v.is_nan() || v <= 0.0 {
