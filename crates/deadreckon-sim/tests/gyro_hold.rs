@@ -78,7 +78,8 @@ fn mean_final(drive: &Drive, sim: &SimOutput, timing: Timing) -> f64 {
 /// 20 ms, speed 0.5 m/s) removes it here (jittered / unjittered 0.395 /
 /// 0.365, 0.348 / 0.353, 0.267 / 0.245 m), but on the comma2k19 segment
 /// calibrated on one half and evaluated on the other it gave 0.888 / 1.372 m
-/// against the default's 0.807 / 0.691 m (median), so it is not the default.
+/// against the default's 0.807 / 0.511 m (median, the pull-away windows
+/// apart), so it is not the default.
 #[test]
 fn a_late_gyro_reading_handed_the_yaw_rate_to_the_steering() {
     for seed in 1..=3 {
