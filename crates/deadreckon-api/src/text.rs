@@ -290,9 +290,14 @@ pub fn unsettled_line(ev: &deadreckon_core::outage::OutageEvaluation) -> Option<
         .iter()
         .map(|w| format!("{:.2}", w.final_m()))
         .collect();
+    let range = if (hi - lo).abs() < 0.05 {
+        format!("{lo:.1}°")
+    } else {
+        format!("{lo:.1}–{hi:.1}°")
+    };
     Some(format!(
         "left out: {} window{} starting before the heading was known (the aided filter's yaw \
-         standard deviation {lo:.1}–{hi:.1}° at the start, above {:.1}°), final errors {} m",
+         standard deviation {range} at the start, above {:.1}°), final errors {} m",
         ev.unsettled.len(),
         if ev.unsettled.len() == 1 { "" } else { "s" },
         ev.heading_limit_rad.to_degrees(),
