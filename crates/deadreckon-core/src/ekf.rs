@@ -845,8 +845,10 @@ pub fn fixed_filter<L: Layout<N>, const N: usize>(
     opts: &FilterOptions,
 ) -> Result<Filter<L, N>, Error> {
     let (t0, x0, p0) = start(drive, opts)?;
+    // A walking gyro bias (crate::gyro_drift) starts at the calibrated value.
+    let prior = L::bias_walks().then(|| crate::gyro_drift::prior_std(&drive.vehicle.noise));
     Ok(
-        Filter::<L, N>::new(&drive.vehicle, params, None, t0, x0, p0)?
+        Filter::<L, N>::new(&drive.vehicle, params, prior.as_ref(), t0, x0, p0)?
             .with_covariance_form(opts.covariance_form),
     )
 }

@@ -69,6 +69,12 @@ pub trait Layout<const N: usize>: Copy + std::fmt::Debug + Default + PartialEq {
     fn wander_index() -> Option<usize> {
         None
     }
+    /// Whether the gyro bias (parameter 0, which must then be a state) walks
+    /// by `noise.gyro_bias_walk_rps_per_sqrt_s` ([`crate::gyro_drift`]);
+    /// the calibration's parameters are constants.
+    fn bias_walks() -> bool {
+        false
+    }
 }
 
 /// The five car states; the parameters are fixed.
@@ -332,7 +338,10 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
                 // σ(1/ρ) = σ(ρ)/ρ².
                 set(2 + i, 1.0 / c[i], (cs[i] / (c[i] * c[i])).powi(2));
             }
-            if (5..N).any(|j| p[(j, j)].is_nan() || p[(j, j)] <= 0.0) {
+            if (0..6)
+                .filter_map(L::param_index)
+                .any(|j| p[(j, j)].is_nan() || p[(j, j)] <= 0.0)
+            {
                 return Err(Error::InvalidParams(
                     "prior standard deviations of the parameters must be positive".into(),
                 ));
@@ -532,6 +541,13 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
         // The receiver's wander: F = diag(F_car, I, φ·I₂) (crate::gnss_error).
         if let Some(w) = L::wander_index() {
             self.wander().propagate(w, dt, &mut self.x, &mut self.p);
+        }
+        // The gyro bias's random walk: F = I, Q = walk²·dt.
+        if L::bias_walks() {
+            if let Some(i) = L::param_index(0) {
+                let walk = self.noise.gyro_bias_walk_rps_per_sqrt_s;
+                self.p[(i, i)] += walk * walk * dt;
+            }
         }
         self.t_s = t_s.max(self.t_s);
         f5

@@ -15,7 +15,8 @@
 use serde::{Deserialize, Serialize};
 
 use crate::ekf::{Event, Feeder, FilterOptions, FilterStats, GnssInit};
-use crate::filter::{AugmentedFilter, CarFilter};
+use crate::filter::{AugmentedFilter, CarFilter, Filter};
+use crate::gyro_drift::{CarBiasLayout, N_BIAS};
 use crate::model::{Mat, State};
 use crate::track::TrackPoint;
 use crate::vehicle::{Params, Vehicle};
@@ -86,6 +87,11 @@ enum Stage {
     Waiting { init: GnssInit, buffer: Vec<Event> },
     Car {
         filter: Box<CarFilter>,
+        feeder: Feeder,
+    },
+    /// Fixed parameters but a walking gyro bias ([`crate::gyro_drift`]).
+    Walking {
+        filter: Box<Filter<CarBiasLayout, N_BIAS>>,
         feeder: Feeder,
     },
     Learning {
@@ -174,7 +180,22 @@ impl Online {
     fn started(&self, t0: f64, x0: State, p0: Mat) -> Result<Stage, Error> {
         let feeder = Feeder::new(&self.opts, t0);
         let form = self.opts.covariance_form;
+        let walks = self.vehicle.noise.gyro_bias_walk_rps_per_sqrt_s > 0.0;
         Ok(match &self.prior_std {
+            None if walks => Stage::Walking {
+                filter: Box::new(
+                    Filter::new(
+                        &self.vehicle,
+                        &self.params,
+                        Some(&crate::gyro_drift::prior_std(&self.vehicle.noise)),
+                        t0,
+                        x0,
+                        p0,
+                    )?
+                    .with_covariance_form(form),
+                ),
+                feeder,
+            },
             None => Stage::Car {
                 filter: Box::new(
                     CarFilter::new(&self.vehicle, &self.params, None, t0, x0, p0)?
@@ -232,6 +253,9 @@ impl Online {
             Stage::Car { filter, feeder } => feeder.push(filter.as_mut(), ev, &mut |f, _| {
                 out(point(f.time_s(), f.state(), f.covariance()))
             }),
+            Stage::Walking { filter, feeder } => feeder.push(filter.as_mut(), ev, &mut |f, _| {
+                out(point(f.time_s(), f.state(), f.covariance()))
+            }),
             Stage::Learning { filter, feeder } => feeder.push(filter.as_mut(), ev, &mut |f, _| {
                 out(point(f.time_s(), f.state(), f.covariance()))
             }),
@@ -245,6 +269,9 @@ impl Online {
             Stage::Car { filter, feeder } => feeder.finish(filter.as_mut(), &mut |f, _| {
                 out(point(f.time_s(), f.state(), f.covariance()))
             }),
+            Stage::Walking { filter, feeder } => feeder.finish(filter.as_mut(), &mut |f, _| {
+                out(point(f.time_s(), f.state(), f.covariance()))
+            }),
             Stage::Learning { filter, feeder } => feeder.finish(filter.as_mut(), &mut |f, _| {
                 out(point(f.time_s(), f.state(), f.covariance()))
             }),
@@ -256,6 +283,7 @@ impl Online {
         match &self.stage {
             Stage::Waiting { .. } => None,
             Stage::Car { filter, feeder } => Some(feeder.stats_with(filter.as_ref())),
+            Stage::Walking { filter, feeder } => Some(feeder.stats_with(filter.as_ref())),
             Stage::Learning { filter, feeder } => Some(feeder.stats_with(filter.as_ref())),
         }
     }

@@ -28,6 +28,7 @@ use crate::drive::Drive;
 use crate::ekf::{self, EpochHook, EpochOut, FilterOptions};
 use crate::filter::{CarLayout, Filter, GateCounts, Layout};
 use crate::gnss_error::{CarWanderLayout, N_WANDER};
+use crate::gyro_drift::{CarBiasLayout, CarWanderBiasLayout, N_BIAS, N_WANDER_BIAS};
 use crate::metrics::Summary;
 use crate::model::{Mat, State, V, X, Y, YAW};
 use crate::reference::Reference;
@@ -203,10 +204,23 @@ pub fn evaluate(
     warmup_s: f64,
     base: &FilterOptions,
 ) -> Result<OutageEvaluation, Error> {
-    if drive.vehicle.noise.gnss_wander_std_m > 0.0 {
-        evaluate_in::<CarWanderLayout, N_WANDER>(drive, params, outage_s, step_s, warmup_s, base)
-    } else {
-        evaluate_in::<CarLayout, 5>(drive, params, outage_s, step_s, warmup_s, base)
+    let n = &drive.vehicle.noise;
+    match (
+        n.gnss_wander_std_m > 0.0,
+        n.gyro_bias_walk_rps_per_sqrt_s > 0.0,
+    ) {
+        (false, false) => {
+            evaluate_in::<CarLayout, 5>(drive, params, outage_s, step_s, warmup_s, base)
+        }
+        (true, false) => evaluate_in::<CarWanderLayout, N_WANDER>(
+            drive, params, outage_s, step_s, warmup_s, base,
+        ),
+        (false, true) => {
+            evaluate_in::<CarBiasLayout, N_BIAS>(drive, params, outage_s, step_s, warmup_s, base)
+        }
+        (true, true) => evaluate_in::<CarWanderBiasLayout, N_WANDER_BIAS>(
+            drive, params, outage_s, step_s, warmup_s, base,
+        ),
     }
 }
 

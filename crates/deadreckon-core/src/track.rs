@@ -3,6 +3,8 @@
 //! the filtered and smoothed ones, and the truth as a track of its own.
 
 use crate::ekf::{self, FilterOptions, Init, SensorSet};
+use crate::filter::{CarLayout, Layout};
+use crate::gyro_drift::{CarBiasLayout, N_BIAS};
 use crate::model::{Mat, State};
 use crate::vehicle::Origin;
 use crate::{rts, Drive, Error, Params};
@@ -99,32 +101,48 @@ impl TrackPoint {
 
 impl Track {
     /// The filtered states of a filter run.
-    pub fn from_epochs(name: &str, epochs: &[crate::ekf::Epoch], origin: Option<Origin>) -> Track {
+    /// (the car block of a state with more, [`crate::filter::Layout`]).
+    pub fn from_epochs<const N: usize>(
+        name: &str,
+        epochs: &[crate::ekf::Epoch<N>],
+        origin: Option<Origin>,
+    ) -> Track {
         Track {
             name: name.into(),
             points: epochs
                 .iter()
-                .map(|e| TrackPoint::from_state(e.t_s, &e.x, &e.p))
+                .map(|e| car_point(e.t_s, &e.x, &e.p))
                 .collect(),
             origin,
         }
     }
 
     /// The smoothed states of an RTS pass.
-    pub fn from_smoothed(
+    pub fn from_smoothed<const N: usize>(
         name: &str,
-        smoothed: &[crate::rts::Smoothed],
+        smoothed: &[crate::rts::Smoothed<N>],
         origin: Option<Origin>,
     ) -> Track {
         Track {
             name: name.into(),
             points: smoothed
                 .iter()
-                .map(|s| TrackPoint::from_state(s.t_s, &s.x, &s.p))
+                .map(|s| car_point(s.t_s, &s.x, &s.p))
                 .collect(),
             origin,
         }
     }
+}
+
+/// The track point of the car block of a state and covariance.
+fn car_point<const N: usize>(
+    t_s: f64,
+    x: &nalgebra::SVector<f64, N>,
+    p: &nalgebra::SMatrix<f64, N, N>,
+) -> TrackPoint {
+    let car: State = x.fixed_rows::<5>(0).into_owned();
+    let pc: Mat = p.fixed_view::<5, 5>(0, 0).into_owned();
+    TrackPoint::from_state(t_s, &car, &pc)
 }
 
 impl Track {
@@ -175,27 +193,57 @@ pub fn drive_tracks(
     opts: &FilterOptions,
     init_pose: Option<(f64, f64, f64)>,
 ) -> Result<Vec<Track>, Error> {
-    let origin = drive.vehicle.origin;
     let mut out = Vec::new();
     let mut smoothed_start = None;
     if drive.gnss.len() >= 2 {
-        let f = ekf::run(
-            drive,
-            params,
-            &FilterOptions {
-                record_epochs: true,
-                ..opts.clone()
-            },
-            &mut (),
-        )?;
-        let s = rts::smooth(&f.epochs)?;
-        smoothed_start = s.first().map(|s| (s.t_s, s.x, s.p));
-        out.push(Track::from_epochs(names::FILTERED, &f.epochs, origin));
-        out.push(Track::from_smoothed(names::SMOOTHED, &s, origin));
+        let (filtered, smoothed, start) = if drive.vehicle.noise.gyro_bias_walk_rps_per_sqrt_s > 0.0
+        {
+            aided_tracks::<CarBiasLayout, N_BIAS>(drive, params, opts)?
+        } else {
+            aided_tracks::<CarLayout, 5>(drive, params, opts)?
+        };
+        smoothed_start = start;
+        out.push(filtered);
+        out.push(smoothed);
     }
     let init = dead_reckoning_init(drive, init_pose, smoothed_start)?;
     out.insert(0, dead_reckoned(drive, params, opts, init)?);
     Ok(out)
+}
+
+/// The filtered and smoothed tracks of the GNSS-aided filter of layout `L`
+/// (a walking gyro bias: [`crate::gyro_drift`]), and the smoothed start's
+/// car state.
+#[allow(clippy::type_complexity)]
+fn aided_tracks<L: Layout<N>, const N: usize>(
+    drive: &Drive,
+    params: &Params,
+    opts: &FilterOptions,
+) -> Result<(Track, Track, Option<(f64, State, Mat)>), Error> {
+    let opts = FilterOptions {
+        record_epochs: true,
+        ..opts.clone()
+    };
+    let f = ekf::run_filter(
+        drive,
+        ekf::fixed_filter::<L, N>(drive, params, &opts)?,
+        &opts,
+        &mut (),
+    )?;
+    let s = rts::smooth(&f.epochs)?;
+    let start = s.first().map(|s| {
+        (
+            s.t_s,
+            s.x.fixed_rows::<5>(0).into_owned(),
+            s.p.fixed_view::<5, 5>(0, 0).into_owned(),
+        )
+    });
+    let origin = drive.vehicle.origin;
+    Ok((
+        Track::from_epochs(names::FILTERED, &f.epochs, origin),
+        Track::from_smoothed(names::SMOOTHED, &s, origin),
+        start,
+    ))
 }
 
 /// Where dead reckoning starts: the given pose, else the truth, else the

@@ -97,6 +97,14 @@ pub struct Noise {
     /// with `gnss_wander_std_m` above 0).
     #[serde(skip_serializing_if = "is_default_wander_tau")]
     pub gnss_wander_tau_s: f64,
+    /// The gyro bias's rate random walk, rad/s per √s (default 0: the bias
+    /// is the calibrated constant, the paper's model). Above 0 the aided
+    /// filter carries the bias as a state that walks by this much
+    /// ([`crate::gyro_drift`]): an automotive MEMS gyro's bias moves by
+    /// 10–40 °/h over minutes (temperature), and an outage starts from the
+    /// bias the fixes last showed instead of the calibration drive's mean.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub gyro_bias_walk_rps_per_sqrt_s: f64,
     /// χ² gate (1 degree of freedom) of each wheel reading, ticks or speed
     /// (default [`GROSS_FAULT_CHI2`]: only gross faults such as a spinning
     /// wheel or a counter glitch are rejected; `inf` switches the gate off).
@@ -225,6 +233,7 @@ impl Default for Noise {
             gnss_recovery_after_s: 0.0,
             gnss_wander_std_m: 0.0,
             gnss_wander_tau_s: DEFAULT_GNSS_WANDER_TAU_S,
+            gyro_bias_walk_rps_per_sqrt_s: 0.0,
             wheel_gate_chi2: GROSS_FAULT_CHI2,
             gyro_gate_chi2: GROSS_FAULT_CHI2,
             speed_gate_chi2: GROSS_FAULT_CHI2,
@@ -461,6 +470,13 @@ impl Vehicle {
             return Err(Error::InvalidVehicle(format!(
                 "noise.gnss_wander_std_m must be a non-negative number (0: white fixes), got {}",
                 n.gnss_wander_std_m
+            )));
+        }
+        if !(n.gyro_bias_walk_rps_per_sqrt_s.is_finite() && n.gyro_bias_walk_rps_per_sqrt_s >= 0.0)
+        {
+            return Err(Error::InvalidVehicle(format!(
+                "noise.gyro_bias_walk_rps_per_sqrt_s must be a non-negative number (0: a constant bias), got {}",
+                n.gyro_bias_walk_rps_per_sqrt_s
             )));
         }
         if !(n.gnss_wander_tau_s.is_finite() && n.gnss_wander_tau_s > 0.0) {
