@@ -1,0 +1,127 @@
+//! What a user gets on the dynamic family (issue 28) with the commands'
+//! defaults: `calibrate` (the RTS calibration after the default corrections,
+//! `--corrections gnss`: the driven axle's slip, the IMU tilt, the GNSS
+//! delay and the gyro scale estimated and applied) on one drive, then
+//! `evaluate --params` on another drive of the same car (the stored
+//! corrections applied to it, 30 s outages, step 10 s), beside the bare
+//! RTS calibration (`--corrections none`) the ablation in
+//! `deadreckon-sim/tests/dynamics_ablation.rs` uses.
+//!
+//! ```text
+//! cargo test --profile ci -p deadreckon-api --test dynamic_family_defaults -- --ignored --nocapture
+//! ```
+
+use std::sync::Mutex;
+
+use deadreckon_api::calibrate::calibrate_car;
+use deadreckon_api::corrections::stored_corrections;
+use deadreckon_core::calibrate::CalibrationOptions;
+use deadreckon_core::ekf::FilterOptions;
+use deadreckon_core::outage::evaluate;
+use deadreckon_core::timing::Which;
+use deadreckon_sim::family::{DynamicCar, Effects};
+use deadreckon_sim::simulate;
+
+/// The mean final error of one car's 30 s outages with the corrections
+/// `which`, m.
+fn user_path(
+    car: &DynamicCar,
+    effects: &Effects,
+    which: Which,
+    drive_s: f64,
+) -> Result<f64, String> {
+    let seed = car.base.seed;
+    let cal = simulate(&car.drive(1000 + seed, drive_s, effects), 1000 + seed)
+        .map_err(|e| format!("calibration drive: {e}"))?;
+    let ev = simulate(&car.drive(2000 + seed, drive_s, effects), 2000 + seed)
+        .map_err(|e| format!("evaluation drive: {e}"))?;
+    let c = calibrate_car(
+        &cal.drive,
+        "rts",
+        CalibrationOptions::default(),
+        which,
+        "cal",
+    )
+    .map_err(|e| format!("calibration: {e}"))?;
+    let stored = stored_corrections(&c.params_extra()).map_err(|e| format!("stored: {e}"))?;
+    let drive = stored.apply(&ev.drive);
+    let out = evaluate(
+        &drive,
+        &c.calibration.estimate.params,
+        30.0,
+        10.0,
+        5.0,
+        &FilterOptions::default(),
+    )
+    .map_err(|e| format!("evaluation: {e}"))?;
+    Ok(out.final_error().mean)
+}
+
+/// Every (configuration, car, corrections) on two threads; the mean over
+/// the cars per configuration and corrections.
+fn run(cars: &[u64], configs: &[(&str, Effects)], drive_s: f64) -> Vec<[(f64, usize); 2]> {
+    let jobs: Vec<(usize, usize, usize)> = (0..configs.len())
+        .flat_map(|c| (0..cars.len()).flat_map(move |k| [(c, k, 0), (c, k, 1)]))
+        .collect();
+    let next = Mutex::new(0usize);
+    let sums = Mutex::new(vec![[(0.0, 0usize); 2]; configs.len()]);
+    let drawn: Vec<DynamicCar> = cars.iter().map(|&s| DynamicCar::draw(s)).collect();
+    std::thread::scope(|scope| {
+        for _ in 0..2 {
+            scope.spawn(|| loop {
+                let j = {
+                    let mut n = next.lock().unwrap();
+                    *n += 1;
+                    *n - 1
+                };
+                let Some(&(c, k, w)) = jobs.get(j) else { break };
+                let which = [Which::None, Which::Gnss][w];
+                match user_path(&drawn[k], &configs[c].1, which, drive_s) {
+                    Ok(e) => {
+                        let mut s = sums.lock().unwrap();
+                        s[c][w].0 += e;
+                        s[c][w].1 += 1;
+                    }
+                    Err(e) => println!("{} car {} {which:?}: {e}", configs[c].0, cars[k]),
+                }
+            });
+        }
+    });
+    sums.into_inner().unwrap()
+}
+
+fn configs() -> Vec<(&'static str, Effects)> {
+    let mut v = vec![("none", Effects::none())];
+    for name in Effects::NAMES {
+        v.push((name, Effects::only(name).unwrap()));
+    }
+    v.push(("all", Effects::all()));
+    v
+}
+
+#[test]
+#[ignore]
+fn the_default_corrections_on_the_dynamic_family() {
+    for (title, cars) in [
+        ("development cars 1–6", (1..=6).collect::<Vec<u64>>()),
+        (
+            "held-out cars 101–110 (104 apart)",
+            (101..=110).filter(|&c| c != 104).collect(),
+        ),
+    ] {
+        let configs = configs();
+        let rows = run(&cars, &configs, 300.0);
+        println!("\n{title}, 300 s drives: mean final error of 30 s outages, m");
+        println!("{:<16} {:>10} {:>10}", "effects", "none", "gnss");
+        for ((name, _), r) in configs.iter().zip(&rows) {
+            let m = |i: usize| r[i].0 / r[i].1 as f64;
+            println!(
+                "{name:<16} {:>10.3} {:>10.3}   ({} / {} cars)",
+                m(0),
+                m(1),
+                r[0].1,
+                r[1].1
+            );
+        }
+    }
+}
