@@ -162,9 +162,7 @@ pub fn run(
     let learned = online.learned(&targets);
     if write_error.is_none() {
         if let Some(path) = &o.state {
-            let text = serde_json::to_string(&*online).doing(|| "the filter's state".into())?;
-            deadreckon_io::atomic_write(path, |w| w.write_all(text.as_bytes()))
-                .doing(|| format!("writing state {}", path.display()))?;
+            save_state(path, online)?;
         }
         if let (Some(l), Some(path)) = (&learned, &o.params_out) {
             save_learned(path, l)?;
@@ -176,6 +174,14 @@ pub fn run(
         learned,
         write_error,
     })
+}
+
+/// Writes the filter's state to `path` (atomically), which [`open`] resumes
+/// from: `stream --state` and `ros2 --state` share the file.
+pub fn save_state(path: &Path, online: &Online) -> Result<(), Error> {
+    let text = serde_json::to_string(online).doing(|| "the filter's state".into())?;
+    deadreckon_io::atomic_write(path, |w| w.write_all(text.as_bytes()))
+        .doing(|| format!("writing state {}", path.display()))
 }
 
 /// Writes learned parameters as a params.toml (method `online`, whether

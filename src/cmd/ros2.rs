@@ -1,0 +1,62 @@
+//! `deadreckon ros2`: the online filter as a live ROS 2 node
+//! ([`deadreckon_ros2::run`]), started and resumed as `stream` is.
+
+use std::sync::atomic::AtomicBool;
+
+use anyhow::{Context, Result};
+use deadreckon_api::stream::{self, StreamOptions};
+use deadreckon_core::ekf::FilterOptions;
+use deadreckon_ros2::NodeOptions;
+
+use super::common;
+use crate::args::ros2::Ros2Args;
+
+/// Runs `ros2` until `stop` is set (SIGINT/SIGTERM) or the idle time passes.
+pub fn run(a: Ros2Args, load: &common::Loader, stop: &AtomicBool) -> Result<()> {
+    let inputs = [a.vehicle.as_path(), std::path::Path::new(&a.params)];
+    for out in a.state.iter() {
+        common::check_output(out, &inputs)?;
+    }
+    let vehicle = deadreckon_io::read_vehicle(&a.vehicle)
+        .with_context(|| format!("reading {}", a.vehicle.display()))?;
+    let (params, prior, warning) = stream::start_params(&a.params, &vehicle)?;
+    if let Some(w) = warning {
+        eprintln!("warning: {w}");
+    }
+    let mut mapping = deadreckon_api::source::live_mapping(load.mapping.as_deref())?;
+    mapping.vehicle = vehicle.clone();
+    let o = StreamOptions {
+        filter: FilterOptions {
+            timing: a.timing.into(),
+            ..Default::default()
+        },
+        state: a.state.clone(),
+        learn: a.learn,
+        params_out: None,
+        save_every_s: None,
+        skip_bad_lines: false,
+    };
+    let mut online = stream::open(&vehicle, &params, &prior, &o)?;
+    let node = NodeOptions {
+        domain_id: a.domain_id,
+        until_idle_s: a.until_idle,
+        reorder_window_s: a.reorder_window,
+        learned_every_s: a.learned_every_s,
+        ..Default::default()
+    };
+    let summary = deadreckon_ros2::run(&mut online, &mapping, &node, stop)?;
+    if let Some(path) = &a.state {
+        stream::save_state(path, &online)?;
+    }
+    for line in summary.lines() {
+        eprintln!("{line}");
+    }
+    if let Some(l) = summary.learned {
+        eprintln!(
+            "learned: {:.0}% calibrated, {}",
+            l.calibrated_pct,
+            if l.valid { "valid" } else { "not yet valid" }
+        );
+    }
+    Ok(())
+}
