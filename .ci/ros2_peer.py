@@ -8,12 +8,14 @@ every nav_msgs/Odometry it receives on /deadreckon/odom as one JSON line.
 
 It starts the node (the command after `--`) itself, waits until every topic is
 matched both ways, replays, waits for the node to exit (it stops after its
-`--until-idle`), and exits with the node's status. Run it in a private network
+`--until-idle`, or `--signal-after` sends it SIGTERM), and exits with the node's
+status. Run it in a private network
 namespace: `unshare -n` with `ip link set lo up multicast on`.
 """
 
 import argparse
 import json
+import signal
 import subprocess
 import sys
 import threading
@@ -206,6 +208,7 @@ def main():
     ap.add_argument("--topics", required=True, help="comma-separated topics to replay")
     ap.add_argument("--rate", type=float, default=5.0)
     ap.add_argument("--domain-id", type=int, default=0)
+    ap.add_argument("--signal-after", type=float, help="send the node SIGTERM after this many seconds of bag")
     ap.add_argument("--out", required=True, type=Path, help="JSON lines of what was received")
     ap.add_argument("--node-log", required=True, type=Path)
     ap.add_argument("node", nargs=argparse.REMAINDER, help="-- the node's command")
@@ -277,6 +280,10 @@ def main():
             for c, t_ns, raw in bag.messages(connections=conns):
                 if t0 is None:
                     t0 = t_ns
+                if a.signal_after is not None and (t_ns - t0) * 1e-9 >= a.signal_after:
+                    node.send_signal(signal.SIGTERM)
+                    print(f"ros2_peer: sent the node SIGTERM after {a.signal_after} s of bag", flush=True)
+                    break
                 due = start + (t_ns - t0) * 1e-9 / a.rate
                 pause = due - time.monotonic()
                 if pause > 0:

@@ -45,11 +45,14 @@ pub fn run(a: Ros2Args, load: &common::Loader, stop: &AtomicBool) -> Result<()> 
         ..Default::default()
     };
     let summary = deadreckon_ros2::run(&mut online, &mapping, &node, stop)?;
-    if let Some(path) = &a.state {
-        stream::save_state(path, &online)?;
-    }
     for line in summary.lines() {
         eprintln!("{line}");
+    }
+    if let Some(why) = &summary.not_started {
+        anyhow::bail!("the filter never started: {why}");
+    }
+    if let Some(path) = &a.state {
+        stream::save_state(path, &online)?;
     }
     if let Some(l) = summary.learned {
         eprintln!(

@@ -80,6 +80,8 @@ impl std::fmt::Display for Stop {
 pub struct Summary {
     /// Why it stopped.
     pub stop: Stop,
+    /// Why the filter never started (no GNSS start), when it did not.
+    pub not_started: Option<String>,
     /// Per mapped stream: what the conversion used and dropped.
     pub streams: Vec<StreamReport>,
     /// Per mapped stream: messages refused as late (older than one already
@@ -263,11 +265,19 @@ pub fn run(
     while let Some((_, p)) = window.drain() {
         feed(online, &mut conv, &mut out, p)?;
     }
-    online.finish(&mut |p| out.epoch(p))?;
+    // A filter that never started has nothing to finish: say why instead.
+    let not_started = match online.finish(&mut |p| out.epoch(p)) {
+        Err(e) if !online.is_started() => Some(e.to_string()),
+        r => {
+            r?;
+            None
+        }
+    };
     learned(online, &out, o, &targets, &mut last_learned, true);
     std::thread::sleep(LINGER);
     let summary = Summary {
         stop: stopped,
+        not_started,
         streams: conv.reports().to_vec(),
         late,
         published: out.published,
