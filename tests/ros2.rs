@@ -43,7 +43,14 @@ fn python() -> PathBuf {
 /// multicast on; returns (success, standard output + error).
 fn in_namespace(args: &[&str], work: &Path) -> (bool, String) {
     let out = Command::new("unshare")
-        .args(["-n", "--", "sh", "-c", "ip link set lo up multicast on && exec \"$@\"", "sh"])
+        .args([
+            "-n",
+            "--",
+            "sh",
+            "-c",
+            "ip link set lo up multicast on && exec \"$@\"",
+            "sh",
+        ])
         .args(args)
         .current_dir(work)
         .env("CYCLONEDDS_URI", CYCLONE_LO)
@@ -71,7 +78,11 @@ fn events_stream(vehicle: &Path) -> Vec<Value> {
     let writer = std::thread::spawn(move || stdin.write_all(events.as_bytes()));
     let out = child.wait_with_output().unwrap();
     writer.join().unwrap().unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     lines(&String::from_utf8(out.stdout).unwrap())
 }
 
@@ -147,7 +158,12 @@ fn the_node_fed_by_cyclone_dds_publishes_what_stream_prints() {
     let (got, log) = replay(work.path(), &vehicle, &[], &["--until-idle", "3"]);
     let by_stamp: std::collections::HashMap<(i64, i64), &Value> = got
         .iter()
-        .map(|r| ((r["sec"].as_i64().unwrap(), r["nanosec"].as_i64().unwrap()), r))
+        .map(|r| {
+            (
+                (r["sec"].as_i64().unwrap(), r["nanosec"].as_i64().unwrap()),
+                r,
+            )
+        })
         .collect();
     let (mut matched, mut max_pos_m, mut max_other) = (0usize, 0.0f64, 0.0f64);
     for e in &expected {
@@ -164,10 +180,20 @@ fn the_node_fed_by_cyclone_dds_publishes_what_stream_prints() {
         let cov = |i: usize| f(&r["cov"][i]);
         let ce = |i: usize| f(&e["cov_pose"][i]);
         // (x, y, yaw) of the 6 × 6 row-major covariance: indices 0, 1, 5 of each row.
-        let cov_d = [(0, 0), (1, 1), (5, 2), (6, 3), (7, 4), (11, 5), (30, 6), (31, 7), (35, 8)]
-            .iter()
-            .map(|&(i, j)| d(cov(i), ce(j)))
-            .fold(0.0, f64::max);
+        let cov_d = [
+            (0, 0),
+            (1, 1),
+            (5, 2),
+            (6, 3),
+            (7, 4),
+            (11, 5),
+            (30, 6),
+            (31, 7),
+            (35, 8),
+        ]
+        .iter()
+        .map(|&(i, j)| d(cov(i), ce(j)))
+        .fold(0.0, f64::max);
         max_other = max_other
             .max(d(f(&r["qz"]), half.sin()))
             .max(d(f(&r["qw"]), half.cos()))
@@ -190,7 +216,10 @@ fn the_node_fed_by_cyclone_dds_publishes_what_stream_prints() {
     // epochs, positions and every other value equal to the last bit.
     assert!(fraction >= 0.99, "{matched} of {} epochs", expected.len());
     assert!(max_pos_m <= 1e-6, "positions differ by {max_pos_m} m");
-    assert!(max_other <= 1e-9, "orientation, twist or covariance differ by {max_other}");
+    assert!(
+        max_other <= 1e-9,
+        "orientation, twist or covariance differ by {max_other}"
+    );
     assert_eq!(got.len(), expected.len(), "one Odometry per epoch, no more");
     // Replayed in record order, no stamp is more than 33 ms behind the newest:
     // the default 0.1 s window lets none be late.
@@ -231,7 +260,10 @@ fn sigterm_stops_the_node_cleanly_and_late_messages_are_counted_not_applied() {
     // about 60 s of the bag, less the wait for the GNSS start).
     let published = got.len();
     assert!(published > 300, "{published} published");
-    assert!(log.contains(&format!("{published} odometry messages published")), "{log}");
+    assert!(
+        log.contains(&format!("{published} odometry messages published")),
+        "{log}"
+    );
     assert!(got.iter().all(|r| r["frame_id"] == "odom"));
     // The state is written as `stream --state` writes it: `stream` resumes from it.
     let text = std::fs::read_to_string(&state).expect("the state was written");

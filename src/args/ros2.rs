@@ -7,16 +7,10 @@ use clap::Args;
 /// Arguments of `ros2`.
 #[derive(Args, Debug)]
 pub struct Ros2Args {
-    /// The vehicle description (vehicle.toml); NavSatFix positions are about its
-    /// [origin] (else about the first fix).
-    #[arg(long)]
-    pub vehicle: PathBuf,
-    /// `nominal` or a params.toml (with --learn, its [std] is the prior).
-    #[arg(long, default_value = "nominal")]
-    pub params: String,
-    /// Filter timing.
-    #[arg(long, value_enum, default_value = "wheel")]
-    pub timing: super::TimingArg,
+    /// The vehicle (NavSatFix positions are about its [origin], else about the
+    /// first fix), the parameters, the timing.
+    #[command(flatten)]
+    pub start: super::stream::OnlineStartArgs,
     /// Learn the six parameters while filtering (the 11-state filter); they are
     /// published on /diagnostics.
     #[arg(long)]

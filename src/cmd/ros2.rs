@@ -3,7 +3,7 @@
 
 use std::sync::atomic::AtomicBool;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use deadreckon_api::stream::{self, StreamOptions};
 use deadreckon_core::ekf::FilterOptions;
 use deadreckon_ros2::NodeOptions;
@@ -13,21 +13,14 @@ use crate::args::ros2::Ros2Args;
 
 /// Runs `ros2` until `stop` is set (SIGINT/SIGTERM) or the idle time passes.
 pub fn run(a: Ros2Args, load: &common::Loader, stop: &AtomicBool) -> Result<()> {
-    let inputs = [a.vehicle.as_path(), std::path::Path::new(&a.params)];
-    for out in a.state.iter() {
+    let inputs = a.start.inputs();
+    if let Some(out) = &a.state {
         common::check_output(out, &inputs)?;
     }
-    let vehicle = deadreckon_io::read_vehicle(&a.vehicle)
-        .with_context(|| format!("reading {}", a.vehicle.display()))?;
-    let (params, prior, warning) = stream::start_params(&a.params, &vehicle)?;
-    if let Some(w) = warning {
-        eprintln!("warning: {w}");
-    }
     let mut mapping = deadreckon_api::source::live_mapping(load.mapping.as_deref())?;
-    mapping.vehicle = vehicle.clone();
     let o = StreamOptions {
         filter: FilterOptions {
-            timing: a.timing.into(),
+            timing: a.start.timing.into(),
             ..Default::default()
         },
         state: a.state.clone(),
@@ -36,7 +29,12 @@ pub fn run(a: Ros2Args, load: &common::Loader, stop: &AtomicBool) -> Result<()> 
         save_every_s: None,
         skip_bad_lines: false,
     };
-    let mut online = stream::open(&vehicle, &params, &prior, &o)?;
+    let (vehicle, mut online, warning) = stream::start(&a.start.vehicle, &a.start.params, &o)?;
+    if let Some(w) = warning {
+        // Live messages cannot be re-timed or re-projected here: say so.
+        eprintln!("warning: {w}");
+    }
+    mapping.vehicle = vehicle;
     let node = NodeOptions {
         domain_id: a.domain_id,
         until_idle_s: a.until_idle,

@@ -2,7 +2,7 @@
 //! standard input, one JSON line per filter epoch on standard output
 //! ([`deadreckon_api::stream`]).
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use deadreckon_api::stream::{self, StreamOptions};
 use deadreckon_core::ekf::FilterOptions;
 
@@ -13,20 +13,13 @@ use crate::args::stream::{OnBadLine, StreamArgs};
 pub fn run(a: StreamArgs) -> Result<()> {
     // The learned parameters and the state file (read, then written) are
     // outputs: neither may be the vehicle or the parameters read.
-    let inputs = [a.vehicle.as_path(), std::path::Path::new(&a.params)];
+    let inputs = a.start.inputs();
     for out in a.params_out.iter().chain(a.state.iter()) {
         common::check_output(out, &inputs)?;
     }
-    let vehicle = deadreckon_io::read_vehicle(&a.vehicle)
-        .with_context(|| format!("reading {}", a.vehicle.display()))?;
-    let (params, prior, warning) = stream::start_params(&a.params, &vehicle)?;
-    if let Some(w) = warning {
-        // Live events cannot be re-timed or re-projected here: say so.
-        eprintln!("warning: {w}");
-    }
     let o = StreamOptions {
         filter: FilterOptions {
-            timing: a.timing.into(),
+            timing: a.start.timing.into(),
             ..Default::default()
         },
         state: a.state.clone(),
@@ -35,7 +28,11 @@ pub fn run(a: StreamArgs) -> Result<()> {
         save_every_s: a.save_every_s,
         skip_bad_lines: a.on_bad_line == OnBadLine::Skip,
     };
-    let mut online = stream::open(&vehicle, &params, &prior, &o)?;
+    let (_, mut online, warning) = stream::start(&a.start.vehicle, &a.start.params, &o)?;
+    if let Some(w) = warning {
+        // Live events cannot be re-timed or re-projected here: say so.
+        eprintln!("warning: {w}");
+    }
     let s = stream::run(
         &mut online,
         std::io::stdin().lock(),

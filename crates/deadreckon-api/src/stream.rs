@@ -100,6 +100,22 @@ pub fn open(
     })
 }
 
+/// What a live filter starts from: the vehicle read from `vehicle`, the
+/// filter ([`open`]: resumed from `o.state`, else started with the
+/// parameters `params` names, [`start_params`]) and the warning of a
+/// params.toml with corrections live events cannot be given.
+pub fn start(
+    vehicle: &Path,
+    params: &str,
+    o: &StreamOptions,
+) -> Result<(Vehicle, Online, Option<String>), Error> {
+    let v =
+        deadreckon_io::read_vehicle(vehicle).doing(|| format!("reading {}", vehicle.display()))?;
+    let (p, prior, warning) = start_params(params, &v)?;
+    let online = open(&v, &p, &prior, o)?;
+    Ok((v, online, warning))
+}
+
 /// Runs the filter over the event lines of `input` (named `source` in
 /// errors), writing one JSON pose a line to `out`; saves the learned
 /// parameters as asked and the state at the end. A bad line skipped is

@@ -122,15 +122,7 @@ impl Sample {
     /// it in a drive (`None` for a reference pose, which is no measurement).
     pub fn event(&self) -> Option<Event> {
         let (t_s, measurement) = match *self {
-            Sample::Wheels(w) => (
-                w.t_s,
-                Measurement::WheelSpeeds {
-                    fl_mps: w.fl_mps,
-                    fr_mps: w.fr_mps,
-                    rl_mps: w.rl_mps,
-                    rr_mps: w.rr_mps,
-                },
-            ),
+            Sample::Wheels(w) => (w.t_s, Measurement::wheel_speeds(&w)),
             Sample::YawRate(s) => (
                 s.t_s,
                 Measurement::YawRate {
@@ -138,16 +130,7 @@ impl Sample {
                 },
             ),
             Sample::Speed(s) => (s.t_s, Measurement::Speed { speed_mps: s.value }),
-            Sample::Gnss(g) => (
-                g.t_s,
-                Measurement::Gnss {
-                    east_m: g.east_m,
-                    north_m: g.north_m,
-                    std_m: g.std_m,
-                    course_deg: g.course_deg,
-                    speed_mps: g.speed_mps,
-                },
-            ),
+            Sample::Gnss(g) => (g.t_s, Measurement::gnss(&g)),
             Sample::Truth(_) => return None,
         };
         Some(Event { t_s, measurement })

@@ -57,16 +57,8 @@ pub struct DiagnosticArray {
 pub fn learned(l: &Learned, stamp: Time, hardware_id: &str) -> DiagnosticArray {
     let p = l.params.to_array();
     let s = l.std.to_array();
-    let names = [
-        "gyro_bias_rps",
-        "speed_scale",
-        "circumference_fl_m",
-        "circumference_fr_m",
-        "circumference_rl_m",
-        "circumference_rr_m",
-    ];
     let mut values = Vec::with_capacity(14);
-    for (k, name) in names.iter().enumerate() {
+    for (k, name) in deadreckon_core::Params::NAMES.iter().enumerate() {
         values.push(KeyValue {
             key: (*name).into(),
             value: p[k].to_string(),

@@ -110,7 +110,10 @@ mod tests {
         // Held until the start: 2 s.
         l.fed(t0);
         l.published(t0 + ms(2000));
-        assert!(l.summary().is_none(), "nothing received after the start yet");
+        assert!(
+            l.summary().is_none(),
+            "nothing received after the start yet"
+        );
         l.fed(t0 + ms(2010));
         l.fed(t0 + ms(2020));
         l.published(t0 + ms(2040));

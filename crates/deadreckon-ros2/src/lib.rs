@@ -36,10 +36,12 @@ pub mod dds;
 pub mod diagnostics;
 mod latency;
 pub mod node;
+pub mod pipeline;
 mod reorder;
 
 pub use latency::{Latency, LatencySummary};
 pub use node::{run, NodeOptions, Stop, Summary};
+pub use pipeline::{Pipeline, Sink};
 pub use reorder::Reorder;
 
 /// What went wrong in the node.

@@ -1,7 +1,7 @@
-//! The node's loop: messages taken from the subscriptions, put in stamp
-//! order by the reorder window, converted by the bag reader's conversion
-//! ([`deadreckon_ros::Converter`]), given to the online filter as
-//! `deadreckon stream` gives its events, one Odometry published per epoch.
+//! The node's loop: messages taken from the subscriptions into the
+//! [`Pipeline`] (stamp order through the reorder window, the bag reader's
+//! conversion, the online filter as `deadreckon stream` feeds it), one
+//! Odometry published per epoch.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
@@ -10,11 +10,11 @@ use ros2_client::dds::rustdds::mio1 as mio;
 
 use deadreckon_core::online::{LearnTargets, Learned, Online};
 use deadreckon_core::TrackPoint;
-use deadreckon_ros::{ros2_out, Converter, Mapping, Message, StreamKind, StreamReport};
+use deadreckon_ros::{ros2_out, Mapping, StreamReport};
 
 use crate::dds::{Endpoints, Names};
 use crate::latency::{seconds, Latency, LatencySummary};
-use crate::reorder::Reorder;
+use crate::pipeline::{Pipeline, Sink};
 use crate::Error;
 
 /// The frame of the published pose (REP 105's `odom`: east/north/up about
@@ -134,25 +134,6 @@ impl Summary {
     }
 }
 
-/// A message waiting in the reorder window.
-struct Pending {
-    stream: usize,
-    record_t_s: f64,
-    msg: Message,
-    received: Instant,
-}
-
-/// The rank of a kind's events among equal times (as `Event`'s ties).
-fn rank(kind: StreamKind) -> u8 {
-    match kind {
-        StreamKind::OdometryWheels => 0,
-        StreamKind::ImuYawRate => 1,
-        StreamKind::TwistSpeed => 2,
-        StreamKind::NavsatfixGnss => 4,
-        StreamKind::PoseTruth => 5,
-    }
-}
-
 fn wall_s() -> f64 {
     SystemTime::now()
         .duration_since(UNIX_EPOCH)
@@ -169,7 +150,11 @@ struct Output<'a> {
     latency: Latency,
 }
 
-impl Output<'_> {
+impl Sink for Output<'_> {
+    fn fed(&mut self, received: Instant) {
+        self.latency.fed(received);
+    }
+
     fn epoch(&mut self, p: TrackPoint) {
         let Some(m) = ros2_out::odometry_in(&p, FRAME_ID) else {
             self.unstamped += 1;
@@ -208,10 +193,7 @@ pub fn run(
             .map_err(|e| Error::Io("registering a subscription", e))?;
     }
     let mut events = mio::Events::with_capacity(64);
-    let mut conv = Converter::new(mapping);
-    let kinds: Vec<StreamKind> = mapping.streams.iter().map(|s| s.kind).collect();
-    let mut window: Reorder<Pending> = Reorder::new(o.reorder_window_s);
-    let mut late = vec![0u64; kinds.len()];
+    let mut pipe = Pipeline::new(mapping, o.reorder_window_s);
     let mut out = Output {
         ep: &ep,
         published: 0,
@@ -242,44 +224,21 @@ pub fn run(
                 doing: format!("reading {}", mapping.streams[i].topic),
                 detail,
             })? {
-                let received = Instant::now();
-                last_input = received;
-                let record_t_s = wall_s();
-                let t = conv.time_s(i, record_t_s, &msg);
-                let p = Pending {
-                    stream: i,
-                    record_t_s,
-                    msg,
-                    received,
-                };
-                if window.push(t, rank(kinds[i]), p).is_err() {
-                    late[i] += 1;
-                }
+                last_input = Instant::now();
+                pipe.receive(i, wall_s(), msg, last_input);
             }
         }
-        while let Some((_, p)) = window.pop_ready() {
-            feed(online, &mut conv, &mut out, p)?;
-            learned(online, &out, o, &targets, &mut last_learned, false);
-        }
+        pipe.release(online, &mut out)?;
+        learned(online, &out, o, &targets, &mut last_learned, false);
     };
-    while let Some((_, p)) = window.drain() {
-        feed(online, &mut conv, &mut out, p)?;
-    }
-    // A filter that never started has nothing to finish: say why instead.
-    let not_started = match online.finish(&mut |p| out.epoch(p)) {
-        Err(e) if !online.is_started() => Some(e.to_string()),
-        r => {
-            r?;
-            None
-        }
-    };
+    let not_started = pipe.finish(online, &mut out)?;
     learned(online, &out, o, &targets, &mut last_learned, true);
     std::thread::sleep(LINGER);
     let summary = Summary {
         stop: stopped,
         not_started,
-        streams: conv.reports().to_vec(),
-        late,
+        streams: pipe.reports().to_vec(),
+        late: pipe.late().to_vec(),
         published: out.published,
         unstamped: out.unstamped,
         publish_errors: (out.errors, out.first_error.clone()),
@@ -291,26 +250,8 @@ pub fn run(
     Ok(summary)
 }
 
-/// Converts one message and gives it to the filter.
-fn feed(
-    online: &mut Online,
-    conv: &mut Converter,
-    out: &mut Output,
-    p: Pending,
-) -> Result<(), Error> {
-    let Some(ev) = conv
-        .push(p.stream, p.record_t_s, &p.msg)
-        .and_then(|s| s.event())
-    else {
-        return Ok(());
-    };
-    out.latency.fed(p.received);
-    online.push(ev, &mut |tp| out.epoch(tp))?;
-    Ok(())
-}
-
 /// Publishes the learned parameters when learning, every `learned_every_s`
-/// of stream time (and at the end with `last`).
+/// of stream time (and at the end with `at_end`).
 fn learned(
     online: &Online,
     out: &Output,
