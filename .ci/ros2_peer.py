@@ -186,6 +186,27 @@ def navsatfix(m):
     )
 
 
+@dataclass
+class KeyValue(IdlStruct, typename="diagnostic_msgs::msg::dds_::KeyValue_"):
+    key: str
+    value: str
+
+
+@dataclass
+class DiagnosticStatus(IdlStruct, typename="diagnostic_msgs::msg::dds_::DiagnosticStatus_"):
+    level: t.uint8
+    name: str
+    message: str
+    hardware_id: str
+    values: t.sequence[KeyValue]
+
+
+@dataclass
+class DiagnosticArray(IdlStruct, typename="diagnostic_msgs::msg::dds_::DiagnosticArray_"):
+    header: Header
+    status: t.sequence[DiagnosticStatus]
+
+
 # The bag's message types, as ROS 2 types and converters.
 CONVERT = {
     "nav_msgs/msg/Odometry": (Odometry, odometry),
@@ -211,6 +232,7 @@ def main():
     ap.add_argument("--signal-after", type=float, help="send the node SIGTERM after this many seconds of bag")
     ap.add_argument("--out", required=True, type=Path, help="JSON lines of what was received")
     ap.add_argument("--node-log", required=True, type=Path)
+    ap.add_argument("--diagnostics-out", type=Path, help="JSON lines of the /diagnostics received")
     ap.add_argument("node", nargs=argparse.REMAINDER, help="-- the node's command")
     a = ap.parse_args()
     node_cmd = a.node[1:] if a.node[:1] == ["--"] else a.node
@@ -226,6 +248,8 @@ def main():
     received = []
     odom_topic = Topic(dp, "rt/deadreckon/odom", Odometry)
     reader = DataReader(dp, odom_topic, qos=qos)
+    diagnostics = []
+    diag_reader = DataReader(dp, Topic(dp, "rt/diagnostics", DiagnosticArray), qos=qos)
 
     with AnyReader([a.bag], default_typestore=get_typestore(Stores.ROS1_NOETIC)) as bag:
         conns = [c for c in bag.connections if c.topic in topics]
@@ -264,6 +288,22 @@ def main():
                             "wz": m.twist.twist.angular.z,
                         }
                     )
+                for m in diag_reader.take(N=100):
+                    if isinstance(m, DiagnosticArray):
+                        diagnostics.append(
+                            {
+                                "sec": m.header.stamp.sec,
+                                "status": [
+                                    {
+                                        "level": st.level,
+                                        "name": st.name,
+                                        "message": st.message,
+                                        "values": {kv.key: kv.value for kv in st.values},
+                                    }
+                                    for st in m.status
+                                ],
+                            }
+                        )
                 if last:
                     return
                 time.sleep(0.01)
@@ -303,7 +343,11 @@ def main():
     with open(a.out, "w") as f:
         for r in received:
             f.write(json.dumps(r) + "\n")
-    print(f"ros2_peer: received {len(received)} odometry messages; the node exited with {status}", flush=True)
+    if a.diagnostics_out:
+        with open(a.diagnostics_out, "w") as f:
+            for r in diagnostics:
+                f.write(json.dumps(r) + "\n")
+    print(f"ros2_peer: received {len(received)} odometry messages, {len(diagnostics)} diagnostics; the node exited with {status}", flush=True)
     sys.exit(status)
 
 
