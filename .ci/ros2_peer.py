@@ -249,7 +249,9 @@ def main():
     odom_topic = Topic(dp, "rt/deadreckon/odom", Odometry)
     reader = DataReader(dp, odom_topic, qos=qos)
     diagnostics = []
-    diag_reader = DataReader(dp, Topic(dp, "rt/diagnostics", DiagnosticArray), qos=qos)
+    diag_reader = None
+    if a.diagnostics_out:
+        diag_reader = DataReader(dp, Topic(dp, "rt/diagnostics", DiagnosticArray), qos=qos)
 
     with AnyReader([a.bag], default_typestore=get_typestore(Stores.ROS1_NOETIC)) as bag:
         conns = [c for c in bag.connections if c.topic in topics]
@@ -288,7 +290,7 @@ def main():
                             "wz": m.twist.twist.angular.z,
                         }
                     )
-                for m in diag_reader.take(N=100):
+                for m in diag_reader.take(N=100) if diag_reader else []:
                     if isinstance(m, DiagnosticArray):
                         diagnostics.append(
                             {
