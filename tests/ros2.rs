@@ -213,8 +213,8 @@ fn the_node_fed_by_cyclone_dds_publishes_what_stream_prints() {
         got.len()
     );
     // Measured (2026-11-26, this machine, husky_gps.bag at 5×): 3950 of 3950
-    // epochs on a quiet machine (twice); 3915 and 3917 at a load average of 12
-    // on its 2 cores, the node having published all 3950 (a run of 33 epochs
+    // epochs in the first three runs; 3915 to 3917 in the five after them, at
+    // a load average of 6 to 12 on its 2 cores, the node having published all 3950 (a run of 33 epochs
     // just after the filter's start and 2 single ones lost between RustDDS
     // and Cyclone despite the reliable QoS). Every value received equal to
     // the last bit.
