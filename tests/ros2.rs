@@ -213,11 +213,11 @@ fn the_node_fed_by_cyclone_dds_publishes_what_stream_prints() {
         got.len()
     );
     // Measured (2026-11-26, this machine, husky_gps.bag at 5×): 3950 of 3950
-    // epochs in the first three runs; 3915 to 3917 in the five after them, at
-    // a load average of 6 to 12 on its 2 cores, the node having published all 3950 (a run of 33 epochs
-    // just after the filter's start and 2 single ones lost between RustDDS
-    // and Cyclone despite the reliable QoS). Every value received equal to
-    // the last bit.
+    // epochs in 4 runs, 3915 to 3917 in 6 (the node published all 3950 each
+    // time; the same run of 33 epochs after the filter's start was lost
+    // between RustDDS and Cyclone, and 0 to 2 single ones, despite the
+    // reliable QoS; cause not found, docs/ros2.md). Every value received
+    // equal to the last bit.
     assert!(fraction >= 0.99, "{matched} of {} epochs", expected.len());
     assert!(max_pos_m <= 1e-6, "positions differ by {max_pos_m} m");
     assert!(
@@ -262,6 +262,8 @@ fn sigterm_stops_the_node_cleanly_late_messages_are_counted_and_learned_paramete
             diagnostics.to_str().unwrap(),
         ],
         &[
+            "--until-idle",
+            "3",
             "--reorder-window",
             "0",
             "--state",
