@@ -28,6 +28,14 @@ pub struct OnlineStartArgs {
 }
 
 impl OnlineStartArgs {
+    /// The filter's options: the timing, the rest default.
+    pub fn filter(&self) -> deadreckon_core::ekf::FilterOptions {
+        deadreckon_core::ekf::FilterOptions {
+            timing: self.timing.into(),
+            ..Default::default()
+        }
+    }
+
     /// The files read, which no output may be.
     pub fn inputs(&self) -> [&std::path::Path; 2] {
         [self.vehicle.as_path(), std::path::Path::new(&self.params)]

@@ -5,7 +5,6 @@ use std::sync::atomic::AtomicBool;
 
 use anyhow::Result;
 use deadreckon_api::stream::{self, StreamOptions};
-use deadreckon_core::ekf::FilterOptions;
 use deadreckon_ros2::NodeOptions;
 
 use super::common;
@@ -19,10 +18,7 @@ pub fn run(a: Ros2Args, load: &common::Loader, stop: &AtomicBool) -> Result<()> 
     }
     let mut mapping = deadreckon_api::source::live_mapping(load.mapping.as_deref())?;
     let o = StreamOptions {
-        filter: FilterOptions {
-            timing: a.start.timing.into(),
-            ..Default::default()
-        },
+        filter: a.start.filter(),
         state: a.state.clone(),
         learn: a.learn,
         params_out: None,

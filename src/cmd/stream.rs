@@ -4,7 +4,6 @@
 
 use anyhow::Result;
 use deadreckon_api::stream::{self, StreamOptions};
-use deadreckon_core::ekf::FilterOptions;
 
 use super::common;
 use crate::args::stream::{OnBadLine, StreamArgs};
@@ -18,10 +17,7 @@ pub fn run(a: StreamArgs) -> Result<()> {
         common::check_output(out, &inputs)?;
     }
     let o = StreamOptions {
-        filter: FilterOptions {
-            timing: a.start.timing.into(),
-            ..Default::default()
-        },
+        filter: a.start.filter(),
         state: a.state.clone(),
         learn: a.learn,
         params_out: a.params_out.clone(),

@@ -148,6 +148,19 @@ mod tests {
     use super::*;
 
     #[test]
+    fn a_live_node_takes_a_builtin_mapping_by_name_and_the_husky_by_default() {
+        let husky = deadreckon_ros::Mapping::husky();
+        assert_eq!(live_mapping(None).unwrap(), husky);
+        assert_eq!(live_mapping(Some(Path::new("husky"))).unwrap(), husky);
+        let jackal = live_mapping(Some(Path::new("jackal"))).unwrap();
+        assert_eq!(jackal, deadreckon_ros::Mapping::jackal());
+        assert!(matches!(
+            live_mapping(Some(Path::new("no/such/mapping.toml"))),
+            Err(Error::MappingFile { .. })
+        ));
+    }
+
+    #[test]
     fn the_command_line_told_tricycle_logs_apart_by_itself() {
         let dir = tempfile::tempdir().unwrap();
         let d = dir.path();
