@@ -26,8 +26,8 @@ pub const HISTORY_DEPTH: usize = 1000;
 /// How long a reliable `publish` waits for room in a full send window.
 pub const WHEN_FULL_WAIT: Duration = Duration::from_millis(200);
 
-/// The quality of service of every topic: reliable, volatile, keep the last
-/// [`HISTORY_DEPTH`] samples.
+/// The quality of service of every subscription: reliable, volatile, keep
+/// the last [`HISTORY_DEPTH`] samples.
 pub fn qos() -> QosProfile {
     QosProfile::publisher_default()
         .reliability_reliable(WhenFull::Wait(WHEN_FULL_WAIT))
@@ -35,6 +35,16 @@ pub fn qos() -> QosProfile {
         .history(History::KeepLast {
             depth: HISTORY_DEPTH,
         })
+}
+
+/// The quality of service of the publishers: [`qos`], but transient local,
+/// so that a subscriber asking for it gets the last [`HISTORY_DEPTH`]
+/// samples from their start. A volatile subscriber (ROS 2's default) is
+/// unaffected. Against Cyclone DDS with a volatile reader, a run of about 33
+/// epochs just after the filter's start was lost in about one run in three
+/// (docs/ros2.md); with a transient-local reader, in none of 11.
+pub fn publisher_qos() -> QosProfile {
+    qos().durability(Durability::TransientLocal)
 }
 
 /// One mapped stream's subscription, typed by its kind.
@@ -149,7 +159,7 @@ fn publisher<M: Serialize>(
     let t = node
         .create_topic(&name(topic)?, ty, &qos())
         .map_err(dds(format!("creating topic {topic}")))?;
-    node.create_publisher::<M>(&t, None)
+    node.create_publisher::<M>(&t, Some(publisher_qos()))
         .map_err(dds(format!("publishing on {topic}")))
 }
 

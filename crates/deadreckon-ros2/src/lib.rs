@@ -20,7 +20,8 @@
 //!   with the filter's covariance, twist in the body frame:
 //!   [`deadreckon_ros::ros2_out::odometry_in`]); with learning, the learned
 //!   parameters as [`diagnostics`] on `/diagnostics`.
-//! - **QoS**: reliable, volatile, keep last [`dds::HISTORY_DEPTH`] each way.
+//! - **QoS**: reliable, keep last [`dds::HISTORY_DEPTH`] each way; the
+//!   subscriptions volatile, the publishers transient local ([`dds::publisher_qos`]).
 //! - **Latency**: from each message's receipt to the publication of the first
 //!   Odometry after it ([`Latency`]), median and 99th percentile in the
 //!   [`Summary`].
