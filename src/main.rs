@@ -4,6 +4,8 @@
 mod args;
 mod cmd;
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use clap::{Parser, Subcommand};
 
 /// Dead reckoning for cars and wheeled robots through GNSS outages.
@@ -52,18 +54,30 @@ enum Command {
     Events(args::events::EventsArgs),
     /// Run the four-wheel filter on JSON-line events from standard input, one JSON line per epoch out.
     Stream(args::stream::StreamArgs),
+    /// Run the online filter as a live ROS 2 node: mapped topics in, nav_msgs/Odometry out (docs/ros2.md).
+    Ros2(args::ros2::Ros2Args),
     /// Convert a log (comma2k19, ROS bag, MCAP, CAN + DBC, tricycle) into a drive directory.
     Import(args::import::ImportArgs),
     /// Calibrate many drives in parallel, one CSV row each, and each vehicle's calibration history.
     Batch(args::batch::BatchArgs),
 }
 
+/// Set by `ros2`: a signal asks it to stop ([`STOP`]) instead of ending the process.
+static GRACEFUL: AtomicBool = AtomicBool::new(false);
+/// Set by the first SIGINT/SIGTERM while [`GRACEFUL`]: the node stops cleanly.
+static STOP: AtomicBool = AtomicBool::new(false);
+
 fn main() {
     let cli = Cli::parse();
     // An interrupted command leaves no temporary file or directory behind:
     // the writes register them (deadreckon_io::temporaries). Exit status as
-    // a shell reports a SIGINT (128 + 2).
+    // a shell reports a SIGINT (128 + 2). A running ROS 2 node is asked to
+    // stop instead (it finishes the filter and writes its state); a second
+    // signal ends it at once.
     if let Err(e) = ctrlc::set_handler(|| {
+        if GRACEFUL.load(Ordering::SeqCst) && !STOP.swap(true, Ordering::SeqCst) {
+            return;
+        }
         deadreckon_io::temporaries::remove_all();
         eprintln!("interrupted");
         std::process::exit(130);
@@ -119,6 +133,10 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Calibrate(a) => cmd::calibrate::run(a, &load),
         Command::Events(a) => cmd::events::run(a, &load),
         Command::Stream(a) => cmd::stream::run(a),
+        Command::Ros2(a) => {
+            GRACEFUL.store(true, Ordering::SeqCst);
+            cmd::ros2::run(a, &load, &STOP)
+        }
         Command::Evaluate(a) => cmd::evaluate::run(a, &load),
         Command::Run(a) => cmd::run::run(a, &load),
         Command::Demo(a) => cmd::demo::run(a, cli.quiet, &load),

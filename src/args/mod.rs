@@ -11,6 +11,7 @@ pub mod events;
 pub mod import;
 pub mod kinematic;
 pub mod report;
+pub mod ros2;
 pub mod run;
 pub mod simulate;
 pub mod stream;

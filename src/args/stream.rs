@@ -13,9 +13,9 @@ pub enum OnBadLine {
     Skip,
 }
 
-/// Arguments of `stream`.
+/// What an online filter starts from (`stream`, `ros2`).
 #[derive(Args, Debug)]
-pub struct StreamArgs {
+pub struct OnlineStartArgs {
     /// The vehicle description (vehicle.toml).
     #[arg(long)]
     pub vehicle: PathBuf,
@@ -25,6 +25,29 @@ pub struct StreamArgs {
     /// Filter timing.
     #[arg(long, value_enum, default_value = "wheel")]
     pub timing: super::TimingArg,
+}
+
+impl OnlineStartArgs {
+    /// The filter's options: the timing, the rest default.
+    pub fn filter(&self) -> deadreckon_core::ekf::FilterOptions {
+        deadreckon_core::ekf::FilterOptions {
+            timing: self.timing.into(),
+            ..Default::default()
+        }
+    }
+
+    /// The files read, which no output may be.
+    pub fn inputs(&self) -> [&std::path::Path; 2] {
+        [self.vehicle.as_path(), std::path::Path::new(&self.params)]
+    }
+}
+
+/// Arguments of `stream`.
+#[derive(Args, Debug)]
+pub struct StreamArgs {
+    /// The vehicle, the parameters, the timing.
+    #[command(flatten)]
+    pub start: OnlineStartArgs,
     /// Resume from this state file if it exists, and write the state to it at the end.
     #[arg(long)]
     pub state: Option<PathBuf>,

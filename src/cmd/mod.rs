@@ -44,6 +44,7 @@ pub mod events;
 pub mod import;
 pub mod progress;
 pub mod report;
+pub mod ros2;
 pub mod run;
 pub mod simulate;
 pub mod stream;

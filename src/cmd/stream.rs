@@ -2,9 +2,8 @@
 //! standard input, one JSON line per filter epoch on standard output
 //! ([`deadreckon_api::stream`]).
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use deadreckon_api::stream::{self, StreamOptions};
-use deadreckon_core::ekf::FilterOptions;
 
 use super::common;
 use crate::args::stream::{OnBadLine, StreamArgs};
@@ -13,29 +12,23 @@ use crate::args::stream::{OnBadLine, StreamArgs};
 pub fn run(a: StreamArgs) -> Result<()> {
     // The learned parameters and the state file (read, then written) are
     // outputs: neither may be the vehicle or the parameters read.
-    let inputs = [a.vehicle.as_path(), std::path::Path::new(&a.params)];
+    let inputs = a.start.inputs();
     for out in a.params_out.iter().chain(a.state.iter()) {
         common::check_output(out, &inputs)?;
     }
-    let vehicle = deadreckon_io::read_vehicle(&a.vehicle)
-        .with_context(|| format!("reading {}", a.vehicle.display()))?;
-    let (params, prior, warning) = stream::start_params(&a.params, &vehicle)?;
-    if let Some(w) = warning {
-        // Live events cannot be re-timed or re-projected here: say so.
-        eprintln!("warning: {w}");
-    }
     let o = StreamOptions {
-        filter: FilterOptions {
-            timing: a.timing.into(),
-            ..Default::default()
-        },
+        filter: a.start.filter(),
         state: a.state.clone(),
         learn: a.learn,
         params_out: a.params_out.clone(),
         save_every_s: a.save_every_s,
         skip_bad_lines: a.on_bad_line == OnBadLine::Skip,
     };
-    let mut online = stream::open(&vehicle, &params, &prior, &o)?;
+    let (_, mut online, warning) = stream::start(&a.start.vehicle, &a.start.params, &o)?;
+    if let Some(w) = warning {
+        // Live events cannot be re-timed or re-projected here: say so.
+        eprintln!("warning: {w}");
+    }
     let s = stream::run(
         &mut online,
         std::io::stdin().lock(),

@@ -103,16 +103,7 @@ pub fn read_ros(
     mapping: Option<&Path>,
 ) -> Result<(Drive, deadreckon_ros::ImportReport), Error> {
     let mapping = match mapping {
-        Some(m) => {
-            let text = std::fs::read_to_string(m).map_err(|source| Error::MappingFile {
-                path: m.to_path_buf(),
-                source,
-            })?;
-            deadreckon_ros::Mapping::from_toml_str(&text).map_err(|source| Error::Mapping {
-                path: m.to_path_buf(),
-                source,
-            })?
-        }
+        Some(m) => mapping_file(m)?,
         None if path
             .file_name()
             .is_some_and(|n| n.to_string_lossy().contains("jackal")) =>
@@ -127,9 +118,47 @@ pub fn read_ros(
     })
 }
 
+/// Reads and validates a mapping file.
+pub fn mapping_file(m: &Path) -> Result<deadreckon_ros::Mapping, Error> {
+    let text = std::fs::read_to_string(m).map_err(|source| Error::MappingFile {
+        path: m.to_path_buf(),
+        source,
+    })?;
+    deadreckon_ros::Mapping::from_toml_str(&text).map_err(|source| Error::Mapping {
+        path: m.to_path_buf(),
+        source,
+    })
+}
+
+/// The mapping of a live node: a mapping file, the name of a built-in one
+/// (`husky`, `jackal`) when no such file exists, or by default the Husky's.
+pub fn live_mapping(spec: Option<&Path>) -> Result<deadreckon_ros::Mapping, Error> {
+    match spec {
+        None => Ok(deadreckon_ros::Mapping::husky()),
+        Some(p) if !p.exists() && p.as_os_str() == "husky" => Ok(deadreckon_ros::Mapping::husky()),
+        Some(p) if !p.exists() && p.as_os_str() == "jackal" => {
+            Ok(deadreckon_ros::Mapping::jackal())
+        }
+        Some(p) => mapping_file(p),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_live_node_takes_a_builtin_mapping_by_name_and_the_husky_by_default() {
+        let husky = deadreckon_ros::Mapping::husky();
+        assert_eq!(live_mapping(None).unwrap(), husky);
+        assert_eq!(live_mapping(Some(Path::new("husky"))).unwrap(), husky);
+        let jackal = live_mapping(Some(Path::new("jackal"))).unwrap();
+        assert_eq!(jackal, deadreckon_ros::Mapping::jackal());
+        assert!(matches!(
+            live_mapping(Some(Path::new("no/such/mapping.toml"))),
+            Err(Error::MappingFile { .. })
+        ));
+    }
 
     #[test]
     fn the_command_line_told_tricycle_logs_apart_by_itself() {

@@ -100,6 +100,22 @@ pub fn open(
     })
 }
 
+/// What a live filter starts from: the vehicle read from `vehicle`, the
+/// filter ([`open`]: resumed from `o.state`, else started with the
+/// parameters `params` names, [`start_params`]) and the warning of a
+/// params.toml with corrections live events cannot be given.
+pub fn start(
+    vehicle: &Path,
+    params: &str,
+    o: &StreamOptions,
+) -> Result<(Vehicle, Online, Option<String>), Error> {
+    let v =
+        deadreckon_io::read_vehicle(vehicle).doing(|| format!("reading {}", vehicle.display()))?;
+    let (p, prior, warning) = start_params(params, &v)?;
+    let online = open(&v, &p, &prior, o)?;
+    Ok((v, online, warning))
+}
+
 /// Runs the filter over the event lines of `input` (named `source` in
 /// errors), writing one JSON pose a line to `out`; saves the learned
 /// parameters as asked and the state at the end. A bad line skipped is
@@ -162,9 +178,7 @@ pub fn run(
     let learned = online.learned(&targets);
     if write_error.is_none() {
         if let Some(path) = &o.state {
-            let text = serde_json::to_string(&*online).doing(|| "the filter's state".into())?;
-            deadreckon_io::atomic_write(path, |w| w.write_all(text.as_bytes()))
-                .doing(|| format!("writing state {}", path.display()))?;
+            save_state(path, online)?;
         }
         if let (Some(l), Some(path)) = (&learned, &o.params_out) {
             save_learned(path, l)?;
@@ -176,6 +190,14 @@ pub fn run(
         learned,
         write_error,
     })
+}
+
+/// Writes the filter's state to `path` (atomically), which [`open`] resumes
+/// from: `stream --state` and `ros2 --state` share the file.
+pub fn save_state(path: &Path, online: &Online) -> Result<(), Error> {
+    let text = serde_json::to_string(online).doing(|| "the filter's state".into())?;
+    deadreckon_io::atomic_write(path, |w| w.write_all(text.as_bytes()))
+        .doing(|| format!("writing state {}", path.display()))
 }
 
 /// Writes learned parameters as a params.toml (method `online`, whether

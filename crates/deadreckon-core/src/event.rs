@@ -5,7 +5,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::drive::{Drive, GnssFix, Wheels};
+use crate::drive::{Drive, GnssFix, WheelSpeeds, Wheels};
 
 /// One measurement, as a drive or a live stream delivers it. The serde form is
 /// the JSON-lines event schema of `deadreckon events` (see `docs/events.md`):
@@ -65,6 +65,31 @@ pub enum Measurement {
         #[serde(default, skip_serializing_if = "Option::is_none")]
         speed_mps: Option<f64>,
     },
+}
+
+impl Measurement {
+    /// The measurement of a wheel-speed row (its time left out).
+    #[inline(always)]
+    pub fn wheel_speeds(w: &WheelSpeeds) -> Self {
+        Measurement::WheelSpeeds {
+            fl_mps: w.fl_mps,
+            fr_mps: w.fr_mps,
+            rl_mps: w.rl_mps,
+            rr_mps: w.rr_mps,
+        }
+    }
+
+    /// The measurement of a GNSS fix (its time left out).
+    #[inline(always)]
+    pub fn gnss(g: &GnssFix) -> Self {
+        Measurement::Gnss {
+            east_m: g.east_m,
+            north_m: g.north_m,
+            std_m: g.std_m,
+            course_deg: g.course_deg,
+            speed_mps: g.speed_mps,
+        }
+    }
 }
 
 /// A measurement with its timestamp.
@@ -205,12 +230,7 @@ impl Iterator for DriveEvents<'_> {
                     rl: v[i].rl,
                     rr: v[i].rr,
                 },
-                Wheels::Speeds(v) => Measurement::WheelSpeeds {
-                    fl_mps: v[i].fl_mps,
-                    fr_mps: v[i].fr_mps,
-                    rl_mps: v[i].rl_mps,
-                    rr_mps: v[i].rr_mps,
-                },
+                Wheels::Speeds(v) => Measurement::wheel_speeds(&v[i]),
             },
             1 => Measurement::YawRate {
                 yaw_rate_rps: d.yaw_rate[i].value,
@@ -221,16 +241,7 @@ impl Iterator for DriveEvents<'_> {
             3 => Measurement::Steering {
                 steering_wheel_rad: d.steering[i].value,
             },
-            _ => {
-                let g = d.gnss[i];
-                Measurement::Gnss {
-                    east_m: g.east_m,
-                    north_m: g.north_m,
-                    std_m: g.std_m,
-                    course_deg: g.course_deg,
-                    speed_mps: g.speed_mps,
-                }
-            }
+            _ => Measurement::gnss(&d.gnss[i]),
         };
         Some(Event { t_s, measurement })
     }

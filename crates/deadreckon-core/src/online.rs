@@ -278,6 +278,15 @@ impl Online {
         }
     }
 
+    /// The filter's time, s (`None` before the start).
+    pub fn time_s(&self) -> Option<f64> {
+        match &self.stage {
+            Stage::Waiting { .. } => None,
+            Stage::Car { filter, .. } => Some(filter.time_s()),
+            Stage::Learning { filter, .. } => Some(filter.time_s()),
+        }
+    }
+
     /// Counters so far (`None` before the start).
     pub fn stats(&self) -> Option<FilterStats> {
         match &self.stage {

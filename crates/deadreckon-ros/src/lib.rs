@@ -46,6 +46,7 @@
 
 mod bag;
 mod compress;
+pub mod convert;
 mod error;
 pub mod foxglove;
 mod ingest;
@@ -60,6 +61,7 @@ use std::path::Path;
 
 use serde::Serialize;
 
+pub use convert::{Converter, Message, Sample};
 pub use deadreckon_core::{Drive, Track};
 pub use error::{Location, RosError};
 pub use foxglove::{write_mcap, write_mcap_with, write_tracks_mcap, McapOptions};

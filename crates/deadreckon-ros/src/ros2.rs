@@ -11,7 +11,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::msgs::{Decoded, MsgType, Stamp};
+use crate::msgs::{Decoded, MsgType};
 
 /// `builtin_interfaces/msg/Time`.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
@@ -216,60 +216,16 @@ pub fn decode_cdr<T: serde::de::DeserializeOwned>(data: &[u8]) -> Result<T, Stri
     Ok(msg)
 }
 
-fn stamp(h: &Header) -> Stamp {
-    Stamp {
-        sec: i64::from(h.stamp.sec),
-        nsec: h.stamp.nanosec,
-    }
-}
-
-/// Decodes a CDR message of type `t` into the importer's form.
+/// Decodes a CDR message of type `t` into the importer's form, through the
+/// conversion the live node uses ([`crate::convert::Message`]).
 pub(crate) fn decode(t: MsgType, data: &[u8]) -> Result<Decoded, String> {
-    Ok(match t {
-        MsgType::Odometry => {
-            let m: Odometry = decode_cdr(data)?;
-            Decoded::Odometry {
-                stamp: stamp(&m.header),
-                v_mps: m.twist.twist.linear.x,
-                w_rps: m.twist.twist.angular.z,
-            }
-        }
-        MsgType::Imu => {
-            let m: Imu = decode_cdr(data)?;
-            let g = m.angular_velocity;
-            Decoded::Imu {
-                stamp: stamp(&m.header),
-                gyro: [g.x, g.y, g.z],
-            }
-        }
-        MsgType::NavSatFix => {
-            let m: NavSatFix = decode_cdr(data)?;
-            Decoded::NavSatFix {
-                stamp: stamp(&m.header),
-                status: m.status.status,
-                lat_deg: m.latitude,
-                lon_deg: m.longitude,
-                alt_m: m.altitude,
-                cov: m.position_covariance,
-                cov_type: m.position_covariance_type,
-            }
-        }
-        MsgType::TwistStamped => {
-            let m: TwistStamped = decode_cdr(data)?;
-            Decoded::Twist {
-                stamp: stamp(&m.header),
-                v_mps: m.twist.linear.x,
-                w_rps: m.twist.angular.z,
-            }
-        }
-        MsgType::PoseStamped => {
-            let m: PoseStamped = decode_cdr(data)?;
-            let (p, q) = (m.pose.position, m.pose.orientation);
-            Decoded::Pose {
-                stamp: stamp(&m.header),
-                position: [p.x, p.y, p.z],
-                orientation: [q.x, q.y, q.z, q.w],
-            }
-        }
-    })
+    use crate::convert::Message;
+    let m = match t {
+        MsgType::Odometry => Message::from(&decode_cdr::<Odometry>(data)?),
+        MsgType::Imu => Message::from(&decode_cdr::<Imu>(data)?),
+        MsgType::NavSatFix => Message::from(&decode_cdr::<NavSatFix>(data)?),
+        MsgType::TwistStamped => Message::from(&decode_cdr::<TwistStamped>(data)?),
+        MsgType::PoseStamped => Message::from(&decode_cdr::<PoseStamped>(data)?),
+    };
+    Ok(m.0)
 }

@@ -93,6 +93,11 @@ pub fn stamp(t_s: f64) -> Option<Time> {
 /// The Odometry message of one track pose (see the module doc), or `None`
 /// when its time has no ROS 2 stamp.
 pub fn odometry(p: &TrackPoint) -> Option<Odometry> {
+    odometry_in(p, crate::foxglove::FRAME_ID)
+}
+
+/// [`odometry`] with the pose in frame `frame_id` (the live node's `odom`).
+pub fn odometry_in(p: &TrackPoint, frame_id: &str) -> Option<Odometry> {
     let half = 0.5 * p.yaw_rad;
     // 6 × 6 over (x, y, z, roll, pitch, yaw); the track's 3 × 3 is over (x, y, yaw).
     let mut cov = [[0.0; 6]; 6];
@@ -105,7 +110,7 @@ pub fn odometry(p: &TrackPoint) -> Option<Odometry> {
     Some(Odometry {
         header: Header {
             stamp: stamp(p.t_s)?,
-            frame_id: crate::foxglove::FRAME_ID.into(),
+            frame_id: frame_id.into(),
         },
         child_frame_id: CHILD_FRAME_ID.into(),
         pose: PoseWithCovariance {
