@@ -1,0 +1,110 @@
+//! The handle behind `DrFilter*`: the [`Online`] filter of `deadreckon
+//! stream`, the poses it emitted and not yet taken, and the boundary's
+//! checks (time order, values, a call interrupted by a panic).
+
+use std::collections::VecDeque;
+use std::ffi::CString;
+
+use deadreckon_core::ekf::Event;
+use deadreckon_core::online::Online;
+use deadreckon_core::track::TrackPoint;
+
+use crate::status::{DrStatus, Fail};
+
+/// A filter (opaque to C): create it with `dr_filter_new` (or
+/// `dr_filter_new_from_files`, `dr_filter_restore`), free it with
+/// `dr_filter_free`. Use a handle from one thread at a time.
+pub struct DrFilter {
+    pub(crate) online: Online,
+    /// Poses emitted and not yet taken by `dr_next_pose`, oldest first.
+    pub(crate) poses: VecDeque<TrackPoint>,
+    /// The newest pose emitted.
+    pub(crate) latest: Option<TrackPoint>,
+    /// The time of the newest event taken (unknown after a restore).
+    last_t_s: Option<f64>,
+    /// Lines given to `dr_push_line`, for the line number in its errors.
+    pub(crate) lines: u64,
+    /// The warning of the params.toml (corrections `stream` does not apply).
+    pub(crate) warning: Option<CString>,
+    /// True while a call runs: still true at the next call only if a panic
+    /// left the previous one half done.
+    in_call: bool,
+}
+
+impl DrFilter {
+    pub(crate) fn new(online: Online, warning: Option<String>) -> Self {
+        DrFilter {
+            online,
+            poses: VecDeque::new(),
+            latest: None,
+            last_t_s: None,
+            lines: 0,
+            warning: warning.map(|w| CString::new(w.replace('\0', "")).unwrap_or_default()),
+            in_call: false,
+        }
+    }
+
+    /// Takes one event: the time order checked here (also after the start,
+    /// where the filter drops readings it does not use), then the filter.
+    pub(crate) fn push(&mut self, ev: Event) -> Result<(), Fail> {
+        if let Some(last) = self.last_t_s {
+            if ev.t_s < last {
+                return Err(Fail::new(
+                    DrStatus::TimeBackwards,
+                    format!(
+                        "event at t={} s comes after one at t={last} s: events must be in time order",
+                        ev.t_s
+                    ),
+                ));
+            }
+        }
+        let (poses, latest) = (&mut self.poses, &mut self.latest);
+        self.online
+            .push(ev, &mut |p| {
+                *latest = Some(p);
+                poses.push_back(p);
+            })
+            .map_err(|e| filter_fail(&e))?;
+        self.last_t_s = Some(ev.t_s);
+        Ok(())
+    }
+
+    /// Runs what waits at the end of a stream.
+    pub(crate) fn finish(&mut self) -> Result<(), Fail> {
+        let (poses, latest) = (&mut self.poses, &mut self.latest);
+        self.online
+            .finish(&mut |p| {
+                *latest = Some(p);
+                poses.push_back(p);
+            })
+            .map_err(|e| filter_fail(&e))
+    }
+}
+
+/// The filter's error as a failure, with its whole chain of causes.
+pub(crate) fn filter_fail(e: &(dyn std::error::Error + 'static)) -> Fail {
+    Fail::new(DrStatus::Filter, deadreckon_api::chain_text(e))
+}
+
+/// Runs `body` on the handle `h`: a null handle and a handle a panic
+/// interrupted are errors.
+///
+/// # Safety
+/// `h` is null or a live handle of this library used by no other thread.
+pub(crate) unsafe fn with_filter(
+    h: *mut DrFilter,
+    body: impl FnOnce(&mut DrFilter) -> Result<DrStatus, Fail>,
+) -> Result<DrStatus, Fail> {
+    // SAFETY: the caller's contract.
+    let f = unsafe { h.as_mut() }.ok_or_else(|| Fail::null("the filter handle"))?;
+    if f.in_call {
+        return Err(Fail::new(
+            DrStatus::Panic,
+            "an earlier call on this filter was interrupted by an internal error: free it",
+        ));
+    }
+    f.in_call = true;
+    let result = body(f);
+    f.in_call = false;
+    result
+}

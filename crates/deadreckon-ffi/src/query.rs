@@ -1,0 +1,140 @@
+//! Results out: the poses, the learned parameters, the gate counts; the end
+//! of a stream.
+
+use crate::handle::{with_filter, DrFilter};
+use crate::status::{guard, DrStatus, Fail};
+use crate::types::{DrGateCounts, DrLearned, DrPose};
+use deadreckon_core::online::LearnTargets;
+
+/// Writes `value` to `out` (null: an error naming `what`).
+///
+/// # Safety
+/// `out` is null or writable.
+unsafe fn write<T>(out: *mut T, what: &str, value: T) -> Result<DrStatus, Fail> {
+    // SAFETY: the caller's contract.
+    *unsafe { out.as_mut() }.ok_or_else(|| Fail::null(what))? = value;
+    Ok(DrStatus::Ok)
+}
+
+/// Takes the oldest pose not yet taken into `*out`: `DR_STATUS_OK`, or
+/// `DR_STATUS_NO_POSE` (not an error) when none is waiting. Each filter
+/// epoch gives one pose, as `deadreckon stream` prints one line:
+/// `while (dr_next_pose(f, &p) == DR_STATUS_OK) { … }` after each push.
+///
+/// # Safety
+/// `filter` is null or a live handle used by this thread only; `out` is
+/// null or writable.
+#[no_mangle]
+pub unsafe extern "C" fn dr_next_pose(filter: *mut DrFilter, out: *mut DrPose) -> DrStatus {
+    // SAFETY: the caller's contract, passed on.
+    guard(|| unsafe {
+        with_filter(filter, |f| {
+            if out.is_null() {
+                return Err(Fail::null("out"));
+            }
+            match f.poses.pop_front() {
+                Some(p) => write(out, "out", p.into()),
+                None => Ok(DrStatus::NoPose),
+            }
+        })
+    })
+}
+
+/// The newest pose (taken or not) into `*out`; `DR_STATUS_NOT_AVAILABLE`
+/// before the first epoch.
+///
+/// # Safety
+/// As `dr_next_pose`.
+#[no_mangle]
+pub unsafe extern "C" fn dr_latest_pose(filter: *const DrFilter, out: *mut DrPose) -> DrStatus {
+    // SAFETY: the caller's contract, passed on; the handle is only read.
+    guard(|| unsafe {
+        with_filter(filter.cast_mut(), |f| match f.latest {
+            Some(p) => write(out, "out", p.into()),
+            None => Err(Fail::new(
+                DrStatus::NotAvailable,
+                "no pose yet: the filter has run no epoch",
+            )),
+        })
+    })
+}
+
+/// Whether the filter has started (from GNSS: the first fix and the
+/// direction of the first 10 m), into `*out`.
+///
+/// # Safety
+/// As `dr_next_pose`.
+#[no_mangle]
+pub unsafe extern "C" fn dr_is_started(filter: *const DrFilter, out: *mut bool) -> DrStatus {
+    // SAFETY: the caller's contract, passed on.
+    guard(|| unsafe {
+        with_filter(filter.cast_mut(), |f| {
+            write(out, "out", f.online.is_started())
+        })
+    })
+}
+
+/// The parameters learned so far with their standard errors into `*out`;
+/// `DR_STATUS_NOT_AVAILABLE` unless the filter learns (`DrOptions::learn`)
+/// and has started.
+///
+/// # Safety
+/// As `dr_next_pose`.
+#[no_mangle]
+pub unsafe extern "C" fn dr_learned(filter: *const DrFilter, out: *mut DrLearned) -> DrStatus {
+    // SAFETY: the caller's contract, passed on.
+    guard(|| unsafe {
+        with_filter(filter.cast_mut(), |f| {
+            match f.online.learned(&LearnTargets::default()) {
+                Some(l) => write(out, "out", l.into()),
+                None => Err(Fail::new(
+                    DrStatus::NotAvailable,
+                    if f.online.is_started() {
+                        "no learned parameters: the filter was not created to learn them"
+                    } else {
+                        "no learned parameters yet: the filter has not started"
+                    },
+                )),
+            }
+        })
+    })
+}
+
+/// The χ² gate's counts per sensor into `*out`; `DR_STATUS_NOT_AVAILABLE`
+/// before the start.
+///
+/// # Safety
+/// As `dr_next_pose`.
+#[no_mangle]
+pub unsafe extern "C" fn dr_gate_counts(
+    filter: *const DrFilter,
+    out: *mut DrGateCounts,
+) -> DrStatus {
+    // SAFETY: the caller's contract, passed on.
+    guard(|| unsafe {
+        with_filter(filter.cast_mut(), |f| match f.online.stats() {
+            Some(s) => write(out, "out", s.gates.into()),
+            None => Err(Fail::new(
+                DrStatus::NotAvailable,
+                "no gate counts yet: the filter has not started",
+            )),
+        })
+    })
+}
+
+/// Ends the stream: runs the epochs still waiting for later events (their
+/// poses are queued for `dr_next_pose`). A stream that never started (no
+/// GNSS start) is `DR_STATUS_FILTER`, saying why.
+///
+/// # Safety
+/// As `dr_next_pose`.
+#[no_mangle]
+pub unsafe extern "C" fn dr_finish(filter: *mut DrFilter) -> DrStatus {
+    // SAFETY: the caller's contract, passed on.
+    guard(|| unsafe {
+        with_filter(filter, |f| {
+            f.finish()?;
+            Ok(DrStatus::Ok)
+        })
+    })
+}
