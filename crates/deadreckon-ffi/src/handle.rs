@@ -108,3 +108,62 @@ pub(crate) unsafe fn with_filter(
     f.in_call = false;
     result
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::status::guard;
+    use deadreckon_core::ekf::FilterOptions;
+    use deadreckon_core::online::Start;
+    use deadreckon_core::Params;
+
+    #[test]
+    fn a_handle_a_panic_interrupted_refuses_every_later_call() {
+        let sc = deadreckon_sim::Scenario::builtin("evaluation")
+            .unwrap()
+            .with_duration_s(5.0);
+        let v = deadreckon_sim::simulate(&sc, 1).unwrap().drive.vehicle;
+        let online = Online::new(
+            &v,
+            &Params::nominal(&v),
+            &FilterOptions::default(),
+            Start::Gnss,
+        )
+        .unwrap();
+        let h = Box::into_raw(Box::new(DrFilter::new(online, None)));
+        // SAFETY: a live handle of this thread.
+        let s = guard(|| unsafe { with_filter(h, |_| panic!("half way through an update")) });
+        assert_eq!(s, DrStatus::Panic);
+        // SAFETY: as above.
+        let s = guard(|| unsafe { with_filter(h, |_| Ok(DrStatus::Ok)) });
+        assert_eq!(s, DrStatus::Panic);
+        // SAFETY: the handle from Box::into_raw, freed once.
+        drop(unsafe { Box::from_raw(h) });
+    }
+
+    #[test]
+    fn a_failed_call_leaves_the_handle_usable() {
+        let sc = deadreckon_sim::Scenario::builtin("evaluation")
+            .unwrap()
+            .with_duration_s(5.0);
+        let v = deadreckon_sim::simulate(&sc, 1).unwrap().drive.vehicle;
+        let online = Online::new(
+            &v,
+            &Params::nominal(&v),
+            &FilterOptions::default(),
+            Start::Gnss,
+        )
+        .unwrap();
+        let h = Box::into_raw(Box::new(DrFilter::new(online, None)));
+        // SAFETY: a live handle of this thread.
+        let s = guard(|| unsafe {
+            with_filter(h, |_| Err(Fail::new(DrStatus::BadEvent, "a bad line")))
+        });
+        assert_eq!(s, DrStatus::BadEvent);
+        // SAFETY: as above.
+        let s = guard(|| unsafe { with_filter(h, |_| Ok(DrStatus::Ok)) });
+        assert_eq!(s, DrStatus::Ok);
+        // SAFETY: the handle from Box::into_raw, freed once.
+        drop(unsafe { Box::from_raw(h) });
+    }
+}
