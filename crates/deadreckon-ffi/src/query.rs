@@ -6,14 +6,13 @@ use crate::status::{guard, DrStatus, Fail};
 use crate::types::{DrGateCounts, DrLearned, DrPose};
 use deadreckon_core::online::LearnTargets;
 
-/// Writes `value` to `out` (null: an error naming `what`).
+/// The output `out` (null: an error), checked before anything is computed.
 ///
 /// # Safety
 /// `out` is null or writable.
-unsafe fn write<T>(out: *mut T, what: &str, value: T) -> Result<DrStatus, Fail> {
+unsafe fn output<'a, T>(out: *mut T) -> Result<&'a mut T, Fail> {
     // SAFETY: the caller's contract.
-    *unsafe { out.as_mut() }.ok_or_else(|| Fail::null(what))? = value;
-    Ok(DrStatus::Ok)
+    unsafe { out.as_mut() }.ok_or_else(|| Fail::null("out"))
 }
 
 /// Takes the oldest pose not yet taken into `*out`: `DR_STATUS_OK`, or
@@ -29,11 +28,12 @@ pub unsafe extern "C" fn dr_next_pose(filter: *mut DrFilter, out: *mut DrPose) -
     // SAFETY: the caller's contract, passed on.
     guard(|| unsafe {
         with_filter(filter, |f| {
-            if out.is_null() {
-                return Err(Fail::null("out"));
-            }
+            let out = output(out)?;
             match f.poses.pop_front() {
-                Some(p) => write(out, "out", p.into()),
+                Some(p) => {
+                    *out = p.into();
+                    Ok(DrStatus::Ok)
+                }
                 None => Ok(DrStatus::NoPose),
             }
         })
@@ -49,12 +49,18 @@ pub unsafe extern "C" fn dr_next_pose(filter: *mut DrFilter, out: *mut DrPose) -
 pub unsafe extern "C" fn dr_latest_pose(filter: *const DrFilter, out: *mut DrPose) -> DrStatus {
     // SAFETY: the caller's contract, passed on; the handle is only read.
     guard(|| unsafe {
-        with_filter(filter.cast_mut(), |f| match f.latest {
-            Some(p) => write(out, "out", p.into()),
-            None => Err(Fail::new(
-                DrStatus::NotAvailable,
-                "no pose yet: the filter has run no epoch",
-            )),
+        with_filter(filter.cast_mut(), |f| {
+            let out = output(out)?;
+            *out = f
+                .latest
+                .ok_or_else(|| {
+                    Fail::new(
+                        DrStatus::NotAvailable,
+                        "no pose yet: the filter has run no epoch",
+                    )
+                })?
+                .into();
+            Ok(DrStatus::Ok)
         })
     })
 }
@@ -69,7 +75,8 @@ pub unsafe extern "C" fn dr_is_started(filter: *const DrFilter, out: *mut bool) 
     // SAFETY: the caller's contract, passed on.
     guard(|| unsafe {
         with_filter(filter.cast_mut(), |f| {
-            write(out, "out", f.online.is_started())
+            *output(out)? = f.online.is_started();
+            Ok(DrStatus::Ok)
         })
     })
 }
@@ -85,17 +92,19 @@ pub unsafe extern "C" fn dr_learned(filter: *const DrFilter, out: *mut DrLearned
     // SAFETY: the caller's contract, passed on.
     guard(|| unsafe {
         with_filter(filter.cast_mut(), |f| {
-            match f.online.learned(&LearnTargets::default()) {
-                Some(l) => write(out, "out", l.into()),
-                None => Err(Fail::new(
+            let out = output(out)?;
+            let l = f.online.learned(&LearnTargets::default()).ok_or_else(|| {
+                Fail::new(
                     DrStatus::NotAvailable,
                     if f.online.is_started() {
                         "no learned parameters: the filter was not created to learn them"
                     } else {
                         "no learned parameters yet: the filter has not started"
                     },
-                )),
-            }
+                )
+            })?;
+            *out = l.into();
+            Ok(DrStatus::Ok)
         })
     })
 }
@@ -112,12 +121,16 @@ pub unsafe extern "C" fn dr_gate_counts(
 ) -> DrStatus {
     // SAFETY: the caller's contract, passed on.
     guard(|| unsafe {
-        with_filter(filter.cast_mut(), |f| match f.online.stats() {
-            Some(s) => write(out, "out", s.gates.into()),
-            None => Err(Fail::new(
-                DrStatus::NotAvailable,
-                "no gate counts yet: the filter has not started",
-            )),
+        with_filter(filter.cast_mut(), |f| {
+            let out = output(out)?;
+            let s = f.online.stats().ok_or_else(|| {
+                Fail::new(
+                    DrStatus::NotAvailable,
+                    "no gate counts yet: the filter has not started",
+                )
+            })?;
+            *out = s.gates.into();
+            Ok(DrStatus::Ok)
         })
     })
 }
