@@ -30,25 +30,27 @@ static void fail(const char *what, DrStatus status) {
     exit(1);
 }
 
-/* The number after "key": in a flat JSON object; false when absent. */
-static bool number(const char *line, const char *key, double *out) {
+/* Where the value of "key": starts in a flat JSON object, or NULL. */
+static const char *value_of(const char *line, const char *key) {
     char pattern[64];
     snprintf(pattern, sizeof pattern, "\"%s\":", key);
     const char *at = strstr(line, pattern);
-    if (at == NULL) return false;
+    return at == NULL ? NULL : at + strlen(pattern);
+}
+
+/* The number of "key"; false when absent or not a number. */
+static bool number(const char *line, const char *key, double *out) {
+    const char *at = value_of(line, key);
     char *end = NULL;
-    *out = strtod(at + strlen(pattern), &end);
-    return end != at + strlen(pattern);
+    if (at != NULL) *out = strtod(at, &end);
+    return at != NULL && end != at;
 }
 
 static bool integer(const char *line, const char *key, int64_t *out) {
-    char pattern[64];
-    snprintf(pattern, sizeof pattern, "\"%s\":", key);
-    const char *at = strstr(line, pattern);
-    if (at == NULL) return false;
+    const char *at = value_of(line, key);
     char *end = NULL;
-    *out = strtoll(at + strlen(pattern), &end, 10);
-    return end != at + strlen(pattern);
+    if (at != NULL) *out = strtoll(at, &end, 10);
+    return at != NULL && end != at;
 }
 
 static bool is_sensor(const char *line, const char *name) {

@@ -15,7 +15,9 @@ use crate::status::{DrStatus, Fail};
 /// `dr_filter_new_from_files`, `dr_filter_restore`), free it with
 /// `dr_filter_free`. Use a handle from one thread at a time.
 pub struct DrFilter {
-    pub(crate) online: Online,
+    /// Boxed: the boundary's own fields, read on every call, then share a
+    /// cache line or two instead of sitting behind the filter's kilobytes.
+    pub(crate) online: Box<Online>,
     /// Poses emitted and not yet taken by `dr_next_pose`, oldest first.
     pub(crate) poses: VecDeque<TrackPoint>,
     /// The newest pose emitted.
@@ -34,7 +36,7 @@ pub struct DrFilter {
 impl DrFilter {
     pub(crate) fn new(online: Online, warning: Option<String>) -> Self {
         DrFilter {
-            online,
+            online: Box::new(online),
             poses: VecDeque::new(),
             latest: None,
             last_t_s: None,
@@ -46,6 +48,7 @@ impl DrFilter {
 
     /// Takes one event: the time order checked here (also after the start,
     /// where the filter drops readings it does not use), then the filter.
+    #[inline(always)]
     pub(crate) fn push(&mut self, ev: Event) -> Result<(), Fail> {
         if let Some(last) = self.last_t_s {
             if ev.t_s < last {
@@ -67,6 +70,12 @@ impl DrFilter {
             .map_err(|e| filter_fail(&e))?;
         self.last_t_s = Some(ev.t_s);
         Ok(())
+    }
+
+    /// True when a panic interrupted a call on this handle.
+    #[inline]
+    pub(crate) fn in_call(&self) -> bool {
+        self.in_call
     }
 
     /// Runs what waits at the end of a stream.
@@ -91,6 +100,7 @@ pub(crate) fn filter_fail(e: &(dyn std::error::Error + 'static)) -> Fail {
 ///
 /// # Safety
 /// `h` is null or a live handle of this library used by no other thread.
+#[inline(always)]
 pub(crate) unsafe fn with_filter(
     h: *mut DrFilter,
     body: impl FnOnce(&mut DrFilter) -> Result<DrStatus, Fail>,
@@ -117,20 +127,20 @@ mod tests {
     use deadreckon_core::online::Start;
     use deadreckon_core::Params;
 
-    #[test]
-    fn a_handle_a_panic_interrupted_refuses_every_later_call() {
+    /// A handle on a simulated car's filter, for `Box::from_raw` at the end.
+    fn handle() -> *mut DrFilter {
         let sc = deadreckon_sim::Scenario::builtin("evaluation")
             .unwrap()
             .with_duration_s(5.0);
         let v = deadreckon_sim::simulate(&sc, 1).unwrap().drive.vehicle;
-        let online = Online::new(
-            &v,
-            &Params::nominal(&v),
-            &FilterOptions::default(),
-            Start::Gnss,
-        )
-        .unwrap();
-        let h = Box::into_raw(Box::new(DrFilter::new(online, None)));
+        let opts = FilterOptions::default();
+        let online = Online::new(&v, &Params::nominal(&v), &opts, Start::Gnss).unwrap();
+        Box::into_raw(Box::new(DrFilter::new(online, None)))
+    }
+
+    #[test]
+    fn a_handle_a_panic_interrupted_refuses_every_later_call() {
+        let h = handle();
         // SAFETY: a live handle of this thread.
         let s = guard(|| unsafe { with_filter(h, |_| panic!("half way through an update")) });
         assert_eq!(s, DrStatus::Panic);
@@ -143,18 +153,7 @@ mod tests {
 
     #[test]
     fn a_failed_call_leaves_the_handle_usable() {
-        let sc = deadreckon_sim::Scenario::builtin("evaluation")
-            .unwrap()
-            .with_duration_s(5.0);
-        let v = deadreckon_sim::simulate(&sc, 1).unwrap().drive.vehicle;
-        let online = Online::new(
-            &v,
-            &Params::nominal(&v),
-            &FilterOptions::default(),
-            Start::Gnss,
-        )
-        .unwrap();
-        let h = Box::into_raw(Box::new(DrFilter::new(online, None)));
+        let h = handle();
         // SAFETY: a live handle of this thread.
         let s = guard(|| unsafe {
             with_filter(h, |_| Err(Fail::new(DrStatus::BadEvent, "a bad line")))

@@ -8,7 +8,6 @@ use deadreckon_core::ekf::{Event, Measurement};
 use deadreckon_io::events;
 use deadreckon_io::IoError;
 
-use crate::create::text_arg;
 use crate::handle::{with_filter, DrFilter};
 use crate::status::{guard, DrStatus, Fail};
 
@@ -16,18 +15,23 @@ use crate::status::{guard, DrStatus, Fail};
 ///
 /// # Safety
 /// `filter` is null or a live handle used by this thread only.
+// Inlined into each typed function, where the value check folds to the
+// one sensor's values.
+#[inline(always)]
 unsafe fn push_event(
     filter: *mut DrFilter,
     what: &str,
     measurement: Measurement,
     t_s: f64,
 ) -> DrStatus {
-    guard(|| {
-        let ev = Event { t_s, measurement };
+    let ev = Event { t_s, measurement };
+    // Outside the guard (it cannot panic), where it folds to this sensor.
+    let finite = events::values_ok(&ev);
+    guard(move || {
         // SAFETY: the caller's contract.
         unsafe {
             with_filter(filter, |f| {
-                if !events::values_ok(&ev) {
+                if !finite {
                     return Err(Fail::new(
                         DrStatus::NotFinite,
                         format!("{what} at t={t_s} s: {}", events::NOT_FINITE),
@@ -179,7 +183,17 @@ pub unsafe extern "C" fn dr_push_line(
         with_filter(filter, |f| {
             f.lines += 1;
             let n = f.lines;
-            let text = text_arg(line, len, &format!("events: line {n}"), DrStatus::BadEvent)?;
+            if line.is_null() {
+                return Err(Fail::null("line"));
+            }
+            // The message is formatted only on failure: this runs per line.
+            let bytes = std::slice::from_raw_parts(line.cast::<u8>(), len);
+            let text = std::str::from_utf8(bytes).map_err(|e| {
+                Fail::new(
+                    DrStatus::BadEvent,
+                    format!("events: line {n} is not UTF-8: {e}"),
+                )
+            })?;
             if text.trim().is_empty() {
                 return Ok(DrStatus::Ok);
             }
@@ -199,4 +213,44 @@ pub unsafe extern "C" fn dr_push_line(
             Ok(DrStatus::Ok)
         })
     })
+}
+
+/// One [`Event`] through the typed C function of its sensor: for Rust
+/// callers of the C API (the crate's tests, the benchmark against the Rust
+/// loop). Not part of the C header.
+///
+/// # Safety
+/// `filter` is null or a live handle used by this thread only.
+pub unsafe fn push_typed(filter: *mut DrFilter, ev: &Event) -> DrStatus {
+    let t = ev.t_s;
+    // SAFETY: the caller's contract, passed on.
+    unsafe {
+        match ev.measurement {
+            Measurement::WheelTicks { fl, fr, rl, rr } => {
+                dr_push_wheel_ticks(filter, t, fl, fr, rl, rr)
+            }
+            Measurement::WheelSpeeds {
+                fl_mps,
+                fr_mps,
+                rl_mps,
+                rr_mps,
+            } => dr_push_wheel_speeds(filter, t, fl_mps, fr_mps, rl_mps, rr_mps),
+            Measurement::YawRate { yaw_rate_rps } => dr_push_yaw_rate(filter, t, yaw_rate_rps),
+            Measurement::Speed { speed_mps } => dr_push_speed(filter, t, speed_mps),
+            Measurement::Steering { steering_wheel_rad } => {
+                dr_push_steering(filter, t, steering_wheel_rad)
+            }
+            Measurement::Gnss {
+                east_m,
+                north_m,
+                std_m,
+                course_deg,
+                speed_mps,
+            } => {
+                let (c, v) = (course_deg.as_ref(), speed_mps.as_ref());
+                let ptr = |x: Option<&f64>| x.map_or(std::ptr::null(), |x| x as *const f64);
+                dr_push_gnss(filter, t, east_m, north_m, std_m, ptr(c), ptr(v))
+            }
+        }
+    }
 }

@@ -25,6 +25,25 @@ unsafe fn output<'a, T>(out: *mut T) -> Result<&'a mut T, Fail> {
 /// null or writable.
 #[no_mangle]
 pub unsafe extern "C" fn dr_next_pose(filter: *mut DrFilter, out: *mut DrPose) -> DrStatus {
+    // The common answer after a push, without the guard's work: nothing
+    // can panic here.
+    // SAFETY: the caller's contract.
+    if let Some(f) = unsafe { filter.as_ref() } {
+        if f.poses.is_empty() && !f.in_call() && !out.is_null() {
+            return DrStatus::NoPose;
+        }
+    }
+    // SAFETY: the caller's contract, passed on.
+    unsafe { next_pose(filter, out) }
+}
+
+/// `dr_next_pose` past its fast path (apart, so that the fast path has no
+/// frame to set up).
+///
+/// # Safety
+/// As `dr_next_pose`.
+#[inline(never)]
+unsafe fn next_pose(filter: *mut DrFilter, out: *mut DrPose) -> DrStatus {
     // SAFETY: the caller's contract, passed on.
     guard(|| unsafe {
         with_filter(filter, |f| {

@@ -44,21 +44,36 @@ pub enum DrStatus {
     Panic = 12,
 }
 
-/// A failed call: its status and message.
+/// A failed call: its status and message, boxed so that a call's
+/// `Result<DrStatus, Fail>` is two words, returned in registers on the hot
+/// path of every push.
 #[derive(Debug, Clone, PartialEq)]
-pub(crate) struct Fail {
+pub(crate) struct Fail(Box<Failure>);
+
+/// What [`Fail`] holds.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Failure {
     pub(crate) status: DrStatus,
     pub(crate) message: String,
 }
 
+impl std::ops::Deref for Fail {
+    type Target = Failure;
+    fn deref(&self) -> &Failure {
+        &self.0
+    }
+}
+
 impl Fail {
+    #[cold]
     pub(crate) fn new(status: DrStatus, message: impl Into<String>) -> Self {
-        Fail {
+        Fail(Box::new(Failure {
             status,
             message: message.into(),
-        }
+        }))
     }
 
+    #[cold]
     pub(crate) fn null(what: &str) -> Self {
         Fail::new(DrStatus::NullArgument, format!("{what} is null"))
     }
@@ -84,6 +99,7 @@ pub(crate) fn last_error_ptr() -> *const c_char {
 
 /// Runs `body`, turning its failure into a status and the last error, and a
 /// panic into `DrStatus::Panic` (with the panic's message).
+#[inline(always)]
 pub(crate) fn guard(body: impl FnOnce() -> Result<DrStatus, Fail>) -> DrStatus {
     match catch_unwind(AssertUnwindSafe(body)) {
         Ok(Ok(status)) => status,

@@ -15,7 +15,7 @@ fn started_filter() -> (*mut DrFilter, f64) {
     let evs = events(&d);
     let mut poses = Vec::new();
     for ev in &evs {
-        assert_eq!(push_typed(f, ev), DrStatus::Ok, "{}", last_error());
+        assert_eq!(push_event(f, ev), DrStatus::Ok, "{}", last_error());
         drain(f, &mut poses);
     }
     assert!(!poses.is_empty());
@@ -220,7 +220,7 @@ fn bad_configuration_and_state_are_refused_without_a_handle() {
     let d = drive(30.0);
     let v = vehicle_toml(&d);
     let new = |vehicle: &str, params: Option<&str>, o: DrOptions| {
-        let mut f = 1usize as *mut DrFilter;
+        let mut f = std::ptr::dangling_mut::<DrFilter>(); // must be overwritten
         let (pp, pl) = params.map_or((null(), 0), |p| (p.as_ptr().cast(), p.len()));
         // SAFETY: valid text and pointers.
         let s =

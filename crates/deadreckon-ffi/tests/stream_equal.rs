@@ -53,7 +53,7 @@ fn ffi_poses(f: *mut DrFilter, events: &[Event], lines: bool, finish: bool) -> V
         let s = if lines {
             push_line(f, &deadreckon_io::events::to_line(ev))
         } else {
-            push_typed(f, ev)
+            push_event(f, ev)
         };
         assert_eq!(s, DrStatus::Ok, "t={}: {}", ev.t_s, last_error());
         drain(f, &mut out);

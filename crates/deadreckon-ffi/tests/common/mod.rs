@@ -4,7 +4,7 @@
 
 use std::ffi::CStr;
 
-use deadreckon_core::ekf::{DriveEvents, Event, Measurement};
+use deadreckon_core::ekf::{DriveEvents, Event};
 use deadreckon_core::Drive;
 use deadreckon_ffi::*;
 
@@ -51,40 +51,9 @@ pub fn new_filter(vehicle_toml: &str, options: DrOptions) -> *mut DrFilter {
 }
 
 /// One event through the typed function of its sensor.
-pub fn push_typed(f: *mut DrFilter, ev: &Event) -> DrStatus {
-    let t = ev.t_s;
+pub fn push_event(f: *mut DrFilter, ev: &Event) -> DrStatus {
     // SAFETY: `f` is a live handle of this thread.
-    unsafe {
-        match ev.measurement {
-            Measurement::WheelTicks { fl, fr, rl, rr } => dr_push_wheel_ticks(f, t, fl, fr, rl, rr),
-            Measurement::WheelSpeeds {
-                fl_mps,
-                fr_mps,
-                rl_mps,
-                rr_mps,
-            } => dr_push_wheel_speeds(f, t, fl_mps, fr_mps, rl_mps, rr_mps),
-            Measurement::YawRate { yaw_rate_rps } => dr_push_yaw_rate(f, t, yaw_rate_rps),
-            Measurement::Speed { speed_mps } => dr_push_speed(f, t, speed_mps),
-            Measurement::Steering { steering_wheel_rad } => {
-                dr_push_steering(f, t, steering_wheel_rad)
-            }
-            Measurement::Gnss {
-                east_m,
-                north_m,
-                std_m,
-                course_deg,
-                speed_mps,
-            } => dr_push_gnss(
-                f,
-                t,
-                east_m,
-                north_m,
-                std_m,
-                course_deg.as_ref().map_or(std::ptr::null(), |c| c),
-                speed_mps.as_ref().map_or(std::ptr::null(), |s| s),
-            ),
-        }
-    }
+    unsafe { deadreckon_ffi::push_typed(f, ev) }
 }
 
 /// One event as a line of the event schema.
