@@ -49,7 +49,7 @@ impl DrFilter {
     /// Takes one event: the time order checked here (also after the start,
     /// where the filter drops readings it does not use), then the filter.
     #[inline(always)]
-    pub(crate) fn push(&mut self, ev: Event) -> Result<(), Fail> {
+    pub(crate) fn push(&mut self, ev: &Event) -> Result<(), Fail> {
         if let Some(last) = self.last_t_s {
             if ev.t_s < last {
                 return Err(Fail::new(
@@ -63,7 +63,7 @@ impl DrFilter {
         }
         let (poses, latest) = (&mut self.poses, &mut self.latest);
         self.online
-            .push(ev, &mut |p| {
+            .push(*ev, &mut |p| {
                 *latest = Some(p);
                 poses.push_back(p);
             })

@@ -40,7 +40,7 @@ unsafe fn push_event(
                         format!("{what} at t={t_s} s: {}", events::NOT_FINITE),
                     ));
                 }
-                f.push(*ev)
+                f.push(ev)
                     .map_err(|e| Fail::new(e.status, format!("{what}: {}", e.message)))?;
                 Ok(DrStatus::Ok)
             })
@@ -211,7 +211,7 @@ pub unsafe extern "C" fn dr_push_line(
                 };
                 Fail::new(status, e.to_string())
             })?;
-            f.push(ev)
+            f.push(&ev)
                 .map_err(|e| Fail::new(e.status, format!("events: line {n}: {}", e.message)))?;
             Ok(DrStatus::Ok)
         })
