@@ -213,10 +213,10 @@ impl Online {
                 }
                 if let Some(b) = buffer.last() {
                     if ev.t_s < b.t_s {
-                        return Err(Error::InvalidDrive(format!(
-                            "event at t={} s comes after one at t={} s: events must be in time order",
-                            ev.t_s, b.t_s
-                        )));
+                        return Err(Error::OutOfOrder {
+                            t_s: ev.t_s,
+                            previous_t_s: b.t_s,
+                        });
                     }
                 }
                 buffer.push(ev);

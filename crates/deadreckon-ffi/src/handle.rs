@@ -52,13 +52,10 @@ impl DrFilter {
     pub(crate) fn push(&mut self, ev: &Event) -> Result<(), Fail> {
         if let Some(last) = self.last_t_s {
             if ev.t_s < last {
-                return Err(Fail::new(
-                    DrStatus::TimeBackwards,
-                    format!(
-                        "event at t={} s comes after one at t={last} s: events must be in time order",
-                        ev.t_s
-                    ),
-                ));
+                return Err(filter_fail(&deadreckon_core::Error::OutOfOrder {
+                    t_s: ev.t_s,
+                    previous_t_s: last,
+                }));
             }
         }
         let (poses, latest) = (&mut self.poses, &mut self.latest);
@@ -90,9 +87,15 @@ impl DrFilter {
     }
 }
 
-/// The filter's error as a failure, with its whole chain of causes.
-pub(crate) fn filter_fail(e: &(dyn std::error::Error + 'static)) -> Fail {
-    Fail::new(DrStatus::Filter, deadreckon_api::chain_text(e))
+/// The filter's error as a failure, with its whole chain of causes; events
+/// out of time order are `DrStatus::TimeBackwards` (also when the filter
+/// finds them: after a restore the boundary does not know the last time).
+pub(crate) fn filter_fail(e: &deadreckon_core::Error) -> Fail {
+    let status = match e {
+        deadreckon_core::Error::OutOfOrder { .. } => DrStatus::TimeBackwards,
+        _ => DrStatus::Filter,
+    };
+    Fail::new(status, deadreckon_api::chain_text(e))
 }
 
 /// Runs `body` on the handle `h`: a null handle and a handle a panic

@@ -178,6 +178,12 @@ fn time_going_backwards_is_an_error_before_and_after_the_start() {
     );
     assert_eq!(save(f), before);
     free(f);
+    // Right after a restore the filter itself finds it.
+    let g = restore(&before);
+    // SAFETY: a live handle.
+    let s = unsafe { dr_push_yaw_rate(g, t - 1.0, 0.0) };
+    assert_eq!(s, DrStatus::TimeBackwards, "{}", last_error());
+    free(g);
 }
 
 #[test]

@@ -157,6 +157,8 @@ int main(int argc, char **argv) {
     DrFilter *g = NULL;
     EXPECT(dr_filter_restore(bytes, len, &g), DR_STATUS_OK, "restore");
     free(bytes);
+    EXPECT(dr_push_wheel_ticks(g, last_t - 1.0, 1, 1, 1, 1), DR_STATUS_TIME_BACKWARDS,
+           "back in time right after a restore");
     EXPECT(dr_finish(g), DR_STATUS_OK, "finish the restored filter");
     EXPECT(dr_filter_free(g), DR_STATUS_OK, "free the restored filter");
     EXPECT(dr_filter_free(f), DR_STATUS_OK, "free");
