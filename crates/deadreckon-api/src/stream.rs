@@ -34,9 +34,31 @@ pub fn start_params(
     }
     let p = crate::load::params_file(spec)?;
     let stored = crate::corrections::stored_in_file(Path::new(spec)).map_err(Error::Invalid)?;
-    let warning = (stored != Default::default()).then(|| {
+    Ok(started_from(spec, &p, &stored))
+}
+
+/// [`start_params`] on the text of a params.toml (the C API is handed text);
+/// `name` names it in errors and in the warning.
+pub fn start_params_from_text(
+    text: &str,
+    name: &str,
+) -> Result<(Params, Params, Option<String>), Error> {
+    let (p, extra) = deadreckon_io::parse_params_with_extra(text, Path::new(name))
+        .doing(|| format!("reading parameters {name}"))?;
+    let stored = crate::corrections::stored_corrections(&extra)
+        .map_err(|e| Error::Invalid(format!("parameters {name}: {e}")))?;
+    Ok(started_from(name, &p, &stored))
+}
+
+/// The starting parameters, the prior and the warning of a read params.toml.
+fn started_from(
+    name: &str,
+    p: &ParamsWithStd,
+    stored: &crate::corrections::Stored,
+) -> (Params, Params, Option<String>) {
+    let warning = (*stored != Default::default()).then(|| {
         format!(
-            "{spec} stores corrections that `stream` does not apply to the events (delays {:?} s, IMU vertical {:?}, gyro scale error {}, driven-axle slip {} per m/s²); its parameters were calibrated on corrected streams (calibrate --corrections none gives parameters for raw events)",
+            "{name} stores corrections that `stream` does not apply to the events (delays {:?} s, IMU vertical {:?}, gyro scale error {}, driven-axle slip {} per m/s²); its parameters were calibrated on corrected streams (calibrate --corrections none gives parameters for raw events)",
             stored.delays_s, stored.up, stored.gyro_scale_error, stored.traction_slip_per_mps2
         )
     });
@@ -45,7 +67,7 @@ pub fn start_params(
     let prior = Params::from_array(std::array::from_fn(
         |i| if s[i] > 0.0 { s[i] } else { d[i] },
     ));
-    Ok((p.params, prior, warning))
+    (p.params, prior, warning)
 }
 
 /// How a stream runs.
@@ -93,7 +115,7 @@ pub fn open(
         Some(path) => {
             let text = std::fs::read_to_string(path)
                 .doing(|| format!("reading state {}", path.display()))?;
-            serde_json::from_str::<Online>(&text).doing(|| format!("state {}", path.display()))?
+            state_from_text(&text, &path.display().to_string())?
         }
         None if o.learn => Online::learning(vehicle, params, prior, &o.filter, Start::Gnss)?,
         None => Online::new(vehicle, params, &o.filter, Start::Gnss)?,
@@ -195,9 +217,20 @@ pub fn run(
 /// Writes the filter's state to `path` (atomically), which [`open`] resumes
 /// from: `stream --state` and `ros2 --state` share the file.
 pub fn save_state(path: &Path, online: &Online) -> Result<(), Error> {
-    let text = serde_json::to_string(online).doing(|| "the filter's state".into())?;
+    let text = state_text(online)?;
     deadreckon_io::atomic_write(path, |w| w.write_all(text.as_bytes()))
         .doing(|| format!("writing state {}", path.display()))
+}
+
+/// The filter's whole state as the text `--state` writes (JSON): what the C
+/// API's `dr_save_state` returns as bytes.
+pub fn state_text(online: &Online) -> Result<String, Error> {
+    serde_json::to_string(online).doing(|| "the filter's state".into())
+}
+
+/// The filter from [`state_text`]'s text; `name` names it in errors.
+pub fn state_from_text(text: &str, name: &str) -> Result<Online, Error> {
+    serde_json::from_str::<Online>(text).doing(|| format!("state {name}"))
 }
 
 /// Writes learned parameters as a params.toml (method `online`, whether

@@ -494,10 +494,10 @@ impl Feeder {
         }
         if let Some(last) = self.batch.last() {
             if ev.t_s < last.t_s {
-                return Err(Error::InvalidDrive(format!(
-                    "event at t={} s comes after one at t={} s: events must be in time order",
-                    ev.t_s, last.t_s
-                )));
+                return Err(Error::OutOfOrder {
+                    t_s: ev.t_s,
+                    previous_t_s: last.t_s,
+                });
             }
             if ev.t_s > last.t_s {
                 self.process_batch(f, epoch)?;

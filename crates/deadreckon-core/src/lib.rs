@@ -70,6 +70,17 @@ pub enum Error {
     /// The drive breaks an invariant (unsorted time, non-finite value, too short).
     #[error("invalid drive: {0}")]
     InvalidDrive(String),
+    /// An event earlier than the one before it: a stream's events must be
+    /// in time order (equal times are fine).
+    #[error(
+        "invalid drive: event at t={t_s} s comes after one at t={previous_t_s} s: events must be in time order"
+    )]
+    OutOfOrder {
+        /// The event's time, s.
+        t_s: f64,
+        /// The time of the event before it, s.
+        previous_t_s: f64,
+    },
     /// The vehicle description is not usable.
     #[error("invalid vehicle: {0}")]
     InvalidVehicle(String),

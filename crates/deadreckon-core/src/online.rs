@@ -234,10 +234,10 @@ impl Online {
                 }
                 if let Some(b) = buffer.last() {
                     if ev.t_s < b.t_s {
-                        return Err(Error::InvalidDrive(format!(
-                            "event at t={} s comes after one at t={} s: events must be in time order",
-                            ev.t_s, b.t_s
-                        )));
+                        return Err(Error::OutOfOrder {
+                            t_s: ev.t_s,
+                            previous_t_s: b.t_s,
+                        });
                     }
                 }
                 buffer.push(ev);
@@ -283,6 +283,7 @@ impl Online {
         match &self.stage {
             Stage::Waiting { .. } => None,
             Stage::Car { filter, .. } => Some(filter.time_s()),
+            Stage::Walking { filter, .. } => Some(filter.time_s()),
             Stage::Learning { filter, .. } => Some(filter.time_s()),
         }
     }

@@ -26,8 +26,20 @@ pub fn parse_line(text: &str, source: &str, line: u64) -> Result<Event, IoError>
         msg,
     };
     let ev: Event = serde_json::from_str(text).map_err(|e| bad(e.column(), e.to_string()))?;
+    if !values_ok(&ev) {
+        return Err(bad(1, NOT_FINITE.into()));
+    }
+    Ok(ev)
+}
+
+/// What [`parse_line`] says of an event whose [`values_ok`] is false.
+pub const NOT_FINITE: &str = "a value is not finite (or std_m is not positive)";
+
+/// True when every value of `ev` is finite and a GNSS `std_m` is positive:
+/// the check of [`parse_line`], also made by the C API on its typed events.
+pub fn values_ok(ev: &Event) -> bool {
     let finite = |v: f64| v.is_finite();
-    let ok = finite(ev.t_s)
+    finite(ev.t_s)
         && match ev.measurement {
             Measurement::WheelTicks { .. } => true,
             Measurement::WheelSpeeds {
@@ -53,14 +65,7 @@ pub fn parse_line(text: &str, source: &str, line: u64) -> Result<Event, IoError>
                     && course_deg.is_none_or(finite)
                     && speed_mps.is_none_or(finite)
             }
-        };
-    if !ok {
-        return Err(bad(
-            1,
-            "a value is not finite (or std_m is not positive)".into(),
-        ));
-    }
-    Ok(ev)
+        }
 }
 
 /// One event as a JSON line (without the newline). Numbers are written with

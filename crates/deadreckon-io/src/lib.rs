@@ -59,8 +59,8 @@ pub use error::IoError;
 pub use kinematic_toml::{read_kinematic_params, write_kinematic_params, KinematicParamsFile};
 pub use read::{read_drive, read_drive_with, ReadOptions, WheelFile};
 pub use toml_files::{
-    read_params, read_params_with_extra, read_truth_params, read_vehicle, write_params,
-    write_truth_params, write_vehicle,
+    parse_params_with_extra, parse_vehicle, read_params, read_params_with_extra, read_truth_params,
+    read_vehicle, write_params, write_truth_params, write_vehicle,
 };
 pub use track_out::{
     write_track_csv, write_track_geojson, write_track_geojson_with, GeoJsonOptions,

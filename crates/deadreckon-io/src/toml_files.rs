@@ -35,8 +35,13 @@ fn invalid(path: &Path, source: deadreckon_core::Error) -> IoError {
 /// Reads `vehicle.toml` and checks it with [`Vehicle::validate`]. Unknown keys
 /// are errors (a misspelt noise key must not silently fall back to its default).
 pub fn read_vehicle(path: &Path) -> Result<Vehicle, IoError> {
-    let text = read_text(path)?;
-    let vehicle: Vehicle = toml::from_str(&text).map_err(|e| toml_error(path, e))?;
+    parse_vehicle(&read_text(path)?, path)
+}
+
+/// [`read_vehicle`] on the text of a `vehicle.toml` (embedders hand it over
+/// as text); `path` only names it in errors.
+pub fn parse_vehicle(text: &str, path: &Path) -> Result<Vehicle, IoError> {
+    let vehicle: Vehicle = toml::from_str(text).map_err(|e| toml_error(path, e))?;
     vehicle.validate().map_err(|e| invalid(path, e))?;
     Ok(vehicle)
 }
@@ -76,7 +81,15 @@ pub fn read_params(path: &Path) -> Result<ParamsWithStd, IoError> {
 
 /// Like [`read_params`], also returning every other top-level key and table.
 pub fn read_params_with_extra(path: &Path) -> Result<(ParamsWithStd, toml::Table), IoError> {
-    let text = read_text(path)?;
+    parse_params_with_extra(&read_text(path)?, path)
+}
+
+/// [`read_params_with_extra`] on the text of a `params.toml`; `path` only
+/// names it in errors.
+pub fn parse_params_with_extra(
+    text: &str,
+    path: &Path,
+) -> Result<(ParamsWithStd, toml::Table), IoError> {
     let mut table: toml::Table = text.parse().map_err(|e| toml_error(path, e))?;
     let params = take_params(path, &mut table, None)?;
     params.validate().map_err(|e| invalid(path, e))?;
