@@ -18,7 +18,7 @@ use crate::ekf::{Event, Feeder, FilterOptions, FilterStats, GnssInit};
 use crate::filter::{AugmentedFilter, CarFilter, Filter};
 use crate::gyro_drift::{CarBiasLayout, N_BIAS};
 use crate::model::{Mat, State};
-use crate::track::TrackPoint;
+use crate::track::{car_point, TrackPoint};
 use crate::vehicle::{Params, Vehicle};
 use crate::Error;
 
@@ -251,13 +251,13 @@ impl Online {
                 Ok(())
             }
             Stage::Car { filter, feeder } => feeder.push(filter.as_mut(), ev, &mut |f, _| {
-                out(point(f.time_s(), f.state(), f.covariance()))
+                out(car_point(f.time_s(), f.state(), f.covariance()))
             }),
             Stage::Walking { filter, feeder } => feeder.push(filter.as_mut(), ev, &mut |f, _| {
-                out(point(f.time_s(), f.state(), f.covariance()))
+                out(car_point(f.time_s(), f.state(), f.covariance()))
             }),
             Stage::Learning { filter, feeder } => feeder.push(filter.as_mut(), ev, &mut |f, _| {
-                out(point(f.time_s(), f.state(), f.covariance()))
+                out(car_point(f.time_s(), f.state(), f.covariance()))
             }),
         }
     }
@@ -267,13 +267,13 @@ impl Online {
         match &mut self.stage {
             Stage::Waiting { init, .. } => Err(init.why_not()),
             Stage::Car { filter, feeder } => feeder.finish(filter.as_mut(), &mut |f, _| {
-                out(point(f.time_s(), f.state(), f.covariance()))
+                out(car_point(f.time_s(), f.state(), f.covariance()))
             }),
             Stage::Walking { filter, feeder } => feeder.finish(filter.as_mut(), &mut |f, _| {
-                out(point(f.time_s(), f.state(), f.covariance()))
+                out(car_point(f.time_s(), f.state(), f.covariance()))
             }),
             Stage::Learning { filter, feeder } => feeder.finish(filter.as_mut(), &mut |f, _| {
-                out(point(f.time_s(), f.state(), f.covariance()))
+                out(car_point(f.time_s(), f.state(), f.covariance()))
             }),
         }
     }
@@ -309,12 +309,3 @@ impl Online {
     }
 }
 
-fn point<const N: usize>(
-    t_s: f64,
-    x: &nalgebra::SVector<f64, N>,
-    p: &nalgebra::SMatrix<f64, N, N>,
-) -> TrackPoint {
-    let car: State = x.fixed_rows::<5>(0).into_owned();
-    let pc: Mat = p.fixed_view::<5, 5>(0, 0).into_owned();
-    TrackPoint::from_state(t_s, &car, &pc)
-}

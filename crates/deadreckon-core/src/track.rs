@@ -135,7 +135,7 @@ impl Track {
 }
 
 /// The track point of the car block of a state and covariance.
-fn car_point<const N: usize>(
+pub(crate) fn car_point<const N: usize>(
     t_s: f64,
     x: &nalgebra::SVector<f64, N>,
     p: &nalgebra::SMatrix<f64, N, N>,
