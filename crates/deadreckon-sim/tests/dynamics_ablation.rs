@@ -739,3 +739,48 @@ fn print_walk_tables(
         println!();
     }
 }
+
+/// What the per-stream clocks (offsets, drift, stamp jitter) do to the
+/// calibrated circumferences (issue 28: "with jitter on the stamps, the
+/// circumferences move by under 0.3 mm"): the same calibration drive of each
+/// development car with and without the clocks.
+///
+/// ```text
+/// cargo test --profile ci -p deadreckon-sim --test dynamics_ablation \
+///     clocks_move_the_circumferences -- --ignored --nocapture
+/// ```
+///
+/// Measured (300 s drives, core calibration): the two cars with tick
+/// counters +31.5 to +32.5 mm (car 1) and +21.4 to +21.8 mm (car 3) on all
+/// four wheels; the four with wheel speeds −0.08 to +0.11 mm. The filter
+/// predicts a count over the stamps' interval, and with stamps jittered by
+/// 0.2–2 ms on a 10–20 ms cycle the regression of counts on that interval
+/// is attenuated by about (σΔt/Δt)² (errors in the regressor), which the
+/// circumference absorbs. Not yet fixed: the counts of a counter read on a
+/// fixed cycle belong over the cycle, not over the stamps' difference.
+#[test]
+#[ignore]
+fn clocks_move_the_circumferences() {
+    let mut all = Vec::new();
+    for seed in 1..=6u64 {
+        let car = DynamicCar::draw(seed);
+        let circ = |e: &Effects| {
+            let sc = car.drive(1000 + seed, DEV_DRIVE_S, e);
+            let cal = simulate(&sc, 1000 + seed).unwrap();
+            let c = calibrate(&cal.drive, &CalibrationOptions::default()).unwrap();
+            c.estimate.params.circumferences()
+        };
+        let (a, b) = (
+            circ(&Effects::none()),
+            circ(&Effects::only("clocks").unwrap()),
+        );
+        let d: Vec<f64> = (0..4).map(|i| (b[i] - a[i]) * 1000.0).collect();
+        println!(
+            "car {seed} ({:?}): clocks move the circumferences by {:+.2} {:+.2} {:+.2} {:+.2} mm",
+            car.wheel_kind, d[0], d[1], d[2], d[3]
+        );
+        all.extend(d);
+    }
+    let largest = all.iter().map(|d| d.abs()).fold(0.0, f64::max);
+    println!("largest {largest:.2} mm");
+}
