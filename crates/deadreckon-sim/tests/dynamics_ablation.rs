@@ -753,11 +753,13 @@ fn print_walk_tables(
 /// Measured (300 s drives, core calibration): the two cars with tick
 /// counters +31.5 to +32.5 mm (car 1) and +21.4 to +21.8 mm (car 3) on all
 /// four wheels; the four with wheel speeds −0.08 to +0.11 mm. The filter
-/// predicts a count over the stamps' interval, and with stamps jittered by
-/// 0.2–2 ms on a 10–20 ms cycle the regression of counts on that interval
-/// is attenuated by about (σΔt/Δt)² (errors in the regressor), which the
-/// circumference absorbs. Not yet fixed: the counts of a counter read on a
-/// fixed cycle belong over the cycle, not over the stamps' difference.
+/// predicts a count over the stamps' interval, so stamps jittered by 0.2–2
+/// ms on a 10–20 ms cycle were the suspect (errors in the regressor,
+/// (σΔt/Δt)²); but taking each count over the counter's cycle instead (the
+/// median of the first 64 intervals, or the stamps when off every multiple
+/// by 45 %) left car 3 at +22.1 to +22.4 mm and moved car 1 to +37.9 to
+/// +38.7 mm (its cycle read 0.01952 s for 0.02 s), so that is not (all of)
+/// the cause, and the attempt was not kept. Cause not found yet.
 #[test]
 #[ignore]
 fn clocks_move_the_circumferences() {
