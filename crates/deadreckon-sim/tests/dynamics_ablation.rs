@@ -758,9 +758,11 @@ fn print_walk_tables(
 /// (σΔt/Δt)²); but taking each count over the counter's cycle instead (the
 /// median of the first 64 intervals, or the stamps when off every multiple
 /// by 45 %) left car 3 at +22.1 to +22.4 mm and moved car 1 to +37.9 to
-/// +38.7 mm (its cycle read 0.01952 s for 0.02 s): the median of 64
-/// jittered intervals is too rough a cycle, and the epochs stayed at the
-/// jittered stamps. The attempt was not kept. The wheel stamps are the
+/// +38.7 mm (its cycle read 0.01952 s for 0.02 s); with the cycle as the
+/// elapsed time over the cycles seen (error falling as 1/n) instead, the
+/// same: +37.9 to +38.8 and +22.1 to +22.4 mm. So the counts' interval is
+/// not what matters: the epochs stayed at the jittered stamps. The attempts
+/// were not kept. The wheel stamps are the
 /// cause all the same: restamped on their exact cycle, the shift is gone
 /// ([`the_shift_is_in_the_wheel_stamps`]).
 #[test]
