@@ -39,7 +39,7 @@
 //! the four cars it is estimated on: issue 29's "corrections applied on
 //! evidence of noise", on the family.
 
-use std::sync::Mutex;
+use rayon::prelude::*;
 
 use deadreckon_api::calibrate::calibrate_car;
 use deadreckon_api::corrections::stored_corrections;
@@ -85,37 +85,32 @@ fn user_path(
     Ok(out.final_error().mean)
 }
 
-/// Every (configuration, car, corrections) on two threads; the mean over
-/// the cars per configuration and corrections.
+/// Every (configuration, car, corrections), the cars in parallel (rayon);
+/// the sum and count over the cars per configuration and corrections.
 fn run(cars: &[u64], configs: &[(&str, Effects)], drive_s: f64) -> Vec<[(f64, usize); 2]> {
-    let jobs: Vec<(usize, usize, usize)> = (0..configs.len())
-        .flat_map(|c| (0..cars.len()).flat_map(move |k| [(c, k, 0), (c, k, 1)]))
-        .collect();
-    let next = Mutex::new(0usize);
-    let sums = Mutex::new(vec![[(0.0, 0usize); 2]; configs.len()]);
     let drawn: Vec<DynamicCar> = cars.iter().map(|&s| DynamicCar::draw(s)).collect();
-    std::thread::scope(|scope| {
-        for _ in 0..2 {
-            scope.spawn(|| loop {
-                let j = {
-                    let mut n = next.lock().unwrap();
-                    *n += 1;
-                    *n - 1
-                };
-                let Some(&(c, k, w)) = jobs.get(j) else { break };
-                let which = [Which::None, Which::Gnss][w];
-                match user_path(&drawn[k], &configs[c].1, which, drive_s) {
-                    Ok(e) => {
-                        let mut s = sums.lock().unwrap();
-                        s[c][w].0 += e;
-                        s[c][w].1 += 1;
+    configs
+        .iter()
+        .map(|(name, effects)| {
+            let mut sums = [(0.0, 0usize); 2];
+            for (w, which) in [Which::None, Which::Gnss].into_iter().enumerate() {
+                let results: Vec<Result<f64, String>> = drawn
+                    .par_iter()
+                    .map(|car| user_path(car, effects, which, drive_s))
+                    .collect();
+                for (r, car) in results.into_iter().zip(cars) {
+                    match r {
+                        Ok(e) => {
+                            sums[w].0 += e;
+                            sums[w].1 += 1;
+                        }
+                        Err(e) => println!("{name} car {car} {which:?}: {e}"),
                     }
-                    Err(e) => println!("{} car {} {which:?}: {e}", configs[c].0, cars[k]),
                 }
-            });
-        }
-    });
-    sums.into_inner().unwrap()
+            }
+            sums
+        })
+        .collect()
 }
 
 fn configs() -> Vec<(&'static str, Effects)> {

@@ -53,6 +53,8 @@
 use std::collections::HashMap;
 use std::sync::{Mutex, OnceLock};
 
+use rayon::prelude::*;
+
 use deadreckon_core::angle;
 use deadreckon_core::calibrate::{calibrate, CalibrationOptions};
 use deadreckon_core::drive::Wheels;
@@ -105,35 +107,24 @@ fn ablate(car: &DynamicCar, effects: Option<&Effects>, drive_s: f64, walk: f64) 
     Ok((f.mean, f.n))
 }
 
-/// Every (car, effects) pair, on two threads, with the gyro bias walk `walk`.
+/// Every (car, effects) pair, the cars in parallel (rayon), with the gyro
+/// bias walk `walk`.
 fn table(
     cars: &[u64],
     configs: &[(String, Option<Effects>)],
     drive_s: f64,
     walk: f64,
 ) -> Vec<Vec<CarResult>> {
-    let jobs: Vec<(usize, usize)> = (0..configs.len())
-        .flat_map(|c| (0..cars.len()).map(move |k| (c, k)))
-        .collect();
-    let next = Mutex::new(0usize);
-    let out = Mutex::new(vec![vec![Err(String::new()); cars.len()]; configs.len()]);
     let drawn: Vec<DynamicCar> = cars.iter().map(|&s| DynamicCar::draw(s)).collect();
-    std::thread::scope(|scope| {
-        for _ in 0..2 {
-            scope.spawn(|| loop {
-                let j = {
-                    let mut n = next.lock().unwrap();
-                    let j = *n;
-                    *n += 1;
-                    j
-                };
-                let Some(&(c, k)) = jobs.get(j) else { break };
-                let r = ablate(&drawn[k], configs[c].1.as_ref(), drive_s, walk);
-                out.lock().unwrap()[c][k] = r;
-            });
-        }
-    });
-    out.into_inner().unwrap()
+    configs
+        .iter()
+        .map(|(_, effects)| {
+            drawn
+                .par_iter()
+                .map(|car| ablate(car, effects.as_ref(), drive_s, walk))
+                .collect()
+        })
+        .collect()
 }
 
 /// The configurations: the kinematic family (for reference), every effect

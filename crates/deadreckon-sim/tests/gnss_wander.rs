@@ -14,7 +14,7 @@
 //! cargo test --profile ci -p deadreckon-sim --test gnss_wander -- --ignored --nocapture
 //! ```
 
-use std::sync::Mutex;
+use rayon::prelude::*;
 
 use deadreckon_core::calibrate::{calibrate, CalibrationOptions};
 use deadreckon_core::ekf::FilterOptions;
@@ -96,33 +96,17 @@ fn measure(car: &DynamicCar, effects: &Effects, setup: Setup, drive_s: f64) -> M
     })
 }
 
-/// Every (car, model) pair on two threads; `rows[model][car]`.
+/// Every (car, model) pair, the cars in parallel (rayon); `rows[model][car]`.
 fn table(cars: &[u64], effects: &Effects, models: &[Setup], drive_s: f64) -> Vec<Vec<Measured>> {
-    let jobs: Vec<(usize, usize)> = (0..models.len())
-        .flat_map(|m| (0..cars.len()).map(move |k| (m, k)))
-        .collect();
-    let next = Mutex::new(0usize);
-    let out: Mutex<Vec<Vec<Option<Measured>>>> =
-        Mutex::new(vec![vec![None; cars.len()]; models.len()]);
     let drawn: Vec<DynamicCar> = cars.iter().map(|&s| DynamicCar::draw(s)).collect();
-    std::thread::scope(|scope| {
-        for _ in 0..2 {
-            scope.spawn(|| loop {
-                let j = {
-                    let mut n = next.lock().unwrap();
-                    *n += 1;
-                    *n - 1
-                };
-                let Some(&(m, k)) = jobs.get(j) else { break };
-                let r = measure(&drawn[k], effects, models[m], drive_s);
-                out.lock().unwrap()[m][k] = Some(r);
-            });
-        }
-    });
-    out.into_inner()
-        .unwrap()
-        .into_iter()
-        .map(|row| row.into_iter().map(|r| r.unwrap()).collect())
+    models
+        .iter()
+        .map(|&model| {
+            drawn
+                .par_iter()
+                .map(|car| measure(car, effects, model, drive_s))
+                .collect()
+        })
         .collect()
 }
 
