@@ -601,6 +601,20 @@ impl Fit1d {
     }
 }
 
+/// Tick rows are fitted over blocks of consecutive rows at least this long,
+/// s: a count is over the counter's own interval, the regressor over the
+/// stamps' (`t_k − t_{k−1}`), and stamp jitter in a least-squares regressor
+/// shrinks the slope by `σ²_Δt/(Δt² + σ²_Δt)` (errors in variables), which
+/// made every circumference (σΔt/Δt)² too long: +21 to +32 mm for 2 m tyres
+/// at 1–3 ms of jitter on a 20 ms cycle (dynamic family cars 1 and 3,
+/// `dynamics_ablation.rs`). Summed over a block, the stamps telescope: only
+/// the block's two end stamps are jittered, (σ/1 s)² ≈ 10⁻⁵ of the slope,
+/// and the ticks' ±1 quantisation is over the block too. Not tuned: the
+/// length only needs to be many cycles of the slowest counter (10 Hz) and
+/// short against a change of speed; blocks cut short by a gap or a slow
+/// stretch are used when at least half this long.
+pub const TICK_BLOCK_S: f64 = 1.0;
+
 /// Eq. (23)–(26): the least-squares parameters from reference states (smoothed or
 /// true). `mid_interval` evaluates the state at the middle of each wheel
 /// counting interval (for the truth) instead of at its end (the filter's model).
@@ -649,44 +663,65 @@ pub fn least_squares(
     }
 
     // Inverse circumferences: z = (1/ρ)·r with r = N·T·g (ticks) or ρ_nom·g (speeds).
+    // Ticks are fitted over blocks of consecutive rows (see `TICK_BLOCK_S`).
     let sensors = Sensors::new(v, &nominal);
     let n_wheel = drive.wheels.len();
+    let rows_used = std::cell::Cell::new([0usize; 4]);
     let fits = fit_streamed::<4>(|f| {
+        let mut rows = [0usize; 4];
+        // The open block of tick rows: Σz, Σr per wheel, and its duration.
+        let mut block = ([0.0f64; 4], [0.0f64; 4], 0.0f64);
+        let flush = |f: &mut dyn FnMut(usize, f64, f64), b: &mut ([f64; 4], [f64; 4], f64)| {
+            if b.2 >= 0.5 * TICK_BLOCK_S {
+                for i in 0..4 {
+                    f(i, b.0[i], b.1[i]);
+                }
+            }
+            *b = ([0.0; 4], [0.0; 4], 0.0);
+        };
         for k in 1..n_wheel {
             let (t0, t1) = (drive.wheels.t_s(k - 1), drive.wheels.t_s(k));
             let t_eval = if mid_interval { 0.5 * (t0 + t1) } else { t1 };
-            let Some(x) = reference.state_at(t_eval) else {
-                continue;
-            };
-            if x[V] < min_speed {
-                continue;
-            }
-            let x: State = x;
+            let x = reference.state_at(t_eval).filter(|x| x[V] >= min_speed);
             match &drive.wheels {
-                Wheels::Ticks(rows) => {
-                    let r = rows[k];
+                Wheels::Ticks(rows_t) => {
                     let interval = t1 - t0;
-                    if interval > 0.5 {
+                    let Some(x) = x.filter(|_| interval <= 0.5) else {
+                        flush(f, &mut block);
                         continue;
-                    }
+                    };
+                    let r = rows_t[k];
                     for (i, z) in [r.fl, r.fr, r.rl, r.rr].into_iter().enumerate() {
                         let g = sensors.wheel_ground_speed(i, x[V], x[YAW_RATE]).0;
-                        f(i, z as f64, sensors.ticks_per_rev * interval * g);
+                        block.0[i] += z as f64;
+                        block.1[i] += sensors.ticks_per_rev * interval * g;
+                        rows[i] += 1;
+                    }
+                    block.2 += interval;
+                    if block.2 >= TICK_BLOCK_S {
+                        flush(f, &mut block);
                     }
                 }
-                Wheels::Speeds(rows) => {
-                    let r = rows[k];
+                Wheels::Speeds(rows_s) => {
+                    let Some(x) = x else {
+                        continue;
+                    };
+                    let r = rows_s[k];
                     for (i, z) in [r.fl_mps, r.fr_mps, r.rl_mps, r.rr_mps]
                         .into_iter()
                         .enumerate()
                     {
                         let g = sensors.wheel_ground_speed(i, x[V], x[YAW_RATE]).0;
                         f(i, z, sensors.nominal_circumference_m * g);
+                        rows[i] += 1;
                     }
                 }
             }
         }
+        flush(f, &mut block);
+        rows_used.set(rows);
     });
+    let rows_used = rows_used.get();
     let mut circ = nominal.circumferences();
     let mut circ_std = [0.0; 4];
     for i in 0..4 {
@@ -697,7 +732,8 @@ pub fn least_squares(
             if k > 0.0 {
                 circ[i] = 1.0 / k;
                 circ_std[i] = sk / (k * k);
-                samples[2 + i] = n;
+                // Rows, not blocks: what the drive gave.
+                samples[2 + i] = if n > 0 { rows_used[i] } else { 0 };
             }
         }
     }

@@ -33,6 +33,7 @@ use crate::filter::{AugmentedLayout, CarLayout, Filter, Layout, Prediction};
 use crate::gyro_hold::GyroHold;
 use crate::kalman::CovarianceForm;
 use crate::model::{Mat, State};
+use crate::tick_interval::CountingInterval;
 use crate::vehicle::Params;
 use crate::wheel_health::{WheelHealth, WheelMonitor, WheelMonitorConfig, WheelReading};
 use crate::Error;
@@ -318,6 +319,9 @@ pub struct Feeder {
     /// The first wheel intervals, for the gap rule.
     intervals: Vec<f64>,
     max_interval_s: Option<f64>,
+    /// The interval a wheel row's tick count covers ([`crate::tick_interval`]).
+    #[serde(default)]
+    counting: CountingInterval,
     /// Events sharing the newest timestamp, not yet processed.
     batch: Vec<Event>,
     /// The paper's scheme: newest unused reading of each other sensor.
@@ -373,6 +377,7 @@ impl Feeder {
             last_wheel_s: None,
             intervals: Vec::new(),
             max_interval_s: None,
+            counting: CountingInterval::default(),
             batch: Vec::new(),
             pending_gyro: None,
             pending_speed: None,
@@ -550,7 +555,9 @@ impl Feeder {
         result
     }
 
-    /// The wheel interval ending at `t`, and whether it is a gap.
+    /// The wheel interval ending at `t`, and whether it is a gap: the
+    /// interval its counts cover ([`crate::tick_interval`]), which for a
+    /// regular counter with jittered stamps is its cycle.
     fn wheel_interval(&mut self, t: f64) -> Option<(f64, bool)> {
         let prev = self.last_wheel_s.replace(t)?;
         let interval = t - prev;
@@ -564,7 +571,10 @@ impl Feeder {
             }
         }
         let gap = self.max_interval_s.is_some_and(|m| interval > m);
-        Some((interval, gap))
+        if gap {
+            return Some((interval, true));
+        }
+        Some((self.counting.push(interval), false))
     }
 
     fn wheel_updates<L: Layout<N>, const N: usize>(

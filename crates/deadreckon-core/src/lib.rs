@@ -52,6 +52,7 @@ pub mod plausibility;
 pub mod reference;
 pub mod rts;
 pub mod side_slip;
+pub mod tick_interval;
 pub mod timing;
 pub mod track;
 pub mod traction;

@@ -104,12 +104,14 @@ fn tyre_change_is_flagged_at_its_drive_and_wheel_and_a_steady_car_is_not() {
             );
             assert_eq!(tyre.drives[c.index].path, tyre_paths[CHANGE_AT - 1]);
             assert!(tyre.drives[c.index].path.ends_with("drive-2"));
-            // Measured: −0.028755 ± 0.000918 m against the true −0.028701 m
-            // (± 0.000811 before the GNSS chords widened the standard errors).
+            // Measured: −0.028736 ± 0.000400 m against the true −0.028701 m
+            // since ticks are fitted over 1 s blocks (−0.028755 ± 0.000918
+            // per row, ± 0.000811 before the GNSS chords widened the
+            // standard errors).
             let truth = NEW_FL_M - FL_M;
-            assert!((c.shift - truth).abs() < 0.0005, "{} vs {truth}", c.shift);
+            assert!((c.shift - truth).abs() < 0.0002, "{} vs {truth}", c.shift);
             assert!(
-                c.shift_std > 0.0005 && c.shift_std < 0.0012,
+                c.shift_std > 0.0003 && c.shift_std < 0.0005,
                 "{}",
                 c.shift_std
             );

