@@ -52,6 +52,9 @@ struct Member {
     pose_white: Verdict,
 }
 
+/// A member's figures, or why it has none.
+type Outcome = Result<Member, String>;
+
 fn member(seed: u64, calibration_yaw_rad: Option<f64>) -> Result<Member, String> {
     let car = CarFamily::draw(seed);
     let cal = simulate(&car.drive(100 + seed, 600.0), 100 + seed).map_err(|e| e.to_string())?;
@@ -95,7 +98,7 @@ fn verdict_text(v: Verdict) -> String {
 
 #[test]
 fn calibrated_parameters_within_their_error_bars_over_the_family() {
-    let rows: Vec<(u64, Result<Member, String>, Result<Member, String>)> = CARS
+    let rows: Vec<(u64, Outcome, Outcome)> = CARS
         .into_par_iter()
         .map(|seed| (seed, member(seed, None), member(seed, Some(1e-5))))
         .collect();
