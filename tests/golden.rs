@@ -24,6 +24,8 @@
 //! DEADRECKON_BLESS=1 cargo test --profile ci --test golden
 //! ```
 //!
+//! With `CI` set, a bless fails and writes nothing.
+//!
 //! Every path here is sequential (no parallel reductions), so the numbers are
 //! the same from run to run (`golden_outputs_are_deterministic`, bit for bit).
 
@@ -287,6 +289,13 @@ fn golden_files_match() {
     let dir = golden_dir();
     let outs = outputs();
     if std::env::var_os("DEADRECKON_BLESS").is_some() {
+        // Under CI a bless would pass whatever changed: refused, and nothing
+        // is written (issue 33).
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "DEADRECKON_BLESS is refused when CI is set: golden files are regenerated \
+             by hand, with the reason in the commit"
+        );
         std::fs::create_dir_all(&dir).unwrap();
         for (name, text) in &outs {
             std::fs::write(dir.join(name), text).unwrap();
