@@ -372,6 +372,53 @@ fn check_in_chromium(html: &Path, min_figures: usize) {
 
 const COMMA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/comma2k19-rav4");
 
+/// comma2k19 held out (issue 33): calibrated on one half of the segment
+/// (split at 46438.6 s), evaluated on the other with 20 s outages every
+/// 2 s, both ways, as the README's commands do. The in-sample figures above
+/// calibrate on the windows they judge; these do not. Bounds near the
+/// measured figures (printed).
+#[test]
+fn comma2k19_held_out_halves() {
+    let tmp = tempfile::tempdir().unwrap();
+    let drive = tmp.path().join("rav4");
+    let d = drive.to_str().unwrap();
+    run_ok(&["import", "comma2k19", COMMA, "--out", d]);
+    let mut got = Vec::new();
+    for (cal, eval) in [("--until", "--from"), ("--from", "--until")] {
+        let params = tmp
+            .path()
+            .join(format!("half{}.toml", cal.trim_start_matches('-')));
+        let p = params.to_str().unwrap();
+        run_ok(&["calibrate", d, cal, "46438.6", "--out", p]);
+        let o = json(&run_ok(&[
+            "evaluate", d, eval, "46438.6", "--params", p, "--outage", "20", "--step", "2",
+            "--warmup", "2", "--json",
+        ]));
+        let (mean, median) = (
+            o["final_error_m"]["mean"].as_f64().unwrap(),
+            o["final_error_m"]["median"].as_f64().unwrap(),
+        );
+        eprintln!(
+            "comma2k19 calibrated {cal} 46438.6, evaluated {eval}: {} windows, final mean {mean:.3} m, median {median:.3} m, {} unsettled",
+            o["windows"],
+            o["unsettled"].as_array().map_or(0, |u| u.len())
+        );
+        got.push((mean, median));
+    }
+    // Measured: first half -> second 0.773 / 0.807 m (mean / median, 4
+    // windows), second -> first 0.593 / 0.511 m (3 windows, the pull-away
+    // reported apart): the README's figures. Within about 10 %.
+    let within = |x: f64, m: f64| (x - m).abs() < 0.1 * m;
+    assert!(
+        within(got[0].0, 0.773) && within(got[0].1, 0.807),
+        "{got:?}"
+    );
+    assert!(
+        within(got[1].0, 0.593) && within(got[1].1, 0.511),
+        "{got:?}"
+    );
+}
+
 #[test]
 fn comma2k19_import_calibrate_evaluate_report() {
     let tmp = tempfile::tempdir().unwrap();
