@@ -122,7 +122,8 @@ pub fn import(format: ImportFormat, source: &Path, o: &ImportOptions) -> Result<
             }
         }
         ImportFormat::Ros => {
-            let (mut drive, report) = crate::read_ros(source, o.ros_mapping.as_deref())?;
+            let (mut drive, report, said) =
+                crate::source::read_ros_saying(source, o.ros_mapping.as_deref())?;
             if let Some(v) = &o.vehicle {
                 let origin = drive.vehicle.origin;
                 drive.vehicle = Vehicle {
@@ -132,7 +133,7 @@ pub fn import(format: ImportFormat, source: &Path, o: &ImportOptions) -> Result<
             }
             Imported {
                 drive,
-                report: format!("{report}\n"),
+                report: format!("{said}\n{report}\n"),
             }
         }
     })

@@ -96,26 +96,75 @@ pub fn read_drive_with(
 }
 
 /// Reads a ROS1 bag or ROS2 MCAP recording with the `mapping` file, or the
-/// built-in mapping (Jackal when the file name says so, else Husky), with the
-/// reader's report of what was used, dropped and counted.
+/// built-in mapping whose wheel topic the recording has
+/// ([`builtin_mapping`]), with the reader's report of what was used,
+/// dropped and counted.
 pub fn read_ros(
     path: &Path,
     mapping: Option<&Path>,
 ) -> Result<(Drive, deadreckon_ros::ImportReport), Error> {
-    let mapping = match mapping {
-        Some(m) => mapping_file(m)?,
-        None if path
-            .file_name()
-            .is_some_and(|n| n.to_string_lossy().contains("jackal")) =>
-        {
-            deadreckon_ros::Mapping::jackal()
-        }
-        None => deadreckon_ros::Mapping::husky(),
-    };
-    deadreckon_ros::read_log(path, &mapping).map_err(|source| Error::Ros {
+    read_ros_saying(path, mapping).map(|(d, r, _)| (d, r))
+}
+
+/// [`read_ros`], and which mapping was used and why, in words (for the
+/// import's report).
+pub fn read_ros_saying(
+    path: &Path,
+    mapping: Option<&Path>,
+) -> Result<(Drive, deadreckon_ros::ImportReport, String), Error> {
+    let ros_err = |source| Error::Ros {
         path: path.to_path_buf(),
         source,
-    })
+    };
+    let (mapping, said) = match mapping {
+        Some(m) => (mapping_file(m)?, format!("mapping: {}", m.display())),
+        None => {
+            let topics = if path.is_dir() {
+                deadreckon_ros::rosbag2_storage(path).and_then(deadreckon_ros::list_topics)
+            } else {
+                deadreckon_ros::list_topics(path)
+            }
+            .map_err(ros_err)?;
+            let names: Vec<&str> = topics.iter().map(|t| t.topic.as_str()).collect();
+            builtin_mapping(&names)
+        }
+    };
+    let (drive, report) = deadreckon_ros::read_log(path, &mapping).map_err(ros_err)?;
+    Ok((drive, report, said))
+}
+
+/// The built-in mapping for a recording with these topics: the Jackal's when
+/// it has the Jackal's wheel odometry topic, else the Husky's (whose
+/// missing topics the reader then names); and the choice in words. It used
+/// to be the Jackal's when the file's name contained "jackal", silently
+/// (issue 33).
+pub fn builtin_mapping(topics: &[&str]) -> (deadreckon_ros::Mapping, String) {
+    let wheel_topic = |m: &deadreckon_ros::Mapping| {
+        m.streams
+            .iter()
+            .find(|s| s.kind == deadreckon_ros::StreamKind::OdometryWheels)
+            .map(|s| s.topic.clone())
+            .unwrap_or_default()
+    };
+    let jackal = deadreckon_ros::Mapping::jackal();
+    let jt = wheel_topic(&jackal);
+    if topics.contains(&jt.as_str()) {
+        return (
+            jackal,
+            format!("mapping: the built-in Jackal mapping (the recording has {jt}; --mapping FILE to choose another)"),
+        );
+    }
+    let husky = deadreckon_ros::Mapping::husky();
+    let ht = wheel_topic(&husky);
+    let why = if topics.contains(&ht.as_str()) {
+        format!("the recording has {ht}")
+    } else {
+        format!("the default: the recording has neither {ht} nor {jt}")
+    };
+    (
+        husky,
+        format!("mapping: the built-in Husky mapping ({why}; --mapping FILE to choose another)"),
+    )
 }
 
 /// Reads and validates a mapping file.
