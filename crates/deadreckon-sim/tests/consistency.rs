@@ -109,3 +109,29 @@ fn the_default_noise_is_consistent_on_the_evaluation_drives() {
     let c = nees_seeds(n, &SEEDS);
     assert!(factor(c.pose.verdict()) < -2.0, "{}", c.pose.verdict());
 }
+
+/// `vehicle::PROCESS_YAW_RAD` was chosen on evaluation seeds 3–6; seeds
+/// 20–29 saw no choice (issue 33), run once when this test was written.
+#[test]
+fn the_default_noise_on_held_out_evaluation_seeds() {
+    let seeds: Vec<u64> = (20..=29).collect();
+    let c = nees_seeds(Noise::default(), &seeds);
+    print("defaults, held-out seeds 20-29", &c);
+    let t1 = nees_seeds(
+        Noise {
+            process_yaw_rad: 1e-5,
+            ..Noise::default()
+        },
+        &seeds,
+    );
+    print("table I's yaw noise, held-out seeds 20-29", &t1);
+    // Measured: pose ε̄ 4.22, 4.15, 3.68, 3.47 (bounds 2.54..3.50),
+    // over-confident ×1.4 (at a quarter of the windows; ×1.8 with table I's
+    // value: 5.30, 4.73, 4.53, 4.72); motion consistent. So the choice
+    // helps out of sample but does not make the pose consistent on these
+    // seeds (issue 31's calibrated bound is the remedy).
+    let k = factor(c.pose.verdict());
+    assert!((1.25..1.6).contains(&k), "pose {}", c.pose.verdict());
+    assert!(factor(t1.pose.verdict()) > k + 0.2, "{}", t1.pose.verdict());
+    assert_eq!(c.motion.verdict(), Verdict::Consistent);
+}
