@@ -81,8 +81,19 @@ fn calibrate(seed: u64, white: bool, hold: bool) -> Result<Figures, String> {
 /// rejected cars, the largest |error| / least-squares error and the largest
 /// |error| / standard error.
 fn every_car(white: bool) -> (Vec<u64>, f64, f64) {
+    let (rejected, worst_ls, worst, largest_std) = cars(white, 1..=32);
+    if white {
+        // Measured 0.18–1.80 mm for errors of 0.00–1.83 mm.
+        assert!(largest_std < 2.0e-3, "{largest_std}");
+    }
+    (rejected, worst_ls, worst)
+}
+
+/// [`every_car`] over `seeds`, with the largest standard error, m.
+fn cars(white: bool, seeds: std::ops::RangeInclusive<u64>) -> (Vec<u64>, f64, f64, f64) {
     let (mut rejected, mut worst_ls, mut worst) = (Vec::new(), 0.0f64, 0.0f64);
-    for seed in 1..=32 {
+    let mut largest_std = 0.0f64;
+    for seed in seeds {
         match calibrate(seed, white, true) {
             Ok(f) => {
                 let (z, z_ls) = (f.err / f.std, f.err / f.ls);
@@ -98,10 +109,7 @@ fn every_car(white: bool) -> (Vec<u64>, f64, f64) {
                     f.chords
                 );
                 assert!(z.abs() < 3.0, "car {seed}: z {z}");
-                if white {
-                    // Measured 0.18–1.80 mm for errors of 0.00–1.83 mm.
-                    assert!(f.std < 2.0e-3, "car {seed}: {}", f.std);
-                }
+                largest_std = largest_std.max(f.std);
             }
             Err(e) => {
                 println!("car {seed} (white fixes: {white}): {e}");
@@ -109,7 +117,7 @@ fn every_car(white: bool) -> (Vec<u64>, f64, f64) {
             }
         }
     }
-    (rejected, worst_ls, worst)
+    (rejected, worst_ls, worst, largest_std)
 }
 
 #[test]
@@ -148,4 +156,29 @@ fn the_circumferences_were_learnt_while_the_heading_was_unknown() {
         let f = calibrate(30, white, true).unwrap_or_else(|e| panic!("white {white}: {e}"));
         assert!(f.err.abs() < 2.5e-3, "white {white}: {f:?}");
     }
+}
+
+/// The scale hold (`noise.scale_hold_yaw_std_rad`) and the chords'
+/// rejection were chosen and tested on cars 1–32; cars 101–132 saw no
+/// choice (issue 33), run once when this test was written.
+#[test]
+fn the_hold_and_the_chords_on_held_out_cars() {
+    let (rejected, worst_ls, worst, _) = cars(false, 101..=132);
+    let (rejected_white, _, worst_white, std_white) = cars(true, 101..=132);
+    println!(
+        "held out: worst z {worst:.2} (least squares alone {worst_ls:.1}), white fixes {worst_white:.2} \
+         (largest standard error {:.2} mm); rejected {rejected:?} / {rejected_white:?}",
+        std_white * 1e3
+    );
+    // Measured: every car calibrated (none rejected) and within 1.93
+    // standard errors with the wander (the least squares alone up to 178),
+    // 0.52 with white fixes; the largest white-fix standard error 2.18 mm
+    // (car 112, error 0.31 mm), above the dev cars' 1.80 mm. Bounds near
+    // these.
+    assert_eq!(rejected, [] as [u64; 0]);
+    assert_eq!(rejected_white, [] as [u64; 0]);
+    assert!(worst < 2.4, "{worst}");
+    assert!(worst_ls > 20.0, "{worst_ls}");
+    assert!(worst_white < 0.7, "{worst_white}");
+    assert!(std_white < 2.7e-3, "{std_white}");
 }
