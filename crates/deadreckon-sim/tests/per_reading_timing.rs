@@ -87,3 +87,55 @@ fn per_reading_timing_read_the_gnss_fixes_as_speed() {
     let b = per_reading.estimate.params.gyro_bias_rps - sim.truth_params.gyro_bias_rps;
     assert!(b.abs() < 4e-5, "gyro bias {b:+e} off");
 }
+
+/// `EACH_MAX_PROCESS_*` were chosen on family cars 1, 2, 3, 5, 6 and
+/// measured on 7–10; cars 101–110 saw no choice (issue 33), run once when
+/// this test was written: the per-reading calibration at the bounds against
+/// the wheel epochs', both against the truth.
+#[test]
+fn per_reading_bounds_on_held_out_cars() {
+    use rayon::prelude::*;
+    let rows: Vec<(u64, f64, f64)> = (101..=110u64)
+        .into_par_iter()
+        .map(|seed| {
+            let car = CarFamily::draw(seed);
+            let mut sc = car.drive(100 + seed, 600.0);
+            let g = sc.sensors.gyro.as_mut().expect("family gyro");
+            (g.tilt_deg, g.latency_s, g.scale_error) = (None, 0.0, 0.0);
+            let sim = simulate(&sc, 100 + seed).unwrap();
+            let each = CalibrationOptions {
+                filter: deadreckon_core::ekf::FilterOptions {
+                    timing: Timing::EachMeasurement,
+                    ..CalibrationOptions::default().filter
+                },
+                ..CalibrationOptions::default()
+            };
+            let mut d = sim.drive.clone();
+            d.vehicle.noise.process_speed_mps = calibrate::EACH_MAX_PROCESS_SPEED_MPS;
+            d.vehicle.noise.process_yaw_rate_rps = calibrate::EACH_MAX_PROCESS_YAW_RATE_RPS;
+            let t = sim.truth_params.circumferences();
+            let worst = |c: &calibrate::Calibration| {
+                let e = c.estimate.params.circumferences();
+                (0..4).map(|i| (e[i] - t[i]).abs()).fold(0.0, f64::max)
+            };
+            let per_reading = calibrate::calibrate(&d, &each).unwrap();
+            let wheel = calibrate::calibrate(&sim.drive, &CalibrationOptions::default()).unwrap();
+            (seed, worst(&per_reading), worst(&wheel))
+        })
+        .collect();
+    for (seed, p, w) in &rows {
+        eprintln!(
+            "car {seed}: largest circumference error per reading {:.2} mm, wheel epochs {:.2} mm",
+            p * 1e3,
+            w * 1e3
+        );
+    }
+    let (p, w) = rows
+        .iter()
+        .fold((0.0f64, 0.0f64), |(a, b), r| (a.max(r.1), b.max(r.2)));
+    // Measured: per reading 0.04–1.91 mm (car 105), wheel epochs 0.04–1.75
+    // mm (car 104): the bounds hold out of sample, at the wheel epochs'
+    // accuracy (table I's values were +4 to +5457 mm off on the dev cars).
+    assert!(p < 2.4e-3, "{p}");
+    assert!(w < 2.2e-3, "{w}");
+}
