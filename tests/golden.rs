@@ -8,6 +8,10 @@
 //! - `params.toml`: the RTS calibration of the drive, written as
 //!   `deadreckon calibrate --out` writes it (estimates, passes, not-estimated
 //!   parameters, standard errors);
+//! - `calibrate.json`: `calibrate --json` with the default corrections (the
+//!   receiver's 0.1 s latency estimated and applied, the other delays and
+//!   the gyro scale measured), the speed scale of the drive's CAN speed
+//!   (1.5 % high) estimated;
 //! - `dead_reckoned.csv`: the four-wheel dead-reckoned track (`run`'s first
 //!   track) with the calibrated parameters;
 //! - `tedris_model.json`: a TedriS model trained on the drive (default car
@@ -127,6 +131,22 @@ fn outputs() -> Vec<(&'static str, String)> {
         std::fs::read_to_string(&params_path).unwrap(),
     ));
     let params = c.estimate.params;
+
+    // The command's calibration (`calibrate --json` with the default
+    // corrections): the corrections estimated and applied, then the RTS
+    // calibration, its steering and what it could not estimate.
+    let car = deadreckon_api::calibrate::calibrate_car(
+        &drive,
+        "rts",
+        CalibrationOptions::default(),
+        deadreckon_core::timing::Which::default(),
+        "the golden drive",
+    )
+    .unwrap();
+    out.push((
+        "calibrate.json",
+        serde_json::to_string_pretty(&car.json()).unwrap() + "\n",
+    ));
 
     // Filter and smoother with the calibrated parameters.
     let f = ekf::run(
