@@ -34,7 +34,7 @@
 
 mod dynamic;
 
-pub use dynamic::{Clocks, DynamicCar, Effects};
+pub use dynamic::{Clocks, DynamicCar, Effects, TICK_COUNTER_RATES_HZ, TICK_COUNTER_TEETH};
 
 use deadreckon_core::{Params, Vehicle};
 use rand::{RngExt, SeedableRng};

@@ -254,7 +254,9 @@
 //! | [`tuning`] | the internal thresholds, named and documented |
 #![deny(missing_docs)]
 
+pub mod acceptance;
 pub mod baseline;
+pub mod blocks;
 pub mod ccf;
 pub mod config;
 pub mod history;

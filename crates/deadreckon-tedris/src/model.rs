@@ -99,6 +99,7 @@ pub fn fit_kind(
     repos: &Repositories,
     cfg: &TedrisConfig,
     omega_noise_var: f64,
+    tau: usize,
 ) -> Result<KindFit, Error> {
     let rows: Vec<(Vec<f64>, f64)> = tuples
         .iter()
@@ -166,7 +167,7 @@ pub fn fit_kind(
         };
         repositories.insert(n, beta);
     }
-    let sim_bic = simulation_bic(kind, tuples, &beta_g, cfg.tau_samples as u64, global.bic);
+    let sim_bic = simulation_bic(kind, tuples, &beta_g, tau as u64, global.bic);
     Ok(KindFit {
         kind,
         global,
@@ -323,6 +324,20 @@ pub struct TedrisModel {
     /// The rear wheels' distance scale (see [`DistanceScale`]).
     #[serde(default)]
     pub distance_scale: DistanceScale,
+    /// The blocks chosen for quantised wheel ticks ([`crate::blocks`]):
+    /// τ and block means in place of `config.tau_samples` and medians.
+    /// `None`: the configuration's τ with medians (wheel speeds, or ticks
+    /// fine against the turning).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub blocks: Option<crate::blocks::QuantisedBlocks>,
+    /// The kinds the physical acceptance refused ([`crate::acceptance`]),
+    /// with why: never chosen, never tried by the calibration.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub refused_kinds: Vec<crate::acceptance::KindRefusal>,
+    /// The physical acceptance's checks at training (not kept in the model
+    /// file: for the summary `tedris train` prints).
+    #[serde(skip)]
+    pub acceptance: Option<crate::acceptance::Acceptance>,
     /// The timing and mounting corrections the training drive had applied
     /// (a params.toml's delays, IMU tilt and gyro scale; `None`: none). A
     /// drive run through the model needs the same ones.
@@ -374,16 +389,34 @@ impl TedrisModel {
             self.lag_samples,
             self.ccf.clone(),
             self.repositories.clone(),
+            self.blocks,
         )
     }
 
-    /// Fits every kind on the repositories and chooses one.
+    /// τ of the blocks: the quantised blocks' ([`TedrisModel::blocks`]) or
+    /// the configuration's `tau_samples`.
+    pub fn tau(&self) -> usize {
+        self.blocks
+            .map_or(self.config.tau_samples, |b| b.tau_samples)
+            .max(1)
+    }
+
+    /// Blocks (and the predictor's repository choice) by means instead of
+    /// medians: with quantised blocks.
+    pub fn block_means(&self) -> bool {
+        self.blocks.is_some()
+    }
+
+    /// Fits every kind on the repositories and chooses one. `blocks`: the
+    /// quantised blocks the repositories were formed with (`None`: the
+    /// configuration's τ and medians).
     pub fn fit(
         config: TedrisConfig,
         sample_period_s: f64,
         lag_samples: i64,
         ccf: CrossCorrelation,
         repositories: Repositories,
+        blocks: Option<crate::blocks::QuantisedBlocks>,
     ) -> Result<Self, Error> {
         let tuples = repositories.all_sorted();
         // Compare the kinds on the same tuples: those with a contiguous previous block.
@@ -394,14 +427,18 @@ impl TedrisModel {
             .collect();
         let base = if common.len() > 20 { &common } else { &tuples };
         let (straight_omega, straight_sigma_m) = straight_stats(&repositories);
+        // Quantised blocks: the quantisation variance is the noise's floor
+        // (the straight blocks' spread also has the road's and the tyres').
         let noise_var = if config.eiv_correction() {
-            straight_sigma_m * straight_sigma_m
+            let q = blocks.map_or(0.0, |b| b.quantisation_var_m2());
+            (straight_sigma_m * straight_sigma_m).max(q)
         } else {
             0.0
         };
+        let tau = blocks.map_or(config.tau_samples, |b| b.tau_samples);
         let mut fits = Vec::new();
         for kind in ModelKind::ALL {
-            match fit_kind(kind, base, &repositories, &config, noise_var) {
+            match fit_kind(kind, base, &repositories, &config, noise_var, tau) {
                 Ok(f) => fits.push(f),
                 Err(e) if kind == ModelKind::Paper => return Err(e),
                 Err(_) => {}
@@ -440,6 +477,9 @@ impl TedrisModel {
             dcf_distance_std_rad_per_m: None,
             turn_gain_std: None,
             distance_scale: DistanceScale::default(),
+            blocks,
+            refused_kinds: Vec::new(),
+            acceptance: None,
             corrections: None,
         };
         m.set_dcf0();
@@ -492,6 +532,7 @@ impl TedrisModel {
     /// blocks, which the per-metre form's "turn from ω = 0" would cut).
     pub fn kind_usable(&self, kind: ModelKind) -> bool {
         !(self.per_metre_straight && kind == ModelKind::Arx)
+            && !self.refused_kinds.iter().any(|r| r.kind == kind)
     }
 
     /// Moves the automatic choice off a kind the form cannot use (ARX in the
@@ -502,7 +543,7 @@ impl TedrisModel {
             return;
         }
         for k in [ModelKind::Distance, ModelKind::Paper] {
-            if self.fits.iter().any(|f| f.kind == k) {
+            if self.fits.iter().any(|f| f.kind == k) && self.kind_usable(k) {
                 self.chosen = k;
                 return;
             }
@@ -683,6 +724,7 @@ mod tests {
             &repos,
             &TedrisConfig::default(),
             0.0,
+            6,
         )
         .unwrap();
         assert!(f.repositories.is_empty());
