@@ -31,6 +31,7 @@ pub fn design_row(kind: ModelKind, t: &Tuple) -> Option<Vec<f64>> {
             vec![1.0, t.omega_m, t.dist_m, wp, gp]
         }
         ModelKind::Baseline => vec![t.omega_m, t.dist_m],
+        ModelKind::Speed => vec![1.0, t.omega_m, t.dist_m, t.omega_m * t.dist_m * t.dist_m],
     })
 }
 
@@ -107,14 +108,18 @@ pub fn fit_kind(
         .collect();
     let (x, y): (Vec<Vec<f64>>, Vec<f64>) = rows.into_iter().unzip();
     let names = kind.regressors();
+    // ω·d²'s noise is ω's times d⁴ (d is far less noisy than ω).
+    let d4 = if x.is_empty() {
+        0.0
+    } else {
+        tuples.iter().map(|t| t.dist_m.powi(4)).sum::<f64>() / tuples.len() as f64
+    };
     let noise: Vec<f64> = names
         .iter()
-        .map(|n| {
-            if *n == "alpha1" || *n == "omega_prev" {
-                omega_noise_var
-            } else {
-                0.0
-            }
+        .map(|n| match *n {
+            "alpha1" | "omega_prev" => omega_noise_var,
+            "omega_speed" => omega_noise_var * d4,
+            _ => 0.0,
         })
         .collect();
     let global = ols_eiv(&x, &y, names, &noise)?;
@@ -438,6 +443,10 @@ impl TedrisModel {
         let tau = blocks.map_or(config.tau_samples, |b| b.tau_samples);
         let mut fits = Vec::new();
         for kind in ModelKind::ALL {
+            // The speed kind is the extended variant's.
+            if kind == ModelKind::Speed && config.variant != crate::config::Variant::Extended {
+                continue;
+            }
             match fit_kind(kind, base, &repositories, &config, noise_var, tau) {
                 Ok(f) => fits.push(f),
                 Err(e) if kind == ModelKind::Paper => return Err(e),
@@ -675,9 +684,10 @@ fn choose(fits: &[KindFit]) -> ModelKind {
         None => true,
         Some(c) => c.ljung_box.p_value >= 0.01,
     };
+    // The speed kind is chosen only by the held-back calibrated heading.
     let best = |pred: &dyn Fn(&KindFit) -> bool| {
         fits.iter()
-            .filter(|f| pred(f))
+            .filter(|f| f.kind != ModelKind::Speed && pred(f))
             .min_by(|a, b| a.sim_bic.total_cmp(&b.sim_bic))
             .map(|f| f.kind)
     };

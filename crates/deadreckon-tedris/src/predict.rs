@@ -73,6 +73,9 @@ impl Predictor {
                 lin + beta[3] * wp + beta[4] * gp
             }
             ModelKind::Baseline => beta[0] * w + beta[1] * dist_m,
+            ModelKind::Speed => {
+                beta[0] + beta[1] * w + beta[2] * dist_m + beta[3] * w * dist_m * dist_m
+            }
         };
         // γ̂ = γ̂(straight) + g·(γ̂(ω) − γ̂(straight)): the turn gain g scales the part
         // of the increment that comes from turning.

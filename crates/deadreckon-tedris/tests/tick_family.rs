@@ -13,6 +13,7 @@ fn scratch() {
         .map(|s| s.parse().unwrap())
         .collect();
     let plain = std::env::var("PLAIN").is_ok();
+    let (mut st, mut sb, mut n) = (0.0, 0.0, 0);
     for seed in seeds {
         let car = if plain {
             DynamicCar::draw(seed)
@@ -26,14 +27,24 @@ fn scratch() {
             car.wheel_rate_hz,
             car.base.vehicle.track_rear_m
         );
-        let tr = simulate(&car.drive(1000 + seed, 900.0, &Effects::all()), 1000 + seed)
+        let eff = match std::env::var("EFFECTS").ok().as_deref() {
+            Some("none") => Effects::none(),
+            Some(x) if x.starts_with('-') => Effects::all_but(&x[1..]).unwrap(),
+            Some(x) => Effects::only(x).unwrap(),
+            None => Effects::all(),
+        };
+        let tr = simulate(&car.drive(1000 + seed, 900.0, &eff), 1000 + seed)
             .unwrap()
             .drive;
-        let te = simulate(&car.drive(2000 + seed, 500.0, &Effects::all()), 2000 + seed)
+        let te = simulate(&car.drive(2000 + seed, 500.0, &eff), 2000 + seed)
             .unwrap()
             .drive;
         let t0 = std::time::Instant::now();
-        let (model, _) = train(&tr, TedrisConfig::default(), None).unwrap();
+        let mut c = TedrisConfig::default();
+        if let Ok(m) = std::env::var("MODEL") {
+            c.model = serde_json::from_str(&format!("\"{m}\"")).unwrap();
+        }
+        let (model, _) = train(&tr, c, None).unwrap();
         let f = model.chosen_fit();
         let a1 = f
             .global
@@ -52,11 +63,16 @@ fn scratch() {
             model.ccf.values.iter().copied().fold(f64::MIN, f64::max)
         );
         eprintln!(
-            "  blocks {:?}\n  acceptance {:?}",
-            model.blocks.map(|b| b.describe(model.sample_period_s)),
-            model.acceptance
+            "  blocks {:?}",
+            model.blocks.map(|b| b.describe(model.sample_period_s))
         );
+        if std::env::var("ACC").is_ok() {
+            eprintln!("  acceptance {:?}", model.acceptance);
+        }
         let b = Baseline::fit_blocks(&tr, 2.0).unwrap();
+        let e = &car.base.errors;
+        let tr_m = car.base.vehicle.track_rear_m;
+        eprintln!("  truth per metre {:.3e} rad/m; tedris dcf_d {:.3e} (std {:?}) gain {:.4}; baseline b {:.3e}", (e.circumference_rr_m - e.circumference_rl_m) / (0.5 * (e.circumference_rr_m + e.circumference_rl_m)) / tr_m, model.dcf_distance_rad_per_m, model.dcf_distance_std_rad_per_m, model.turn_gain, b.per_metre_rad);
         eprintln!(
             "  block baseline k {:.3}",
             b.gain_rad_per_m * car.base.vehicle.track_rear_m
@@ -68,11 +84,35 @@ fn scratch() {
             };
             let r = run_outages(&te, &model, &[o]).unwrap();
             let e = b.run_outage(&te, &o).unwrap();
-            eprintln!(
-                "  [{s}] tedris {:.2} m, block baseline {:.2} m",
-                r.outages[0].mean_error_m(),
-                e.mean_error_m()
-            );
+            let m = r.machine.model().unwrap();
+            if std::env::var("DIAG")
+                .ok()
+                .and_then(|v| v.parse::<f64>().ok())
+                == Some(s)
+            {
+                let mut next = s;
+                for p in &r.track.points {
+                    if p.t_s >= next && p.t_s < s + 81.0 {
+                        let i = te
+                            .truth
+                            .partition_point(|q| q.t_s < p.t_s)
+                            .min(te.truth.len() - 1);
+                        let q = &te.truth[i];
+                        let dy = deadreckon_core::angle::wrap(p.yaw_rad - q.yaw_rad);
+                        eprintln!("    t {:.0}: truth yaw {:+.3} yaw err {:+.4} rad, pos err {:.2} m, speed {:.1}", p.t_s, q.yaw_rad, dy, (p.east_m - q.east_m).hypot(p.north_m - q.north_m), p.speed_mps);
+                        next += 5.0;
+                    }
+                }
+            }
+            st += r.outages[0].mean_error_m();
+            sb += e.mean_error_m();
+            n += 1;
+            eprintln!("  [{s}] tedris {:.2} m (max {:.2}), block baseline {:.2} m (end: {:?} {} gain {:.3} dcf_d {:.2e} scale {:.4}; alarms {} refits {}/{})", r.outages[0].mean_error_m(), r.outages[0].max_error_m(), e.mean_error_m(), m.chosen, m.chosen_fit().correction().label(), m.turn_gain, m.dcf_distance_rad_per_m, m.distance_scale.value, r.machine.model_alarms(), r.machine.accepted_refits(), r.machine.refused_refits());
         }
     }
+    eprintln!(
+        "mean tedris {:.2} m, block baseline {:.2} m over {n}",
+        st / n as f64,
+        sb / n as f64
+    );
 }
