@@ -6,7 +6,9 @@
 //! - **Turn gain**: the heading the model gives per metre of right − left
 //!   wheel distance, times the rear track: `α1·track` for the paper,
 //!   distance and baseline kinds, `(α1 + β_ω,prev)/(1 − β_γ,prev)·track` (the
-//!   steady state) for ARX, each times the calibrated turn gain. Rigid
+//!   steady state) for ARX, `(α1 + α3·d²)·track` for the speed kind at the
+//!   blocks' turning-weighted mean square distance per sample d² (at rest
+//!   it is an extrapolation), each times the calibrated turn gain. Rigid
 //!   wheels on a rigid axle give 1; tyre deflection, a rear radius
 //!   mismatch and the track's uncertainty move it by a few per cent, a
 //!   skid-steered robot's scrubbing more. Outside
@@ -90,11 +92,13 @@ fn coef(f: &KindFit, name: &str) -> Option<f64> {
         .map(|c| c.estimate)
 }
 
-/// A kind's turn gain: heading per metre of ω (steady state for ARX) times
-/// `calibrated_gain` times `track_m`.
-pub fn turn_gain(f: &KindFit, calibrated_gain: f64, track_m: f64) -> Option<f64> {
+/// A kind's turn gain: heading per metre of ω (steady state for ARX; for
+/// the speed kind at `turn_d2_m2`, the turning-weighted mean square of the
+/// distance per sample) times `calibrated_gain` times `track_m`.
+pub fn turn_gain(f: &KindFit, calibrated_gain: f64, track_m: f64, turn_d2_m2: f64) -> Option<f64> {
     let a1 = coef(f, "alpha1")?;
     let slope = match f.kind {
+        ModelKind::Speed => a1 + coef(f, "omega_speed")? * turn_d2_m2,
         ModelKind::Arx => {
             let (wp, gp) = (coef(f, "omega_prev")?, coef(f, "gamma_prev")?);
             if (1.0 - gp).abs() < 1e-3 {
@@ -175,11 +179,19 @@ pub fn check(model: &TedrisModel, track_m: f64, expected_ccf_peak: Option<f64>) 
                 "cross-correlation peak {ccf_peak:.3} is below {MIN_CCF_SHARE} of the {e:.3} the data's turning should give"
             )
         });
+    // The speed at which the blocks turned: Σω²d²/Σω² (the speed kind's
+    // gain there; at rest it is an extrapolation).
+    let tuples = model.repositories.all_sorted();
+    let (sw, swd) = tuples.iter().fold((0.0, 0.0), |(a, b), t| {
+        let w2 = t.omega_m * t.omega_m;
+        (a + w2, b + w2 * t.dist_m * t.dist_m)
+    });
+    let turn_d2 = if sw > 0.0 { swd / sw } else { 0.0 };
     let kinds = model
         .fits
         .iter()
         .map(|f| {
-            let g = turn_gain(f, model.turn_gain, track_m);
+            let g = turn_gain(f, model.turn_gain, track_m, turn_d2);
             let r2 = f.global.r_squared;
             let mut why = Vec::new();
             match g {
