@@ -80,7 +80,7 @@ pub fn tedris_train(
         "speed" => Some(ModelKind::Speed),
         m => {
             return Err(DeadreckonError::new_err(format!(
-                "unknown model `{m}` (auto, paper, distance, arx, baseline)"
+                "unknown model `{m}` (auto, paper, distance, arx, baseline, speed)"
             )))
         }
     };

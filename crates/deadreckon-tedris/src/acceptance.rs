@@ -14,8 +14,10 @@
 //!   skid-steered robot's scrubbing more. Outside
 //!   [`MIN_TURN_GAIN`, `MAX_TURN_GAIN`] the kind is refused (the quantised
 //!   ticks of issue 35 gave 0.09).
-//! - **R²** of the kind's block regression below [`MIN_R_SQUARED`]: the
-//!   wheels do not explain the reference's turning.
+//! - **R²** of the kind's block regression near 0: not significantly above
+//!   what its blocks would give without any link between ω and γ (F test
+//!   at [`R_SQUARED_TEST_LEVEL`], [`min_r_squared`]): the wheels do not
+//!   explain the reference's turning.
 //! - **Cross-correlation peak** below [`MIN_CCF_SHARE`] of the peak the
 //!   data's turning should give: the correlation of ω and γ per sample is
 //!   at most the product of their turning shares (the share of each
@@ -26,15 +28,16 @@
 //!   measured one. This refuses every kind.
 //!
 //! A chosen kind that is refused gives way to the baseline kind if that
-//! passes; otherwise the model is refused as a whole, with the failed checks
-//! and what the user can do.
+//! passes, else to another kind that passes; when every kind is refused the
+//! model is refused as a whole, with the failed checks and what the user
+//! can do.
 
 use serde::{Deserialize, Serialize};
 
 use crate::config::ModelKind;
 use crate::history::History;
 use crate::model::{KindFit, TedrisModel};
-use crate::tuning::{MAX_TURN_GAIN, MIN_CCF_SHARE, MIN_R_SQUARED, TURN_SIGNAL_WINDOW_S};
+use crate::tuning::{MAX_TURN_GAIN, MIN_CCF_SHARE, R_SQUARED_TEST_LEVEL, TURN_SIGNAL_WINDOW_S};
 
 /// A kind the acceptance refused, and why.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -110,6 +113,25 @@ pub fn turn_gain(f: &KindFit, calibrated_gain: f64, track_m: f64, turn_d2_m2: f6
     };
     let g = slope * calibrated_gain * track_m;
     g.is_finite().then_some(g)
+}
+
+/// The smallest R² a regression of `regressors` columns besides the
+/// intercept on `n` rows must reach to be significantly above 0 at
+/// [`R_SQUARED_TEST_LEVEL`] (F test: R² = k·F/(k·F + n − k − 1)).
+pub fn min_r_squared(n: usize, regressors: usize) -> f64 {
+    use statrs::distribution::{ContinuousCDF, FisherSnedecor};
+    let k = regressors.max(1) as f64;
+    let dof = n as f64 - k - 1.0;
+    if dof < 1.0 {
+        return 1.0;
+    }
+    match FisherSnedecor::new(k, dof) {
+        Ok(f) => {
+            let q = f.inverse_cdf(1.0 - R_SQUARED_TEST_LEVEL);
+            k * q / (k * q + dof)
+        }
+        Err(_) => 1.0,
+    }
 }
 
 /// The cross-correlation peak of ω (at `lag` samples before γ) and γ that
@@ -201,8 +223,18 @@ pub fn check(model: &TedrisModel, track_m: f64, expected_ccf_peak: Option<f64>) 
                 Some(_) => {}
                 None => why.push("turn gain not defined (ARX feedback of 1)".to_string()),
             }
-            if r2 < MIN_R_SQUARED {
-                why.push(format!("R² {r2:.3} is below {MIN_R_SQUARED}"));
+            let k = f
+                .global
+                .coefficients
+                .iter()
+                .filter(|c| c.name != "alpha0")
+                .count();
+            let min_r2 = min_r_squared(f.global.n, k);
+            if r2 < min_r2 {
+                why.push(format!(
+                    "R² {r2:.3} of {} blocks is not significantly above 0 (needs {min_r2:.3})",
+                    f.global.n
+                ));
             }
             if let Some(c) = &ccf_failed {
                 why.push(c.clone());
@@ -227,9 +259,10 @@ pub fn check(model: &TedrisModel, track_m: f64, expected_ccf_peak: Option<f64>) 
 pub const REMEDY: &str = "check track_rear_m, wheel_circumference_m and ticks_per_rev in vehicle.toml against the car, that the reference heading belongs to this vehicle (tedris train --reference), and train on a drive with more turns; --model baseline fits the plain model alone";
 
 /// Applies the checks to `model`: the refused kinds are recorded, a refused
-/// chosen kind gives way to the baseline kind if that passes. `Err` with
-/// the failed checks and [`REMEDY`] when the chosen kind and the baseline
-/// kind are both refused.
+/// chosen kind gives way to the baseline kind if that passes, else to the
+/// first other kind (in [`ModelKind::ALL`]'s order) that passes and the
+/// model's form can use. `Err` with the failed checks and [`REMEDY`] when
+/// every kind is refused.
 pub fn apply(model: &mut TedrisModel, mut acc: Acceptance) -> Result<(), String> {
     model.refused_kinds = acc
         .kinds
@@ -243,9 +276,12 @@ pub fn apply(model: &mut TedrisModel, mut acc: Acceptance) -> Result<(), String>
         .collect();
     let refused = |k: ModelKind| model.refused_kinds.iter().find(|r| r.kind == k);
     if let Some(r) = refused(model.chosen) {
-        let baseline_ok = model.fits.iter().any(|f| f.kind == ModelKind::Baseline)
-            && refused(ModelKind::Baseline).is_none();
-        if !baseline_ok {
+        // The baseline kind first, then any other kind that passes.
+        let order = std::iter::once(ModelKind::Baseline).chain(ModelKind::ALL);
+        let fallback = order
+            .into_iter()
+            .find(|&k| model.fits.iter().any(|f| f.kind == k) && model.kind_usable(k));
+        let Some(fallback) = fallback else {
             let why = format!(
                 "the {} model was refused: {}{}; what to do: {REMEDY}",
                 model.chosen.name(),
@@ -258,9 +294,9 @@ pub fn apply(model: &mut TedrisModel, mut acc: Acceptance) -> Result<(), String>
             );
             model.acceptance = Some(acc);
             return Err(why);
-        }
+        };
         acc.fell_back_from = Some(model.chosen);
-        model.chosen = ModelKind::Baseline;
+        model.chosen = fallback;
     }
     model.acceptance = Some(acc);
     Ok(())
