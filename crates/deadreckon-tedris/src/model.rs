@@ -536,12 +536,14 @@ impl TedrisModel {
         }
     }
 
-    /// False for a kind the model's form cannot use: the ARX kind in the
+    /// False for a kind the model's form cannot use — the ARX kind in the
     /// per-metre form (its turn is spread over the feedback of previous
-    /// blocks, which the per-metre form's "turn from ω = 0" would cut).
+    /// blocks, which the per-metre form's "turn from ω = 0" would cut) —
+    /// or one the physical acceptance refused ([`TedrisModel::refused_kinds`]).
     pub fn kind_usable(&self, kind: ModelKind) -> bool {
-        !(self.per_metre_straight && kind == ModelKind::Arx)
-            && !self.refused_kinds.iter().any(|r| r.kind == kind)
+        let arx_per_metre = self.per_metre_straight && kind == ModelKind::Arx;
+        let refused = self.refused_kinds.iter().any(|r| r.kind == kind);
+        !(arx_per_metre || refused)
     }
 
     /// Moves the automatic choice off a kind the form cannot use (ARX in the

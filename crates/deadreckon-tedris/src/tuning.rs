@@ -187,5 +187,9 @@ pub const MAX_TURN_GAIN: f64 = 1.33;
 /// with one turning the wrong way, which the turn gain refuses).
 pub const R_SQUARED_TEST_LEVEL: f64 = 0.01;
 /// Smallest share of the expected cross-correlation peak the measured one
-/// must reach (`acceptance::expected_ccf_peak`).
-pub const MIN_CCF_SHARE: f64 = 0.5;
+/// must reach (`acceptance::expected_ccf_peak`). On the tick family's dev
+/// cars 1–3 and 7–9 the measured peak was 0.71–1.7 times the expected one
+/// (0.71 on car 3); half of the lowest, so that the check refuses a
+/// reference that does not follow the wheels (a peak near 0), not the
+/// spread of the estimate.
+pub const MIN_CCF_SHARE: f64 = 0.35;

@@ -67,11 +67,14 @@ fn run_car(seed: u64) -> CarResult {
     let gain = accepted_gain(&model, track, "trained");
     let blocks = model.blocks.expect("quantised blocks for tick counters");
     let base = Baseline::fit_blocks(&train_drive, 2.0).expect("block baseline");
+    let acc = model.acceptance.as_ref().expect("checked at training");
     eprintln!(
-        "car {seed}: {} teeth at {} Hz, track {track:.2} m: {:?} kind, turn gain {gain:.3}; {}; block baseline k = {:.3}",
+        "car {seed}: {} teeth at {} Hz, track {track:.2} m: {:?} kind, turn gain {gain:.3}, cross-correlation peak {:.3} (expected {:?}); {}; block baseline k = {:.3}",
         car.base.vehicle.ticks_per_rev,
         car.wheel_rate_hz,
         model.chosen,
+        acc.ccf_peak,
+        acc.expected_ccf_peak,
         blocks.describe(model.sample_period_s),
         base.gain_rad_per_m * track,
     );
@@ -141,19 +144,44 @@ fn run_family(seeds: &[u64]) -> (f64, f64, f64) {
 
 #[test]
 fn tick_family_dev_members_80s_outages() {
-    let (t, b, worst) = run_family(&[1, 2, 3]);
+    // TEDRIS_TICK_CARS=4,5,6 runs other dev cars (not 101–108) instead.
+    let cars: Vec<u64> = std::env::var("TEDRIS_TICK_CARS").map_or(vec![1, 2, 3], |v| {
+        v.split(',')
+            .map(|c| c.trim().parse().expect("car seeds"))
+            .collect()
+    });
+    assert!(
+        cars.iter().all(|c| !(101..=108).contains(c)),
+        "held-out cars"
+    );
+    let (t, b, worst) = run_family(&cars);
     // Measured on cars 1–3 (12 outages): TedriS 5.81 m mean (worst 19.0 m),
     // block baseline 6.81 m (worst 24.2 m). Before issue 35: TedriS 74.0 m
-    // mean (α1·track 0.33–0.49: medians of quantised ticks).
-    assert!(t <= b, "TedriS {t} m against the block baseline's {b} m");
-    assert!(t < 6.5, "TedriS mean {t} m");
-    assert!(worst < 25.0, "TedriS worst {worst} m");
+    // mean (α1·track 0.33–0.49: medians of quantised ticks). NOT the
+    // issue's target on more cars: over dev cars 1–9 (36 outages) TedriS
+    // 11.41 m (worst 150.5 m: car 9, [200, 280), where the baseline has
+    // 50.6 m) against the block baseline's 7.49 m; without the speed kind
+    // 10.41 m. The bounds below guard the fix (the turn gain, the blocks),
+    // not a win over the baseline.
+    eprintln!("cars {cars:?}: tedris {t:.2} m, block baseline {b:.2} m, worst {worst:.2} m");
+    if cars == [1, 2, 3] {
+        assert!(t < 6.5, "TedriS mean {t} m");
+        assert!(worst < 25.0, "TedriS worst {worst} m");
+        assert!(b > 6.0, "block baseline {b} m (measured 6.81 m)");
+    }
 }
 
 #[test]
 #[ignore = "held-out members, about a minute on two cores; run once at the end"]
 fn tick_family_held_out_members_80s_outages() {
-    let (t, b, _) = run_family(&(101..=108).collect::<Vec<_>>());
+    let (t, b, worst) = run_family(&(101..=108).collect::<Vec<_>>());
+    eprintln!("held out: tedris {t:.2} m, block baseline {b:.2} m, worst {worst:.2} m");
+    // Run once, at the end, nothing changed after (32 outages): TedriS
+    // 6.33 m mean (worst 43.0 m) against the block baseline's 7.56 m (worst
+    // 41.1 m); per car TedriS lower on 101, 102, 103, 108 (1.73–8.53 m
+    // against 2.66–14.50 m), higher on 104, 105, 106, 107 (5.31–13.63 m
+    // against 4.38–12.25 m). Every model accepted had a physical turn gain
+    // (0.889–0.967, checked per car in `run_car`).
     assert!(t <= b, "TedriS {t} m against the block baseline's {b} m");
 }
 

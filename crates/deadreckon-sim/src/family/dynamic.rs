@@ -314,7 +314,11 @@ impl DynamicCar {
         let (lo, hi) = TICK_COUNTER_TEETH;
         car.base.vehicle.ticks_per_rev = r.random_range(lo..=hi);
         car.wheel_kind = WheelKind::Ticks;
-        car.wheel_rate_hz = TICK_COUNTER_RATES_HZ[r.random_range(0..TICK_COUNTER_RATES_HZ.len())];
+        let rate = TICK_COUNTER_RATES_HZ[r.random_range(0..TICK_COUNTER_RATES_HZ.len())];
+        // The wheel clock's jitter was drawn as a share of the drawn rate's
+        // period: the same share of this one's.
+        car.clocks.wheels.jitter_std_s *= car.wheel_rate_hz / rate;
+        car.wheel_rate_hz = rate;
         car
     }
 
@@ -462,10 +466,15 @@ mod tests {
             assert_eq!(c.tooth_error_std, plain.tooth_error_std);
             assert_eq!(c.base.errors, plain.base.errors);
         }
-        let sc = cars[0].drive(1, 100.0, &Effects::all());
-        assert_eq!(sc.sensors.wheels.kind, WheelKind::Ticks);
-        assert_eq!(sc.sensors.wheels.rate_hz, cars[0].wheel_rate_hz);
-        sc.validate().unwrap();
+        // Every car's drive is valid with every effect (the wheel clock's
+        // jitter within a tenth of the counter's period: car 4 at 100 Hz
+        // was not, with the jitter drawn for 50 Hz).
+        for c in &cars {
+            let sc = c.drive(1, 100.0, &Effects::all());
+            assert_eq!(sc.sensors.wheels.kind, WheelKind::Ticks);
+            assert_eq!(sc.sensors.wheels.rate_hz, c.wheel_rate_hz);
+            sc.validate().unwrap();
+        }
     }
 
     #[test]
