@@ -350,7 +350,7 @@ def tedris_train(
 
     ``reference``: ``auto``, ``course``, ``track`` or ``gyro``; ``variant``:
     ``paper`` or ``extended``; ``model``: ``auto``, ``paper``, ``distance``,
-    ``arx``, ``baseline``; ``config``: TedriS settings (docs/tedris.md);
+    ``arx``, ``baseline``, ``speed``; ``config``: TedriS settings (docs/tedris.md);
     ``from_s``/``until_s``: train on that part of the drive only. The drive
     is checked across its streams first, as by :func:`calibrate`
     (``skip_checks``); the summary's ``checks`` holds the warnings.

@@ -77,9 +77,10 @@ pub fn tedris_train(
         "distance" => Some(ModelKind::Distance),
         "arx" => Some(ModelKind::Arx),
         "baseline" => Some(ModelKind::Baseline),
+        "speed" => Some(ModelKind::Speed),
         m => {
             return Err(DeadreckonError::new_err(format!(
-                "unknown model `{m}` (auto, paper, distance, arx, baseline)"
+                "unknown model `{m}` (auto, paper, distance, arx, baseline, speed)"
             )))
         }
     };

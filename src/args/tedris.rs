@@ -55,6 +55,9 @@ pub enum Kind {
     /// The plain least-squares model: γ = α1·ω + α2·d, one global fit, no
     /// intercept, no repositories.
     Baseline,
+    /// γ = α0 + α1·ω + α2·d + α3·ω·d²: the distance kind with a turn gain
+    /// falling with the square of the speed (loaded outer tyres in turns).
+    Speed,
 }
 
 /// TedriS subcommands.
@@ -186,6 +189,7 @@ impl TrainArgs {
                 Kind::Distance => Some(ModelKind::Distance),
                 Kind::Arx => Some(ModelKind::Arx),
                 Kind::Baseline => Some(ModelKind::Baseline),
+                Kind::Speed => Some(ModelKind::Speed),
             },
             tau_samples: self.tau.map(|t| t as usize),
             epsilon_factor: self.epsilon_k.map(|k| k.0),

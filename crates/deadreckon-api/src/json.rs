@@ -289,7 +289,15 @@ pub fn tedris_train_json(m: &TedrisModel, source: ReferenceSource) -> Value {
         "source": source,
         "chosen": m.chosen.name(),
         "lag_samples": m.lag_samples,
-        "tau_samples": m.config.tau_samples,
+        "tau_samples": m.tau(),
+        // Block means for quantised wheel ticks (issue 35), with why; null:
+        // the configured tau_samples with block medians.
+        "blocks": m.blocks,
+        "blocks_chosen_because": m.blocks.map(|b| b.describe(m.sample_period_s)),
+        // The physical acceptance's checks per kind (null for a model read
+        // from a file: they are not kept in it) and the kinds it refused.
+        "acceptance": m.acceptance,
+        "refused_kinds": m.refused_kinds,
         "sample_period_s": m.sample_period_s,
         "mu_m": s.mu_m,
         "w_low_m": s.w_low_m,

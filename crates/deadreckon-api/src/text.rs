@@ -420,7 +420,7 @@ pub fn tedris_train_lines(
     }
     out.push(format!(
         "tau = {} samples, sample period {:.4} s, lag h = {} samples (peak corr {:.3})",
-        m.config.tau_samples,
+        m.tau(),
         m.sample_period_s,
         m.lag_samples,
         m.ccf
@@ -429,6 +429,29 @@ pub fn tedris_train_lines(
             .copied()
             .fold(f64::NEG_INFINITY, f64::max)
     ));
+    out.push(match &m.blocks {
+        Some(b) => format!("blocks: {}", b.describe(m.sample_period_s)),
+        None => format!(
+            "blocks: tau_samples = {} with block medians (wheel distances not quantised coarser than the turning)",
+            m.config.tau_samples
+        ),
+    });
+    if let Some(a) = &m.acceptance {
+        out.push(format!(
+            "physical acceptance: cross-correlation peak {:.3}{}",
+            a.ccf_peak,
+            a.expected_ccf_peak.map_or(
+                " (expected from the turning: not estimated)".to_string(),
+                |e| format!(" against {e:.3} expected from the turning")
+            )
+        ));
+        if let Some(k) = a.fell_back_from {
+            out.push(format!(
+                "  the {} model was refused: the baseline model is used",
+                k.name()
+            ));
+        }
+    }
     let eps = s.epsilon_m.map_or("inf".to_string(), |e| format!("{e:.6}"));
     out.push(format!(
         "straight line ({} blocks{}): mu = {:.6} m, W_L = {:.6} m, W_H = {:.6} m, epsilon = {} m (per wheel sample)",
@@ -479,6 +502,18 @@ pub fn tedris_train_lines(
             f.global.bic
         ));
         out.extend(coefficient_lines(&f.global.coefficients));
+        if let Some(k) = m.acceptance.as_ref().and_then(|a| a.kind(f.kind)) {
+            out.push(format!(
+                "  turn gain {} (heading per metre of right - left × track): {}",
+                k.turn_gain
+                    .map_or("not defined".to_string(), |g| format!("{g:.3}")),
+                k.refused
+                    .as_ref()
+                    .map_or("accepted".to_string(), |r| format!("refused: {r}"))
+            ));
+        } else if let Some(r) = m.refused_kinds.iter().find(|r| r.kind == f.kind) {
+            out.push(format!("  refused: {}", r.reason));
+        }
         out.push(format!(
             "  Box-Pierce Q = {:.2} (L = {}, p = {:.4}); Ljung-Box Q* = {:.2} (p = {:.4})",
             f.box_pierce.statistic,

@@ -31,10 +31,12 @@
 //! stream on its own clock, tone-ring tooth errors, gyro bias drift and
 //! scale error, GNSS multipath, wander and latency, a steering offset —
 //! each drawn per car and switchable, wheel ticks among the wheel kinds.
+//! [`DynamicCar::draw_tick_counter`] gives the same cars with tick-counting
+//! wheels on tone rings of 40–100 teeth at 25, 50 or 100 Hz.
 
 mod dynamic;
 
-pub use dynamic::{Clocks, DynamicCar, Effects};
+pub use dynamic::{Clocks, DynamicCar, Effects, TICK_COUNTER_RATES_HZ, TICK_COUNTER_TEETH};
 
 use deadreckon_core::{Params, Vehicle};
 use rand::{RngExt, SeedableRng};

@@ -11,7 +11,7 @@ use std::collections::VecDeque;
 use serde::{Deserialize, Serialize};
 
 use crate::repository::Tuple;
-use crate::stats::median;
+use crate::stats::{mean, median};
 
 /// One wheel sample.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -214,6 +214,10 @@ pub struct BlockFormer {
     pub slt_window: u64,
     /// Largest heading change over that window on a straight line, rad.
     pub slt_max_change_rad: f64,
+    /// Block means (cumulative increments over τ) instead of medians: for
+    /// quantised wheel ticks ([`crate::blocks`]).
+    #[serde(default)]
+    pub mean: bool,
     next: u64,
     last: Option<(u64, f64, f64)>,
 }
@@ -226,6 +230,7 @@ impl BlockFormer {
             lag,
             slt_window: slt_window.max(1),
             slt_max_change_rad,
+            mean: false,
             next: start,
             last: None,
         }
@@ -268,7 +273,11 @@ impl BlockFormer {
                 self.last = None;
                 continue;
             }
-            let (wm, dm, gm) = (median(&w), median(&d), median(&g));
+            let (wm, dm, gm) = if self.mean {
+                (mean(&w), mean(&d), mean(&g))
+            } else {
+                (median(&w), median(&d), median(&g))
+            };
             let straight = match (
                 h.get(end).and_then(|s| s.theta_rad),
                 end.checked_sub(self.slt_window)

@@ -129,6 +129,20 @@
 //!   ([`machine::course_convention`]): antenna velocity or body yaw, by which
 //!   heading fits the wheels better at its best lag; undecided (antenna
 //!   assumed) without a 10 % difference.
+//! - **Wheel-tick counters** ([`blocks`], issue 35): per-sample ticks are
+//!   mostly quantisation noise, and medians of whole ticks attenuated α1
+//!   tenfold. When the wheel distances lie on a lattice coarse against the
+//!   reference's turning, blocks are means (cumulative increments) with τ
+//!   chosen so that the quantisation leaves at most 1 % attenuation; the
+//!   choice and why are in the model ([`TedrisModel::blocks`]) and printed
+//!   by `tedris train`. The speed kind ([`config::ModelKind::Speed`])
+//!   follows the loaded outer tyres' smaller radius in turns.
+//! - **Physical acceptance** ([`acceptance`]): a kind whose turn gain
+//!   (α1·track, or its equivalent) is outside [0.75, 1.33], whose block R²
+//!   is not significantly above 0, or a cross-correlation peak far below what the data's
+//!   turning should give, is refused with the failed check and what to do;
+//!   the baseline kind stands in if it passes. docs/tedris.md, "Wheel-tick
+//!   counters and physical acceptance", has the measurements.
 //! - **A plain baseline** ([`baseline`]): least squares of course increments
 //!   on wheel increments, what a user writes in an afternoon, run through the
 //!   same outages.
@@ -254,7 +268,9 @@
 //! | [`tuning`] | the internal thresholds, named and documented |
 #![deny(missing_docs)]
 
+pub mod acceptance;
 pub mod baseline;
+pub mod blocks;
 pub mod ccf;
 pub mod config;
 pub mod history;

@@ -31,6 +31,7 @@ pub fn design_row(kind: ModelKind, t: &Tuple) -> Option<Vec<f64>> {
             vec![1.0, t.omega_m, t.dist_m, wp, gp]
         }
         ModelKind::Baseline => vec![t.omega_m, t.dist_m],
+        ModelKind::Speed => vec![1.0, t.omega_m, t.dist_m, t.omega_m * t.dist_m * t.dist_m],
     })
 }
 
@@ -99,6 +100,7 @@ pub fn fit_kind(
     repos: &Repositories,
     cfg: &TedrisConfig,
     omega_noise_var: f64,
+    tau: usize,
 ) -> Result<KindFit, Error> {
     let rows: Vec<(Vec<f64>, f64)> = tuples
         .iter()
@@ -106,14 +108,18 @@ pub fn fit_kind(
         .collect();
     let (x, y): (Vec<Vec<f64>>, Vec<f64>) = rows.into_iter().unzip();
     let names = kind.regressors();
+    // ω·d²'s noise is ω's times d⁴ (d is far less noisy than ω).
+    let d4 = if x.is_empty() {
+        0.0
+    } else {
+        tuples.iter().map(|t| t.dist_m.powi(4)).sum::<f64>() / tuples.len() as f64
+    };
     let noise: Vec<f64> = names
         .iter()
-        .map(|n| {
-            if *n == "alpha1" || *n == "omega_prev" {
-                omega_noise_var
-            } else {
-                0.0
-            }
+        .map(|n| match *n {
+            "alpha1" | "omega_prev" => omega_noise_var,
+            "omega_speed" => omega_noise_var * d4,
+            _ => 0.0,
         })
         .collect();
     let global = ols_eiv(&x, &y, names, &noise)?;
@@ -166,7 +172,7 @@ pub fn fit_kind(
         };
         repositories.insert(n, beta);
     }
-    let sim_bic = simulation_bic(kind, tuples, &beta_g, cfg.tau_samples as u64, global.bic);
+    let sim_bic = simulation_bic(kind, tuples, &beta_g, tau as u64, global.bic);
     Ok(KindFit {
         kind,
         global,
@@ -323,6 +329,20 @@ pub struct TedrisModel {
     /// The rear wheels' distance scale (see [`DistanceScale`]).
     #[serde(default)]
     pub distance_scale: DistanceScale,
+    /// The blocks chosen for quantised wheel ticks ([`crate::blocks`]):
+    /// τ and block means in place of `config.tau_samples` and medians.
+    /// `None`: the configuration's τ with medians (wheel speeds, or ticks
+    /// fine against the turning).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub blocks: Option<crate::blocks::QuantisedBlocks>,
+    /// The kinds the physical acceptance refused ([`crate::acceptance`]),
+    /// with why: never chosen, never tried by the calibration.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub refused_kinds: Vec<crate::acceptance::KindRefusal>,
+    /// The physical acceptance's checks at training (not kept in the model
+    /// file: for the summary `tedris train` prints).
+    #[serde(skip)]
+    pub acceptance: Option<crate::acceptance::Acceptance>,
     /// The timing and mounting corrections the training drive had applied
     /// (a params.toml's delays, IMU tilt and gyro scale; `None`: none). A
     /// drive run through the model needs the same ones.
@@ -374,16 +394,34 @@ impl TedrisModel {
             self.lag_samples,
             self.ccf.clone(),
             self.repositories.clone(),
+            self.blocks,
         )
     }
 
-    /// Fits every kind on the repositories and chooses one.
+    /// τ of the blocks: the quantised blocks' ([`TedrisModel::blocks`]) or
+    /// the configuration's `tau_samples`.
+    pub fn tau(&self) -> usize {
+        self.blocks
+            .map_or(self.config.tau_samples, |b| b.tau_samples)
+            .max(1)
+    }
+
+    /// Blocks (and the predictor's repository choice) by means instead of
+    /// medians: with quantised blocks.
+    pub fn block_means(&self) -> bool {
+        self.blocks.is_some()
+    }
+
+    /// Fits every kind on the repositories and chooses one. `blocks`: the
+    /// quantised blocks the repositories were formed with (`None`: the
+    /// configuration's τ and medians).
     pub fn fit(
         config: TedrisConfig,
         sample_period_s: f64,
         lag_samples: i64,
         ccf: CrossCorrelation,
         repositories: Repositories,
+        blocks: Option<crate::blocks::QuantisedBlocks>,
     ) -> Result<Self, Error> {
         let tuples = repositories.all_sorted();
         // Compare the kinds on the same tuples: those with a contiguous previous block.
@@ -394,14 +432,22 @@ impl TedrisModel {
             .collect();
         let base = if common.len() > 20 { &common } else { &tuples };
         let (straight_omega, straight_sigma_m) = straight_stats(&repositories);
+        // Quantised blocks: the quantisation variance is the noise's floor
+        // (the straight blocks' spread also has the road's and the tyres').
         let noise_var = if config.eiv_correction() {
-            straight_sigma_m * straight_sigma_m
+            let q = blocks.map_or(0.0, |b| b.quantisation_var_m2());
+            (straight_sigma_m * straight_sigma_m).max(q)
         } else {
             0.0
         };
+        let tau = blocks.map_or(config.tau_samples, |b| b.tau_samples);
         let mut fits = Vec::new();
         for kind in ModelKind::ALL {
-            match fit_kind(kind, base, &repositories, &config, noise_var) {
+            // The speed kind is the extended variant's.
+            if kind == ModelKind::Speed && config.variant != crate::config::Variant::Extended {
+                continue;
+            }
+            match fit_kind(kind, base, &repositories, &config, noise_var, tau) {
                 Ok(f) => fits.push(f),
                 Err(e) if kind == ModelKind::Paper => return Err(e),
                 Err(_) => {}
@@ -440,6 +486,9 @@ impl TedrisModel {
             dcf_distance_std_rad_per_m: None,
             turn_gain_std: None,
             distance_scale: DistanceScale::default(),
+            blocks,
+            refused_kinds: Vec::new(),
+            acceptance: None,
             corrections: None,
         };
         m.set_dcf0();
@@ -487,11 +536,14 @@ impl TedrisModel {
         }
     }
 
-    /// False for a kind the model's form cannot use: the ARX kind in the
+    /// False for a kind the model's form cannot use — the ARX kind in the
     /// per-metre form (its turn is spread over the feedback of previous
-    /// blocks, which the per-metre form's "turn from ω = 0" would cut).
+    /// blocks, which the per-metre form's "turn from ω = 0" would cut) —
+    /// or one the physical acceptance refused ([`TedrisModel::refused_kinds`]).
     pub fn kind_usable(&self, kind: ModelKind) -> bool {
-        !(self.per_metre_straight && kind == ModelKind::Arx)
+        let arx_per_metre = self.per_metre_straight && kind == ModelKind::Arx;
+        let refused = self.refused_kinds.iter().any(|r| r.kind == kind);
+        !(arx_per_metre || refused)
     }
 
     /// Moves the automatic choice off a kind the form cannot use (ARX in the
@@ -502,7 +554,7 @@ impl TedrisModel {
             return;
         }
         for k in [ModelKind::Distance, ModelKind::Paper] {
-            if self.fits.iter().any(|f| f.kind == k) {
+            if self.fits.iter().any(|f| f.kind == k) && self.kind_usable(k) {
                 self.chosen = k;
                 return;
             }
@@ -634,9 +686,10 @@ fn choose(fits: &[KindFit]) -> ModelKind {
         None => true,
         Some(c) => c.ljung_box.p_value >= 0.01,
     };
+    // The speed kind is chosen only by the held-back calibrated heading.
     let best = |pred: &dyn Fn(&KindFit) -> bool| {
         fits.iter()
-            .filter(|f| pred(f))
+            .filter(|f| f.kind != ModelKind::Speed && pred(f))
             .min_by(|a, b| a.sim_bic.total_cmp(&b.sim_bic))
             .map(|f| f.kind)
     };
@@ -683,6 +736,7 @@ mod tests {
             &repos,
             &TedrisConfig::default(),
             0.0,
+            6,
         )
         .unwrap();
         assert!(f.repositories.is_empty());

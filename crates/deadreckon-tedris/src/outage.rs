@@ -196,8 +196,20 @@ pub fn train(
         f.distance_scale = model.distance_scale;
         f.per_metre_straight = model.per_metre_straight;
         f.course_convention = model.course_convention;
+        f.refused_kinds = model.refused_kinds.clone();
+        f.acceptance = model.acceptance.clone();
         f.settle_kind();
         f
+    });
+    // A closing refit the physical acceptance refuses is not kept.
+    let refit = refit.and_then(|mut f| {
+        let chosen = f.chosen;
+        m.accept(&mut f).map_err(Error::Insufficient)?;
+        if f.chosen != chosen {
+            // It would fall back where the machine's model did not.
+            return Err(Error::Insufficient("refit refused".into()));
+        }
+        Ok(f)
     });
     // The closing refit is guarded like every refit once trained.
     let mut refit = match refit {

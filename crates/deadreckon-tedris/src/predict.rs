@@ -40,12 +40,17 @@ impl Predictor {
     /// The increment for a sample with rear wheel difference `omega_m` and distance
     /// `dist_m` (m per sample). `dcf_rad` is added; the error correction only while predicting.
     pub fn step(&mut self, model: &TedrisModel, omega_m: f64, dist_m: f64, dcf_rad: f64) -> Rate {
-        let tau = model.config.tau_samples.max(1);
+        let tau = model.tau();
         self.fifo.push_back(omega_m);
         while self.fifo.len() > tau {
             self.fifo.pop_front();
         }
-        let med = median(self.fifo.make_contiguous());
+        // Quantised ticks: the mean of the FIFO, as their blocks are formed.
+        let med = if model.block_means() {
+            crate::stats::mean(self.fifo.make_contiguous())
+        } else {
+            median(self.fifo.make_contiguous())
+        };
         let fit = model.chosen_fit();
         let repository = model.straight().bin(med).unwrap_or(0);
         let beta = fit.beta(repository);
@@ -68,6 +73,9 @@ impl Predictor {
                 lin + beta[3] * wp + beta[4] * gp
             }
             ModelKind::Baseline => beta[0] * w + beta[1] * dist_m,
+            ModelKind::Speed => {
+                beta[0] + beta[1] * w + beta[2] * dist_m + beta[3] * w * dist_m * dist_m
+            }
         };
         // γ̂ = γ̂(straight) + g·(γ̂(ω) − γ̂(straight)): the turn gain g scales the part
         // of the increment that comes from turning.

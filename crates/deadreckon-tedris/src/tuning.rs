@@ -153,3 +153,43 @@ pub const CALIBRATION_STD_BLOCKS: usize = 10;
 /// long (else the standard errors are not estimated): as the refit guard's
 /// batches, [`REFIT_TEST_DECORRELATIONS`].
 pub const CALIBRATION_STD_DECORRELATIONS: f64 = REFIT_TEST_DECORRELATIONS;
+
+/// Largest slope attenuation the wheel ticks' quantisation may leave in the
+/// block regressions before the errors-in-variables correction
+/// (`blocks::choose`): the block length is chosen so that the quantisation
+/// variance of a block mean of ω is at most this share of the total. 1 %:
+/// what is left is then within the errors-in-variables correction's reach
+/// (it subtracts a known variance from a much larger one).
+pub const MAX_QUANTISATION_ATTENUATION: f64 = 0.01;
+/// Longest block for quantised wheel distances, s (the block
+/// baseline used 2 s; beyond a few seconds a block spans turn entries and
+/// exits and the repositories fill slowly).
+pub const MAX_BLOCK_S: f64 = 3.0;
+/// Share of the per-sample wheel distances that must lie on one lattice for
+/// the wheels to be taken as tick counts (`blocks::wheel_resolution`).
+pub const MIN_LATTICE_SHARE: f64 = 0.99;
+/// Window over which the reference heading's change measures the turning
+/// for the block choice, s (a second averages the course's noise out and
+/// keeps a turn's rate).
+pub const TURN_SIGNAL_WINDOW_S: f64 = 1.0;
+
+/// Smallest turn gain a model may have (`acceptance`: heading per metre of
+/// right − left wheel distance × rear track; 1 for rigid wheels).
+pub const MIN_TURN_GAIN: f64 = 0.75;
+/// Largest turn gain a model may have (see [`MIN_TURN_GAIN`]).
+pub const MAX_TURN_GAIN: f64 = 1.33;
+/// Level of the F test that refuses a kind whose block R² is "near 0"
+/// (`acceptance`): not significantly above what its blocks would give
+/// without any link between ω and γ. A fixed R² floor refused good models:
+/// the blocks' R² falls with the wheels' and the reference's noise as well
+/// as with a wrong model (the family's car 11 trained on 150 s: 0.036 with
+/// a model that beat the baseline; the Husky's fix-track reference 0.038
+/// with one turning the wrong way, which the turn gain refuses).
+pub const R_SQUARED_TEST_LEVEL: f64 = 0.01;
+/// Smallest share of the expected cross-correlation peak the measured one
+/// must reach (`acceptance::expected_ccf_peak`). On the tick family's dev
+/// cars 1–3 and 7–9 the measured peak was 0.71–1.7 times the expected one
+/// (0.71 on car 3); half of the lowest, so that the check refuses a
+/// reference that does not follow the wheels (a peak near 0), not the
+/// spread of the estimate.
+pub const MIN_CCF_SHARE: f64 = 0.35;

@@ -181,6 +181,12 @@ const STREAMS: u64 = 108;
 const PHASES: u64 = 109;
 const LONGITUDINAL: u64 = 110;
 const TERRAIN: u64 = 111;
+const TICK_COUNTER: u64 = 112;
+
+/// The tone rings' tooth counts of [`DynamicCar::draw_tick_counter`]: 40–100 teeth.
+pub const TICK_COUNTER_TEETH: (u32, u32) = (40, 100);
+/// The counters' rates of [`DynamicCar::draw_tick_counter`], Hz.
+pub const TICK_COUNTER_RATES_HZ: [f64; 3] = [25.0, 50.0, 100.0];
 
 fn signed(r: &mut rand_pcg::Pcg64, lo: f64, hi: f64) -> f64 {
     let m = between(r, lo, hi);
@@ -292,6 +298,28 @@ impl DynamicCar {
             can_latency_s,
             steering_offset_rad,
         }
+    }
+
+    /// The car of `seed` ([`DynamicCar::draw`], every draw the same) with
+    /// tick-counting wheels: a tone ring of 40–100 teeth
+    /// ([`TICK_COUNTER_TEETH`], the nominal and the true ring alike) counted
+    /// at 25, 50 or 100 Hz ([`TICK_COUNTER_RATES_HZ`]), both drawn from a
+    /// generator of their own. With [`Effects::tooth_error`] the teeth are
+    /// misplaced by the car's `tooth_error_std`. The TedriS tick-counter
+    /// tests (`deadreckon-tedris/tests/tick_family.rs`) train and test on
+    /// these cars.
+    pub fn draw_tick_counter(seed: u64) -> Self {
+        let mut car = DynamicCar::draw(seed);
+        let r = &mut rng(seed, TICK_COUNTER);
+        let (lo, hi) = TICK_COUNTER_TEETH;
+        car.base.vehicle.ticks_per_rev = r.random_range(lo..=hi);
+        car.wheel_kind = WheelKind::Ticks;
+        let rate = TICK_COUNTER_RATES_HZ[r.random_range(0..TICK_COUNTER_RATES_HZ.len())];
+        // The wheel clock's jitter was drawn as a share of the drawn rate's
+        // period: the same share of this one's.
+        car.clocks.wheels.jitter_std_s *= car.wheel_rate_hz / rate;
+        car.wheel_rate_hz = rate;
+        car
     }
 
     /// A drive of this car from `seed` with `effects`: the family car's
@@ -420,6 +448,33 @@ mod tests {
             .dynamics
             .rear_slip_gradient_rad_per_mps2(&car.base.vehicle);
         assert!((0.003..=0.007).contains(&g), "{g}");
+    }
+
+    #[test]
+    fn tick_counters_span_their_teeth_and_rates_and_keep_the_cars_other_draws() {
+        let cars: Vec<DynamicCar> = (1..=40).map(DynamicCar::draw_tick_counter).collect();
+        let teeth: Vec<u32> = cars.iter().map(|c| c.base.vehicle.ticks_per_rev).collect();
+        assert!(teeth.iter().all(|t| (40..=100).contains(t)), "{teeth:?}");
+        assert!(teeth.iter().any(|&t| t < 55) && teeth.iter().any(|&t| t > 85));
+        for rate in TICK_COUNTER_RATES_HZ {
+            assert!(cars.iter().any(|c| c.wheel_rate_hz == rate), "{rate} Hz");
+        }
+        for (i, c) in cars.iter().enumerate() {
+            assert_eq!(c.wheel_kind, WheelKind::Ticks);
+            let plain = DynamicCar::draw(i as u64 + 1);
+            assert_eq!(c.dynamics, plain.dynamics);
+            assert_eq!(c.tooth_error_std, plain.tooth_error_std);
+            assert_eq!(c.base.errors, plain.base.errors);
+        }
+        // Every car's drive is valid with every effect (the wheel clock's
+        // jitter within a tenth of the counter's period: car 4 at 100 Hz
+        // was not, with the jitter drawn for 50 Hz).
+        for c in &cars {
+            let sc = c.drive(1, 100.0, &Effects::all());
+            assert_eq!(sc.sensors.wheels.kind, WheelKind::Ticks);
+            assert_eq!(sc.sensors.wheels.rate_hz, c.wheel_rate_hz);
+            sc.validate().unwrap();
+        }
     }
 
     #[test]

@@ -24,7 +24,7 @@ impl Tedris {
         let Some(model) = self.model.as_mut() else {
             return;
         };
-        let tau = model.config.tau_samples;
+        let tau = model.tau();
         let lag = model.lag_samples;
         let t0 = t - model.config.update_window_s;
         let samples: Vec<Sample> = self.history.iter().copied().collect();
@@ -122,7 +122,7 @@ impl Tedris {
             cum.push((k, b, d, tr));
         }
         let mut out = CalibrationRows::default();
-        for (j, s) in samples.iter().enumerate().skip(model.config.tau_samples) {
+        for (j, s) in samples.iter().enumerate().skip(model.tau()) {
             let Some(th) = s.theta_rad else { continue };
             let Some(src) = usize::try_from(j as i64 - lag).ok() else {
                 continue;

@@ -324,17 +324,18 @@ impl Tedris {
         // from 0, a refit sorted the two drives' blocks into one another, and
         // the ARX kind's fit took blocks of different drives for neighbours.
         let start = model.repositories.all_sorted().last().map_or(0, |t| {
-            t.seq + c.tau_samples as u64 + model.lag_samples.unsigned_abs() + 1
+            t.seq + model.tau() as u64 + model.lag_samples.unsigned_abs() + 1
         });
         m.next_idx = start;
         m.pending_from = start;
-        let former = BlockFormer::new(
-            c.tau_samples,
+        let mut former = BlockFormer::new(
+            model.tau(),
             model.lag_samples,
             1,
             c.slt_max_change_deg.to_radians(),
             start,
         );
+        former.mean = model.block_means();
         m.former = Some(former);
         m.convention = model.course_convention.map(|c| c.convention);
         m.model = Some(model);
@@ -603,7 +604,7 @@ impl Tedris {
             return;
         };
         let fit = model.chosen_fit();
-        let tau = model.config.tau_samples as u64;
+        let tau = model.tau() as u64;
         // The trailing run of contiguous blocks.
         let mut run: Vec<&Tuple> = Vec::new();
         for t in self.recent.iter().rev() {

@@ -124,24 +124,32 @@ impl Tedris {
         final_upto: u64,
         ccf: crate::ccf::CrossCorrelation,
     ) -> bool {
-        let c = &self.config;
         let lag = self.choose_lag(&ccf);
         let period = self.sample_period();
+        let extended = self.config.variant == crate::config::Variant::Extended;
+        let blocks = if extended {
+            self.quantised_blocks(period)
+        } else {
+            None
+        };
+        let c = &self.config;
+        let tau = blocks.map_or(c.tau_samples, |b| b.tau_samples);
         let slt_window = (c.slt_window_s / period).round().max(1.0) as u64;
         let start = self.history.span().map_or(0, |s| s.0);
         let mut former = BlockFormer::new(
-            c.tau_samples,
+            tau,
             lag,
             slt_window,
             c.slt_max_change_deg.to_radians(),
             start,
         );
+        former.mean = blocks.is_some();
         let tuples = former.form(&self.history, final_upto);
         let Some(straight) = straight_line(&tuples, c.epsilon_factor) else {
             self.untrained_because = Some(format!(
-                "{} blocks of tau_samples = {} are too few for the straight-line parameters",
+                "{} blocks of tau = {} samples are too few for the straight-line parameters",
                 tuples.len(),
-                c.tau_samples
+                tau
             ));
             return false;
         };
@@ -155,7 +163,7 @@ impl Tedris {
             && c.joint_calibration()
             && self.geometry.heading_is_course
             && c.model != crate::config::ModelChoice::Fixed(crate::config::ModelKind::Arx);
-        match TedrisModel::fit(c.clone(), period, lag, ccf, repos) {
+        match TedrisModel::fit(c.clone(), period, lag, ccf, repos, blocks) {
             Ok(mut model) => {
                 model.per_metre_straight = per_metre;
                 // A rebuilt model keeps the scale (the tyres did not change).
@@ -168,6 +176,12 @@ impl Tedris {
                     .and_then(|m| m.course_convention)
                     .or(self.pending_convention);
                 model.settle_kind();
+                if let Err(why) = self.accept(&mut model) {
+                    if self.model.is_none() {
+                        self.untrained_because = Some(why);
+                    }
+                    return false;
+                }
                 self.recent = tuples
                     .iter()
                     .rev()
@@ -256,7 +270,11 @@ impl Tedris {
                 m.dcf_distance_std_rad_per_m = dist_std;
                 m.dcf_std_rad = dcf_std;
             }
-            if self.guard_refit(&m, guarded, t) {
+            if self.accept(&mut m).is_err() {
+                // A refit the physical acceptance refuses never replaces
+                // the current model.
+                self.refused_refits += 1;
+            } else if self.guard_refit(&m, guarded, t) {
                 self.model = Some(m);
             }
         }
@@ -265,6 +283,31 @@ impl Tedris {
 }
 
 impl Tedris {
+    /// The blocks for quantised wheel ticks in the history
+    /// ([`crate::blocks`]; `None`: the configuration's τ and medians).
+    pub(super) fn quantised_blocks(&self, period: f64) -> Option<crate::blocks::QuantisedBlocks> {
+        let q = crate::blocks::wheel_resolution(self.history.iter())?;
+        let signal =
+            crate::blocks::turn_signal_m(self.history.iter(), self.geometry.track_rear_m, period)?;
+        crate::blocks::choose(q, signal, period, self.config.tau_samples)
+    }
+
+    /// The physical acceptance of a fitted model ([`crate::acceptance`]) in
+    /// the extended variant (the paper variant is the paper's alone):
+    /// `Err` with the failed checks when the model is refused.
+    pub(crate) fn accept(&self, model: &mut TedrisModel) -> Result<(), String> {
+        if model.config.variant != crate::config::Variant::Extended {
+            return Ok(());
+        }
+        let expected = crate::acceptance::expected_ccf_peak(
+            &self.history,
+            model.lag_samples,
+            model.sample_period_s,
+        );
+        let acc = crate::acceptance::check(model, self.geometry.track_rear_m, expected);
+        crate::acceptance::apply(model, acc)
+    }
+
     /// The refit at the end of a training drive ([`crate::train`]), guarded
     /// like every refit once trained: false when refused (counted).
     pub(crate) fn closing_refit_accepted(&mut self, refit: &TedrisModel) -> bool {

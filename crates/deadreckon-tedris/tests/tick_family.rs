@@ -1,0 +1,295 @@
+//! TedriS on wheel-tick counters in a dynamic world (issue 35).
+//!
+//! Members: [`DynamicCar::draw_tick_counter`] cars (tone rings of 40–100
+//! teeth counted at 25, 50 or 100 Hz) with every effect of the dynamic
+//! family ([`Effects::all`]: tyre side slip, longitudinal slip and loaded
+//! radii, grade and bumps, clocks, tooth errors, gyro drift and scale,
+//! multipath, wander, latencies, steering offset). Each car is trained on
+//! drive 1000 + seed (900 s) and run through 80 s outages starting at 120,
+//! 200, 280 and 360 s of drive 2000 + seed (500 s); the block baseline
+//! ([`Baseline::fit_blocks`], 2 s blocks of cumulative increments, the
+//! issue's) is fitted on the same training drive and run through the same
+//! outages.
+//!
+//! **Which members saw which choices**: the dev members, cars 1–3, saw every
+//! choice of issue 35 — the block means and the attenuation target of the
+//! block length (`tuning::MAX_QUANTISATION_ATTENUATION`), the speed kind
+//! (found on car 3's [280, 360) outage drifting on a straight), the
+//! acceptance thresholds (`tuning::{MIN_TURN_GAIN, MAX_TURN_GAIN,
+//! R_SQUARED_TEST_LEVEL, MIN_CCF_SHARE}`). The held-out members, cars 101–108, were
+//! run once, at the end, with nothing changed after
+//! (`tick_family_held_out_members_80s_outages`, `#[ignore]`d: about a
+//! minute on two cores).
+//!
+//! `cargo test --profile ci -p deadreckon-tedris --test tick_family -- --nocapture`
+
+use deadreckon_sim::family::{DynamicCar, Effects};
+use deadreckon_sim::simulate;
+use deadreckon_tedris::acceptance;
+use deadreckon_tedris::baseline::Baseline;
+use deadreckon_tedris::config::ModelKind;
+use deadreckon_tedris::{run_outages, train, Outage, TedrisConfig, TedrisModel};
+
+const OUTAGE_STARTS_S: [f64; 4] = [120.0, 200.0, 280.0, 360.0];
+
+/// One car's outages: TedriS and the block baseline, mean errors, m.
+struct CarResult {
+    seed: u64,
+    tedris_m: Vec<f64>,
+    baseline_m: Vec<f64>,
+}
+
+/// The chosen kind of `model` passes the physical acceptance (turn gain,
+/// R²) on a car of rear track `track_m`; returns its turn gain.
+fn accepted_gain(model: &TedrisModel, track_m: f64, what: &str) -> f64 {
+    let acc = acceptance::check(model, track_m, None);
+    let k = acc.kind(model.chosen).expect("the chosen kind was fitted");
+    assert!(
+        k.refused.is_none(),
+        "{what}: the chosen {:?} would be refused: {:?}",
+        model.chosen,
+        k.refused
+    );
+    k.turn_gain.expect("a turn gain")
+}
+
+fn run_car(seed: u64) -> CarResult {
+    let car = DynamicCar::draw_tick_counter(seed);
+    let track = car.base.vehicle.track_rear_m;
+    let effects = Effects::all();
+    let train_drive = simulate(&car.drive(1000 + seed, 900.0, &effects), 1000 + seed)
+        .expect("train drive")
+        .drive;
+    let test_drive = simulate(&car.drive(2000 + seed, 500.0, &effects), 2000 + seed)
+        .expect("test drive")
+        .drive;
+    let (model, _) = train(&train_drive, TedrisConfig::default(), None).expect("trained");
+    let gain = accepted_gain(&model, track, "trained");
+    let blocks = model.blocks.expect("quantised blocks for tick counters");
+    let base = Baseline::fit_blocks(&train_drive, 2.0).expect("block baseline");
+    let acc = model.acceptance.as_ref().expect("checked at training");
+    eprintln!(
+        "car {seed}: {} teeth at {} Hz, track {track:.2} m: {:?} kind, turn gain {gain:.3}, cross-correlation peak {:.3} (expected {:?}); {}; block baseline k = {:.3}",
+        car.base.vehicle.ticks_per_rev,
+        car.wheel_rate_hz,
+        model.chosen,
+        acc.ccf_peak,
+        acc.expected_ccf_peak,
+        blocks.describe(model.sample_period_s),
+        base.gain_rad_per_m * track,
+    );
+    let mut r = CarResult {
+        seed,
+        tedris_m: Vec::new(),
+        baseline_m: Vec::new(),
+    };
+    for start_s in OUTAGE_STARTS_S {
+        let o = Outage {
+            start_s,
+            end_s: start_s + 80.0,
+        };
+        let run = run_outages(&test_drive, &model, &[o]).expect("run");
+        // The model the machine holds after its refits and calibrations on
+        // the test drive passes too.
+        let held = run.machine.model().expect("a model");
+        accepted_gain(held, track, "after the run");
+        let b = base.run_outage(&test_drive, &o).expect("baseline run");
+        eprintln!(
+            "  [{start_s:.0}, {:.0}): tedris {:.2} m (max {:.2}), block baseline {:.2} m",
+            o.end_s,
+            run.outages[0].mean_error_m(),
+            run.outages[0].max_error_m(),
+            b.mean_error_m()
+        );
+        r.tedris_m.push(run.outages[0].mean_error_m());
+        r.baseline_m.push(b.mean_error_m());
+    }
+    r
+}
+
+/// Runs the cars two at a time; returns (TedriS mean, baseline mean, worst TedriS).
+fn run_family(seeds: &[u64]) -> (f64, f64, f64) {
+    let results: Vec<CarResult> = std::thread::scope(|s| {
+        let handles: Vec<_> = seeds
+            .chunks(seeds.len().div_ceil(2))
+            .map(|chunk| s.spawn(move || chunk.iter().map(|&c| run_car(c)).collect::<Vec<_>>()))
+            .collect();
+        handles
+            .into_iter()
+            .flat_map(|h| h.join().expect("a car's thread"))
+            .collect()
+    });
+    let all_t: Vec<f64> = results.iter().flat_map(|r| r.tedris_m.clone()).collect();
+    let all_b: Vec<f64> = results.iter().flat_map(|r| r.baseline_m.clone()).collect();
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    for r in &results {
+        eprintln!(
+            "car {}: tedris {:.2} m, block baseline {:.2} m",
+            r.seed,
+            mean(&r.tedris_m),
+            mean(&r.baseline_m)
+        );
+    }
+    let worst = all_t.iter().copied().fold(0.0, f64::max);
+    eprintln!(
+        "{} outages: tedris mean {:.2} m (worst {:.2}), block baseline {:.2} m (worst {:.2})",
+        all_t.len(),
+        mean(&all_t),
+        worst,
+        mean(&all_b),
+        all_b.iter().copied().fold(0.0, f64::max)
+    );
+    (mean(&all_t), mean(&all_b), worst)
+}
+
+#[test]
+fn tick_family_dev_members_80s_outages() {
+    // TEDRIS_TICK_CARS=4,5,6 runs other dev cars (not 101–108) instead.
+    let cars: Vec<u64> = std::env::var("TEDRIS_TICK_CARS").map_or(vec![1, 2, 3], |v| {
+        v.split(',')
+            .map(|c| c.trim().parse().expect("car seeds"))
+            .collect()
+    });
+    assert!(
+        cars.iter().all(|c| !(101..=108).contains(c)),
+        "held-out cars"
+    );
+    let (t, b, worst) = run_family(&cars);
+    // Measured on cars 1–3 (12 outages): TedriS 5.81 m mean (worst 19.0 m),
+    // block baseline 6.81 m (worst 24.2 m). Before issue 35: TedriS 74.0 m
+    // mean (α1·track 0.33–0.49: medians of quantised ticks). NOT the
+    // issue's target on more cars: over dev cars 1–9 (36 outages) TedriS
+    // 11.41 m (worst 150.5 m: car 9, [200, 280), where the baseline has
+    // 50.6 m) against the block baseline's 7.49 m; without the speed kind
+    // 10.41 m. The bounds below guard the fix (the turn gain, the blocks),
+    // not a win over the baseline.
+    eprintln!("cars {cars:?}: tedris {t:.2} m, block baseline {b:.2} m, worst {worst:.2} m");
+    if cars == [1, 2, 3] {
+        assert!(t < 6.5, "TedriS mean {t} m");
+        assert!(worst < 25.0, "TedriS worst {worst} m");
+        assert!(b > 6.0, "block baseline {b} m (measured 6.81 m)");
+    }
+}
+
+#[test]
+#[ignore = "held-out members, about a minute on two cores; run once at the end"]
+fn tick_family_held_out_members_80s_outages() {
+    let (t, b, worst) = run_family(&(101..=108).collect::<Vec<_>>());
+    eprintln!("held out: tedris {t:.2} m, block baseline {b:.2} m, worst {worst:.2} m");
+    // Run once, at the end, nothing changed after (32 outages): TedriS
+    // 6.33 m mean (worst 43.0 m) against the block baseline's 7.56 m (worst
+    // 41.1 m); per car TedriS lower on 101, 102, 103, 108 (1.73–8.53 m
+    // against 2.66–14.50 m), higher on 104, 105, 106, 107 (5.31–13.63 m
+    // against 4.38–12.25 m). Every model accepted had a physical turn gain
+    // (0.889–0.967, checked per car in `run_car`).
+    assert!(t <= b, "TedriS {t} m against the block baseline's {b} m");
+}
+
+/// A drive of a 48-tooth tick counter at 100 Hz (the issue's) in a
+/// kinematic world with tooth errors, where the turn gain's truth is
+/// exact: the rear wheels' true mean circumference over the nominal one.
+fn ticks_48_at_100_hz() -> (DynamicCar, deadreckon_core::Drive) {
+    let mut car = DynamicCar::draw_tick_counter(1);
+    car.base.vehicle.ticks_per_rev = 48;
+    car.wheel_rate_hz = 100.0;
+    let drive = simulate(
+        &car.drive(
+            1001,
+            900.0,
+            &Effects::only("tooth_error").expect("an effect"),
+        ),
+        1001,
+    )
+    .expect("drive")
+    .drive;
+    (car, drive)
+}
+
+#[test]
+fn quantised_ticks_attenuated_the_turn_gain_48_teeth_100_hz() {
+    let (car, drive) = ticks_48_at_100_hz();
+    let v = &car.base.vehicle;
+    let e = &car.base.errors;
+    let truth = 0.5 * (e.circumference_rl_m + e.circumference_rr_m) / v.wheel_circumference_m;
+    let (model, _) = train(&drive, TedrisConfig::default(), None).expect("trained");
+    let f = model.chosen_fit();
+    let alpha1 = f
+        .global
+        .coefficients
+        .iter()
+        .find(|c| c.name == "alpha1")
+        .expect("alpha1")
+        .estimate;
+    let fitted = alpha1 * v.track_rear_m;
+    let calibrated = accepted_gain(&model, v.track_rear_m, "trained");
+    let blocks = model.blocks.expect("quantised blocks");
+    eprintln!(
+        "truth {truth:.4}, fitted α1·track {fitted:.4} ({:?}), calibrated {calibrated:.4}; {}",
+        model.chosen,
+        blocks.describe(model.sample_period_s)
+    );
+    // Measured: truth 1.0040, fitted 1.0103 (the baseline kind chosen),
+    // calibrated 1.0044; blocks of 228 samples (2.28 s, 1 % attenuation
+    // before the errors-in-variables correction). Before issue 35: α1·track
+    // 0.09 on the issue's 48-tooth drives, 0.33–0.49 on the dev members
+    // (block medians of whole ticks).
+    assert!(
+        (fitted / truth - 1.0).abs() < 0.05,
+        "fitted {fitted} vs {truth}"
+    );
+    assert!(
+        (calibrated / truth - 1.0).abs() < 0.05,
+        "calibrated {calibrated} vs {truth}"
+    );
+    assert!(blocks.tau_samples > 50 && blocks.attenuation <= 0.0101);
+}
+
+#[test]
+fn a_model_turning_a_tenth_of_the_wheels_turn_is_refused() {
+    let (car, drive) = ticks_48_at_100_hz();
+    let track = car.base.vehicle.track_rear_m;
+    let (model, _) = train(&drive, TedrisConfig::default(), None).expect("trained");
+    // The issue's model: α1 ten times too small, in every kind but the baseline.
+    let mut m = model.clone();
+    m.chosen = ModelKind::Distance;
+    let scale = |m: &mut TedrisModel, keep: Option<ModelKind>| {
+        for f in m.fits.iter_mut().filter(|f| Some(f.kind) != keep) {
+            for c in f.global.coefficients.iter_mut() {
+                if c.name == "alpha1" {
+                    c.estimate *= 0.09;
+                }
+            }
+        }
+    };
+    scale(&mut m, Some(ModelKind::Baseline));
+    let acc = acceptance::check(&m, track, None);
+    let d = acc.kind(ModelKind::Distance).unwrap();
+    assert!(d.turn_gain.unwrap() < 0.1, "{d:?}");
+    assert!(d.refused.as_deref().unwrap().contains("turn gain"), "{d:?}");
+    acceptance::apply(&mut m, acc).expect("the baseline kind passes");
+    assert_eq!(m.chosen, ModelKind::Baseline);
+    assert_eq!(
+        m.acceptance.as_ref().unwrap().fell_back_from,
+        Some(ModelKind::Distance)
+    );
+    assert!(!m.kind_usable(ModelKind::Distance));
+    // The baseline kind too: the model is refused, with what to do.
+    let mut m = model.clone();
+    m.chosen = ModelKind::Distance;
+    scale(&mut m, None);
+    let acc = acceptance::check(&m, track, None);
+    let why = acceptance::apply(&mut m, acc).expect_err("refused");
+    assert!(
+        why.contains("distance model was refused: turn gain")
+            && why.contains("baseline model")
+            && why.contains("what to do"),
+        "{why}"
+    );
+    // A cross-correlation peak far below what the turning should give
+    // refuses every kind.
+    let acc = acceptance::check(&model, track, Some(10.0));
+    assert!(acc.kinds.iter().all(|k| k
+        .refused
+        .as_deref()
+        .is_some_and(|r| r.contains("cross-correlation peak"))));
+}
