@@ -23,11 +23,24 @@ use deadreckon_tedris::{
 const CAR_WINDOWS: [f64; 3] = [200.0, 350.0, 500.0];
 const SEEDS: std::ops::RangeInclusive<u64> = 1..=6;
 
+/// Seeds no choice was made on (issue 33), run once when their tests were
+/// written.
+const HELD_OUT: std::ops::RangeInclusive<u64> = 7..=12;
+
 /// Per seed, the mean of the mean errors of its 80 s outages.
 fn car_seed_means(cfg: &TedrisConfig, name: &str) -> Vec<f64> {
+    car_seed_means_over(cfg, name, SEEDS)
+}
+
+/// [`car_seed_means`] over `seeds`.
+fn car_seed_means_over(
+    cfg: &TedrisConfig,
+    name: &str,
+    seeds: std::ops::RangeInclusive<u64>,
+) -> Vec<f64> {
     let sc = Scenario::builtin("tedris-car").unwrap();
     let mut means = Vec::new();
-    for seed in SEEDS {
+    for seed in seeds.clone() {
         let train_drive = simulate(&sc, seed).unwrap().drive;
         let run_drive = simulate(&sc, seed + 100).unwrap().drive;
         let (model, _) = train(&train_drive, cfg.clone(), None).unwrap();
@@ -62,7 +75,7 @@ fn car_seed_means(cfg: &TedrisConfig, name: &str) -> Vec<f64> {
     }
     let all = means.iter().sum::<f64>() / means.len() as f64;
     eprintln!(
-        "car {name}: mean error over 80 s outages {all:.2} m (seeds {SEEDS:?}, per seed {:?})",
+        "car {name}: mean error over 80 s outages {all:.2} m (seeds {seeds:?}, per seed {:?})",
         means
             .iter()
             .map(|v| (v * 100.0).round() / 100.0)
@@ -71,13 +84,23 @@ fn car_seed_means(cfg: &TedrisConfig, name: &str) -> Vec<f64> {
     means
 }
 
-fn assert_car_target(means: &[f64]) {
+/// The issue's targets (3 m over the seeds, 4 m per seed), and bounds near
+/// what was measured: `mean` over the seeds, `worst` per seed.
+fn assert_car_target(means: &[f64], mean: f64, worst: f64) {
     let all = means.iter().sum::<f64>() / means.len() as f64;
     assert!(means.len() >= 4);
     assert!(all < 3.0, "mean over seeds {all} m, target < 3 m");
     assert!(
         means.iter().all(|m| *m < 4.0),
         "a seed's mean error reaches 4 m: {means:?}"
+    );
+    assert!(
+        all < mean,
+        "mean over seeds {all} m, measured bound {mean} m"
+    );
+    assert!(
+        means.iter().all(|m| *m < worst),
+        "a seed's mean error reaches {worst} m: {means:?}"
     );
 }
 
@@ -91,19 +114,35 @@ fn with_kind(kind: ModelKind) -> TedrisConfig {
 #[test]
 fn car_80s_outages_distance_model() {
     // The paper's target (figure 6b). Measured 0.97 m over the seeds, 0.41–1.61 m per seed.
-    assert_car_target(&car_seed_means(&with_kind(ModelKind::Distance), "distance"));
+    assert_car_target(
+        &car_seed_means(&with_kind(ModelKind::Distance), "distance"),
+        1.25,
+        2.0,
+    );
 }
 
 #[test]
 fn car_80s_outages_paper_model() {
     // The paper's regression with the default calibration; measured 0.96 m (0.47–1.66).
-    assert_car_target(&car_seed_means(&with_kind(ModelKind::Paper), "paper"));
+    assert_car_target(
+        &car_seed_means(&with_kind(ModelKind::Paper), "paper"),
+        1.25,
+        2.1,
+    );
 }
 
 #[test]
 fn car_80s_outages_automatic_choice() {
     // Measured 0.94 m, 0.52–1.66 m per seed.
-    assert_car_target(&car_seed_means(&TedrisConfig::default(), "auto"));
+    assert_car_target(&car_seed_means(&TedrisConfig::default(), "auto"), 1.25, 2.1);
+}
+
+#[test]
+fn car_80s_outages_automatic_choice_held_out_seeds() {
+    // Seeds 7–12 (HELD_OUT). Measured 0.91 m over the seeds, 0.42–1.73 m
+    // per seed (the development seeds: 0.94 m, 0.52–1.66 m).
+    let means = car_seed_means_over(&TedrisConfig::default(), "auto, held out", HELD_OUT);
+    assert_car_target(&means, 1.15, 2.2);
 }
 
 #[test]
@@ -119,9 +158,29 @@ fn car_80s_outages_paper_method_alone() {
 
 #[test]
 fn robot_time_under_0_159_m() {
+    let (over60, n, median) = robot_times(SEEDS);
+    // Measured: 42/48 at least 60 s (39/48 before issue 35), median 90 s.
+    // The paper's target is a majority; the bound is near the measured.
+    assert!(over60 >= 38, "{over60}/{n}");
+    assert!(median >= 60.0, "{median}");
+}
+
+#[test]
+fn robot_time_under_0_159_m_held_out_seeds() {
+    let (over60, n, median) = robot_times(HELD_OUT);
+    // Seeds 7–12 (HELD_OUT). Measured: 25/48 outages at least 60 s (the
+    // development seeds: 42/48), median 71 s, shortest 14 s: the paper's
+    // majority, by one outage. The robot holds less well out of sample.
+    assert!(2 * over60 > n, "{over60}/{n}");
+    assert!(median >= 65.0, "{median}");
+}
+
+/// Over `seeds`' robot drives: how many 90 s outages stay under 0.159 m for
+/// at least 60 s, of how many, and the median time under it.
+fn robot_times(seeds: std::ops::RangeInclusive<u64>) -> (usize, usize, f64) {
     let sc = Scenario::builtin("tedris-robot").unwrap();
     let mut times = Vec::new();
-    for seed in SEEDS {
+    for seed in seeds {
         let train_drive = simulate(&sc, seed).unwrap().drive;
         let run_drive = simulate(&sc, seed + 100).unwrap().drive;
         let (model, _) = train(
@@ -158,7 +217,5 @@ fn robot_time_under_0_159_m() {
         times.len(),
         sorted[0]
     );
-    // Measured: 39/48 at least 60 s, median 90 s, shortest 37 s.
-    assert!(2 * over60 > times.len(), "{times:?}");
-    assert!(median >= 60.0, "{times:?}");
+    (over60, times.len(), median)
 }
