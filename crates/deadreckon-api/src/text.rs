@@ -195,7 +195,7 @@ pub fn comparison_lines(c: &deadreckon_eval::compare::Comparison, t0: f64) -> Ve
 /// column only when it is not the 1 m one), and the machine's checks.
 pub fn tedris_outage_lines(r: &deadreckon_tedris::OutageReport, threshold_m: f64) -> Vec<String> {
     let mut out = vec![format!(
-        "reference heading: {:?}; errors of the rear axle against {}",
+        "reference heading: {}; errors of the rear axle against {}",
         r.source, r.reference
     )];
     let extra = (threshold_m != 1.0).then(|| format!("to_{threshold_m}m_s"));
@@ -411,7 +411,7 @@ pub fn tedris_train_lines(
     use deadreckon_tedris::ReferenceSource;
     let mut out = Vec::new();
     let s = m.straight();
-    out.push(format!("reference heading: {source:?}"));
+    out.push(format!("reference heading: {source}"));
     if let Some(c) = &m.corrections {
         out.push(format!(
             "trained on corrected streams (kept in the model, applied by tedris run): {}",
@@ -454,7 +454,7 @@ pub fn tedris_train_lines(
     }
     match &m.course_convention {
         Some(c) => out.push(format!(
-            "course convention found on the data: {:?} (residual as body yaw / as antenna course = {:.3})",
+            "course convention found on the data: the course is {} (residual as body yaw / as antenna course = {:.3})",
             c.convention, c.rss_ratio
         )),
         None if source == ReferenceSource::GnssCourse => {
@@ -589,12 +589,15 @@ pub fn kinematic_table(c: &deadreckon_core::kinematics::KinematicCalibration) ->
         }
     }
     out.push(format!(
-        "{} of {} windows above {} m/s, RMS at the window ends {:.3} m / {:.4} rad; {} ({})",
+        "{} of {} windows above {} m/s, RMS at the window ends {:.3} m / {}; {} ({})",
         c.windows_used,
         c.windows_total,
         c.min_speed_mps,
         c.rms_position_m,
-        c.rms_heading_rad,
+        c.rms_heading_rad.map_or_else(
+            || "heading not computed (the reference has none)".to_string(),
+            |h| format!("{h:.4} rad")
+        ),
         if c.converged {
             "converged"
         } else {
