@@ -30,6 +30,12 @@ pub fn corrections_lines(c: &deadreckon_core::timing::Corrections) -> Vec<String
                 d.delay_s,
                 d.std_s
             ),
+            Some(r) if r == deadreckon_core::timing::MEASURED_NOT_APPLIED => format!(
+                "{:<10} {:>+10.4} {:>9.4}  {r}",
+                s.name(),
+                d.delay_s,
+                d.std_s
+            ),
             Some(r) => format!(
                 "{:<10} {:>10} {:>9}  not estimated: {r}",
                 s.name(),
@@ -344,6 +350,15 @@ pub fn wheel_health_lines(h: &deadreckon_core::wheel_health::WheelHealth) -> Vec
         out.push("wheel health: no wheel slipped or read wrong".to_string());
     }
     out.extend(h.lines());
+    if h.wheels.iter().any(|w| w.epochs_checked > 0) {
+        let m = deadreckon_core::wheel_health::WheelMonitorConfig::default();
+        out.push(format!(
+            "  (|T|: a wheel's largest normalised residual against the other sensors, about standard normal on a healthy wheel; \
+             short: over {} s, a wheel spinning or locking; long: over {} m of travel, a tyre reading wrong for good; \
+             a wheel is dropped above {})",
+            m.short_window_s, m.long_window_m, m.drop_sigma
+        ));
+    }
     for (name, w) in deadreckon_core::wheel_health::WHEEL_NAMES
         .iter()
         .zip(&h.wheels)

@@ -570,15 +570,18 @@ pub fn tedris_from_model(
 pub fn correction_rows(c: &deadreckon_core::timing::Corrections) -> Vec<rp::CorrectionRow> {
     use deadreckon_core::timing::Stream;
     let finite = |v: f64| v.is_finite().then_some(v);
+    use deadreckon_core::timing::MEASURED_NOT_APPLIED;
     let status = |reason: Option<&str>| match reason {
         None => "estimated, applied".to_string(),
+        Some(MEASURED_NOT_APPLIED) => MEASURED_NOT_APPLIED.to_string(),
         Some(r) => format!("not estimated: {r}"),
     };
     let mut rows: Vec<rp::CorrectionRow> = Stream::ALL
         .iter()
         .map(|&s| {
             let d = c.delays.get(s);
-            let estimated = d.status.is_estimated();
+            let estimated =
+                d.status.is_estimated() || d.status.reason() == Some(MEASURED_NOT_APPLIED);
             rp::CorrectionRow {
                 what: format!("{} delay", s.name()),
                 unit: "s".into(),
