@@ -117,7 +117,7 @@ fn import_help_gives_the_gnss_latency_default_the_import_uses() {
     let default: f64 = after
         .split("(default ")
         .nth(1)
-        .and_then(|s| s.split(|c: char| c == ':' || c == ')').next())
+        .and_then(|s| s.split([':', ')']).next())
         .and_then(|s| s.trim().parse().ok())
         .unwrap_or_else(|| panic!("no default in:\n{after}"));
     let used = deadreckon_import::comma2k19::Comma2k19Options::default().gnss_latency_s;
