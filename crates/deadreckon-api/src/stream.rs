@@ -33,6 +33,7 @@ pub fn start_params(
         return Ok((Params::nominal(vehicle), default_prior(), None));
     }
     let p = crate::load::params_file(spec)?;
+    crate::load::check_against_vehicle(spec, &p.params, vehicle)?;
     let stored = crate::corrections::stored_in_file(Path::new(spec)).map_err(Error::Invalid)?;
     Ok(started_from(spec, &p, &stored))
 }
