@@ -51,9 +51,12 @@ pub struct ImportArgs {
     pub format: FormatArg,
     /// Source file or directory.
     pub source: PathBuf,
-    /// Output drive directory.
+    /// Output drive directory (new or empty; an existing drive is replaced only with --force).
     #[arg(long)]
     pub out: PathBuf,
+    /// Replace the files of an existing, non-empty --out directory.
+    #[arg(long)]
+    pub force: bool,
     /// vehicle.toml to use (default: comma2k19 the built-in RAV4 profile,
     /// can the built-in RAV4 profile with the built-in DBC, tricycle the log's header).
     #[arg(long)]
