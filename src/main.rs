@@ -19,7 +19,7 @@ struct Cli {
     #[arg(long, global = true)]
     mapping: Option<std::path::PathBuf>,
     /// Read drives without the cross-stream plausibility checks (units,
-    /// clocks, signs: see the README's "What the tool checks").
+    /// clocks, signs: see docs/checks.md).
     #[arg(long, global = true)]
     skip_checks: bool,
     /// The wheel file to read when a drive directory has both
