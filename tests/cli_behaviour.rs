@@ -176,3 +176,47 @@ fn tedris_track_csv_wrote_std_zero_where_it_has_no_uncertainty() {
     let std_east: f64 = row.split(',').nth(7).unwrap().parse().unwrap();
     assert!(std_east > 0.0, "{row}");
 }
+
+#[test]
+fn report_had_no_step_so_an_evaluate_figure_could_not_be_reproduced_in_a_report() {
+    let tmp = tempfile::tempdir().unwrap();
+    let p = |n: &str| tmp.path().join(n).to_str().unwrap().to_string();
+    let d = p("d");
+    run_ok(&[
+        "simulate",
+        "--scenario",
+        "calibration",
+        "--duration",
+        "300",
+        "--out",
+        &d,
+    ]);
+    let windows = |extra: &[&str]| -> u64 {
+        let mut args = vec!["evaluate", d.as_str(), "--outage", "30", "--json"];
+        args.extend_from_slice(extra);
+        let v: serde_json::Value = serde_json::from_str(&run_ok(&args)).unwrap();
+        v["windows"].as_u64().unwrap_or_else(|| panic!("{v}"))
+    };
+    let (every_10, every_15) = (windows(&["--step", "10"]), windows(&[]));
+    assert!(every_10 > every_15, "{every_10} {every_15}");
+    let html = |extra: &[&str]| -> String {
+        let out = p("r.html");
+        let mut args = vec![
+            "report",
+            d.as_str(),
+            "--outage",
+            "30",
+            "--out",
+            out.as_str(),
+        ];
+        args.extend_from_slice(extra);
+        run_ok(&args);
+        std::fs::read_to_string(&out).unwrap()
+    };
+    // The outage histogram's legend counts the windows of each method.
+    let rts = |n: u64| format!("RTS (n = {n})");
+    assert!(html(&["--step", "10"]).contains(&rts(every_10)));
+    assert!(html(&[]).contains(&rts(every_15)));
+    let e = run_err(&["report", &d, "--step", "10", "--out", &p("x.html")]);
+    assert!(e.contains("--outage"), "{e}");
+}
