@@ -12,14 +12,14 @@ use clap::{Parser, Subcommand};
 #[derive(Parser, Debug)]
 #[command(name = "deadreckon", version, about, long_about = None)]
 struct Cli {
-    /// No progress display.
+    /// Print nothing but errors and the data asked for (--json, tracks and events on standard output): no progress, no tables, no warnings.
     #[arg(long, global = true)]
     quiet: bool,
     /// Topic-to-stream mapping (TOML) for ROS bags and MCAP files (default: built-in Husky/Jackal).
     #[arg(long, global = true)]
     mapping: Option<std::path::PathBuf>,
     /// Read drives without the cross-stream plausibility checks (units,
-    /// clocks, signs: see the README's "What the tool checks").
+    /// clocks, signs: see docs/checks.md).
     #[arg(long, global = true)]
     skip_checks: bool,
     /// The wheel file to read when a drive directory has both
@@ -121,12 +121,17 @@ fn message(e: &anyhow::Error) -> String {
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
+    cmd::set_quiet(cli.quiet);
     // The global reading options, passed to each command (no global state).
     let load = cmd::Loader::new(
         cli.mapping,
         cli.skip_checks,
         cli.wheels.map(Into::into),
-        Some(|path, f| eprintln!("warning: {}: {} ({})", path.display(), f.message, f.check)),
+        Some(|path, f| {
+            if !cmd::is_quiet() {
+                eprintln!("warning: {}: {} ({})", path.display(), f.message, f.check)
+            }
+        }),
     );
     match cli.command {
         Command::Simulate(a) => cmd::simulate::run(a),

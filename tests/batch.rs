@@ -81,7 +81,6 @@ fn batch_writes_a_row_per_drive_and_the_history() {
         "30",
         "--step",
         "60",
-        "--quiet",
     ]);
     let stdout = String::from_utf8_lossy(&o.stdout);
     let stderr = String::from_utf8_lossy(&o.stderr);

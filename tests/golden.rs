@@ -115,7 +115,11 @@ fn outputs() -> Vec<(&'static str, String)> {
     extra.insert("method".into(), "rts".into());
     extra.insert("iterations".into(), (c.iterations as i64).into());
     extra.insert("converged".into(), c.converged.into());
-    let not_estimated = deadreckon_api::json::not_estimated(&c, opts.min_speed_mps);
+    let not_estimated = deadreckon_api::json::not_estimated(
+        &c,
+        opts.min_speed_mps,
+        deadreckon_api::json::Absent::of(&drive),
+    );
     if !not_estimated.is_empty() {
         let t: toml::Table = not_estimated
             .iter()

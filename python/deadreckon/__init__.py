@@ -203,7 +203,7 @@ def calibrate(
     the GIL.
 
     The drive is first checked across its streams, as the command does (units,
-    clocks, signs: see the README's "What the tool checks"): a drive that
+    clocks, signs: see docs/checks.md): a drive that
     cannot be right raises :class:`DeadreckonError` saying what disagrees; the
     warnings are under ``checks``. ``skip_checks=True`` skips the checks.
     """

@@ -180,6 +180,9 @@ pub fn run_tracks<'py>(
 /// One track's columns (those of the track CSV but `track`).
 pub fn track_columns<'py>(py: Python<'py>, t: &track::Track) -> PyResult<Bound<'py, PyDict>> {
     let p = &t.points;
+    // No uncertainty (TedriS, the reference): NaN, as the CSV leaves them empty.
+    let none = deadreckon_io::carries_no_covariance(t);
+    let unc = |v: f64| if none { f64::NAN } else { v };
     let mut c = ColumnsOut::new(py);
     c.add("t_s", p, |r| r.t_s)?
         .add("east_m", p, |r| r.east_m)?
@@ -187,10 +190,10 @@ pub fn track_columns<'py>(py: Python<'py>, t: &track::Track) -> PyResult<Bound<'
         .add("yaw_rad", p, |r| r.yaw_rad)?
         .add("speed_mps", p, |r| r.speed_mps)?
         .add("yaw_rate_rps", p, |r| r.yaw_rate_rps)?
-        .add("std_east_m", p, |r| r.std_east_m())?
-        .add("std_north_m", p, |r| r.std_north_m())?
-        .add("std_yaw_rad", p, |r| r.std_yaw_rad())?
-        .add("cov_en_m2", p, |r| r.cov_pose[1])?;
+        .add("std_east_m", p, |r| unc(r.std_east_m()))?
+        .add("std_north_m", p, |r| unc(r.std_north_m()))?
+        .add("std_yaw_rad", p, |r| unc(r.std_yaw_rad()))?
+        .add("cov_en_m2", p, |r| unc(r.cov_pose[1]))?;
     Ok(c.finish())
 }
 

@@ -25,9 +25,9 @@ pub struct BatchArgs {
     /// Worker threads (0: one per core).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
-    /// rts, zupt or truth (needs truth.csv).
-    #[arg(long, value_enum, default_value_t = super::MethodArg::Rts)]
-    pub method: super::MethodArg,
+    /// rts, zupt or truth (needs truth.csv): `batch` calibrates cars.
+    #[arg(long, value_enum, default_value_t = CarMethodArg::Rts)]
+    pub method: CarMethodArg,
     /// Maximum smoothing passes per drive.
     #[arg(long, default_value_t = 60, value_parser = clap::value_parser!(u32).range(1..))]
     pub max_iterations: u32,
@@ -60,11 +60,35 @@ pub struct BatchArgs {
     pub tolerance: Vec<String>,
 }
 
+/// `batch --method`: the car's calibration methods only (`gnss`, the
+/// differential drive's, is not offered: `batch` calibrates cars).
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CarMethodArg {
+    /// RTS-smoothed states of a GNSS-aided filter.
+    Rts,
+    /// The gyro bias at standstill.
+    Zupt,
+    /// `truth.csv`.
+    Truth,
+}
+
+impl CarMethodArg {
+    /// The core's method.
+    pub fn method(self) -> deadreckon_core::calibrate::Method {
+        use deadreckon_core::calibrate::Method;
+        match self {
+            CarMethodArg::Rts => Method::Rts,
+            CarMethodArg::Zupt => Method::Zupt,
+            CarMethodArg::Truth => Method::Truth,
+        }
+    }
+}
+
 impl BatchArgs {
     /// The calibration and outage options of every drive.
     pub fn options(&self) -> Result<BatchOptions> {
         let a = self;
-        let method = a.method.car()?;
+        let method = a.method.method();
         let options = BatchOptions {
             calibration: CalibrationOptions {
                 method,

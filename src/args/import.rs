@@ -51,9 +51,12 @@ pub struct ImportArgs {
     pub format: FormatArg,
     /// Source file or directory.
     pub source: PathBuf,
-    /// Output drive directory.
+    /// Output drive directory (new or empty; an existing drive is replaced only with --force).
     #[arg(long)]
     pub out: PathBuf,
+    /// Replace the files of an existing, non-empty --out directory.
+    #[arg(long)]
+    pub force: bool,
     /// vehicle.toml to use (default: comma2k19 the built-in RAV4 profile,
     /// can the built-in RAV4 profile with the built-in DBC, tricycle the log's header).
     #[arg(long)]
@@ -76,7 +79,7 @@ pub struct ImportArgs {
     /// comma2k19: forward distance from the rear axle to the device, m (default 1.5).
     #[arg(long, value_parser = super::finite, allow_hyphen_values = true)]
     pub device_forward_m: Option<f64>,
-    /// comma2k19: u-blox fix latency subtracted from its log time, s (default 0.1).
+    /// comma2k19: u-blox fix latency subtracted from its log time, s (default 0: fixes at their log time; calibrate estimates the delay, about 0.09 s on the RAV4 segment).
     #[arg(long, value_parser = super::finite, allow_hyphen_values = true)]
     pub gnss_latency_s: Option<f64>,
     /// comma2k19: standard deviation given to each u-blox fix, m (default 1.0).

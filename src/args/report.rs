@@ -18,6 +18,9 @@ pub struct ReportArgs {
     /// Also run the sliding-window outage evaluation with windows of this length, s.
     #[arg(long, value_parser = super::positive)]
     pub outage: Option<f64>,
+    /// Step between the outage windows, s (default: half the outage length), as `evaluate --step`.
+    #[arg(long, value_parser = super::positive, requires = "outage")]
+    pub step: Option<f64>,
     /// The timing and mounting corrections estimated on the drive and applied
     /// for every section when --params stores none: all, gnss or none (as
     /// `calibrate --corrections`). A params.toml that stores corrections

@@ -37,7 +37,7 @@ pub struct SimulateArgs {
     /// Number of laps of the route.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     pub laps: Option<u32>,
-    /// Drive duration, s (laps repeat until then).
+    /// Drive duration, s (laps repeat until then: with --laps, that many laps and standstill after them).
     #[arg(long, value_parser = super::positive)]
     pub duration: Option<f64>,
     /// Geodetic origin LAT,LON[,HEIGHT] (degrees, WGS84; height above the
@@ -91,6 +91,10 @@ impl SimulateArgs {
             sc = sc.with_laps(l);
         }
         if let Some(d) = a.duration {
+            if a.laps.is_none() {
+                let laps = sc.laps_lasting(d)?;
+                sc = sc.with_laps(laps);
+            }
             sc = sc.with_duration_s(d);
         }
         if let Some(o) = &a.origin {

@@ -70,6 +70,9 @@ pub fn run(a: BatchArgs, quiet: bool, loader: &common::Loader) -> Result<()> {
     let written: Vec<&std::path::Path> = std::iter::once(a.out.as_path())
         .chain(a.history.as_deref())
         .collect();
+    if quiet {
+        return Ok(());
+    }
     let text = output::summary_text(&results, &histories, wall_s, threads, &written);
     common::quiet_on_broken_pipe(std::io::stdout().lock().write_all(text.as_bytes()))
 }

@@ -22,13 +22,13 @@ pub fn check_output(out: &Path, inputs: &[&Path]) -> Result<()> {
 /// said of the drive `load` read last) and `"time_span_s"`.
 pub fn print_json(load: &Loader, mut v: serde_json::Value) -> Result<()> {
     load.checks().annotate(&mut v);
-    outln!("{}", serde_json::to_string_pretty(&v)?);
+    super::write_data_line(format_args!("{}", serde_json::to_string_pretty(&v)?))?;
     Ok(())
 }
 
 /// Prints a `--json` object as it is.
 pub fn print_pretty(v: &serde_json::Value) -> Result<()> {
-    outln!("{}", serde_json::to_string_pretty(v)?);
+    super::write_data_line(format_args!("{}", serde_json::to_string_pretty(v)?))?;
     Ok(())
 }
 

@@ -12,6 +12,16 @@ use crate::args::import::*;
 
 /// Runs an import.
 pub fn run(a: ImportArgs, load: &super::common::Loader) -> Result<()> {
+    // Before the import's work: an existing drive is not replaced unasked.
+    if !a.force {
+        let occupied =
+            a.out.is_file() || std::fs::read_dir(&a.out).is_ok_and(|mut d| d.next().is_some());
+        anyhow::ensure!(
+            !occupied,
+            "{} exists and is not empty: the import would replace its files (--force replaces them)",
+            a.out.display()
+        );
+    }
     let (format, options) = a.options(load.mapping.clone())?;
     let Imported { drive, report } = import(format, &a.source, &options)?;
     deadreckon_api::import::write(&a.out, &drive)?;

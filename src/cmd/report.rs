@@ -22,6 +22,7 @@ pub fn run(a: ReportArgs, quiet: bool, load: &common::Loader) -> Result<()> {
         params: a.params.as_deref(),
         model: a.model.as_deref(),
         outage_s: a.outage,
+        step_s: a.step,
         corrections: a.corrections.into(),
     };
     deadreckon_api::report::write(&drive, &o, &a.out, &steps, &common::footer())?;

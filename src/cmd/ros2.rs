@@ -28,7 +28,7 @@ pub fn run(a: Ros2Args, load: &common::Loader, stop: &AtomicBool) -> Result<()> 
     let (vehicle, mut online, warning) = stream::start(&a.start.vehicle, &a.start.params, &o)?;
     if let Some(w) = warning {
         // Live messages cannot be re-timed or re-projected here: say so.
-        eprintln!("warning: {w}");
+        note!("warning: {w}");
     }
     mapping.vehicle = vehicle;
     let node = NodeOptions {
@@ -40,7 +40,7 @@ pub fn run(a: Ros2Args, load: &common::Loader, stop: &AtomicBool) -> Result<()> 
     };
     let summary = deadreckon_ros2::run(&mut online, &mapping, &node, stop)?;
     for line in summary.lines() {
-        eprintln!("{line}");
+        note!("{line}");
     }
     if let Some(why) = &summary.not_started {
         anyhow::bail!("the filter never started: {why}");
@@ -49,7 +49,7 @@ pub fn run(a: Ros2Args, load: &common::Loader, stop: &AtomicBool) -> Result<()> 
         stream::save_state(path, &online)?;
     }
     if let Some(l) = summary.learned {
-        eprintln!(
+        note!(
             "learned: {:.0}% calibrated, {}",
             l.calibrated_pct,
             if l.valid { "valid" } else { "not yet valid" }

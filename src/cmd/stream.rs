@@ -27,7 +27,7 @@ pub fn run(a: StreamArgs) -> Result<()> {
     let (_, mut online, warning) = stream::start(&a.start.vehicle, &a.start.params, &o)?;
     if let Some(w) = warning {
         // Live events cannot be re-timed or re-projected here: say so.
-        eprintln!("warning: {w}");
+        note!("warning: {w}");
     }
     let s = stream::run(
         &mut online,
@@ -35,25 +35,25 @@ pub fn run(a: StreamArgs) -> Result<()> {
         "stdin",
         std::io::stdout().lock(),
         &o,
-        &mut |e| eprintln!("skipped: {e}"),
+        &mut |e| note!("skipped: {e}"),
     )?;
     if let Some(e) = s.write_error {
         return common::quiet_on_broken_pipe(Err(e));
     }
     if let Some(st) = s.stats {
-        eprintln!("{st}");
+        note!("{st}");
     }
     if s.skipped > 0 {
-        eprintln!("{} bad lines skipped", s.skipped);
+        note!("{} bad lines skipped", s.skipped);
     }
     if let Some(l) = s.learned {
-        eprintln!(
+        note!(
             "learned: {:.0}% calibrated, {}",
             l.calibrated_pct,
             if l.valid { "valid" } else { "not yet valid" }
         );
         if let Some(path) = &a.params_out {
-            eprintln!("wrote {}", path.display());
+            note!("wrote {}", path.display());
         }
     }
     Ok(())

@@ -30,6 +30,9 @@ pub struct CarCalibration {
     /// method; with the understeer gradient against the smoothed states with
     /// the RTS method).
     pub steering: Option<SteeringCalibration>,
+    /// The streams the drive had none of (named when a parameter is not
+    /// estimated).
+    pub absent: crate::json::Absent,
 }
 
 /// Estimates and applies the corrections `which` asks for, then calibrates
@@ -60,6 +63,7 @@ pub fn calibrate_car(
         corrections,
         which,
         steering,
+        absent: crate::json::Absent::of(&drive),
     })
 }
 
@@ -67,7 +71,7 @@ impl CarCalibration {
     /// The parameters no sample above the speed threshold informed, with why
     /// (they keep their nominal value and are reported as not estimated).
     pub fn not_estimated(&self) -> Vec<(&'static str, String)> {
-        crate::json::not_estimated(&self.calibration, self.options.min_speed_mps)
+        crate::json::not_estimated(&self.calibration, self.options.min_speed_mps, self.absent)
     }
 
     /// The `--json` object of `calibrate` (without `"checks"`).
@@ -76,6 +80,7 @@ impl CarCalibration {
             &self.method_name,
             &self.calibration,
             self.options.min_speed_mps,
+            self.absent,
             self.steering.as_ref(),
         );
         v["corrections"] = crate::corrections::corrections_json(&self.corrections);

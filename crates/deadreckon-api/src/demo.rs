@@ -84,7 +84,7 @@ pub fn run(
             .collect(),
         skipped: Vec::new(),
     };
-    let mut input = report::four_wheel_input(&eval, &methods, Some(20.0), steps)?;
+    let mut input = report::four_wheel_input(&eval, &methods, Some(20.0), None, steps)?;
     input.header = report::header(
         &eval,
         "demo: evaluation drive",
@@ -150,7 +150,7 @@ fn campus(
     let c = deadreckon_eval::compare::compare(&drive, &outages, None, None)?;
     steps.step("TedriS report");
     let methods = report::calibrations(&drive, steps);
-    let mut input = report::four_wheel_input(&drive, &methods, None, steps)?;
+    let mut input = report::four_wheel_input(&drive, &methods, None, None, steps)?;
     // The report's outage curves are the comparison printed.
     input.tedris = Some(report::tedris_from_model(&drive, &c.model, &c)?);
     input.header = report::header(

@@ -79,18 +79,54 @@ pub fn summary_json(s: &Summary) -> Value {
     json!({"mean": s.mean, "median": s.median, "p95": s.p95, "min": s.min, "max": s.max, "std": s.std, "n": s.n})
 }
 
+/// Which of the calibrated streams a drive lacks altogether: a parameter
+/// with no sample is then said to have no stream, not no sample above the
+/// speed threshold.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Absent {
+    /// No yaw-rate stream (`yaw_rate.csv`): the gyro bias has no reading.
+    pub gyro: bool,
+    /// No CAN speed stream (`speed.csv`): the speed scale has no reading.
+    pub speed: bool,
+}
+
+impl Absent {
+    /// What `drive` lacks.
+    pub fn of(drive: &deadreckon_core::Drive) -> Absent {
+        Absent {
+            gyro: drive.yaw_rate.is_empty(),
+            speed: drive.speed.is_empty(),
+        }
+    }
+}
+
 /// The parameters of `c` no sample above `min_speed_mps` informed (they keep
-/// their nominal value), with why: `(name, reason)`.
-pub fn not_estimated(c: &Calibration, min_speed_mps: f64) -> Vec<(&'static str, String)> {
+/// their nominal value), with why: `(name, reason)`; `absent` names the
+/// streams the drive has none of.
+pub fn not_estimated(
+    c: &Calibration,
+    min_speed_mps: f64,
+    absent: Absent,
+) -> Vec<(&'static str, String)> {
     Params::NAMES
         .iter()
         .zip(c.samples)
-        .filter(|(_, n)| *n == 0)
-        .map(|(name, _)| {
-            (
-                *name,
-                format!("0 samples above the speed threshold {min_speed_mps} m/s: nominal kept"),
-            )
+        .enumerate()
+        .filter(|(_, (_, n))| *n == 0)
+        .map(|(i, (name, _))| {
+            let why = match i {
+                0 if absent.gyro => {
+                    "the drive has no yaw_rate.csv, no gyro to read the bias from: nominal kept"
+                        .to_string()
+                }
+                1 if absent.speed => {
+                    "the drive has no speed.csv, no CAN speed to scale: nominal kept".to_string()
+                }
+                _ => {
+                    format!("0 samples above the speed threshold {min_speed_mps} m/s: nominal kept")
+                }
+            };
+            (*name, why)
         })
         .collect()
 }
@@ -132,10 +168,11 @@ pub fn calibrate_json(
     method: &str,
     c: &Calibration,
     min_speed_mps: f64,
+    absent: Absent,
     steering: Option<&deadreckon_core::kinematics::steering::SteeringCalibration>,
 ) -> Value {
     let mut v = calibration_json(method, c);
-    v["not_estimated"] = not_estimated(c, min_speed_mps)
+    v["not_estimated"] = not_estimated(c, min_speed_mps, absent)
         .into_iter()
         .map(|(k, why)| (k.to_string(), Value::from(why)))
         .collect::<serde_json::Map<_, _>>()

@@ -130,8 +130,14 @@ pub fn load_params_file_with_std(
 ) -> Result<LoadedParams, Error> {
     let path = Path::new(spec);
     if !is_kinematic_params(path) {
+        // A differential drive is calibrated against GNSS, a tricycle
+        // against its tracker.
+        let how = match shape {
+            Shape::DiffDrive => "--shape diff-drive --method gnss",
+            _ => "--method truth",
+        };
         invalid!(
-            "{spec}: not a {} parameter file (no `shape` key): write one with `deadreckon calibrate <log> --method truth --out {spec}`",
+            "{spec}: not a {} parameter file (no `shape` key: a four-wheel car's parameters?): write one with `deadreckon calibrate <log> {how} --out {spec}`",
             shape.name()
         );
     }

@@ -96,12 +96,48 @@ pub fn params_file(spec: &str) -> Result<ParamsWithStd, Error> {
     Ok(p)
 }
 
-/// `nominal` (the vehicle's) or a params.toml's parameters.
+/// `nominal` (the vehicle's) or a params.toml's parameters, checked
+/// against the drive's vehicle ([`check_against_vehicle`]).
 pub fn params(spec: &str, drive: &Drive) -> Result<Params, Error> {
     if spec == "nominal" {
         return Ok(Params::nominal(&drive.vehicle));
     }
-    Ok(params_file(spec)?.params)
+    let p = params_file(spec)?.params;
+    check_against_vehicle(spec, &p, &drive.vehicle)?;
+    Ok(p)
+}
+
+/// A calibrated circumference further than this factor from the vehicle's
+/// nominal one is a unit mistake or another vehicle's file (tyres differ
+/// from their nominal size by a few per cent).
+pub const MAX_CIRCUMFERENCE_FACTOR: f64 = 1.5;
+
+/// Refuses parameters whose circumferences are far from `vehicle`'s nominal
+/// `wheel_circumference_m` (millimetres, or another vehicle's file), naming
+/// the file, the key and both values.
+pub fn check_against_vehicle(
+    spec: &str,
+    p: &Params,
+    vehicle: &deadreckon_core::Vehicle,
+) -> Result<(), Error> {
+    let nominal = vehicle.wheel_circumference_m;
+    for (name, c) in Params::NAMES[2..].iter().zip(p.circumferences()) {
+        let factor = c / nominal;
+        if !(1.0 / MAX_CIRCUMFERENCE_FACTOR..=MAX_CIRCUMFERENCE_FACTOR).contains(&factor) {
+            let hint = if (factor / 1000.0 - 1.0).abs() < 0.5 {
+                " (millimetres?)"
+            } else if (factor / 100.0 - 1.0).abs() < 0.5 {
+                " (centimetres?)"
+            } else {
+                " (another vehicle's parameters?)"
+            };
+            return Err(Error::Invalid(format!(
+                "{spec}: {name} = {c} m is {factor:.3} times the vehicle's nominal \
+                 wheel_circumference_m = {nominal} m{hint}"
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// The drive with the corrections stored in the params.toml `spec`

@@ -32,6 +32,9 @@ pub struct ReportOptions<'a> {
     pub model: Option<&'a Path>,
     /// The outage length, s (default: the report's and TedriS's own).
     pub outage_s: Option<f64>,
+    /// The step between the four-wheel outage windows, s (default half
+    /// their length).
+    pub step_s: Option<f64>,
     /// The corrections estimated on the drive when `params` stores none.
     pub corrections: deadreckon_core::timing::Which,
 }
@@ -94,7 +97,7 @@ pub fn write(
             calibration: None,
         });
     }
-    let mut input = four_wheel_input(drive, &methods, o.outage_s, steps)?;
+    let mut input = four_wheel_input(drive, &methods, o.outage_s, o.step_s, steps)?;
     input
         .calibration
         .get_or_insert_with(Default::default)

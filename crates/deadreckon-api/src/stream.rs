@@ -33,6 +33,7 @@ pub fn start_params(
         return Ok((Params::nominal(vehicle), default_prior(), None));
     }
     let p = crate::load::params_file(spec)?;
+    crate::load::check_against_vehicle(spec, &p.params, vehicle)?;
     let stored = crate::corrections::stored_in_file(Path::new(spec)).map_err(Error::Invalid)?;
     Ok(started_from(spec, &p, &stored))
 }
@@ -50,6 +51,23 @@ pub fn start_params_from_text(
     Ok(started_from(name, &p, &stored))
 }
 
+/// Stored corrections in words: each stream's delay by its name, the IMU's
+/// tilt, the gyro scale error and the driven axle's slip, the zero ones left
+/// out.
+fn stored_words(stored: &crate::corrections::Stored) -> String {
+    let mut text = crate::text::known_corrections_text(stored);
+    if stored.traction_slip_per_mps2 != 0.0 {
+        if !text.is_empty() {
+            text.push_str(", ");
+        }
+        text.push_str(&format!(
+            "driven-axle slip {:+.3}% per m/s²",
+            100.0 * stored.traction_slip_per_mps2
+        ));
+    }
+    text
+}
+
 /// The starting parameters, the prior and the warning of a read params.toml.
 fn started_from(
     name: &str,
@@ -58,8 +76,8 @@ fn started_from(
 ) -> (Params, Params, Option<String>) {
     let warning = (*stored != Default::default()).then(|| {
         format!(
-            "{name} stores corrections that `stream` does not apply to the events (delays {:?} s, IMU vertical {:?}, gyro scale error {}, driven-axle slip {} per m/s²); its parameters were calibrated on corrected streams (calibrate --corrections none gives parameters for raw events)",
-            stored.delays_s, stored.up, stored.gyro_scale_error, stored.traction_slip_per_mps2
+            "{name} stores corrections that `stream` does not apply to the events ({}); its parameters were calibrated on corrected streams (calibrate --corrections none gives parameters for raw events)",
+            stored_words(stored)
         )
     });
     let d = default_prior().to_array();

@@ -30,6 +30,12 @@ pub fn corrections_lines(c: &deadreckon_core::timing::Corrections) -> Vec<String
                 d.delay_s,
                 d.std_s
             ),
+            Some(r) if r == deadreckon_core::timing::MEASURED_NOT_APPLIED => format!(
+                "{:<10} {:>+10.4} {:>9.4}  {r}",
+                s.name(),
+                d.delay_s,
+                d.std_s
+            ),
             Some(r) => format!(
                 "{:<10} {:>10} {:>9}  not estimated: {r}",
                 s.name(),
@@ -195,7 +201,7 @@ pub fn comparison_lines(c: &deadreckon_eval::compare::Comparison, t0: f64) -> Ve
 /// column only when it is not the 1 m one), and the machine's checks.
 pub fn tedris_outage_lines(r: &deadreckon_tedris::OutageReport, threshold_m: f64) -> Vec<String> {
     let mut out = vec![format!(
-        "reference heading: {:?}; errors of the rear axle against {}",
+        "reference heading: {}; errors of the rear axle against {}",
         r.source, r.reference
     )];
     let extra = (threshold_m != 1.0).then(|| format!("to_{threshold_m}m_s"));
@@ -344,6 +350,15 @@ pub fn wheel_health_lines(h: &deadreckon_core::wheel_health::WheelHealth) -> Vec
         out.push("wheel health: no wheel slipped or read wrong".to_string());
     }
     out.extend(h.lines());
+    if h.wheels.iter().any(|w| w.epochs_checked > 0) {
+        let m = deadreckon_core::wheel_health::WheelMonitorConfig::default();
+        out.push(format!(
+            "  (|T|: a wheel's largest normalised residual against the other sensors, about standard normal on a healthy wheel; \
+             short: over {} s, a wheel spinning or locking; long: over {} m of travel, a tyre reading wrong for good; \
+             a wheel is dropped above {})",
+            m.short_window_s, m.long_window_m, m.drop_sigma
+        ));
+    }
     for (name, w) in deadreckon_core::wheel_health::WHEEL_NAMES
         .iter()
         .zip(&h.wheels)
@@ -411,7 +426,7 @@ pub fn tedris_train_lines(
     use deadreckon_tedris::ReferenceSource;
     let mut out = Vec::new();
     let s = m.straight();
-    out.push(format!("reference heading: {source:?}"));
+    out.push(format!("reference heading: {source}"));
     if let Some(c) = &m.corrections {
         out.push(format!(
             "trained on corrected streams (kept in the model, applied by tedris run): {}",
@@ -477,7 +492,7 @@ pub fn tedris_train_lines(
     }
     match &m.course_convention {
         Some(c) => out.push(format!(
-            "course convention found on the data: {:?} (residual as body yaw / as antenna course = {:.3})",
+            "course convention found on the data: the course is {} (residual as body yaw / as antenna course = {:.3})",
             c.convention, c.rss_ratio
         )),
         None if source == ReferenceSource::GnssCourse => {
@@ -624,12 +639,15 @@ pub fn kinematic_table(c: &deadreckon_core::kinematics::KinematicCalibration) ->
         }
     }
     out.push(format!(
-        "{} of {} windows above {} m/s, RMS at the window ends {:.3} m / {:.4} rad; {} ({})",
+        "{} of {} windows above {} m/s, RMS at the window ends {:.3} m / {}; {} ({})",
         c.windows_used,
         c.windows_total,
         c.min_speed_mps,
         c.rms_position_m,
-        c.rms_heading_rad,
+        c.rms_heading_rad.map_or_else(
+            || "heading not computed (the reference has none)".to_string(),
+            |h| format!("{h:.4} rad")
+        ),
         if c.converged {
             "converged"
         } else {

@@ -35,6 +35,7 @@ pub mod evo;
 pub mod filter;
 pub mod geo;
 pub mod gnss_error;
+pub mod gnss_jumps;
 pub mod gyro_drift;
 pub mod gyro_hold;
 pub mod gyro_scale;

@@ -16,6 +16,8 @@
 //! | `gyro_vs_wheel_yaw_rate` | gyro with the rear wheels' yaw rate | a flipped sign, deg/s (skid steering turns less than the wheels say: only a gyro below 0.1 times them is suspicious) |
 //! | `course_vs_track` | GNSS course with the direction of the GNSS track | radians, counter-clockwise from east |
 //! | `stuck_gnss` | GNSS position with wheel motion | a receiver repeating its last fix |
+//! | `gnss_jump` | consecutive fixes with the fastest a vehicle goes ([`crate::gnss_jumps`]) | a jump of the position that stays (refused) or outlier fixes (a warning: the gate rejects them) |
+//! | `time_unit` | speeds as read (GNSS `speed_mps`, CAN, wheel speeds) with the speed between fixes over their times; the wheel rows' interval | every file's times in milliseconds at once (all spans agree, so `time_overlap` cannot see it) |
 //!
 //! A finding is an [`Severity::Error`] when the data cannot be right (the
 //! commands refuse the drive), a [`Severity::Warning`] when it is suspicious.
@@ -70,7 +72,136 @@ pub fn check(drive: &Drive) -> Vec<Finding> {
     }
     course_vs_track(drive, &mut out);
     stuck_gnss(drive, &speed, &mut out);
+    time_unit(drive, &speed, &mut out);
+    gnss_jump(drive, &mut out);
     out
+}
+
+fn gnss_jump(d: &Drive, out: &mut Vec<Finding>) {
+    use crate::gnss_jumps::{jumps, MAX_SPEED_MPS, RETURN_WITHIN_S};
+    let all = jumps(&d.gnss);
+    for j in all.iter().filter(|j| !j.returns) {
+        out.push(error(
+            "gnss_jump",
+            format!(
+                "the GNSS position jumps {:.0} m between the fixes at {:.3} and {:.3} s \
+                 (faster than {MAX_SPEED_MPS} m/s) and does not come back within {RETURN_WITHIN_S} s: \
+                 a change of datum or base station, or a receiver restarting elsewhere? \
+                 The fixes before and after cannot be fused; use the drive before or after it",
+                j.distance_m, j.from_t_s, j.to_t_s
+            ),
+        ));
+    }
+    let outliers: Vec<_> = all.iter().filter(|j| j.returns).collect();
+    if let Some(worst) = outliers
+        .iter()
+        .max_by(|a, b| a.distance_m.total_cmp(&b.distance_m))
+    {
+        out.push(Finding {
+            check: "gnss_jump",
+            severity: Severity::Warning,
+            message: format!(
+                "{} GNSS outlier stretch{} (fixes farther than a vehicle can go, back within \
+                 {RETURN_WITHIN_S} s; the largest {:.0} m at {:.3} s): the filter's gate rejects \
+                 and counts them",
+                outliers.len(),
+                if outliers.len() == 1 { "" } else { "es" },
+                worst.distance_m,
+                worst.to_t_s
+            ),
+        });
+    }
+}
+
+/// A ratio of a speed as read to the same speed over the timestamps near
+/// this factor (within [`TIME_UNIT_TOLERANCE`]) is a time unit mistake.
+const TIME_UNIT_FACTORS: [(f64, &str); 2] = [
+    (1000.0, "every file's times in milliseconds?"),
+    (1e6, "every file's times in microseconds?"),
+];
+/// How far (as a factor) from a [`TIME_UNIT_FACTORS`] entry a ratio may be.
+const TIME_UNIT_TOLERANCE: f64 = 2.0;
+/// A median interval of wheel rows above this is slower than any wheel
+/// odometry logs (they run at 10–100 Hz), s.
+const MAX_WHEEL_INTERVAL_S: f64 = 1.0;
+
+/// Speeds read as m/s do not depend on the timestamps; speeds derived from
+/// positions over time do. With every file's times multiplied by 1000 the
+/// spans agree with each other, and the wheel speeds are all below the
+/// thresholds of the other checks, so those see nothing; but a speed read
+/// (the receiver's `speed_mps`, the CAN speed, wheel speeds in m/s) is then
+/// 1000 times the speed between the fixes.
+fn time_unit(d: &Drive, wheel_speed: &[(f64, f64)], out: &mut Vec<Finding>) {
+    let read_speed = |t: f64, fix: &crate::drive::GnssFix| -> Option<(f64, &'static str)> {
+        if let Some(v) = fix.speed_mps {
+            return Some((v.abs(), "the receiver's speed_mps"));
+        }
+        if !d.speed.is_empty() {
+            let i = d.speed.partition_point(|c| c.t_s < t);
+            if i > 0 && i < d.speed.len() {
+                return Some((d.speed[i].value.abs(), "the CAN speed"));
+            }
+        }
+        if matches!(d.wheels, Wheels::Speeds(_)) {
+            return interpolate(wheel_speed, t).map(|v| (v.abs(), "the wheel speeds"));
+        }
+        None
+    };
+    let mut ratios = Vec::new();
+    let mut what = "";
+    for p in d.gnss.windows(2) {
+        let dt = p[1].t_s - p[0].t_s;
+        if dt <= 0.0 {
+            continue;
+        }
+        let chord = (p[1].east_m - p[0].east_m).hypot(p[1].north_m - p[0].north_m);
+        let Some((v, w)) = read_speed(0.5 * (p[0].t_s + p[1].t_s), &p[1]) else {
+            continue;
+        };
+        // Moving, and far enough for the fixes' noise not to decide.
+        if v > MIN_SPEED_MPS && chord > 2.0 * p[1].std_m {
+            ratios.push(v / (chord / dt));
+            what = w;
+        }
+    }
+    if ratios.len() >= 10 {
+        let ratio = quantile_of(&ratios, 0.5);
+        if let Some((k, hint)) = TIME_UNIT_FACTORS
+            .iter()
+            .find(|(k, _)| (ratio / k).max(k / ratio) < TIME_UNIT_TOLERANCE)
+        {
+            out.push(error(
+                "time_unit",
+                format!(
+                    "{what} is {ratio:.0} times the speed between the GNSS fixes over their \
+                     timestamps (median of {} pairs): the timestamps run {k:.0} times too fast; {hint} \
+                     (the drive would last {:.1} h instead of {:.0} s)",
+                    ratios.len(),
+                    d.wheels.t_s(d.wheels.len() - 1) / 3600.0 - d.wheels.t_s(0) / 3600.0,
+                    (d.wheels.t_s(d.wheels.len() - 1) - d.wheels.t_s(0)) / k,
+                ),
+            ));
+            return;
+        }
+    }
+    let n = d.wheels.len();
+    if n >= 10 {
+        let dts: Vec<f64> = (1..n)
+            .map(|i| d.wheels.t_s(i) - d.wheels.t_s(i - 1))
+            .collect();
+        let median = quantile_of(&dts, 0.5);
+        if median > MAX_WHEEL_INTERVAL_S {
+            out.push(Finding {
+                check: "time_unit",
+                severity: Severity::Warning,
+                message: format!(
+                    "the wheel rows come every {median:.3} s (median): wheel odometry is logged at \
+                     10–100 Hz; are the times in milliseconds ({:.4} s)?",
+                    median / 1000.0
+                ),
+            });
+        }
+    }
 }
 
 /// The `q` quantile of unsorted values.

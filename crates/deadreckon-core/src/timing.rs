@@ -45,6 +45,11 @@ use crate::{rts, Error, Params};
 /// Speed above which the steering is compared with the curvature, m/s.
 pub const MIN_CURVATURE_SPEED_MPS: f64 = 2.0;
 
+/// The reason of a delay that was measured but not applied because only the
+/// GNSS delay was asked for (`Which::Gnss`); such a [`Delay`] keeps its
+/// measured `delay_s` and `std_s`.
+pub const MEASURED_NOT_APPLIED: &str = "measured, not applied: only the GNSS delay was asked for";
+
 /// Estimated, or not with the reason.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Status {
@@ -983,10 +988,8 @@ pub fn prepare_with(
     if which == Which::Gnss {
         for d in [&mut delays.gyro, &mut delays.speed, &mut delays.steering] {
             if d.status.is_estimated() {
-                d.status = Status::NotEstimated(format!(
-                    "not applied (GNSS delay only): {:+.4} ± {:.4} s measured",
-                    d.delay_s, d.std_s
-                ));
+                // The measured delay and its std stay in `d` for the reports.
+                d.status = Status::NotEstimated(MEASURED_NOT_APPLIED.to_string());
             }
         }
     }

@@ -79,7 +79,7 @@ pub fn compare(
         None => {
             let (m, _) = deadreckon_tedris::train(&hidden, TedrisConfig::default(), None)
                 .map_err(Error::HiddenTraining)?;
-            (m, "TedriS trained on the drive, outages hidden".into())
+            (m, "trained on the drive, outages hidden".into())
         }
     };
     let td = deadreckon_tedris::run_outages(drive, &model, outages)?;

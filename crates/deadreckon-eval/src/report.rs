@@ -307,10 +307,13 @@ fn consistency(drive: &Drive, params: &Params) -> Option<rp::NeesConsistency> {
 /// Builds the four-wheel part of a report for `drive` with the given
 /// parameter sets. What cannot be computed (a skipped calibration, a failed
 /// step) is listed in the report's `not_computed`, never dropped silently.
+/// `outage_s` adds sliding outages of that length, every `step_s` (default
+/// half the length), as `evaluate --outage LEN --step STEP` runs them.
 pub fn four_wheel_input(
     drive: &Drive,
     calibrations: &Calibrations,
     outage_s: Option<f64>,
+    step_s: Option<f64>,
     steps: &dyn Progress,
 ) -> Result<rp::ReportInput, Error> {
     let methods = &calibrations.sets;
@@ -438,7 +441,8 @@ pub fn four_wheel_input(
         };
         for m in methods {
             steps.step(&format!("{len} s outages with {}", m.source.name()));
-            match outage::evaluate(drive, &m.params.params, len, len / 2.0, 5.0, &opts) {
+            let step = step_s.unwrap_or(len / 2.0);
+            match outage::evaluate(drive, &m.params.params, len, step, 5.0, &opts) {
                 Ok(o) => ev.methods.push(rp::MethodSample {
                     method: m.source.name().into(),
                     final_error_m: o.windows.iter().map(|w| w.final_m()).collect(),
@@ -570,15 +574,18 @@ pub fn tedris_from_model(
 pub fn correction_rows(c: &deadreckon_core::timing::Corrections) -> Vec<rp::CorrectionRow> {
     use deadreckon_core::timing::Stream;
     let finite = |v: f64| v.is_finite().then_some(v);
+    use deadreckon_core::timing::MEASURED_NOT_APPLIED;
     let status = |reason: Option<&str>| match reason {
         None => "estimated, applied".to_string(),
+        Some(MEASURED_NOT_APPLIED) => MEASURED_NOT_APPLIED.to_string(),
         Some(r) => format!("not estimated: {r}"),
     };
     let mut rows: Vec<rp::CorrectionRow> = Stream::ALL
         .iter()
         .map(|&s| {
             let d = c.delays.get(s);
-            let estimated = d.status.is_estimated();
+            let estimated =
+                d.status.is_estimated() || d.status.reason() == Some(MEASURED_NOT_APPLIED);
             rp::CorrectionRow {
                 what: format!("{} delay", s.name()),
                 unit: "s".into(),

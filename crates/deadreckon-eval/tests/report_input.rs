@@ -26,7 +26,7 @@ fn a_failed_calibration_silently_vanished_from_the_report() {
     assert_eq!(c.sets.len() - 1 + c.skipped.len(), 3);
     assert!(c.skipped.iter().all(|s| !s.reason.is_empty()));
 
-    let input = four_wheel_input(&drive, &c, None, &()).unwrap();
+    let input = four_wheel_input(&drive, &c, None, None, &()).unwrap();
     assert_eq!(input.not_computed[..c.skipped.len()], c.skipped[..]);
     let html = tempfile::tempdir().unwrap();
     let path = html.path().join("r.html");

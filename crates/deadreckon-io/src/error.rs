@@ -21,6 +21,17 @@ pub enum IoError {
         /// What is wrong.
         msg: String,
     },
+    /// The drive directory itself does not exist (or is not a directory).
+    #[error(
+        "{}: {what} (a drive is a directory holding vehicle.toml and the CSV files, or a recording: a comma2k19 segment, a .bag, an .mcap, a tricycle .txt)",
+        dir.display()
+    )]
+    NoDirectory {
+        /// The path given.
+        dir: PathBuf,
+        /// `no such directory` or `not a directory`.
+        what: &'static str,
+    },
     /// A required file does not exist.
     #[error("{}: missing required file ({note})", path.display())]
     MissingFile {

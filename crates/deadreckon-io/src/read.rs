@@ -68,6 +68,16 @@ pub fn read_drive(dir: &Path) -> Result<Drive, IoError> {
 /// about `[origin]` of `vehicle.toml` or, when absent, the first fix (recorded
 /// in the returned `vehicle.origin`), and the result passes [`Drive::validate`].
 pub fn read_drive_with(dir: &Path, options: &ReadOptions) -> Result<Drive, IoError> {
+    if !dir.is_dir() {
+        return Err(IoError::NoDirectory {
+            dir: dir.to_path_buf(),
+            what: if dir.exists() {
+                "not a directory"
+            } else {
+                "no such directory"
+            },
+        });
+    }
     let vehicle_path = dir.join(files::VEHICLE);
     if !vehicle_path.exists() {
         return Err(IoError::MissingFile {

@@ -26,7 +26,10 @@ pub const TRACK_CSV_COLUMNS: [&str; 11] = [
 /// Writes `tracks` into one CSV file (atomically), track after track, with the
 /// columns of [`TRACK_CSV_COLUMNS`]: the `track` column holds the track's name
 /// (quoted when needed), the standard deviations are the square roots of the
-/// covariance diagonal, and `cov_en_m2` is its east-north term.
+/// covariance diagonal, and `cov_en_m2` is its east-north term. A track
+/// that carries no uncertainty ([`carries_no_covariance`]: TedriS, the
+/// kinematic shapes' integration, a reference) leaves those four columns
+/// empty rather than writing 0, which would read as certainty.
 pub fn write_track_csv(path: &Path, tracks: &[Track]) -> Result<(), IoError> {
     let mut w = csv::Writer::from_writer(Vec::new());
     let csv_err = |e: csv::Error| IoError::Unwritable {
@@ -35,6 +38,14 @@ pub fn write_track_csv(path: &Path, tracks: &[Track]) -> Result<(), IoError> {
     };
     w.write_record(TRACK_CSV_COLUMNS).map_err(csv_err)?;
     for track in tracks {
+        let none = carries_no_covariance(track);
+        let unc = |v: f64| {
+            if none {
+                String::new()
+            } else {
+                format!("{v:.6e}")
+            }
+        };
         for p in &track.points {
             // Fixed precision per column (the shortest round-trip form of a
             // tiny number runs to 40 digits): times, positions and angles to
@@ -48,10 +59,10 @@ pub fn write_track_csv(path: &Path, tracks: &[Track]) -> Result<(), IoError> {
                 format!("{:.9}", p.yaw_rad),
                 format!("{:.6}", p.speed_mps),
                 format!("{:.9}", p.yaw_rate_rps),
-                format!("{:.6e}", p.std_east_m()),
-                format!("{:.6e}", p.std_north_m()),
-                format!("{:.6e}", p.std_yaw_rad()),
-                format!("{:.6e}", p.cov_pose[1]),
+                unc(p.std_east_m()),
+                unc(p.std_north_m()),
+                unc(p.std_yaw_rad()),
+                unc(p.cov_pose[1]),
             ])
             .map_err(csv_err)?;
         }
@@ -61,6 +72,16 @@ pub fn write_track_csv(path: &Path, tracks: &[Track]) -> Result<(), IoError> {
         message: e.to_string(),
     })?;
     atomic_write(path, |out| out.write_all(&bytes))
+}
+
+/// Whether `track` has no uncertainty at all: a pose covariance of exactly
+/// zero at every pose (what estimators without one, TedriS and the kinematic
+/// integration, leave in it; a filter's covariance is never exactly zero).
+pub fn carries_no_covariance(track: &Track) -> bool {
+    track
+        .points
+        .iter()
+        .all(|p| p.cov_pose.iter().all(|&c| c == 0.0))
 }
 
 /// Options of [`write_track_geojson_with`].
@@ -141,6 +162,7 @@ pub fn write_track_geojson_with(
         });
         if let Some(every) = options.point_every_s.filter(|s| *s > 0.0) {
             let mut next = f64::NEG_INFINITY;
+            let none = carries_no_covariance(track);
             for p in &track.points {
                 if p.t_s < next {
                     continue;
@@ -152,8 +174,9 @@ pub fn write_track_geojson_with(
                 props.insert("t_s".into(), number(Some(p.t_s)));
                 props.insert("yaw_rad".into(), number(Some(p.yaw_rad)));
                 props.insert("speed_mps".into(), number(Some(p.speed_mps)));
-                props.insert("std_east_m".into(), number(Some(p.std_east_m())));
-                props.insert("std_north_m".into(), number(Some(p.std_north_m())));
+                let unc = |v: f64| number((!none).then_some(v));
+                props.insert("std_east_m".into(), unc(p.std_east_m()));
+                props.insert("std_north_m".into(), unc(p.std_north_m()));
                 features.push(Feature {
                     geometry: Some(Geometry::new_point([degrees(lon), degrees(lat)])),
                     properties: Some(props),

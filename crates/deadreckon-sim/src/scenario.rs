@@ -317,6 +317,45 @@ impl Scenario {
         self
     }
 
+    /// How long `laps` laps of the route last as planned (the speed policy's
+    /// profile), s: what the drive lasts without `duration_s`.
+    ///
+    /// # Errors
+    /// [`SimError::Invalid`] naming the key when the route or the speed
+    /// policy cannot be planned.
+    pub fn planned_duration_s(&self, laps: u32) -> Result<f64, SimError> {
+        let invalid = |key: &str, message: String| SimError::Invalid {
+            scenario: self.name.clone(),
+            key: key.into(),
+            message,
+        };
+        let route = crate::route::Route::build(&self.route, laps)
+            .map_err(|(key, message)| invalid(&key, message))?;
+        let profile = crate::profile::SpeedProfile::plan(&route, &self.speed)
+            .map_err(|message| invalid("speed", message))?;
+        Ok(profile.duration_s())
+    }
+
+    /// The fewest laps (at least `laps`) whose planned drive lasts
+    /// `duration_s`: a drive longer than the route repeats it rather than
+    /// standing still after it.
+    ///
+    /// # Errors
+    /// As [`Scenario::planned_duration_s`].
+    pub fn laps_lasting(&self, duration_s: f64) -> Result<u32, SimError> {
+        let one = self.planned_duration_s(1)?;
+        if one <= 0.0 {
+            return Ok(self.laps);
+        }
+        let mut laps = ((duration_s / one).ceil() as u32).clamp(self.laps.max(1), MAX_LAPS);
+        // Consecutive laps join without their stops at the start and end: a
+        // lap more may be needed.
+        while laps < MAX_LAPS && self.planned_duration_s(laps)? < duration_s {
+            laps += 1;
+        }
+        Ok(laps)
+    }
+
     /// The true parameters: `errors`, or the vehicle's nominal values.
     pub fn true_params(&self) -> Params {
         self.errors

@@ -23,6 +23,17 @@ pub enum ReferenceSource {
     Gyro,
 }
 
+impl std::fmt::Display for ReferenceSource {
+    /// Words for people: where the heading comes from.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            ReferenceSource::GnssCourse => "the GNSS receiver's course over ground",
+            ReferenceSource::GnssTrack => "the direction between successive GNSS fixes",
+            ReferenceSource::Gyro => "the integrated gyro",
+        })
+    }
+}
+
 impl ReferenceSource {
     /// The source a drive supports: the GNSS course first, then the gyro, then the
     /// chords between fixes. Without a course, the integrated gyro is the better

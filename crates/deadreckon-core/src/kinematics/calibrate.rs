@@ -97,13 +97,40 @@ pub struct KinematicCalibration {
     /// RMS position residual at the end of the windows, m.
     pub rms_position_m: f64,
     /// RMS heading residual at the end of the windows, rad.
-    pub rms_heading_rad: f64,
+    /// `None` where the reference has no heading (a differential drive
+    /// calibrated against GNSS positions).
+    pub rms_heading_rad: Option<f64>,
     /// Residual evaluations of the solver (all fits).
     pub evaluations: usize,
     /// True only when the solver succeeded and something was estimated.
     pub converged: bool,
     /// How the last fit ended.
     pub termination: String,
+}
+
+/// How a Levenberg–Marquardt fit ended, in words for people (the solver's
+/// own `Debug` text, `Converged { ftol: true, xtol: false }`, is for code).
+pub fn termination_words(t: &levenberg_marquardt::TerminationReason) -> String {
+    use levenberg_marquardt::TerminationReason as R;
+    match t {
+        R::Converged { ftol, xtol } => match (ftol, xtol) {
+            (true, true) => "the cost and the parameters stopped changing".to_string(),
+            (true, false) => "the cost stopped decreasing".to_string(),
+            (false, true) => "the parameters stopped changing".to_string(),
+            (false, false) => "converged".to_string(),
+        },
+        R::ResidualsZero => "the residuals are zero".to_string(),
+        R::Orthogonal => "the gradient vanished (residuals orthogonal to the Jacobian)".to_string(),
+        R::User(why) => format!("stopped by the model: {why}"),
+        R::Numerical(why) => format!("a non-finite number in the {why}"),
+        R::NoImprovementPossible(what) => {
+            format!("no improvement possible within machine precision ({what} tolerance too small)")
+        }
+        R::LostPatience => "too many evaluations without converging".to_string(),
+        R::NoParameters => "no parameter to fit".to_string(),
+        R::NoResiduals => "no residual to fit".to_string(),
+        R::WrongDimensions(what) => format!("wrong dimensions of the {what}"),
+    }
 }
 
 impl KinematicCalibration {
@@ -309,7 +336,7 @@ pub fn calibrate<M: KinematicModel>(
             .with_patience(200)
             .minimize(problem);
         evaluations += report.number_of_evaluations;
-        termination = format!("{:?}", report.termination);
+        termination = termination_words(&report.termination);
         success = report.termination.was_successful();
         full = solved.full.clone();
         // Angles are kept in (−π, π].
@@ -436,7 +463,7 @@ pub fn calibrate<M: KinematicModel>(
         windows_total: total,
         min_speed_mps: o.min_speed_mps,
         rms_position_m: rms_p,
-        rms_heading_rad: rms_h,
+        rms_heading_rad: Some(rms_h),
         evaluations,
         converged: success && cov.is_some() && !free.is_empty(),
         termination,

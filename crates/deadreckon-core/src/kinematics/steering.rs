@@ -203,7 +203,12 @@ pub fn calibrate_steering(
     let std = |k: usize| cov.as_ref().map(|c| c[(k, k)].max(0.0).sqrt());
     let ok = report.termination.was_successful() && cov.is_some();
     let [ratio, offset] = solved.p;
-    let fail = || format!("the fit did not converge ({:?})", report.termination);
+    let fail = || {
+        format!(
+            "the fit did not converge ({})",
+            crate::kinematics::calibrate::termination_words(&report.termination)
+        )
+    };
     let ratio = if !fit_ratio {
         not_estimated(
             "steering_ratio",

@@ -343,6 +343,16 @@ pub enum CourseConvention {
     BodyYaw,
 }
 
+impl std::fmt::Display for CourseConvention {
+    /// Words for people: what the receiver's course is the direction of.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            CourseConvention::AntennaVelocity => "the antenna's velocity",
+            CourseConvention::BodyYaw => "the body's yaw",
+        })
+    }
+}
+
 impl CourseConvention {
     /// True for [`CourseConvention::AntennaVelocity`].
     pub fn is_antenna(self) -> bool {

@@ -207,7 +207,7 @@ pub fn calibrate_diff_drive(
         };
         let (solved, report) = LevenbergMarquardt::new().minimize(problem);
         evaluations += report.number_of_evaluations;
-        termination = format!("{:?}", report.termination);
+        termination = crate::kinematics::calibrate::termination_words(&report.termination);
         success = report.termination.was_successful();
         global = solved.global.clone();
         let (r, j) = solved.eval(true);
@@ -296,7 +296,7 @@ pub fn calibrate_diff_drive(
         windows_total: total,
         min_speed_mps: o.min_speed_mps,
         rms_position_m: rms,
-        rms_heading_rad: f64::NAN,
+        rms_heading_rad: None,
         evaluations,
         converged: success && cov.is_some() && nf > 0,
         termination,
