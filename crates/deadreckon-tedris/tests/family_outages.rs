@@ -118,16 +118,25 @@ fn run_car(car_seed: u64) -> (Vec<PairResult>, ConventionCheck) {
     (out, check)
 }
 
-#[test]
-fn family_train_test_80s_outages() {
+/// What one set of twelve cars gave.
+struct FamilyFigures {
+    pairs: usize,
+    /// TedriS's mean, worst outage, the paper's method and TedriS over the
+    /// pairs the paper's method trained for, the baseline's mean.
+    tedris_m: f64,
+    worst_m: f64,
+    paper_m: f64,
+    tedris_on_paper_pairs_m: f64,
+    baseline_m: f64,
+    /// Course conventions right, wrong, undecided.
+    conventions: (usize, usize, usize),
+    alarms: u64,
+}
+
+/// Cars `first..first + 12`: train, run, print the per-pair table.
+fn family(first: u64) -> FamilyFigures {
     let mut all = Vec::new();
     let mut conventions = Vec::new();
-    // TEDRIS_FAMILY_FIRST_CAR=101 runs cars 101–112 (never looked at while
-    // developing) instead of 1–12.
-    let first: u64 = std::env::var("TEDRIS_FAMILY_FIRST_CAR")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(1);
     for car in first..first + 12 {
         let c = CarFamily::draw(car);
         eprintln!(
@@ -169,60 +178,114 @@ fn family_train_test_80s_outages() {
     let over_paper = |f: fn(&PairResult) -> f64| {
         paper_pairs.iter().map(|r| f(r)).sum::<f64>() / paper_pairs.len() as f64
     };
-    let p = over_paper(|r| r.paper_m.unwrap_or(f64::NAN));
-    let t_paper_pairs = over_paper(|r| r.tedris_m);
+    let count = |c| conventions.iter().filter(|x| **x == c).count();
+    let fig = FamilyFigures {
+        pairs: all.len(),
+        tedris_m: mean(|r| r.tedris_m),
+        worst_m: worst,
+        paper_m: over_paper(|r| r.paper_m.unwrap_or(f64::NAN)),
+        tedris_on_paper_pairs_m: over_paper(|r| r.tedris_m),
+        baseline_m: mean(|r| r.baseline_m),
+        conventions: (
+            count(ConventionCheck::Right),
+            count(ConventionCheck::Wrong),
+            count(ConventionCheck::Undecided),
+        ),
+        alarms: all.iter().map(|r| r.alarms).sum(),
+    };
+    let (accepted, refused) = all
+        .iter()
+        .fold((0, 0), |(a, r), p| (a + p.refits.0, r + p.refits.1));
     eprintln!(
-        "{} pairs: tedris mean {:.2} m (worst {:.2}), paper {:.2} m over the {} pairs it trained for (tedris {:.2} m there), baseline {:.2} m (worst {:.2})",
-        all.len(),
-        mean(|r| r.tedris_m),
-        worst,
-        p,
+        "{} pairs: tedris mean {:.2} m (worst {:.2}), paper {:.2} m over the {} pairs it trained for (tedris {:.2} m there), baseline {:.2} m (worst {:.2}); course convention {} right, {} wrong, {} undecided; watchdog alarms {}; refits {accepted} accepted, {refused} refused",
+        fig.pairs,
+        fig.tedris_m,
+        fig.worst_m,
+        fig.paper_m,
         paper_pairs.len(),
-        t_paper_pairs,
-        mean(|r| r.baseline_m),
-        all.iter().map(|r| r.baseline_m).fold(0.0, f64::max)
+        fig.tedris_on_paper_pairs_m,
+        fig.baseline_m,
+        all.iter().map(|r| r.baseline_m).fold(0.0, f64::max),
+        fig.conventions.0,
+        fig.conventions.1,
+        fig.conventions.2,
+        fig.alarms,
     );
-    assert!(all.len() >= 20, "{} pairs", all.len());
+    fig
+}
+
+#[test]
+fn family_train_test_80s_outages() {
+    // TEDRIS_FAMILY_FIRST_CAR=101 runs cars 101–112 instead of 1–12 (held
+    // out once, but choices in deadreckon-tedris were since compared on them:
+    // no longer untouched; cars 201–212 are, below).
+    let first: u64 = std::env::var("TEDRIS_FAMILY_FIRST_CAR")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(1);
+    let f = family(first);
+    assert!(f.pairs >= 20, "{} pairs", f.pairs);
     // Measured (cars 1–12, 26 pairs, reversing at 40 % of the stops):
-    // TedriS 2.44 m mean, worst 5.80 m (2.46 m and 6.07 m before held courses
-    // were skipped and the run's blocks numbered after the model's); the
-    // paper's method alone 34.9 m over the 23 pairs it trained for (not on
-    // car 11: cross-correlation peak 0.265); the baseline 6.00 m (worst 18.1
-    // m). Cars 101–112 (29 pairs, not looked at while developing): 1.37 m,
-    // worst 2.94 m (1.43 m and 3.65 m before); paper 20.4 m; baseline 5.23 m. Before reversing was added to the family (24 and 28
+    // TedriS 2.41 m mean, worst 5.80 m (2.44 m before issue 35's speed kind;
+    // 2.46 m and 6.07 m before held courses were skipped and the run's
+    // blocks numbered after the model's); the paper's method alone 34.9 m
+    // over the 23 pairs it trained for (not on car 11: cross-correlation
+    // peak 0.265); the baseline 6.00 m (worst 18.1 m). Cars 101–112 (29
+    // pairs): 1.37 m, worst 2.94 m (1.43 m and 3.65 m before); paper 20.4 m;
+    // baseline 5.23 m. Before reversing was added to the family (24 and 28
     // pairs): 2.70 m (worst 8.61) and 1.92 m (worst 5.68) with the distance
     // scale, 3.17 m and 2.22 m without it. Before the heading segments, the
     // consistency check and the per-metre form: 82.3 m mean, worst 390 m.
     // The issue's targets: mean under 3 m, no outage above 10 m.
-    let (t, b) = (mean(|r| r.tedris_m), mean(|r| r.baseline_m));
-    assert!(t < 2.7, "TedriS mean {t} m");
-    assert!(worst < 7.0, "TedriS worst outage {worst} m");
+    assert!(f.tedris_m < 2.7, "TedriS mean {} m", f.tedris_m);
+    assert!(f.worst_m < 7.0, "TedriS worst outage {} m", f.worst_m);
     // The course convention: measured 9 right, 3 undecided (cars 101–112: 9
     // right, 3 undecided), none wrong.
-    let count = |c| conventions.iter().filter(|x| **x == c).count();
-    eprintln!(
-        "course convention: {} right, {} wrong, {} undecided",
-        count(ConventionCheck::Right),
-        count(ConventionCheck::Wrong),
-        count(ConventionCheck::Undecided)
-    );
-    assert_eq!(count(ConventionCheck::Wrong), 0);
+    assert_eq!(f.conventions.1, 0);
+    assert!(f.conventions.0 >= 8);
     // The watchdog is a noisy signal: measured 3 alarms on trained models over
     // the 26 test runs of cars 1–12 (0 over the 29 of cars 101–112). An alarm
     // only brings a calibration forward, which the held-back check guards, so
     // the errors above are the same with and without it.
-    let alarms: u64 = all.iter().map(|r| r.alarms).sum();
-    eprintln!("watchdog alarms over the test drives: {alarms}");
-    let (accepted, refused) = all
-        .iter()
-        .fold((0, 0), |(a, r), p| (a + p.refits.0, r + p.refits.1));
-    eprintln!("refits over the test drives: {accepted} accepted, {refused} refused");
-    assert!(alarms <= 5, "{alarms} watchdog alarms on trained models");
-    assert!(count(ConventionCheck::Right) >= 8);
-    assert!(t < 0.6 * b, "TedriS {t} m against the baseline's {b} m");
     assert!(
-        t_paper_pairs < 0.1 * p,
-        "TedriS {t_paper_pairs} m against the paper method's {p} m"
+        f.alarms <= 5,
+        "{} watchdog alarms on trained models",
+        f.alarms
+    );
+    assert!(
+        f.tedris_m < 0.6 * f.baseline_m,
+        "{} against {}",
+        f.tedris_m,
+        f.baseline_m
+    );
+    assert!(
+        f.tedris_on_paper_pairs_m < 0.1 * f.paper_m,
+        "TedriS {} m against the paper method's {} m",
+        f.tedris_on_paper_pairs_m,
+        f.paper_m
+    );
+}
+
+/// Cars 201–212: drawn for issue 33 and run once when this test was
+/// written, after issue 35's changes; no choice was made on them. Bounds
+/// near their own figures.
+#[test]
+fn family_held_out_cars_201_to_212() {
+    let f = family(201);
+    // Measured: 29 pairs, TedriS 1.59 m mean (worst 5.19 m), the paper's
+    // method 25.50 m over the 29 pairs, the baseline 5.05 m; course
+    // convention 7 right, 0 wrong, 5 undecided; no watchdog alarm.
+    assert!(f.pairs >= 27, "{} pairs", f.pairs);
+    assert!(f.tedris_m < 2.0, "TedriS mean {} m", f.tedris_m);
+    assert!(f.worst_m < 6.5, "TedriS worst outage {} m", f.worst_m);
+    assert_eq!(f.conventions.1, 0);
+    assert!(f.conventions.0 >= 6, "{:?}", f.conventions);
+    assert!(f.alarms <= 2, "{}", f.alarms);
+    assert!(
+        f.tedris_m < 0.4 * f.baseline_m,
+        "{} against {}",
+        f.tedris_m,
+        f.baseline_m
     );
 }
 
