@@ -555,10 +555,11 @@ impl Feeder {
         result
     }
 
-    /// The wheel interval ending at `t`, and whether it is a gap: the
-    /// interval its counts cover ([`crate::tick_interval`]), which for a
-    /// regular counter with jittered stamps is its cycle.
-    fn wheel_interval(&mut self, t: f64) -> Option<(f64, bool)> {
+    /// The wheel interval ending at `t`, and whether it is a gap: for tick
+    /// counts (`ticks`) the interval they cover ([`crate::tick_interval`]),
+    /// which for a regular counter with jittered stamps is its cycle; for
+    /// wheel speeds the stamps' (a speed is not a count over an interval).
+    fn wheel_interval(&mut self, t: f64, ticks: bool) -> Option<(f64, bool)> {
         let prev = self.last_wheel_s.replace(t)?;
         let interval = t - prev;
         if self.max_interval_s.is_none() || self.intervals.len() < GAP_MEDIAN_OF {
@@ -571,8 +572,8 @@ impl Feeder {
             }
         }
         let gap = self.max_interval_s.is_some_and(|m| interval > m);
-        if gap {
-            return Some((interval, true));
+        if gap || !ticks {
+            return Some((interval, gap));
         }
         Some((self.counting.push(interval), false))
     }
@@ -675,7 +676,8 @@ impl Feeder {
                     }
                 }
                 Measurement::WheelTicks { .. } | Measurement::WheelSpeeds { .. } => {
-                    let Some((interval, gap)) = self.wheel_interval(t) else {
+                    let ticks = matches!(ev.measurement, Measurement::WheelTicks { .. });
+                    let Some((interval, gap)) = self.wheel_interval(t, ticks) else {
                         return Ok(());
                     };
                     let prediction = self.predict(f, t);
@@ -723,7 +725,8 @@ impl Feeder {
             Timing::EachMeasurement => {
                 let wheel = if ev.is_wheel() {
                     // The first row after the start only opens an interval.
-                    let Some(iv) = self.wheel_interval(t) else {
+                    let ticks = matches!(ev.measurement, Measurement::WheelTicks { .. });
+                    let Some(iv) = self.wheel_interval(t, ticks) else {
                         return Ok(());
                     };
                     Some(iv)
