@@ -515,7 +515,7 @@ fn a_dead_reckoned_spiral_set_the_trajectory_frame() {
     let html = render_html(&input).unwrap();
     assert!(html.contains("trajectories-whole"), "no full-extent figure");
     assert!(
-        html.contains("DR (nominal) leaves it"),
+        html.contains("DR (nominal) runs out of it"),
         "the caption does not name the track"
     );
     // Without a wandering track there is one figure.
@@ -530,5 +530,88 @@ fn the_gate_flattened_the_nis_figure() {
     assert!(
         html.contains("(above the frame)"),
         "the gate outside the frame is not named in the caption"
+    );
+}
+
+/// The SVG of the named figure of a page.
+fn figure<'a>(html: &'a str, name: &str) -> &'a str {
+    let at = html
+        .find(&format!("data-figure=\"{name}\""))
+        .unwrap_or_else(|| panic!("no figure {name}"));
+    let body = &html[at..];
+    &body[..body.find("</figure>").expect("figure closed")]
+}
+
+/// Issue 34: the GNSS fixes were drawn before the tracks, which hid them on the
+/// comma2k19 straight. Every track line must come before the first fix; only the
+/// gated crosses (drawn in the gated colour) may follow.
+#[test]
+fn gnss_fixes_were_hidden_under_the_tracks() {
+    let html = render_html(&sample_input(120.0)).unwrap();
+    let fig = figure(&html, "trajectories");
+    let data = fig
+        .split("<g class=\"data\">")
+        .nth(1)
+        .and_then(|g| g.split("</g>").next())
+        .expect("data group");
+    let first_fix = data.find("<circle").expect("GNSS fixes drawn");
+    let before = data[..first_fix].matches("<polyline").count();
+    assert!(
+        before >= 4,
+        "the tracks come before the fixes ({before} lines)"
+    );
+    let gated = "#D55E00";
+    for line in data[first_fix..].split("<polyline").skip(1) {
+        let tag = line.split('>').next().unwrap_or("");
+        assert!(
+            tag.contains(gated),
+            "a line drawn above the GNSS fixes that is not a gated cross: {tag}"
+        );
+    }
+}
+
+/// Issue 34: a filtered track that ran away (and a dead-reckoned one) set the
+/// axes of the trajectory figure; the axes follow the reference and the GNSS
+/// fixes, the runaway tracks are clipped and the caption names them.
+#[test]
+fn a_runaway_filtered_track_set_the_trajectory_axes() {
+    let mut input = sample_input(120.0);
+    let t = input.trajectories.as_mut().unwrap();
+    let runaway = |p: &EnPath| EnPath {
+        east_m: p
+            .east_m
+            .iter()
+            .enumerate()
+            .map(|(k, e)| e + 3.0 * k as f64)
+            .collect(),
+        north_m: p.north_m.clone(),
+    };
+    t.filtered = t.filtered.as_ref().map(runaway);
+    let html = render_html(&input).unwrap();
+    let cap = figure(&html, "trajectories");
+    assert!(
+        cap.contains("The frame is set by the reference and the GNSS fixes"),
+        "the caption does not say what sets the frame"
+    );
+    assert!(
+        cap.contains("filtered runs out of it and is clipped"),
+        "the caption does not name the clipped track"
+    );
+    assert!(html.contains("trajectories-whole"), "no full-extent figure");
+    // The runaway track reaches 3 m × its samples east; the frame's x ticks
+    // stay within the reference's extent plus the margin and the equal-aspect
+    // widening.
+    let ticks_max = |fig: &str| {
+        fig.split("<text")
+            .filter_map(|t| t.split('>').nth(1))
+            .filter_map(|t| t.split('<').next())
+            .filter_map(|t| t.trim().parse::<f64>().ok())
+            .fold(f64::NEG_INFINITY, f64::max)
+    };
+    let plain = render_html(&sample_input(120.0)).unwrap();
+    assert_eq!(
+        ticks_max(figure(&html, "trajectories")),
+        ticks_max(figure(&plain, "trajectories")),
+        "the runaway track moved the axes"
     );
 }
