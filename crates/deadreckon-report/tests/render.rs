@@ -601,17 +601,85 @@ fn a_runaway_filtered_track_set_the_trajectory_axes() {
     // The runaway track reaches 3 m × its samples east; the frame's x ticks
     // stay within the reference's extent plus the margin and the equal-aspect
     // widening.
-    let ticks_max = |fig: &str| {
-        fig.split("<text")
-            .filter_map(|t| t.split('>').nth(1))
-            .filter_map(|t| t.split('<').next())
-            .filter_map(|t| t.trim().parse::<f64>().ok())
-            .fold(f64::NEG_INFINITY, f64::max)
-    };
+    let ticks_max = largest_label;
     let plain = render_html(&sample_input(120.0)).unwrap();
     assert_eq!(
         ticks_max(figure(&html, "trajectories")),
         ticks_max(figure(&plain, "trajectories")),
         "the runaway track moved the axes"
     );
+}
+
+/// The largest number among the text labels of a figure (its axis ticks).
+fn largest_label(fig: &str) -> f64 {
+    fig.split("<text")
+        .filter_map(|t| t.split('>').nth(1))
+        .filter_map(|t| t.split('<').next())
+        .filter_map(|t| t.trim().parse::<f64>().ok())
+        .fold(f64::NEG_INFINITY, f64::max)
+}
+
+/// Issue 34: one outlier set bins of 10 m for errors of 0.5 m, and the methods
+/// shared one bar. The bins end at the 95th percentile with a labelled overflow
+/// bin, and each method has its own bars that never overlap another's.
+#[test]
+fn one_outlier_ruled_the_histogram_bins() {
+    let mut input = sample_input(120.0);
+    let o = input.outages.as_mut().unwrap();
+    let regular_max = o
+        .methods
+        .iter()
+        .flat_map(|m| m.final_error_m.iter().copied())
+        .fold(0.0f64, f64::max);
+    o.methods[0].final_error_m[0] = 1.0e4;
+    let html = render_html(&input).unwrap();
+    let fig = figure(&html, "outage-final-error");
+    assert!(
+        fig.contains("counts every value above"),
+        "the overflow bin is not explained"
+    );
+    let top = largest_label(fig);
+    assert!(
+        top < 2.0 * regular_max.max(1.0),
+        "axis reaches {top} for values up to {regular_max} and one outlier"
+    );
+    // Bars of different methods never share an x interval.
+    let data = fig
+        .split("<g class=\"data\">")
+        .nth(1)
+        .and_then(|g| g.split("</g>").next())
+        .expect("data group");
+    let mut bars: Vec<(f64, f64, String)> = Vec::new();
+    for tag in data.split("<rect").skip(1) {
+        let tag = tag.split('>').next().unwrap_or("");
+        let num = |a: &str| {
+            tag.split(&format!(" {a}=\""))
+                .nth(1)
+                .and_then(|s| s.split('"').next())
+                .and_then(|s| s.parse::<f64>().ok())
+                .unwrap_or(0.0)
+        };
+        let fill = tag
+            .split(" fill=\"")
+            .nth(1)
+            .and_then(|s| s.split('"').next())
+            .unwrap_or("")
+            .to_string();
+        bars.push((num("x"), num("x") + num("width"), fill));
+    }
+    let methods = input.outages.as_ref().unwrap().methods.len();
+    let fills: std::collections::BTreeSet<&str> = bars.iter().map(|b| b.2.as_str()).collect();
+    assert_eq!(fills.len(), methods, "one bar colour per method");
+    for a in &bars {
+        for b in &bars {
+            if a.2 != b.2 {
+                assert!(
+                    a.1 <= b.0 + 0.5 || b.1 <= a.0 + 0.5,
+                    "bars of {} and {} overlap",
+                    a.2,
+                    b.2
+                );
+            }
+        }
+    }
 }
