@@ -683,3 +683,39 @@ fn one_outlier_ruled_the_histogram_bins() {
         }
     }
 }
+
+/// Issue 34: innovation plots whose ±2σ bands dwarfed the points read
+/// "0 outside ±2σ, expected 4.6 %" and nothing else; steering innovations were
+/// in m/s without a word.
+#[test]
+fn a_band_that_dwarfed_the_innovations_said_nothing() {
+    let mut input = sample_input(120.0);
+    let h = input.health.as_mut().unwrap();
+    // The sample's gyro: σ 0.0031 rad/s. A band 50 times that.
+    h.innovations[0].std.iter_mut().for_each(|s| *s *= 50.0);
+    let mut steering = h.innovations[0].clone();
+    steering.sensor = "steering".into();
+    steering.unit = "m/s".into();
+    h.innovations.push(steering);
+    let html = render_html(&input).unwrap();
+    let gyro = figure(&html, "health-innovation-0");
+    assert!(
+        gyro.contains("The ±2σ band dwarfs the points"),
+        "no word on the band"
+    );
+    // "/" is escaped in the caption's HTML.
+    assert!(
+        gyro.contains("rad&#x2f;s,") || gyro.contains("rad/s,"),
+        "the caption's numbers have no unit"
+    );
+    let last = h_len(&input) - 1;
+    let steer = figure(&html, &format!("health-innovation-{last}"));
+    assert!(steer.contains("not an angle"), "steering unit unexplained");
+    // The sample as it is (band about 2σ of the innovations) says nothing.
+    let plain = render_html(&sample_input(120.0)).unwrap();
+    assert!(!plain.contains("dwarfs the points"));
+}
+
+fn h_len(input: &ReportInput) -> usize {
+    input.health.as_ref().unwrap().innovations.len()
+}
