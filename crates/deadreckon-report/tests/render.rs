@@ -719,3 +719,41 @@ fn a_band_that_dwarfed_the_innovations_said_nothing() {
 fn h_len(input: &ReportInput) -> usize {
     input.health.as_ref().unwrap().innovations.len()
 }
+
+/// Issue 34: the corrections table ran past the page: its status column did
+/// not wrap, cut even at 1920 px. The status cells wrap (class `text`), the
+/// numbers do not.
+#[test]
+fn the_corrections_status_column_did_not_wrap() {
+    let mut input = sample_input(120.0);
+    let c = input
+        .calibration
+        .as_mut()
+        .and_then(|c| c.corrections.as_mut())
+        .expect("the sample has corrections");
+    let long = "stored in params.toml, applied; estimated on this drive too and the two differ by more than their standard errors";
+    c.rows[0].status = long.into();
+    let html = render_html(&input).unwrap();
+    assert!(
+        html.contains(&format!("<td class=\"text\">{long}</td>")),
+        "the status cell does not wrap"
+    );
+    assert!(html.contains("td.text { white-space: normal"));
+    assert!(html.contains("table { max-width: 100%; }"));
+    // One wrapping cell per corrections row and per NEES row, no more.
+    let rows = input
+        .calibration
+        .as_ref()
+        .unwrap()
+        .corrections
+        .as_ref()
+        .unwrap()
+        .rows
+        .len()
+        + input
+            .health
+            .as_ref()
+            .and_then(|h| h.consistency.as_ref())
+            .map_or(0, |c| c.rows.len());
+    assert_eq!(html.matches("<td class=\"text\">").count(), rows);
+}

@@ -70,6 +70,7 @@ pub(crate) fn section(
                     .into(),
                 headers,
                 rows,
+                text_column: None,
             }],
         });
     }
@@ -100,6 +101,7 @@ pub(crate) fn section(
                     .map(String::from)
                     .to_vec(),
                 rows,
+                text_column: Some(3),
             }],
         });
     }

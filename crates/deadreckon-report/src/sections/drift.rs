@@ -59,6 +59,7 @@ pub(crate) fn section(
                 "n runs".into(),
             ],
             rows,
+            text_column: None,
         }],
     }];
     let errors: Vec<Sample<'_>> = d

@@ -52,6 +52,7 @@ pub(crate) fn section(
                         ],
                     })
                     .collect(),
+                text_column: Some(5),
             }],
         });
     }

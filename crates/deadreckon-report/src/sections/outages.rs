@@ -56,6 +56,7 @@ pub(crate) fn section(
             .map(String::from)
             .to_vec(),
             rows,
+            text_column: None,
         }],
     }];
     let samples: Vec<Sample<'_>> = methods

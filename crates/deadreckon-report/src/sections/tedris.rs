@@ -193,6 +193,7 @@ fn model_table(m: &crate::model::RegressionModel) -> TableView {
             .map(String::from)
             .to_vec(),
         rows,
+        text_column: None,
     }
 }
 
