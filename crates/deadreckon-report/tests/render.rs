@@ -738,7 +738,11 @@ fn the_corrections_status_column_did_not_wrap() {
         html.contains(&format!("<td class=\"text\">{long}</td>")),
         "the status cell does not wrap"
     );
-    assert!(html.contains("td.text { white-space: normal"));
+    assert!(html.contains("th.text, td.text { white-space: normal; text-align: left"));
+    assert!(
+        html.contains("<th class=\"text\">status</th>"),
+        "the status heading is not aligned with its cells"
+    );
     assert!(html.contains("table { max-width: 100%; }"));
     // One wrapping cell per corrections row and per NEES row, no more.
     let rows = input
