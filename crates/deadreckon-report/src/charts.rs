@@ -1,4 +1,4 @@
-//! Chart kinds shared by several sections: overlaid histograms, box plots and
+//! Chart kinds shared by several sections: grouped histograms, box plots and
 //! time series, drawn with a consistent colour per method.
 
 use plotters::prelude::*;
