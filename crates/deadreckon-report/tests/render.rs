@@ -761,3 +761,30 @@ fn the_corrections_status_column_did_not_wrap() {
             .map_or(0, |c| c.rows.len());
     assert_eq!(html.matches("<td class=\"text\">").count(), rows);
 }
+
+/// Issue 34: stored corrections showed "–" as their standard error without a
+/// word; the caption says what the dash means when a value has no error.
+#[test]
+fn a_stored_correction_showed_a_dash_for_its_std() {
+    let mut input = sample_input(120.0);
+    let c = input
+        .calibration
+        .as_mut()
+        .and_then(|c| c.corrections.as_mut())
+        .expect("the sample has corrections");
+    c.rows[0].value = Some(0.1);
+    c.rows[0].std = None;
+    c.rows[0].status = "stored, applied".into();
+    let html = render_html(&input).unwrap();
+    assert!(html.contains("–: no standard error (params.toml keeps the values it applies"));
+    // With every value's error known, no such note.
+    let mut input = sample_input(120.0);
+    let c = input
+        .calibration
+        .as_mut()
+        .and_then(|c| c.corrections.as_mut())
+        .unwrap();
+    c.rows.retain(|r| r.value.is_none() || r.std.is_some());
+    let html = render_html(&input).unwrap();
+    assert!(!html.contains("–: no standard error"));
+}
