@@ -1,10 +1,13 @@
-//! Chart kinds shared by several sections: overlaid histograms, box plots and
+//! Chart kinds shared by several sections: grouped histograms, box plots and
 //! time series, drawn with a consistent colour per method.
 
 use plotters::prelude::*;
 
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+
 use crate::plot::{
     data_begin, data_end, draw_line, padded_range, render_chart, segments, Frame, Legend, OrPlot,
+    Swatch,
 };
 use crate::stats::{bin_edges, histogram, minmax_indices, quantile_sorted, sorted_finite};
 use crate::{ReportError, MAX_POINTS};
@@ -16,29 +19,93 @@ pub(crate) struct Sample<'a> {
     pub values: &'a [f64],
 }
 
-/// Overlaid histograms (fraction of each sample per bin, so methods with different
-/// counts compare), each a light fill under a step outline. `None` without finite values.
+/// Quantile of the pooled values that ends the regular bins of a histogram:
+/// values beyond it go to one overflow bin, so that one outlier (or one method
+/// far worse than the others) does not set bins of 10 m for errors of 0.5 m.
+pub(crate) const HISTOGRAM_QUANTILE: f64 = 0.95;
+/// About this many regular bins.
+const HISTOGRAM_BINS: usize = 20;
+
+/// A histogram figure: the SVG and, when values lay beyond the regular bins,
+/// the lower edge of the overflow bin.
+pub(crate) struct Histogram {
+    /// The chart.
+    pub svg: String,
+    /// Values above this were counted in the last (overflow) bin.
+    pub overflow_above: Option<f64>,
+}
+
+impl Histogram {
+    /// The sentence for the caption about the overflow bin (empty without one).
+    pub fn overflow_note(&self, unit: &str) -> String {
+        match self.overflow_above {
+            Some(x) => format!(
+                " Bins up to the {:.0}th percentile of all values; the last bar, marked \u{201c}>\u{201d}, \
+                 counts every value above {} {unit}.",
+                100.0 * HISTOGRAM_QUANTILE,
+                crate::plot::fmt_trim(x, 3)
+            ),
+            None => String::new(),
+        }
+    }
+}
+
+/// Grouped histograms: in each bin one bar per method side by side (fraction
+/// of each sample per bin, so methods with different counts compare). The bins
+/// run up to the [`HISTOGRAM_QUANTILE`] of the pooled values and one overflow
+/// bin holds the rest. `None` without finite values.
 pub(crate) fn histogram_chart(
     figure: &str,
     samples: &[Sample<'_>],
     x_desc: &str,
     y_desc: &str,
     vline: Option<(f64, &str)>,
-) -> Result<Option<String>, ReportError> {
-    let mut all: Vec<&[f64]> = samples.iter().map(|s| s.values).collect();
+) -> Result<Option<Histogram>, ReportError> {
+    let pooled = sorted_finite(
+        &samples
+            .iter()
+            .flat_map(|s| s.values.iter().copied())
+            .collect::<Vec<_>>(),
+    );
+    let (Some(&lo), Some(&hi)) = (pooled.first(), pooled.last()) else {
+        return Ok(None);
+    };
+    let robust_hi = quantile_sorted(&pooled, HISTOGRAM_QUANTILE);
+    let overflow = hi > robust_hi && robust_hi > lo;
+    let upper = if overflow { robust_hi } else { hi };
     let extra = vline.map(|v| [v.0]);
+    let range = [lo, upper];
+    let mut all: Vec<&[f64]> = vec![&range];
     if let Some(e) = &extra {
         all.push(e);
     }
-    let edges = bin_edges(&all, 30);
+    let mut edges = bin_edges(&all, HISTOGRAM_BINS);
     if edges.len() < 2 {
         return Ok(None);
     }
+    let regular = edges[edges.len() - 1];
+    let overflow_above = (overflow && hi > regular).then_some(regular);
+    if overflow_above.is_some() {
+        let w = edges[1] - edges[0];
+        edges.push(regular + w);
+    }
+    let nb = edges.len() - 1;
     let fractions: Vec<Vec<f64>> = samples
         .iter()
         .map(|s| {
-            let c = histogram(s.values, &edges);
-            let n = c.iter().sum::<usize>().max(1) as f64;
+            let mut c = histogram(
+                s.values,
+                &edges[..if overflow_above.is_some() { nb } else { nb + 1 }],
+            );
+            if overflow_above.is_some() {
+                c.push(
+                    s.values
+                        .iter()
+                        .filter(|v| v.is_finite() && **v > regular)
+                        .count(),
+                );
+            }
+            let n = s.values.iter().filter(|v| v.is_finite()).count().max(1) as f64;
             c.into_iter().map(|k| k as f64 / n).collect()
         })
         .collect();
@@ -47,53 +114,54 @@ pub(crate) fn histogram_chart(
         return Ok(None);
     }
     let x0 = edges[0];
-    let x1 = edges[edges.len() - 1];
-    let frame = Frame::new(x0..x1, 0.0..top * 1.1, x_desc, y_desc);
+    let x1 = edges[nb];
+    let frame = Frame::new(x0..x1, 0.0..top * 1.12, x_desc, y_desc);
     let svg = render_chart(figure, &frame, |chart, keys| {
         data_begin(chart)?;
-        // Outlines drawn from the thickest to the thinnest: two methods with the
-        // same bins (RTS and truth within the first bin) both stay visible, the
-        // later one inside the earlier.
-        let k = samples.len() as u32;
+        // One bar per method in each bin, side by side: two methods in the same
+        // bin (RTS and truth within 0.5 m) are two bars, not one.
+        let k = samples.len().max(1) as f64;
         for (j, (s, f)) in samples.iter().zip(&fractions).enumerate() {
             let c = s.color;
-            let width = 2 + 2 * (k - 1 - j as u32);
             chart
                 .draw_series(
                     f.iter()
                         .enumerate()
                         .filter(|(_, v)| **v > 0.0)
                         .map(|(i, v)| {
-                            Rectangle::new(
-                                [(edges[i], 0.0), (edges[i + 1], *v)],
-                                c.mix(0.07).filled(),
-                            )
+                            let w = edges[i + 1] - edges[i];
+                            let a = edges[i] + w * (0.05 + 0.9 * j as f64 / k);
+                            let b = edges[i] + w * (0.05 + 0.9 * (j + 1) as f64 / k);
+                            Rectangle::new([(a, 0.0), (b, *v)], c.mix(0.85).filled())
                         }),
                 )
                 .or_plot()?;
-            let mut step = vec![(edges[0], 0.0)];
-            for (i, v) in f.iter().enumerate() {
-                step.push((edges[i], *v));
-                step.push((edges[i + 1], *v));
-            }
-            step.push((edges[edges.len() - 1], 0.0));
             let n = s.values.iter().filter(|v| v.is_finite()).count();
-            draw_line(
-                chart,
-                keys,
-                vec![step],
-                c,
-                width,
-                Some(&format!("{} (n = {n})", s.name)),
-            )?;
+            keys.add(format!("{} (n = {n})", s.name), Swatch::Bar(c));
         }
         data_end(chart)?;
+        if let Some(at) = overflow_above {
+            let mid = 0.5 * (edges[nb - 1] + edges[nb]);
+            chart
+                .draw_series(std::iter::once(Text::new(
+                    format!(">{}", crate::plot::fmt_trim(at, 3)),
+                    (mid, top * 1.1),
+                    (crate::plot::FONT, 13)
+                        .into_font()
+                        .color(&BLACK)
+                        .pos(Pos::new(HPos::Center, VPos::Top)),
+                )))
+                .or_plot()?;
+        }
         if let Some((x, label)) = vline {
             crate::plot::draw_vline(chart, keys, x, crate::plot::REFERENCE, Some(label))?;
         }
         Ok(())
     })?;
-    Ok(Some(svg))
+    Ok(Some(Histogram {
+        svg,
+        overflow_above,
+    }))
 }
 
 /// Horizontal box plots, one row per sample: box from the first to the third

@@ -39,6 +39,10 @@ pub(crate) struct TableView {
     pub caption: String,
     pub headers: Vec<String>,
     pub rows: Vec<RowView>,
+    /// The column of words (a status, a verdict): it wraps and is left-aligned,
+    /// so that the table stays within the page (the corrections' status ran
+    /// past it, even at 1920 px; issue 34).
+    pub text_column: Option<usize>,
 }
 
 /// A table row: the first cell may carry the method's colour swatch.

@@ -580,9 +580,10 @@ pub(crate) struct Palette {
     next: usize,
 }
 
-/// Colours for methods without a fixed colour, in order of first appearance.
-const EXTRA: [RGBColor; 8] = [
-    RGBColor(148, 103, 189),
+/// Colours for methods without a fixed colour, in order of first appearance
+/// (no purple: that is TedriS's, and the four-wheel filter drew in a second
+/// purple beside it; issue 34).
+const EXTRA: [RGBColor; 7] = [
     RGBColor(23, 190, 207),
     RGBColor(188, 189, 34),
     RGBColor(214, 39, 40),
@@ -603,6 +604,8 @@ fn canonical(method: &str) -> String {
         "gt" | "ground truth" | "reference" => "truth".to_string(),
         "ours" | "our method" | "rts calibration" | "rts-calibrated" => "rts".to_string(),
         "ekf" => "filtered".to_string(),
+        // The comparison's four-wheel filter is the RTS-calibrated one.
+        "four-wheel" | "four-wheel ekf" => "rts".to_string(),
         _ => m,
     }
 }
@@ -620,6 +623,54 @@ fn fixed(canonical: &str) -> Option<RGBColor> {
         _ => return None,
     })
 }
+
+/// The word a caption uses for a colour: the hue's name, `grey` or `black` for
+/// the unsaturated ones, `brown` for a dark red or orange. Captions name colours
+/// through this, so that the word matches what is drawn.
+pub(crate) fn colour_name(c: RGBColor) -> &'static str {
+    let (r, g, b) = (f64::from(c.0), f64::from(c.1), f64::from(c.2));
+    let max = r.max(g).max(b);
+    let min = r.min(g).min(b);
+    if max - min < 30.0 {
+        return if max < 70.0 { "black" } else { "grey" };
+    }
+    let d = max - min;
+    let hue = if max == r {
+        (60.0 * (g - b) / d).rem_euclid(360.0)
+    } else if max == g {
+        60.0 * (b - r) / d + 120.0
+    } else {
+        60.0 * (r - g) / d + 240.0
+    };
+    match hue {
+        h if !(15.0..345.0).contains(&h) => {
+            if max < 150.0 {
+                "brown"
+            } else {
+                "red"
+            }
+        }
+        h if h < 45.0 => {
+            if max < 150.0 {
+                "brown"
+            } else {
+                "orange"
+            }
+        }
+        h if h < 70.0 => "yellow",
+        h if h < 170.0 => "green",
+        h if h < 200.0 => "cyan",
+        h if h < 255.0 => "blue",
+        h if h < 295.0 => "purple",
+        _ => "pink",
+    }
+}
+
+/// Every colour word [`colour_name`] can give.
+#[cfg(test)]
+pub(crate) const COLOUR_WORDS: [&str; 11] = [
+    "black", "grey", "brown", "red", "orange", "yellow", "green", "cyan", "blue", "purple", "pink",
+];
 
 impl Palette {
     /// Registers a method so that it keeps its colour in every figure.
@@ -673,6 +724,44 @@ mod tests {
         let b = p.color("other");
         assert_ne!(a, b);
         assert_eq!(p.color("My Method"), a);
+    }
+
+    /// Issue 34: TedriS and the four-wheel filter were drawn in two purples.
+    #[test]
+    fn tedris_and_the_four_wheel_filter_were_two_purples() {
+        let mut p = Palette::default();
+        for m in ["nominal", "RTS", "zupt", "truth", "filtered", "smoothed"] {
+            p.register(m);
+        }
+        let t = p.color("TedriS");
+        let f = p.color("four-wheel");
+        assert_ne!(colour_name(t), colour_name(f), "{t:?} and {f:?}");
+        // The extra colours a further method can get stay away from TedriS's
+        // purple: the removed extra purple was 60.5 away in RGB, the nearest
+        // extra now (brown 140, 86, 75) is 91.8.
+        let d = |a: RGBColor, b: RGBColor| {
+            let sq = |x: u8, y: u8| (f64::from(x) - f64::from(y)).powi(2);
+            (sq(a.0, b.0) + sq(a.1, b.1) + sq(a.2, b.2)).sqrt()
+        };
+        for e in EXTRA {
+            assert!(d(e, t) > 80.0, "{e:?} too close to TedriS {t:?}");
+        }
+    }
+
+    #[test]
+    fn colour_names_follow_the_hue() {
+        assert_eq!(colour_name(REFERENCE), "red");
+        assert_eq!(colour_name(GATED), "orange");
+        assert_eq!(colour_name(RGBColor(117, 60, 160)), "purple");
+        assert_eq!(colour_name(RGBColor(0, 114, 178)), "blue");
+        assert_eq!(colour_name(RGBColor(0, 158, 115)), "green");
+        assert_eq!(colour_name(RGBColor(204, 121, 167)), "pink");
+        assert_eq!(colour_name(RGBColor(120, 120, 120)), "grey");
+        assert_eq!(colour_name(RGBColor(40, 40, 40)), "black");
+        assert_eq!(colour_name(RGBColor(140, 86, 75)), "brown");
+        for c in EXTRA {
+            assert!(COLOUR_WORDS.contains(&colour_name(c)));
+        }
     }
 
     #[test]

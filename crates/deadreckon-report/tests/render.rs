@@ -515,7 +515,7 @@ fn a_dead_reckoned_spiral_set_the_trajectory_frame() {
     let html = render_html(&input).unwrap();
     assert!(html.contains("trajectories-whole"), "no full-extent figure");
     assert!(
-        html.contains("DR (nominal) leaves it"),
+        html.contains("DR (nominal) runs out of it"),
         "the caption does not name the track"
     );
     // Without a wandering track there is one figure.
@@ -531,4 +531,260 @@ fn the_gate_flattened_the_nis_figure() {
         html.contains("(above the frame)"),
         "the gate outside the frame is not named in the caption"
     );
+}
+
+/// The SVG of the named figure of a page.
+fn figure<'a>(html: &'a str, name: &str) -> &'a str {
+    let at = html
+        .find(&format!("data-figure=\"{name}\""))
+        .unwrap_or_else(|| panic!("no figure {name}"));
+    let body = &html[at..];
+    &body[..body.find("</figure>").expect("figure closed")]
+}
+
+/// Issue 34: the GNSS fixes were drawn before the tracks, which hid them on the
+/// comma2k19 straight. Every track line must come before the first fix; only the
+/// gated crosses (drawn in the gated colour) may follow.
+#[test]
+fn gnss_fixes_were_hidden_under_the_tracks() {
+    let html = render_html(&sample_input(120.0)).unwrap();
+    let fig = figure(&html, "trajectories");
+    let data = fig
+        .split("<g class=\"data\">")
+        .nth(1)
+        .and_then(|g| g.split("</g>").next())
+        .expect("data group");
+    let first_fix = data.find("<circle").expect("GNSS fixes drawn");
+    let before = data[..first_fix].matches("<polyline").count();
+    assert!(
+        before >= 4,
+        "the tracks come before the fixes ({before} lines)"
+    );
+    let gated = "#D55E00";
+    for line in data[first_fix..].split("<polyline").skip(1) {
+        let tag = line.split('>').next().unwrap_or("");
+        assert!(
+            tag.contains(gated),
+            "a line drawn above the GNSS fixes that is not a gated cross: {tag}"
+        );
+    }
+}
+
+/// Issue 34: a filtered track that ran away (and a dead-reckoned one) set the
+/// axes of the trajectory figure; the axes follow the reference and the GNSS
+/// fixes, the runaway tracks are clipped and the caption names them.
+#[test]
+fn a_runaway_filtered_track_set_the_trajectory_axes() {
+    let mut input = sample_input(120.0);
+    let t = input.trajectories.as_mut().unwrap();
+    let runaway = |p: &EnPath| EnPath {
+        east_m: p
+            .east_m
+            .iter()
+            .enumerate()
+            .map(|(k, e)| e + 3.0 * k as f64)
+            .collect(),
+        north_m: p.north_m.clone(),
+    };
+    t.filtered = t.filtered.as_ref().map(runaway);
+    let html = render_html(&input).unwrap();
+    let cap = figure(&html, "trajectories");
+    assert!(
+        cap.contains("The frame is set by the reference and the GNSS fixes"),
+        "the caption does not say what sets the frame"
+    );
+    assert!(
+        cap.contains("filtered runs out of it and is clipped"),
+        "the caption does not name the clipped track"
+    );
+    assert!(html.contains("trajectories-whole"), "no full-extent figure");
+    // The runaway track reaches 3 m × its samples east; the frame's x ticks
+    // stay within the reference's extent plus the margin and the equal-aspect
+    // widening.
+    let ticks_max = largest_label;
+    let plain = render_html(&sample_input(120.0)).unwrap();
+    assert_eq!(
+        ticks_max(figure(&html, "trajectories")),
+        ticks_max(figure(&plain, "trajectories")),
+        "the runaway track moved the axes"
+    );
+}
+
+/// The largest number among the text labels of a figure (its axis ticks).
+fn largest_label(fig: &str) -> f64 {
+    fig.split("<text")
+        .filter_map(|t| t.split('>').nth(1))
+        .filter_map(|t| t.split('<').next())
+        .filter_map(|t| t.trim().parse::<f64>().ok())
+        .fold(f64::NEG_INFINITY, f64::max)
+}
+
+/// Issue 34: one outlier set bins of 10 m for errors of 0.5 m, and the methods
+/// shared one bar. The bins end at the 95th percentile with a labelled overflow
+/// bin, and each method has its own bars that never overlap another's.
+#[test]
+fn one_outlier_ruled_the_histogram_bins() {
+    let mut input = sample_input(120.0);
+    let o = input.outages.as_mut().unwrap();
+    let regular_max = o
+        .methods
+        .iter()
+        .flat_map(|m| m.final_error_m.iter().copied())
+        .fold(0.0f64, f64::max);
+    o.methods[0].final_error_m[0] = 1.0e4;
+    let html = render_html(&input).unwrap();
+    let fig = figure(&html, "outage-final-error");
+    assert!(
+        fig.contains("counts every value above"),
+        "the overflow bin is not explained"
+    );
+    let top = largest_label(fig);
+    assert!(
+        top < 2.0 * regular_max.max(1.0),
+        "axis reaches {top} for values up to {regular_max} and one outlier"
+    );
+    // Bars of different methods never share an x interval.
+    let data = fig
+        .split("<g class=\"data\">")
+        .nth(1)
+        .and_then(|g| g.split("</g>").next())
+        .expect("data group");
+    let mut bars: Vec<(f64, f64, String)> = Vec::new();
+    for tag in data.split("<rect").skip(1) {
+        let tag = tag.split('>').next().unwrap_or("");
+        let num = |a: &str| {
+            tag.split(&format!(" {a}=\""))
+                .nth(1)
+                .and_then(|s| s.split('"').next())
+                .and_then(|s| s.parse::<f64>().ok())
+                .unwrap_or(0.0)
+        };
+        let fill = tag
+            .split(" fill=\"")
+            .nth(1)
+            .and_then(|s| s.split('"').next())
+            .unwrap_or("")
+            .to_string();
+        bars.push((num("x"), num("x") + num("width"), fill));
+    }
+    let methods = input.outages.as_ref().unwrap().methods.len();
+    let fills: std::collections::BTreeSet<&str> = bars.iter().map(|b| b.2.as_str()).collect();
+    assert_eq!(fills.len(), methods, "one bar colour per method");
+    for a in &bars {
+        for b in &bars {
+            if a.2 != b.2 {
+                assert!(
+                    a.1 <= b.0 + 0.5 || b.1 <= a.0 + 0.5,
+                    "bars of {} and {} overlap",
+                    a.2,
+                    b.2
+                );
+            }
+        }
+    }
+}
+
+/// Issue 34: innovation plots whose ±2σ bands dwarfed the points read
+/// "0 outside ±2σ, expected 4.6 %" and nothing else; steering innovations were
+/// in m/s without a word.
+#[test]
+fn a_band_that_dwarfed_the_innovations_said_nothing() {
+    let mut input = sample_input(120.0);
+    let h = input.health.as_mut().unwrap();
+    // The sample's gyro: σ 0.0031 rad/s. A band 50 times that.
+    h.innovations[0].std.iter_mut().for_each(|s| *s *= 50.0);
+    let mut steering = h.innovations[0].clone();
+    steering.sensor = "steering".into();
+    steering.unit = "m/s".into();
+    h.innovations.push(steering);
+    let html = render_html(&input).unwrap();
+    let gyro = figure(&html, "health-innovation-0");
+    assert!(
+        gyro.contains("The ±2σ band dwarfs the points"),
+        "no word on the band"
+    );
+    // "/" is escaped in the caption's HTML.
+    assert!(
+        gyro.contains("rad&#x2f;s,") || gyro.contains("rad/s,"),
+        "the caption's numbers have no unit"
+    );
+    let last = h_len(&input) - 1;
+    let steer = figure(&html, &format!("health-innovation-{last}"));
+    assert!(steer.contains("not an angle"), "steering unit unexplained");
+    // The sample as it is (band about 2σ of the innovations) says nothing.
+    let plain = render_html(&sample_input(120.0)).unwrap();
+    assert!(!plain.contains("dwarfs the points"));
+}
+
+fn h_len(input: &ReportInput) -> usize {
+    input.health.as_ref().unwrap().innovations.len()
+}
+
+/// Issue 34: the corrections table ran past the page: its status column did
+/// not wrap, cut even at 1920 px. The status cells wrap (class `text`), the
+/// numbers do not.
+#[test]
+fn the_corrections_status_column_did_not_wrap() {
+    let mut input = sample_input(120.0);
+    let c = input
+        .calibration
+        .as_mut()
+        .and_then(|c| c.corrections.as_mut())
+        .expect("the sample has corrections");
+    let long = "stored in params.toml, applied; estimated on this drive too and the two differ by more than their standard errors";
+    c.rows[0].status = long.into();
+    let html = render_html(&input).unwrap();
+    assert!(
+        html.contains(&format!("<td class=\"text\">{long}</td>")),
+        "the status cell does not wrap"
+    );
+    assert!(html.contains("th.text, td.text { white-space: normal; text-align: left"));
+    assert!(
+        html.contains("<th class=\"text\">status</th>"),
+        "the status heading is not aligned with its cells"
+    );
+    assert!(html.contains("table { max-width: 100%; }"));
+    // One wrapping cell per corrections row and per NEES row, no more.
+    let rows = input
+        .calibration
+        .as_ref()
+        .unwrap()
+        .corrections
+        .as_ref()
+        .unwrap()
+        .rows
+        .len()
+        + input
+            .health
+            .as_ref()
+            .and_then(|h| h.consistency.as_ref())
+            .map_or(0, |c| c.rows.len());
+    assert_eq!(html.matches("<td class=\"text\">").count(), rows);
+}
+
+/// Issue 34: stored corrections showed "–" as their standard error without a
+/// word; the caption says what the dash means when a value has no error.
+#[test]
+fn a_stored_correction_showed_a_dash_for_its_std() {
+    let mut input = sample_input(120.0);
+    let c = input
+        .calibration
+        .as_mut()
+        .and_then(|c| c.corrections.as_mut())
+        .expect("the sample has corrections");
+    c.rows[0].value = Some(0.1);
+    c.rows[0].std = None;
+    c.rows[0].status = "stored, applied".into();
+    let html = render_html(&input).unwrap();
+    assert!(html.contains("–: no standard error (params.toml keeps the values it applies"));
+    // With every value's error known, no such note.
+    let mut input = sample_input(120.0);
+    let c = input
+        .calibration
+        .as_mut()
+        .and_then(|c| c.corrections.as_mut())
+        .unwrap();
+    c.rows.retain(|r| r.value.is_none() || r.std.is_some());
+    let html = render_html(&input).unwrap();
+    assert!(!html.contains("–: no standard error"));
 }

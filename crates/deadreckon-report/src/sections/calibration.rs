@@ -70,6 +70,7 @@ pub(crate) fn section(
                     .into(),
                 headers,
                 rows,
+                text_column: None,
             }],
         });
     }
@@ -93,13 +94,20 @@ pub(crate) fn section(
         blocks.push(Block::Tables {
             tables: vec![TableView {
                 caption: format!(
-                    "Timing and mounting corrections of the streams every section uses: {}.",
-                    k.source
+                    "Timing and mounting corrections of the streams every section uses: {}.{}",
+                    k.source,
+                    if k.rows.iter().any(|r| r.std.is_none() && r.value.is_some()) {
+                        " –: no standard error (params.toml keeps the values it applies, \
+                         not their errors; a correction not estimated has neither)."
+                    } else {
+                        ""
+                    }
                 ),
                 headers: ["correction", "value", "std", "status"]
                     .map(String::from)
                     .to_vec(),
                 rows,
+                text_column: Some(3),
             }],
         });
     }

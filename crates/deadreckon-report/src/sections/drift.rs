@@ -59,6 +59,7 @@ pub(crate) fn section(
                 "n runs".into(),
             ],
             rows,
+            text_column: None,
         }],
     }];
     let errors: Vec<Sample<'_>> = d
@@ -81,10 +82,12 @@ pub(crate) fn section(
         blocks.push(Block::Figure(FigureView {
             name: "drift-error-histogram".into(),
             caption: format!(
-                "Horizontal error after {} m of dead reckoning (figure 4): fraction of segments per bin.",
-                fmt_trim(seg, 3)
+                "Horizontal error after {} m of dead reckoning (figure 4): fraction of segments per bin, \
+                 one bar per method.{}",
+                fmt_trim(seg, 3),
+                svg.overflow_note("m")
             ),
-            svg,
+            svg: svg.svg,
         }));
     }
     let distances: Vec<Sample<'_>> = d

@@ -52,6 +52,7 @@ pub(crate) fn section(
                         ],
                     })
                     .collect(),
+                text_column: Some(5),
             }],
         });
     }
@@ -222,7 +223,60 @@ fn innovation_figure(
         ));
     }
     caption.push('.');
+    if s.sensor == "steering" && s.unit == "m/s" {
+        caption.push_str(
+            " The steering innovation is in m/s, not an angle: eq. (7)'s pseudo-measurement \
+             v·tan δ against the model l·ψ̇ (a lateral speed at the front axle).",
+        );
+    }
+    if let Some(w) = wide_band(&accepted, &s.std) {
+        let u = if s.unit.is_empty() {
+            String::new()
+        } else {
+            format!(" {}", s.unit)
+        };
+        caption.push_str(&format!(
+            " The ±2σ band dwarfs the points: its median half-width is {}{u}, {:.0} times the \
+             95th percentile of |innovation| ({}{u}). The predicted spread (state uncertainty \
+             plus this sensor's noise setting) is far wider than what is observed, so the \
+             count outside ±2σ says little here; the consistency of the state itself is the \
+             NEES table's.",
+            fmt_sig(w.band_half_width, 3),
+            w.ratio,
+            fmt_sig(w.p95_abs, 3),
+        ));
+    }
     Ok(Some(FigureView { name, caption, svg }))
+}
+
+/// Ratio of the band's median half-width 2σ to the 95th percentile of the
+/// accepted |innovation| above which the caption says the band dwarfs the points.
+const WIDE_BAND_RATIO: f64 = 4.0;
+
+/// A ±2σ band much wider than the innovations it should enclose.
+struct WideBand {
+    band_half_width: f64,
+    p95_abs: f64,
+    ratio: f64,
+}
+
+/// `Some` when the median 2σ is more than [`WIDE_BAND_RATIO`] times the 95th
+/// percentile of the accepted |innovation|.
+fn wide_band(accepted: &[f64], std: &[f64]) -> Option<WideBand> {
+    let abs: Vec<f64> = accepted.iter().map(|v| v.abs()).collect();
+    let abs = sorted_finite(&abs);
+    let two_sigma = sorted_finite(&std.iter().map(|s| 2.0 * s).collect::<Vec<_>>());
+    if abs.is_empty() || two_sigma.is_empty() {
+        return None;
+    }
+    let p95_abs = quantile_sorted(&abs, 0.95);
+    let band_half_width = quantile_sorted(&two_sigma, 0.5);
+    let ratio = band_half_width / p95_abs;
+    (p95_abs > 0.0 && ratio > WIDE_BAND_RATIO).then_some(WideBand {
+        band_half_width,
+        p95_abs,
+        ratio,
+    })
 }
 
 fn nis_figure(

@@ -2,6 +2,8 @@
 //! into a [`SectionView`], or nothing when it has no data.
 
 mod calibration;
+#[cfg(test)]
+mod caption_colours;
 mod drift;
 mod health;
 mod outages;

@@ -56,6 +56,7 @@ pub(crate) fn section(
             .map(String::from)
             .to_vec(),
             rows,
+            text_column: None,
         }],
     }];
     let samples: Vec<Sample<'_>> = methods
@@ -75,8 +76,8 @@ pub(crate) fn section(
     )? {
         blocks.push(Block::Figure(FigureView {
             name: "outage-final-error".into(),
-            caption: format!("Error at the end of each sliding outage window{window}: fraction of windows per bin."),
-            svg,
+            caption: format!("Error at the end of each sliding outage window{window}: fraction of windows per bin, one bar per method.{}", svg.overflow_note("m")),
+            svg: svg.svg,
         }));
     }
     Ok(Some(SectionView {

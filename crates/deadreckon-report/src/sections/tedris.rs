@@ -10,8 +10,8 @@ use crate::charts::{lines_chart, Line};
 use crate::model::{CrossCorrelation, OutageRun, Repositories, Tedris, TimeSeries};
 use crate::page::{Block, FigureView, RowView, SectionView, TableView};
 use crate::plot::{
-    data_begin, data_end, draw_hline, draw_vline, fmt_sig, fmt_trim, padded_range, render_chart,
-    Frame, Legend, OrPlot, Palette, Swatch, GATED, REFERENCE, SMALL_WIDTH, WIDTH,
+    colour_name, data_begin, data_end, draw_hline, draw_vline, fmt_sig, fmt_trim, padded_range,
+    render_chart, Frame, Legend, OrPlot, Palette, Swatch, GATED, REFERENCE, SMALL_WIDTH, WIDTH,
 };
 use crate::{check_len, ReportError};
 
@@ -54,7 +54,8 @@ pub(crate) fn section(
     if !figures.is_empty() {
         blocks.push(Block::Note {
             text: format!(
-                "Dead-reckoning error through each outage (figures 6–7 of the TedriS paper); red dashed line: {} m.",
+                "Dead-reckoning error through each outage (figures 6–7 of the TedriS paper); {} dashed line: {} m.",
+                colour_name(REFERENCE),
                 fmt_trim(t.threshold_m, 3)
             ),
         });
@@ -192,6 +193,7 @@ fn model_table(m: &crate::model::RegressionModel) -> TableView {
             .map(String::from)
             .to_vec(),
         rows,
+        text_column: None,
     }
 }
 
@@ -346,7 +348,10 @@ fn repositories(
         r.fill.iter().sum::<u64>()
     );
     if r.min_fill.is_some() {
-        caption.push_str(&format!("; {n_below} below the minimum fill (orange)"));
+        caption.push_str(&format!(
+            "; {n_below} below the minimum fill ({})",
+            colour_name(GATED)
+        ));
     }
     caption.push('.');
     Ok(Some(FigureView {

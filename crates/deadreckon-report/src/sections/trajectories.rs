@@ -15,6 +15,11 @@ use crate::{check_len, ReportError, MAX_POINTS};
 
 /// The reference trajectory: a wide light band.
 const REFERENCE_BAND: RGBColor = RGBColor(200, 200, 200);
+/// Margin around the extent of the reference and GNSS fixes that sets the frame,
+/// as a fraction of that extent.
+const FRAME_MARGIN: f64 = 0.1;
+/// Radius of a GNSS fix, px (drawn above the tracks).
+const GNSS_DOT_PX: i32 = 2;
 
 fn has_points(p: &EnPath) -> bool {
     p.east_m
@@ -58,46 +63,36 @@ pub(crate) fn section(
     if lines.is_empty() && reference.is_none() && gnss.is_none() && gated.is_none() {
         return Ok(None);
     }
-    // The frame covers what is anchored to the ground (the reference, the
-    // GNSS fixes, the filtered and smoothed tracks); a dead-reckoned track that
-    // wanders far beyond it (nominal parameters: a spiral hundreds of metres
-    // off) is clipped there and shown whole in a second, small figure.
-    let anchored: Vec<&EnPath> = lines
-        .iter()
-        .filter(|(n, _, _)| !n.starts_with("DR ("))
-        .map(|(_, p, _)| *p)
-        .chain(reference)
-        .chain(gnss)
-        .collect();
+    // The frame is set by what is tied to the ground: the reference and the
+    // GNSS fixes (the filtered and smoothed tracks only when neither exists),
+    // plus a margin. A track that runs away from it (nominal parameters: a
+    // half-circle hundreds of metres off) is clipped at the frame and shown
+    // whole in a second, small figure; the caption says which.
+    let ground: Vec<&EnPath> = reference.into_iter().chain(gnss).collect();
+    let anchored: Vec<&EnPath> = if ground.is_empty() {
+        lines.iter().map(|(_, p, _)| *p).collect()
+    } else {
+        ground
+    };
     let everything: Vec<&EnPath> = lines
         .iter()
         .map(|(_, p, _)| *p)
         .chain(reference)
         .chain(gnss)
         .collect();
-    let extent = |paths: &[&EnPath]| {
+    let extent = |paths: &[&EnPath], pad: f64| {
         let e = paths.iter().flat_map(|p| p.east_m.iter());
         let n = paths.iter().flat_map(|p| p.north_m.iter());
-        padded_range(e, 0.04).zip(padded_range(n, 0.04))
+        padded_range(e, pad).zip(padded_range(n, pad))
     };
-    let Some((all_x, all_y)) = extent(&everything) else {
+    let Some((all_x, all_y)) = extent(&everything, 0.04) else {
         return Ok(None);
     };
-    let (xr, yr) = match extent(&anchored) {
+    let (xr, yr) = match extent(&anchored, FRAME_MARGIN) {
         Some((x, y)) => (x, y),
         None => (all_x.clone(), all_y.clone()),
     };
     let span = |r: &std::ops::Range<f64>| r.end - r.start;
-    let outside: Vec<&str> = lines
-        .iter()
-        .filter(|(_, p, _)| {
-            p.east_m.iter().zip(&p.north_m).any(|(e, n)| {
-                let (dx, dy) = (0.5 * span(&xr), 0.5 * span(&yr));
-                *e < xr.start - dx || *e > xr.end + dx || *n < yr.start - dy || *n > yr.end + dy
-            })
-        })
-        .map(|(n, _, _)| n.as_str())
-        .collect();
     let mut colors: Vec<RGBColor> = Vec::new();
     for (name, _, _) in &lines {
         let key = name
@@ -122,18 +117,6 @@ pub(crate) fn section(
                     7,
                     Some("truth (reference)"),
                 )?;
-            }
-            if let Some(g) = gnss {
-                let idx = stride_indices(g.east_m.len(), MAX_POINTS);
-                let pts: Vec<(f64, f64)> = segments(&g.east_m, &g.north_m, &idx).concat();
-                counts.push(format!("{} GNSS fixes used", g.east_m.len()));
-                chart
-                    .draw_series(
-                        pts.into_iter()
-                            .map(|p| Circle::new(p, 1, gnss_color.mix(0.7).filled())),
-                    )
-                    .or_plot()?;
-                keys.add("GNSS fixes", Swatch::Dot(gnss_color));
             }
             for ((name, p, w), c) in lines.iter().zip(&colors) {
                 // Points outside the frame break the line (plotters would draw
@@ -160,6 +143,19 @@ pub(crate) fn section(
                     *w,
                     Some(name),
                 )?;
+            }
+            // The fixes above the tracks: under them they were hidden (issue 34).
+            if let Some(g) = gnss {
+                let idx = stride_indices(g.east_m.len(), MAX_POINTS);
+                let pts: Vec<(f64, f64)> = segments(&g.east_m, &g.north_m, &idx).concat();
+                counts.push(format!("{} GNSS fixes used", g.east_m.len()));
+                chart
+                    .draw_series(
+                        pts.into_iter()
+                            .map(|p| Circle::new(p, GNSS_DOT_PX, gnss_color.filled())),
+                    )
+                    .or_plot()?;
+                keys.add("GNSS fixes", Swatch::Dot(gnss_color));
             }
             if let Some(g) = gated {
                 let idx = stride_indices(g.east_m.len(), MAX_POINTS);
@@ -189,6 +185,16 @@ pub(crate) fn section(
         .size(width, height)
         .legend(Legend::Right);
     (frame.x, frame.y) = equal_aspect(xr, yr, frame.plot_area_px());
+    // The tracks with a point outside the frame: clipped there.
+    let outside: Vec<&str> = lines
+        .iter()
+        .filter(|(_, p, _)| {
+            p.east_m.iter().zip(&p.north_m).any(|(e, n)| {
+                e.is_finite() && n.is_finite() && !(frame.x.contains(e) && frame.y.contains(n))
+            })
+        })
+        .map(|(n, _, _)| n.as_str())
+        .collect();
     let svg = draw_all(&frame, "trajectories", &mut counts)?;
     let mut caption = "Trajectories in the local east-north frame, equal scales on both axes. DR: dead reckoning \
                        from the start with each calibration (figure 6 of the four-wheel paper)."
@@ -198,6 +204,12 @@ pub(crate) fn section(
         caption.push_str(&counts.join(", "));
         caption.push('.');
     }
+    let frame_basis = match (reference.is_some(), gnss.is_some()) {
+        (true, true) => "the reference and the GNSS fixes",
+        (true, false) => "the reference",
+        (false, true) => "the GNSS fixes",
+        (false, false) => "the tracks",
+    };
     let mut blocks = Vec::new();
     if outside.is_empty() {
         blocks.push(Block::Figure(FigureView {
@@ -207,11 +219,13 @@ pub(crate) fn section(
         }));
     } else {
         caption.push_str(&format!(
-            " The frame covers the tracks anchored to the ground (reference, GNSS fixes, \
-             filtered, smoothed); {} leave{} it by more than half its size (clipped \
-             here, whole in the next figure).",
+            " The frame is set by {} plus a margin of {:.0} % of their extent; {} run{} \
+             out of it and {} clipped at its edge (whole in the next figure).",
+            frame_basis,
+            100.0 * FRAME_MARGIN,
             outside.join(", "),
-            if outside.len() == 1 { "s" } else { "" }
+            if outside.len() == 1 { "s" } else { "" },
+            if outside.len() == 1 { "is" } else { "are" },
         ));
         blocks.push(Block::Figure(FigureView {
             name: "trajectories".into(),
