@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{run, run_err, run_ok};
+use common::{run, run_err, run_ok, simulated};
 
 /// The last time the truth moves faster than 1 m/s, and the last time.
 fn last_moving_and_end(dir: &str) -> (f64, f64) {
@@ -181,16 +181,7 @@ fn tedris_track_csv_wrote_std_zero_where_it_has_no_uncertainty() {
 fn report_had_no_step_so_an_evaluate_figure_could_not_be_reproduced_in_a_report() {
     let tmp = tempfile::tempdir().unwrap();
     let p = |n: &str| tmp.path().join(n).to_str().unwrap().to_string();
-    let d = p("d");
-    run_ok(&[
-        "simulate",
-        "--scenario",
-        "calibration",
-        "--duration",
-        "300",
-        "--out",
-        &d,
-    ]);
+    let d = simulated(tmp.path(), "d", "300");
     let windows = |extra: &[&str]| -> u64 {
         let mut args = vec!["evaluate", d.as_str(), "--outage", "30", "--json"];
         args.extend_from_slice(extra);

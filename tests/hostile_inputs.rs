@@ -5,23 +5,7 @@
 
 mod common;
 
-use common::{run, run_err, run_ok};
-use std::path::Path;
-
-/// A seeded five-minute calibration drive in `dir/name`; its path.
-fn simulated(dir: &Path, name: &str) -> String {
-    let out = dir.join(name).to_str().unwrap().to_string();
-    run_ok(&[
-        "simulate",
-        "--scenario",
-        "calibration",
-        "--duration",
-        "300",
-        "--out",
-        &out,
-    ]);
-    out
-}
+use common::{run, run_err, run_ok, simulated};
 
 /// Rewrites every data row of the CSV `file` with `f(row index, fields)`.
 fn rewrite(file: &str, f: impl Fn(usize, &mut Vec<String>)) {
@@ -43,7 +27,7 @@ fn scaled(field: &str, k: f64) -> String {
 #[test]
 fn every_files_times_in_milliseconds_are_refused_as_milliseconds() {
     let tmp = tempfile::tempdir().unwrap();
-    let d = simulated(tmp.path(), "d");
+    let d = simulated(tmp.path(), "d", "300");
     for f in std::fs::read_dir(&d).unwrap() {
         let p = f.unwrap().path();
         if p.extension().is_some_and(|e| e == "csv") {
@@ -75,7 +59,7 @@ fn every_files_times_in_milliseconds_are_refused_as_milliseconds() {
 #[test]
 fn a_gnss_jump_of_a_kilometre_that_stays_is_refused_with_its_time() {
     let tmp = tempfile::tempdir().unwrap();
-    let d = simulated(tmp.path(), "d");
+    let d = simulated(tmp.path(), "d", "300");
     // Every fix from the 299th (149.1 s) on, 1 km east.
     rewrite(&format!("{d}/gnss.csv"), |i, r| {
         if i >= 298 {
@@ -93,7 +77,7 @@ fn a_gnss_jump_of_a_kilometre_that_stays_is_refused_with_its_time() {
 #[test]
 fn a_gnss_outlier_a_kilometre_off_is_warned_about_and_gated() {
     let tmp = tempfile::tempdir().unwrap();
-    let d = simulated(tmp.path(), "d");
+    let d = simulated(tmp.path(), "d", "300");
     rewrite(&format!("{d}/gnss.csv"), |i, r| {
         if i == 298 {
             r[1] = (r[1].parse::<f64>().unwrap() + 1000.0).to_string();
@@ -125,7 +109,7 @@ fn a_gnss_outlier_a_kilometre_off_is_warned_about_and_gated() {
 #[test]
 fn a_circumference_in_millimetres_in_params_toml_is_refused_naming_file_key_and_values() {
     let tmp = tempfile::tempdir().unwrap();
-    let d = simulated(tmp.path(), "d");
+    let d = simulated(tmp.path(), "d", "300");
     let p = tmp.path().join("p.toml");
     let p = p.to_str().unwrap();
     run_ok(&["calibrate", &d, "--out", p]);

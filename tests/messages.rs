@@ -3,18 +3,9 @@
 
 mod common;
 
-use common::{run, run_err, run_ok};
+use common::{run, run_err, run_ok, simulated};
 
 const HUSKY: &str = "../shared/data/husky-gps-bag/husky_gps.bag";
-
-/// A seeded simulated drive of `duration_s` in `dir/name`; its path.
-fn simulated(dir: &std::path::Path, name: &str, duration_s: &str) -> String {
-    scenario(
-        dir,
-        name,
-        &["--scenario", "calibration", "--duration", duration_s],
-    )
-}
 
 /// A seeded simulated drive of `args` in `dir/name`; its path.
 fn scenario(dir: &std::path::Path, name: &str, args: &[&str]) -> String {

@@ -63,3 +63,19 @@ pub fn run_err(args: &[&str]) -> String {
     assert!(!r.ok, "deadreckon {args:?} succeeded:\n{}", r.stdout);
     r.stderr
 }
+
+/// Simulates `duration_s` of the built-in calibration scenario (its default
+/// seed) into `dir/name`; returns the drive's path.
+pub fn simulated(dir: &std::path::Path, name: &str, duration_s: &str) -> String {
+    let out = dir.join(name).to_str().unwrap().to_string();
+    run_ok(&[
+        "simulate",
+        "--scenario",
+        "calibration",
+        "--duration",
+        duration_s,
+        "--out",
+        &out,
+    ]);
+    out
+}
