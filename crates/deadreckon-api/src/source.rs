@@ -116,20 +116,19 @@ pub fn read_ros_saying(
         path: path.to_path_buf(),
         source,
     };
+    // Read once: the topics choose the built-in mapping, then the same bytes
+    // are read with it.
+    let (bytes, file) = deadreckon_ros::log_bytes(path).map_err(ros_err)?;
     let (mapping, said) = match mapping {
         Some(m) => (mapping_file(m)?, format!("mapping: {}", m.display())),
         None => {
-            let topics = if path.is_dir() {
-                deadreckon_ros::rosbag2_storage(path).and_then(deadreckon_ros::list_topics)
-            } else {
-                deadreckon_ros::list_topics(path)
-            }
-            .map_err(ros_err)?;
+            let topics = deadreckon_ros::list_topics_bytes(&bytes, &file).map_err(ros_err)?;
             let names: Vec<&str> = topics.iter().map(|t| t.topic.as_str()).collect();
             builtin_mapping(&names)
         }
     };
-    let (drive, report) = deadreckon_ros::read_log(path, &mapping).map_err(ros_err)?;
+    let (drive, report) =
+        deadreckon_ros::read_log_bytes(&bytes, &file, &mapping).map_err(ros_err)?;
     Ok((drive, report, said))
 }
 

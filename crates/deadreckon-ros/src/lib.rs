@@ -193,20 +193,32 @@ pub fn read_log(
     path: impl AsRef<Path>,
     mapping: &Mapping,
 ) -> Result<(Drive, ImportReport), RosError> {
-    let path = path.as_ref();
-    let storage;
-    let path = if path.is_dir() {
-        storage = rosbag2_storage(path)?;
-        storage.as_path()
+    let (bytes, file) = log_bytes(path.as_ref())?;
+    read_log_bytes(&bytes, &file, mapping)
+}
+
+/// The bytes of the recording [`read_log`] reads at `path` (a bag, an MCAP
+/// file, or a rosbag2 directory's MCAP file), and its name for errors: for a
+/// caller that looks at it ([`list_topics_bytes`]) before reading it, once.
+pub fn log_bytes(path: &Path) -> Result<(Vec<u8>, String), RosError> {
+    if path.is_dir() {
+        read_file(&rosbag2_storage(path)?)
     } else {
-        path
-    };
-    let (bytes, file) = read_file(path)?;
-    match Format::detect(&bytes) {
-        Some(Format::Rosbag) => read_rosbag_bytes(&bytes, &file, mapping),
-        Some(Format::Mcap) => read_mcap_bytes(&bytes, &file, mapping),
+        read_file(path)
+    }
+}
+
+/// [`read_log`] of a recording held in memory; `file` names it in errors.
+pub fn read_log_bytes(
+    bytes: &[u8],
+    file: &str,
+    mapping: &Mapping,
+) -> Result<(Drive, ImportReport), RosError> {
+    match Format::detect(bytes) {
+        Some(Format::Rosbag) => read_rosbag_bytes(bytes, file, mapping),
+        Some(Format::Mcap) => read_mcap_bytes(bytes, file, mapping),
         None => Err(RosError::format(
-            Location::file(&file).at(0),
+            Location::file(file).at(0),
             "neither a ROS bag nor an MCAP file",
         )),
     }
