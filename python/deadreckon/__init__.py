@@ -184,7 +184,7 @@ def calibrate(
     timing: str = "wheel",
     min_speed: float = 2.0,
     mapping: Optional[PathLike] = None,
-    corrections: str = "gnss",
+    corrections: str = "auto",
     skip_checks: bool = False,
 ) -> Dict[str, Any]:
     """Calibrates the six parameters; returns ``deadreckon calibrate --json``'s object.
@@ -269,7 +269,7 @@ def evaluate(
     max_diff_s: float = _native.EVO_DEFAULT_MAX_DIFF_S,
     timing: str = "wheel",
     mapping: Optional[PathLike] = None,
-    corrections: str = "gnss",
+    corrections: str = "auto",
     skip_checks: bool = False,
 ) -> Dict[str, Any]:
     """Dead-reckoning accuracy; returns ``deadreckon evaluate --json``'s object.

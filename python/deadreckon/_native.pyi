@@ -105,7 +105,7 @@ def calibrate(
     timing: str = "wheel",
     min_speed: float = 2.0,
     mapping: Optional[str] = None,
-    corrections: str = "gnss",
+    corrections: str = "auto",
     skip_checks: bool = False,
 ) -> Dict[str, Any]: ...
 def run_tracks(
@@ -131,7 +131,7 @@ def evaluate(
     max_diff_s: float = ...,
     timing: str = "wheel",
     mapping: Optional[str] = None,
-    corrections: str = "gnss",
+    corrections: str = "auto",
     skip_checks: bool = False,
 ) -> Dict[str, Any]: ...
 def tedris_train(

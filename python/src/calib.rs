@@ -21,11 +21,12 @@ use crate::{to_py_err, DeadreckonError};
 fn corrections_which(s: &str) -> PyResult<deadreckon_core::timing::Which> {
     use deadreckon_core::timing::Which;
     match s {
+        "auto" => Ok(Which::Auto),
         "gnss" => Ok(Which::Gnss),
         "all" => Ok(Which::All),
         "none" => Ok(Which::None),
         other => Err(err(format!(
-            "unknown corrections `{other}` (gnss, all, none)"
+            "unknown corrections `{other}` (auto, gnss, all, none)"
         ))),
     }
 }
@@ -49,7 +50,7 @@ fn err(e: impl std::fmt::Display) -> PyErr {
 
 /// `calibrate --json` as a dict; the options are the command's.
 #[pyfunction]
-#[pyo3(signature = (source, method="rts", state="augmented", iteration="anderson", max_iterations=60, timing="wheel", min_speed=2.0, mapping=None, corrections="gnss", skip_checks=false))]
+#[pyo3(signature = (source, method="rts", state="augmented", iteration="anderson", max_iterations=60, timing="wheel", min_speed=2.0, mapping=None, corrections="auto", skip_checks=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn calibrate(
     py: Python<'_>,
@@ -199,7 +200,7 @@ pub fn track_columns<'py>(py: Python<'py>, t: &track::Track) -> PyResult<Bound<'
 
 /// `evaluate --json` as a dict; the options are the command's.
 #[pyfunction]
-#[pyo3(signature = (source, params=None, metric="drift", outage=None, step=None, warmup=5.0, segment_m=100.0, threshold_m=1.0, track="dead-reckoned", reference="truth", delta_m=100.0, pairs_from="estimate", max_diff_s=evo::DEFAULT_MAX_DIFF_S, timing="wheel", mapping=None, corrections="gnss", skip_checks=false))]
+#[pyo3(signature = (source, params=None, metric="drift", outage=None, step=None, warmup=5.0, segment_m=100.0, threshold_m=1.0, track="dead-reckoned", reference="truth", delta_m=100.0, pairs_from="estimate", max_diff_s=evo::DEFAULT_MAX_DIFF_S, timing="wheel", mapping=None, corrections="auto", skip_checks=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn evaluate(
     py: Python<'_>,

@@ -107,11 +107,13 @@ pub struct CalibrateArgs {
     /// Print JSON instead of a table.
     #[arg(long)]
     pub json: bool,
-    /// The timing and mounting corrections estimated and applied before
-    /// calibrating, and written to params.toml: all (IMU tilt and every
-    /// stream's delay), gnss (tilt and GNSS delay; the others reported, not
+    /// The timing and mounting corrections estimated before calibrating, and
+    /// written to params.toml: auto (each applied only when it lowers the
+    /// dead-reckoning error through the drive's own GNSS held back from the
+    /// calibration), all (driven axle's slip, IMU tilt, every stream's delay,
+    /// gyro scale), gnss (as all, the other streams' delays reported, not
     /// applied) or none.
-    #[arg(long, value_enum, default_value_t = super::CorrectionsArg::Gnss)]
+    #[arg(long, value_enum, default_value_t = super::CorrectionsArg::Auto)]
     pub corrections: super::CorrectionsArg,
     /// Fuse every wheel reading: no wheel-health monitor (slipping and bad
     /// wheels are then neither dropped nor reported).

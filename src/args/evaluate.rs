@@ -104,10 +104,10 @@ pub struct EvaluateArgs {
     #[arg(long, value_enum)]
     pub start: Option<StartArg>,
     /// Without --params: the timing and mounting corrections estimated and
-    /// applied before the calibration (all: IMU tilt and every stream's
-    /// delay; gnss: tilt and GNSS delay; none). With --params: those stored
-    /// in the file are applied.
-    #[arg(long, value_enum, default_value_t = super::CorrectionsArg::Gnss)]
+    /// applied before the calibration (auto: each only when it helps on
+    /// held-back GNSS; all: IMU tilt and every stream's delay; gnss: tilt and
+    /// GNSS delay; none). With --params: those stored in the file are applied.
+    #[arg(long, value_enum, default_value_t = super::CorrectionsArg::Auto)]
     pub corrections: super::CorrectionsArg,
     /// Evaluate only data from this time on, s (drive clock).
     #[arg(long = "from", value_parser = super::finite, allow_hyphen_values = true)]

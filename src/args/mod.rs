@@ -149,6 +149,9 @@ pub fn probability(s: &str) -> std::result::Result<f64, String> {
 /// applied before calibrating (see `deadreckon_core::timing`).
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum CorrectionsArg {
+    /// Every correction estimated; each applied only when it lowers the dead-reckoning
+    /// error through held-back GNSS (the drive's own fixes, hidden in turn).
+    Auto,
     /// IMU tilt, every stream's delay and the gyro scale.
     All,
     /// IMU tilt, GNSS delay and gyro scale (the other delays reported, not applied).
@@ -161,6 +164,7 @@ impl From<CorrectionsArg> for deadreckon_core::timing::Which {
     fn from(c: CorrectionsArg) -> Self {
         use deadreckon_core::timing::Which;
         match c {
+            CorrectionsArg::Auto => Which::Auto,
             CorrectionsArg::All => Which::All,
             CorrectionsArg::Gnss => Which::Gnss,
             CorrectionsArg::None => Which::None,

@@ -22,10 +22,10 @@ pub struct ReportArgs {
     #[arg(long, value_parser = super::positive, requires = "outage")]
     pub step: Option<f64>,
     /// The timing and mounting corrections estimated on the drive and applied
-    /// for every section when --params stores none: all, gnss or none (as
-    /// `calibrate --corrections`). A params.toml that stores corrections
+    /// for every section when --params stores none: auto, all, gnss or none
+    /// (as `calibrate --corrections`). A params.toml that stores corrections
     /// applies those instead.
-    #[arg(long, value_enum, default_value_t = super::CorrectionsArg::Gnss)]
+    #[arg(long, value_enum, default_value_t = super::CorrectionsArg::Auto)]
     pub corrections: super::CorrectionsArg,
     /// Output HTML file.
     #[arg(long)]

@@ -51,7 +51,7 @@ fn traction_json(t: &deadreckon_core::traction::TractionSlip) -> Value {
     json!({
         "slip_per_mps2": num(t.slip_per_mps2),
         "std": num(t.std),
-        "axle": t.is_estimated().then(|| t.axle.name()),
+        "axle": (t.is_estimated() || t.status.is_measured_not_applied()).then(|| t.axle.name()),
         "blocks": t.blocks,
         "estimated": t.is_estimated(),
         "reason": t.status.reason(),
@@ -69,8 +69,31 @@ fn scale_json(g: &deadreckon_core::gyro_scale::GyroScale) -> Value {
     })
 }
 
+/// `--corrections auto`'s judgement: the windows, the held-back error
+/// without corrections, and each candidate's error and decision.
+fn held_back_json(h: &deadreckon_core::held_back::HeldBack) -> Value {
+    let num = |x: f64| if x.is_finite() { json!(x) } else { Value::Null };
+    json!({
+        "windows": h.windows,
+        "window_s": h.window_s,
+        "without_m": num(h.without_m),
+        "together_m": h.together_m.map(num),
+        "not_judged": h.not_judged,
+        "min_z": h.min_z,
+        "candidates": h.judged.iter().map(|j| json!({
+            "correction": j.correction.key(),
+            "z": num(j.z),
+            "with_m": num(j.with_m),
+            "against_m": num(j.against_m),
+            "t": num(j.t),
+            "applied": j.applied,
+            "by_significance": j.by_significance,
+        })).collect::<Vec<_>>(),
+    })
+}
+
 /// `{"delays": {stream: {...}}, "traction": {...} | null, "imu": {...} | null,
-/// "gyro_scale": {...} | null}`.
+/// "gyro_scale": {...} | null, "held_back": {...} | null}`.
 pub fn corrections_json(c: &Corrections) -> Value {
     let delays: serde_json::Map<String, Value> = Stream::ALL
         .iter()
@@ -81,6 +104,7 @@ pub fn corrections_json(c: &Corrections) -> Value {
         "traction": c.traction.as_ref().map(traction_json),
         "imu": c.tilt.as_ref().map(tilt_json),
         "gyro_scale": c.gyro_scale.as_ref().map(scale_json),
+        "held_back": c.held_back.as_ref().map(held_back_json),
     })
 }
 
@@ -136,6 +160,34 @@ pub fn corrections_toml(c: &Corrections) -> toml::Table {
             t.insert("not_estimated".into(), r.into());
         }
         out.insert("gyro_scale".into(), t.into());
+    }
+    if let Some(h) = &c.held_back {
+        // The decisions, for whoever reads the file later (not read back:
+        // what is applied is the values above).
+        let mut t = toml::Table::new();
+        t.insert("windows".into(), (h.windows as i64).into());
+        t.insert("window_s".into(), h.window_s.into());
+        if h.without_m.is_finite() {
+            t.insert("without_m".into(), h.without_m.into());
+        }
+        if let Some(why) = &h.not_judged {
+            t.insert("not_judged".into(), why.clone().into());
+        }
+        for j in &h.judged {
+            let mut e = toml::Table::new();
+            e.insert("z".into(), j.z.into());
+            for (k, v) in [("with_m", j.with_m), ("against_m", j.against_m), ("t", j.t)] {
+                if v.is_finite() {
+                    e.insert(k.into(), v.into());
+                }
+            }
+            e.insert("applied".into(), j.applied.into());
+            if j.by_significance {
+                e.insert("by_significance".into(), true.into());
+            }
+            t.insert(j.correction.key(), e.into());
+        }
+        out.insert("held_back".into(), t.into());
     }
     out
 }
@@ -272,18 +324,18 @@ pub fn stored_corrections(extra: &toml::Table) -> Result<Stored, String> {
 }
 
 /// Estimates the corrections `which` asks for (driven axle's slip, IMU tilt,
-/// delays, gyro scale)
-/// and applies them: the drive a calibration runs on, and what was found.
+/// delays, gyro scale) and applies them (with `auto`, those the held-back
+/// GNSS chose: [`deadreckon_core::held_back`]): the drive a calibration
+/// runs on, and what was found.
 /// The one call `calibrate`, `evaluate` and Python make.
 pub fn estimate_and_apply(
     drive: &Drive,
     copts: &deadreckon_core::calibrate::CalibrationOptions,
     which: timing::Which,
 ) -> Result<(Drive, Corrections), crate::Error> {
-    timing::prepare_with(drive, copts, &timing::DelayOptions::default(), which).map_err(|source| {
-        crate::Error::Calibration {
+    deadreckon_core::held_back::prepare(drive, copts, &timing::DelayOptions::default(), which)
+        .map_err(|source| crate::Error::Calibration {
             what: "estimating the streams' delays and the IMU tilt",
             source,
-        }
-    })
+        })
 }

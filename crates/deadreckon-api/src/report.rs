@@ -58,11 +58,10 @@ pub fn corrected(
             return Ok((stored.apply(drive), Some(c)));
         }
     }
-    let name = match o.corrections {
-        Which::None => return Ok((drive.clone(), None)),
-        Which::Gnss => "gnss",
-        Which::All => "all",
-    };
+    if o.corrections == Which::None {
+        return Ok((drive.clone(), None));
+    }
+    let name = o.corrections.name();
     steps.step("corrections");
     let (d, c) = crate::corrections::estimate_and_apply(
         drive,

@@ -30,7 +30,7 @@ pub fn corrections_lines(c: &deadreckon_core::timing::Corrections) -> Vec<String
                 d.delay_s,
                 d.std_s
             ),
-            Some(r) if r == deadreckon_core::timing::MEASURED_NOT_APPLIED => format!(
+            Some(r) if d.status.is_measured_not_applied() => format!(
                 "{:<10} {:>+10.4} {:>9.4}  {r}",
                 s.name(),
                 d.delay_s,
@@ -48,6 +48,13 @@ pub fn corrections_lines(c: &deadreckon_core::timing::Corrections) -> Vec<String
         out.push(match t.status.reason() {
             None => format!(
                 "driven axle: {}, slip {:+.3}% ± {:.3}% per m/s² of forward specific force ({} one-second blocks), its wheel speeds corrected",
+                t.axle.name(),
+                100.0 * t.slip_per_mps2.abs(),
+                100.0 * t.std,
+                t.blocks
+            ),
+            Some(r) if t.status.is_measured_not_applied() => format!(
+                "driven axle: {}, slip {:+.3}% ± {:.3}% per m/s² of forward specific force ({} one-second blocks), {r}",
                 t.axle.name(),
                 100.0 * t.slip_per_mps2.abs(),
                 100.0 * t.std,
@@ -74,6 +81,13 @@ pub fn corrections_lines(c: &deadreckon_core::timing::Corrections) -> Vec<String
                 )),
                 t.accel_error_mps2
             ),
+            Some(r) if t.status.is_measured_not_applied() => format!(
+                "imu tilt: {:.2}° ± {:.2}° (pitch {:+.2}°, roll {:+.2}°), {r}",
+                t.tilt_rad.to_degrees(),
+                t.std_rad.to_degrees(),
+                t.pitch_rad.to_degrees(),
+                t.roll_rad.to_degrees(),
+            ),
             Some(r) => format!("imu tilt: not estimated: {r}"),
         }),
     }
@@ -85,10 +99,82 @@ pub fn corrections_lines(c: &deadreckon_core::timing::Corrections) -> Vec<String
                 100.0 * g.std,
                 g.turns
             ),
+            Some(r) if g.status.is_measured_not_applied() => format!(
+                "gyro scale error: {:+.3}% ± {:.3}% ({} turns), {r}",
+                100.0 * g.scale_error,
+                100.0 * g.std,
+                g.turns
+            ),
             Some(r) => format!("gyro scale error: not estimated: {r}"),
         });
     }
+    if let Some(h) = &c.held_back {
+        out.push(held_back_line(h));
+    }
     out
+}
+
+/// `--corrections auto`'s decision in one line: the held-back windows, the
+/// error without corrections and with each candidate.
+pub fn held_back_line(h: &deadreckon_core::held_back::HeldBack) -> String {
+    if h.judged.is_empty() {
+        return format!(
+            "corrections: none applied (no correction at least {:.1} standard errors from none)",
+            h.min_z
+        );
+    }
+    if h.judged.iter().all(|j| j.by_significance) {
+        let why = match &h.not_judged {
+            Some(why) => why.clone(),
+            None => format!(
+                "no other correction at least {:.1} standard errors from none",
+                h.min_z
+            ),
+        };
+        return format!(
+            "corrections: {} ({why})",
+            h.judged
+                .iter()
+                .map(|j| format!(
+                    "{} applied on its significance ({:+.1} standard errors)",
+                    j.correction, j.z
+                ))
+                .collect::<Vec<_>>()
+                .join("; "),
+        );
+    }
+    let each: Vec<String> = h
+        .judged
+        .iter()
+        .map(|j| {
+            if j.by_significance {
+                format!(
+                    "{} applied on its significance ({:+.1} standard errors; the held-back fixes share its clock and cannot judge it)",
+                    j.correction, j.z
+                )
+            } else if j.with_m.is_finite() {
+                format!(
+                    "{} {:.3} m against {:.3} m, t {:+.1} ({})",
+                    j.correction,
+                    j.with_m,
+                    j.against_m,
+                    j.t,
+                    if j.applied { "applied" } else { "not applied" }
+                )
+            } else {
+                format!("{} not applied", j.correction)
+            }
+        })
+        .collect();
+    format!(
+        "corrections chosen on held-back GNSS ({} windows of {:.0} s, the calibration blind to them): without them {:.3} m; {}{}",
+        h.windows,
+        h.window_s,
+        h.without_m,
+        each.join("; "),
+        h.together_m
+            .map_or(String::new(), |t| format!("; with the applied ones {t:.3} m"))
+    )
 }
 
 /// The header of a table-III-like parameter table.

@@ -71,6 +71,12 @@ fn user_path(
         "cal",
     )
     .map_err(|e| format!("calibration: {e}"))?;
+    if let (Some(h), true) = (
+        &c.corrections.held_back,
+        std::env::var("DEFAULTS_SAY").is_ok(),
+    ) {
+        println!("car {seed}: {}", deadreckon_api::text::held_back_line(h));
+    }
     let stored = stored_corrections(&c.params_extra()).map_err(|e| format!("stored: {e}"))?;
     let drive = stored.apply(&ev.drive);
     let out = evaluate(
@@ -87,13 +93,19 @@ fn user_path(
 
 /// Every (configuration, car, corrections), the cars in parallel (rayon);
 /// the sum and count over the cars per configuration and corrections.
-fn run(cars: &[u64], configs: &[(&str, Effects)], drive_s: f64) -> Vec<[(f64, usize); 2]> {
+fn run(cars: &[u64], configs: &[(&str, Effects)], drive_s: f64) -> Vec<[(f64, usize); 3]> {
     let drawn: Vec<DynamicCar> = cars.iter().map(|&s| DynamicCar::draw(s)).collect();
     configs
         .iter()
         .map(|(name, effects)| {
-            let mut sums = [(0.0, 0usize); 2];
-            for (w, which) in [Which::None, Which::Gnss].into_iter().enumerate() {
+            let mut sums = [(0.0, 0usize); 3];
+            for (w, which) in [Which::None, Which::Gnss, Which::Auto]
+                .into_iter()
+                .enumerate()
+            {
+                if std::env::var("DEFAULTS_ONLY_AUTO").is_ok() && which != Which::Auto {
+                    continue;
+                }
                 let results: Vec<Result<f64, String>> = drawn
                     .par_iter()
                     .map(|car| user_path(car, effects, which, drive_s))
@@ -113,37 +125,62 @@ fn run(cars: &[u64], configs: &[(&str, Effects)], drive_s: f64) -> Vec<[(f64, us
         .collect()
 }
 
+/// Every configuration, or those `DEFAULTS_EFFECTS` names (comma-separated).
 fn configs() -> Vec<(&'static str, Effects)> {
     let mut v = vec![("none", Effects::none())];
     for name in Effects::NAMES {
         v.push((name, Effects::only(name).unwrap()));
     }
     v.push(("all", Effects::all()));
+    if let Ok(only) = std::env::var("DEFAULTS_EFFECTS") {
+        let only: Vec<&str> = only.split(',').collect();
+        v.retain(|(n, _)| only.contains(n));
+    }
     v
+}
+
+/// The cars `DEFAULTS_CARS` names (comma-separated), else `default`.
+fn cars_or(default: Vec<u64>) -> Vec<u64> {
+    match std::env::var("DEFAULTS_CARS") {
+        Ok(s) => s.split(',').filter_map(|c| c.trim().parse().ok()).collect(),
+        Err(_) => default,
+    }
 }
 
 #[test]
 #[ignore]
 fn the_default_corrections_on_the_dynamic_family() {
     for (title, cars) in [
-        ("development cars 1–6", (1..=6).collect::<Vec<u64>>()),
+        (
+            "development cars 1–6",
+            cars_or((1..=6).collect::<Vec<u64>>()),
+        ),
         (
             "held-out cars 101–110 (104 apart)",
-            (101..=110).filter(|&c| c != 104).collect(),
+            cars_or((101..=110).filter(|&c| c != 104).collect()),
         ),
     ] {
+        if title.starts_with("held-out") && std::env::var("DEFAULTS_HELD_OUT").is_err() {
+            println!("\n{title}: set DEFAULTS_HELD_OUT=1 to run them");
+            continue;
+        }
         let configs = configs();
         let rows = run(&cars, &configs, 300.0);
         println!("\n{title}, 300 s drives: mean final error of 30 s outages, m");
-        println!("{:<16} {:>10} {:>10}", "effects", "none", "gnss");
+        println!(
+            "{:<16} {:>10} {:>10} {:>10}",
+            "effects", "none", "gnss", "auto"
+        );
         for ((name, _), r) in configs.iter().zip(&rows) {
             let m = |i: usize| r[i].0 / r[i].1 as f64;
             println!(
-                "{name:<16} {:>10.3} {:>10.3}   ({} / {} cars)",
+                "{name:<16} {:>10.3} {:>10.3} {:>10.3}   ({} / {} / {} cars)",
                 m(0),
                 m(1),
+                m(2),
                 r[0].1,
-                r[1].1
+                r[1].1,
+                r[2].1
             );
         }
     }

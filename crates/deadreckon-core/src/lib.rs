@@ -39,6 +39,7 @@ pub mod gnss_jumps;
 pub mod gyro_drift;
 pub mod gyro_hold;
 pub mod gyro_scale;
+pub mod held_back;
 pub mod imu;
 pub mod init;
 pub mod kalman;

@@ -470,8 +470,34 @@ pub fn through_windows(
     windows: &[(f64, f64)],
     base: &FilterOptions,
 ) -> Result<OutageEvaluation, Error> {
+    through_windows_in(drive, params, windows, base, true)
+}
+
+/// [`through_windows`] measured against the hidden fixes even where the
+/// drive has a truth: what the drive's own data can tell
+/// ([`crate::held_back`] chooses the corrections by it).
+pub fn through_windows_against_fixes(
+    drive: &Drive,
+    params: &Params,
+    windows: &[(f64, f64)],
+    base: &FilterOptions,
+) -> Result<OutageEvaluation, Error> {
+    through_windows_in(drive, params, windows, base, false)
+}
+
+fn through_windows_in(
+    drive: &Drive,
+    params: &Params,
+    windows: &[(f64, f64)],
+    base: &FilterOptions,
+    use_truth: bool,
+) -> Result<OutageEvaluation, Error> {
     check_windows(drive, windows)?;
-    let truth = Reference::from_truth(&drive.truth);
+    let truth = if use_truth {
+        Reference::from_truth(&drive.truth)
+    } else {
+        None
+    };
     let reference = if truth.is_some() {
         Against::Truth
     } else {

@@ -45,6 +45,10 @@ use crate::{rts, Error, Params};
 /// Speed above which the steering is compared with the curvature, m/s.
 pub const MIN_CURVATURE_SPEED_MPS: f64 = 2.0;
 
+/// How the reason of every correction measured but not applied starts
+/// (`--corrections gnss`'s other delays, `auto`'s rejected corrections).
+pub const MEASURED: &str = "measured, not applied";
+
 /// The reason of a delay that was measured but not applied because only the
 /// GNSS delay was asked for (`Which::Gnss`); such a [`Delay`] keeps its
 /// measured `delay_s` and `std_s`.
@@ -63,6 +67,11 @@ impl Status {
     /// True when estimated.
     pub fn is_estimated(&self) -> bool {
         matches!(self, Status::Estimated)
+    }
+    /// True when it was measured and deliberately not applied (the reason
+    /// starts with [`MEASURED`]): its value and standard error are kept.
+    pub fn is_measured_not_applied(&self) -> bool {
+        matches!(self, Status::NotEstimated(r) if r.starts_with(MEASURED))
     }
     /// The reason it was not estimated, if not.
     pub fn reason(&self) -> Option<&str> {
@@ -166,6 +175,15 @@ impl Delays {
             Stream::Speed => &self.speed,
             Stream::Steering => &self.steering,
             Stream::Gnss => &self.gnss,
+        }
+    }
+    /// The delay of `s`, to change.
+    pub fn get_mut(&mut self, s: Stream) -> &mut Delay {
+        match s {
+            Stream::Gyro => &mut self.gyro,
+            Stream::Speed => &mut self.speed,
+            Stream::Steering => &mut self.steering,
+            Stream::Gnss => &mut self.gnss,
         }
     }
     /// The drive with every estimated delay removed (timestamps moved back).
@@ -910,19 +928,35 @@ pub fn estimate_with_params(
     Ok((delays, params))
 }
 
-/// Which corrections [`prepare_with`] estimates and applies.
+/// Which corrections [`crate::held_back::prepare`] estimates and applies.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Which {
+    /// Every correction estimated; each applied only when it lowers the
+    /// dead-reckoning error through GNSS the calibration did not see
+    /// ([`crate::held_back`]): the commands' default.
+    #[default]
+    Auto,
     /// The driven axle's slip, the IMU tilt, every stream's delay and the
     /// gyro scale.
     All,
     /// The driven axle's slip, the IMU tilt, the GNSS delay and the gyro
     /// scale (the other streams' delays estimated and reported, not
-    /// applied): `calibrate`'s default.
-    #[default]
+    /// applied).
     Gnss,
     /// Nothing estimated or applied.
     None,
+}
+
+impl Which {
+    /// The word the command line takes: `auto`, `all`, `gnss`, `none`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Which::Auto => "auto",
+            Which::All => "all",
+            Which::Gnss => "gnss",
+            Which::None => "none",
+        }
+    }
 }
 
 /// What [`prepare`] found and applied.
@@ -938,6 +972,9 @@ pub struct Corrections {
     /// The gyro's scale error (`None` when not attempted: no GNSS delay, so
     /// no calibration to take the bias from).
     pub gyro_scale: Option<crate::gyro_scale::GyroScale>,
+    /// With [`Which::Auto`]: what the held-back GNSS said of each
+    /// correction ([`crate::held_back`]).
+    pub held_back: Option<crate::held_back::HeldBack>,
 }
 
 /// Estimates the driven axle's slip ([`crate::traction`], correcting its
@@ -955,6 +992,8 @@ pub fn prepare(
 
 /// [`prepare`] with a choice of what is applied (see [`Which`]); an
 /// unapplied delay is marked not estimated with the reason.
+/// [`Which::Auto`] is decided by [`crate::held_back::prepare`], which calls
+/// this with [`Which::All`]; asked here, it is refused.
 pub fn prepare_with(
     drive: &Drive,
     copts: &CalibrationOptions,
@@ -969,7 +1008,13 @@ pub fn prepare_with(
                 tilt: None,
                 delays: Delays::none(),
                 gyro_scale: None,
+                held_back: None,
             },
+        ));
+    }
+    if which == Which::Auto {
+        return Err(Error::InvalidParams(
+            "the automatic choice of corrections is made by held_back::prepare".into(),
         ));
     }
     // The driven axle's slip first: the wheels are the clock and the scale
@@ -1014,6 +1059,7 @@ pub fn prepare_with(
             tilt,
             delays,
             gyro_scale,
+            held_back: None,
         },
     ))
 }

@@ -574,18 +574,17 @@ pub fn tedris_from_model(
 pub fn correction_rows(c: &deadreckon_core::timing::Corrections) -> Vec<rp::CorrectionRow> {
     use deadreckon_core::timing::Stream;
     let finite = |v: f64| v.is_finite().then_some(v);
-    use deadreckon_core::timing::MEASURED_NOT_APPLIED;
+    use deadreckon_core::timing::MEASURED;
     let status = |reason: Option<&str>| match reason {
         None => "estimated, applied".to_string(),
-        Some(MEASURED_NOT_APPLIED) => MEASURED_NOT_APPLIED.to_string(),
+        Some(r) if r.starts_with(MEASURED) => r.to_string(),
         Some(r) => format!("not estimated: {r}"),
     };
     let mut rows: Vec<rp::CorrectionRow> = Stream::ALL
         .iter()
         .map(|&s| {
             let d = c.delays.get(s);
-            let estimated =
-                d.status.is_estimated() || d.status.reason() == Some(MEASURED_NOT_APPLIED);
+            let estimated = d.status.is_estimated() || d.status.is_measured_not_applied();
             rp::CorrectionRow {
                 what: format!("{} delay", s.name()),
                 unit: "s".into(),
@@ -596,7 +595,7 @@ pub fn correction_rows(c: &deadreckon_core::timing::Corrections) -> Vec<rp::Corr
         })
         .collect();
     if let Some(t) = &c.traction {
-        let estimated = t.is_estimated();
+        let estimated = t.is_estimated() || t.status.is_measured_not_applied();
         rows.push(rp::CorrectionRow {
             what: "driven axle slip per m/s²".into(),
             unit: "%".into(),
@@ -607,12 +606,13 @@ pub fn correction_rows(c: &deadreckon_core::timing::Corrections) -> Vec<rp::Corr
                     "estimated on the {} axle from the front/rear wheel speeds against the forward specific force, its wheel speeds corrected",
                     t.axle.name()
                 ),
+                Some(r) if r.starts_with(MEASURED) => r.to_string(),
                 Some(r) => format!("not estimated: {r}"),
             },
         });
     }
     if let Some(t) = &c.tilt {
-        let estimated = t.is_estimated();
+        let estimated = t.is_estimated() || t.status.is_measured_not_applied();
         rows.push(rp::CorrectionRow {
             what: "IMU tilt".into(),
             unit: "°".into(),
@@ -625,12 +625,13 @@ pub fn correction_rows(c: &deadreckon_core::timing::Corrections) -> Vec<rp::Corr
                     t.pitch_rad.to_degrees(),
                     t.roll_rad.to_degrees()
                 ),
+                Some(r) if r.starts_with(MEASURED) => r.to_string(),
                 Some(r) => format!("not estimated: {r}"),
             },
         });
     }
     if let Some(g) = &c.gyro_scale {
-        let estimated = g.is_estimated();
+        let estimated = g.is_estimated() || g.status.is_measured_not_applied();
         rows.push(rp::CorrectionRow {
             what: "gyro scale error".into(),
             unit: "%".into(),
@@ -638,6 +639,7 @@ pub fn correction_rows(c: &deadreckon_core::timing::Corrections) -> Vec<rp::Corr
             std: finite(100.0 * g.std).filter(|_| estimated),
             status: match g.status.reason() {
                 None => format!("estimated from {} turns, applied", g.turns),
+                Some(r) if r.starts_with(MEASURED) => r.to_string(),
                 Some(r) => format!("not estimated: {r}"),
             },
         });

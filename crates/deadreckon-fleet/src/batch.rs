@@ -158,7 +158,7 @@ pub fn calibrate_drive(drive: &Drive, options: &BatchOptions) -> Result<DriveCal
     let (corrected, corrections) = match options.corrections {
         Which::None => (None, None),
         which => {
-            let (d, c) = timing::prepare_with(
+            let (d, c) = deadreckon_core::held_back::prepare(
                 drive,
                 &options.calibration,
                 &timing::DelayOptions::default(),

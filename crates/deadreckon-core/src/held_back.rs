@@ -1,0 +1,558 @@
+//! Corrections chosen by evidence: `--corrections auto` (issue 29).
+//!
+//! [`crate::timing::prepare_with`] estimates the driven axle's slip, the IMU
+//! tilt, every stream's delay and the gyro scale error. Each estimate comes
+//! with a standard error, but a correction applied at one or two standard
+//! errors moves the results either way: on the simulator's calibration drive,
+//! which has no delay and an exact gyro, the GNSS delay and the gyro scale
+//! came out at 1.6 and 1.8 standard errors, were applied, and took the
+//! evaluation drive's 30 s outages from 0.41 to 0.71 m (median).
+//!
+//! Here a correction is applied only when the drive's own GNSS says it
+//! helps, through fixes the calibration did not see:
+//!
+//! 1. Every correction is estimated on the whole drive
+//!    ([`crate::timing::prepare_with`] with [`Which::All`]). One that is not
+//!    estimated, or within [`MIN_Z`] standard errors of none, is not a
+//!    candidate (reported as measured, not applied).
+//! 2. Windows of [`WINDOW_S`] (shorter on a short drive) start every
+//!    [`PERIOD_WINDOWS`] window lengths once the vehicle has moved as long;
+//!    alternate windows form two folds. For each
+//!    fold the car is calibrated (RTS) with the fold's fixes hidden, and the
+//!    filter dead-reckons through the fold's windows: the error at each
+//!    window's end against the hidden fix is the held-back error.
+//! 3. Forward selection through the same windows (paired: the fixes' own
+//!    noise is the same for every candidate): the drive without the judged
+//!    corrections is the start; each round tries every candidate left added
+//!    to those chosen so far and adds the one that lowers the mean held-back
+//!    error most, if its paired t statistic over the windows is at most
+//!    −[`MIN_T`]; the selection stops when no candidate does. Corrections
+//!    interact (a gyro's delay and its scale error both turn the heading in
+//!    turns): judged one by one from none, a gyro 0.12 s late and 1.5 % off
+//!    scale showed the delay as a loss until the scale was applied.
+//!
+//! The GNSS delay is the exception: it is chosen on its significance alone
+//! (at least [`MIN_Z`] standard errors), and the others are judged with it
+//! applied. A receiver's delay shifts every fix by the same time, the
+//! held-back ones too: a filter that follows late fixes dead-reckons to
+//! where the late fix at the window's end shows the car, so the held-back
+//! error cannot tell a late receiver from a corrected one (only a change of
+//! velocity inside a window shows it, which is what the delay's own
+//! estimate measures). On the comma2k19 segment the held-back fixes
+//! preferred the uncorrected receiver (0.433 against 0.395 m over three
+//! 10 s windows) while the reference trajectory, which has no such delay,
+//! says the correction takes 20 s outages from 1.48 to 0.59 m.
+//!
+//! A drive too short for [`MIN_WINDOWS`] windows cannot judge: there each
+//! candidate is applied on its significance, and the output says so.
+//!
+//! Every candidate's two figures and the decision are returned
+//! ([`HeldBack`]) for the JSON, the text and params.toml.
+//!
+//! What the judgement does not hold back: the correction's value is the
+//! whole drive's estimate, which saw every fix (each correction is one or a
+//! few numbers fitted on hundreds of fixes; re-estimating it per fold would
+//! multiply the cost of the corrections' estimation by three). The
+//! calibration each candidate is judged with, and the dead reckoning, never
+//! see the fixes they are judged on.
+
+use crate::calibrate::{self, CalibrationOptions};
+use crate::drive::Drive;
+use crate::outage;
+use crate::timing::{self, Corrections, DelayOptions, KnownCorrections, Status, Stream, Which};
+use crate::vehicle::Params;
+use crate::Error;
+
+/// Longest held-back window, s: 20 s, the length of the outages `evaluate`
+/// reports on comma2k19 (long enough for a delay or a scale error to show
+/// in the dead-reckoned position, short enough for a 10-minute drive to
+/// give about twenty windows).
+pub const WINDOW_S: f64 = 20.0;
+
+/// Shortest held-back window, s: 8 s. A drive too short for
+/// [`MIN_WINDOWS`] windows of [`WINDOW_S`] gets shorter ones (a sixth of
+/// its moving span), down to this.
+pub const MIN_WINDOW_S: f64 = 8.0;
+
+/// Start-to-start spacing of the windows, in window lengths: 1.5 (10 s of
+/// fixes between two 20 s windows let the aided filter take its position
+/// back). The first window starts as long after the vehicle first moves
+/// (30 s for 20 s windows: the heading is known by then on every drive of
+/// the simulator's families; outage windows before it are the pull-away,
+/// see [`crate::outage`]).
+pub const PERIOD_WINDOWS: f64 = 1.5;
+
+/// Fewest windows (both folds) for a judgement: 6 (about three and a half
+/// minutes of moving). On a shorter drive every candidate (at least
+/// [`SHORT_MIN_Z`] standard errors) is applied on its significance, and the
+/// output says so: a paired t over three windows is too weak to overrule a
+/// significant estimate. On the comma2k19 segment (60 s, three windows of
+/// 9.8 s) the held-back judgement dropped the front axle's slip (13.6
+/// standard errors; t = −0.6) and took 20 s outages from 0.613 to 0.644 m
+/// (median, against the reference); calibrated on either 30 s half, with
+/// too few windows to judge, applying nothing but the GNSS delay gave
+/// 1.223 / 0.640 m on the other half against 0.807 / 0.511 m with every
+/// significant correction.
+pub const MIN_WINDOWS: usize = 6;
+
+/// A candidate must be this many standard errors from none: 3.
+pub const MIN_Z: f64 = 3.0;
+
+/// On a drive too short to judge ([`MIN_WINDOWS`]), a correction is
+/// applied when its estimate is at least √2 standard errors from none: then
+/// applying it is expected to leave a smaller squared error than leaving it
+/// out (with an unbiased estimate x̂ of standard error σ, applying leaves σ²,
+/// leaving it out x², estimated by x̂² − σ²). With [`MIN_Z`] there, the
+/// comma2k19 phone's tilt, 2.64° ± 0.97° on the second 30 s half, was left
+/// out and that half's calibration took the first half's 20 s outages from
+/// 0.513 to 0.599 m (median).
+pub const SHORT_MIN_Z: f64 = std::f64::consts::SQRT_2;
+
+/// A candidate is applied when it lowers the held-back error with a paired
+/// t statistic of at most minus this: 1 (the mean difference at least its
+/// own standard error; about 16 % one-sided for a correction that does
+/// nothing). Chosen on the two drives of `deadreckon-sim/tests/held_back.rs`:
+/// the simulated CAN speed's half-period delay, real but harmless, gave
+/// t = −0.18 (0.6716 against 0.6745 m over 30 windows); a gyro 0.12 s late
+/// gave t = −1.13 (0.812 against 0.938 m), the end errors of 20 s windows
+/// varying by about 0.6 m from window to window. Checked on the dynamic
+/// family (`deadreckon-api/tests/dynamic_family_defaults.rs`), held out on
+/// cars 101–110.
+pub const MIN_T: f64 = 1.0;
+
+/// The corrections a drive can be judged with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Correction {
+    /// The driven axle's slip ([`crate::traction`]).
+    Traction,
+    /// The IMU tilt ([`crate::imu`]).
+    Tilt,
+    /// A stream's delay.
+    Delay(Stream),
+    /// The gyro scale error ([`crate::gyro_scale`]).
+    GyroScale,
+}
+
+impl Correction {
+    /// Words for people: "driven axle's slip", "IMU tilt", "gnss delay",
+    /// "gyro scale".
+    pub fn name(self) -> String {
+        match self {
+            Correction::Traction => "driven axle's slip".into(),
+            Correction::Tilt => "IMU tilt".into(),
+            Correction::Delay(s) => format!("{} delay", s.name()),
+            Correction::GyroScale => "gyro scale".into(),
+        }
+    }
+
+    /// A key for JSON and params.toml: `traction`, `imu`, `delay_gnss`, `gyro_scale`.
+    pub fn key(self) -> String {
+        match self {
+            Correction::Traction => "traction".into(),
+            Correction::Tilt => "imu".into(),
+            Correction::Delay(s) => format!("delay_{}", s.name()),
+            Correction::GyroScale => "gyro_scale".into(),
+        }
+    }
+}
+
+impl std::fmt::Display for Correction {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.name())
+    }
+}
+
+/// One candidate's judgement.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Judged {
+    /// Which correction.
+    pub correction: Correction,
+    /// Its estimate over the whole drive divided by its standard error.
+    pub z: f64,
+    /// Mean held-back error with it added to the corrections chosen before
+    /// it (the last round it was tried in), m.
+    pub with_m: f64,
+    /// Mean held-back error of those corrections without it, m.
+    pub against_m: f64,
+    /// The paired t statistic of the difference (negative: it helps).
+    pub t: f64,
+    /// Applied.
+    pub applied: bool,
+    /// Chosen on its significance alone, not on the held-back fixes (the
+    /// GNSS delay: the held-back fixes keep the receiver's clock).
+    pub by_significance: bool,
+}
+
+/// What the held-back GNSS said.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HeldBack {
+    /// Held-back windows (both folds).
+    pub windows: usize,
+    /// Window length, s.
+    pub window_s: f64,
+    /// Mean held-back error without the judged corrections, m (the GNSS
+    /// delay applied where it was chosen on its significance; NaN when not
+    /// judged).
+    pub without_m: f64,
+    /// Every candidate (estimated, at least [`MIN_Z`] standard errors).
+    pub judged: Vec<Judged>,
+    /// Mean held-back error with the chosen candidates together, m (when
+    /// more than one was chosen).
+    pub together_m: Option<f64>,
+    /// Why nothing was judged (a drive too short), if so.
+    pub not_judged: Option<String>,
+    /// The standard errors a correction needed to be a candidate:
+    /// [`MIN_Z`], or [`SHORT_MIN_Z`] on a drive too short to judge.
+    pub min_z: f64,
+}
+
+impl HeldBack {
+    /// The decision on `c`, if it was a candidate.
+    pub fn decision(&self, c: Correction) -> Option<&Judged> {
+        self.judged.iter().find(|j| j.correction == c)
+    }
+}
+
+/// The corrections `which` asks for, estimated and applied; with
+/// [`Which::Auto`] each one chosen on held-back GNSS (module docs). The one
+/// entry the commands, Python and `batch` call.
+pub fn prepare(
+    drive: &Drive,
+    copts: &CalibrationOptions,
+    o: &DelayOptions,
+    which: Which,
+) -> Result<(Drive, Corrections), Error> {
+    if which != Which::Auto {
+        return timing::prepare_with(drive, copts, o, which);
+    }
+    let (_, mut corrections) = timing::prepare_with(drive, copts, o, Which::All)?;
+    let windows = windows(drive);
+    let short = windows[0].len() + windows[1].len() < MIN_WINDOWS;
+    let min_z = if short { SHORT_MIN_Z } else { MIN_Z };
+    let candidates = candidates(&corrections, min_z);
+    let mut held = HeldBack {
+        min_z,
+        windows: windows[0].len() + windows[1].len(),
+        window_s: windows[0].first().map_or(WINDOW_S, |w| w.1 - w.0),
+        without_m: f64::NAN,
+        judged: Vec::new(),
+        together_m: None,
+        not_judged: None,
+    };
+    // The GNSS delay is chosen on its significance alone (module docs):
+    // the held-back fixes keep the receiver's clock, so they cannot judge it.
+    let gnss = Correction::Delay(Stream::Gnss);
+    let mut chosen: Vec<Correction> = candidates
+        .iter()
+        .filter(|(c, _)| *c == gnss)
+        .map(|(c, _)| *c)
+        .collect();
+    let base = chosen.clone();
+    let judged: Vec<(Correction, f64)> = candidates
+        .iter()
+        .copied()
+        .filter(|(c, _)| *c != gnss)
+        .collect();
+    held.judged = chosen
+        .iter()
+        .map(|&c| Judged {
+            correction: c,
+            z: candidates
+                .iter()
+                .find(|x| x.0 == c)
+                .map_or(f64::NAN, |x| x.1),
+            with_m: f64::NAN,
+            against_m: f64::NAN,
+            t: f64::NAN,
+            applied: true,
+            by_significance: true,
+        })
+        .collect();
+    if judged.is_empty() {
+        // Nothing to judge: no filter runs.
+    } else if short {
+        held.not_judged = Some(format!(
+            "{} held-back windows of {:.0} s, at least {MIN_WINDOWS} needed: the drive is too short to judge a correction on its own GNSS, so each is applied on its significance",
+            held.windows, held.window_s
+        ));
+        held.judged.extend(judged.iter().map(|&(c, z)| Judged {
+            correction: c,
+            z,
+            with_m: f64::NAN,
+            against_m: f64::NAN,
+            t: f64::NAN,
+            applied: true,
+            by_significance: true,
+        }));
+        chosen.extend(judged.iter().map(|j| j.0));
+    } else {
+        let mut won: Vec<Correction> = Vec::new();
+        // Forward selection: each round adds the candidate that lowers the
+        // held-back error most, if it does so significantly (paired t at
+        // most -MIN_T over the same windows); the others are tried again
+        // with it in the next round.
+        let base_drive = known(&corrections, &base).apply(drive);
+        // The calibration of the baseline starts every fold's passes.
+        let initial = calibrate::calibrate(&base_drive, copts)
+            .ok()
+            .map(|c| c.estimate.params);
+        let mut current = held_back_errors(&base_drive, copts, initial, &windows)?;
+        drop(base_drive);
+        held.without_m = mean(&current);
+        let mut set = base.clone();
+        let mut left: Vec<(Correction, f64)> = judged.clone();
+        let mut tried: Vec<Judged> = Vec::new();
+        loop {
+            let mut best: Option<(usize, WindowErrors, f64)> = None;
+            for (i, &(c, z)) in left.iter().enumerate() {
+                let with: Vec<Correction> = set.iter().copied().chain([c]).collect();
+                let d = known(&corrections, &with).apply(drive);
+                let errors = held_back_errors(&d, copts, initial, &windows)?;
+                let (diff_m, t) = paired(&errors, &current);
+                let j = Judged {
+                    correction: c,
+                    z,
+                    with_m: mean(&errors),
+                    against_m: mean(&current),
+                    t,
+                    applied: false,
+                    by_significance: false,
+                };
+                match tried.iter_mut().find(|x| x.correction == c) {
+                    Some(x) => *x = j,
+                    None => tried.push(j),
+                }
+                if t <= -MIN_T && best.as_ref().is_none_or(|b| diff_m < b.2) {
+                    best = Some((i, errors, diff_m));
+                }
+            }
+            match best {
+                Some((i, errors, _)) => {
+                    let (c, _) = left.remove(i);
+                    set.push(c);
+                    won.push(c);
+                    if let Some(x) = tried.iter_mut().find(|x| x.correction == c) {
+                        x.applied = true;
+                    }
+                    current = errors;
+                }
+                None => break,
+            }
+        }
+        if !won.is_empty() {
+            held.together_m = Some(mean(&current));
+        }
+        held.judged.extend(tried);
+        chosen.extend(won);
+    }
+    mark(&mut corrections, &held, &chosen);
+    let out = known(&corrections, &chosen).apply(drive);
+    corrections.held_back = Some(held);
+    Ok((out, corrections))
+}
+
+/// The estimated corrections at least `min_z` standard errors from none,
+/// with their z.
+fn candidates(c: &Corrections, min_z: f64) -> Vec<(Correction, f64)> {
+    let mut out = Vec::new();
+    let mut push = |what: Correction, estimated: bool, value: f64, std: f64| {
+        let z = value / std;
+        if estimated && z.is_finite() && z.abs() >= min_z {
+            out.push((what, z));
+        }
+    };
+    if let Some(t) = &c.traction {
+        push(
+            Correction::Traction,
+            t.is_estimated(),
+            t.slip_per_mps2,
+            t.std,
+        );
+    }
+    if let Some(t) = &c.tilt {
+        push(Correction::Tilt, t.is_estimated(), t.tilt_rad, t.std_rad);
+    }
+    for s in Stream::ALL {
+        let d = c.delays.get(s);
+        push(
+            Correction::Delay(s),
+            d.status.is_estimated(),
+            d.delay_s,
+            d.std_s,
+        );
+    }
+    if let Some(g) = &c.gyro_scale {
+        push(
+            Correction::GyroScale,
+            g.is_estimated(),
+            g.scale_error,
+            g.std,
+        );
+    }
+    out
+}
+
+/// The corrections of `set`, with the values of `c`.
+fn known(c: &Corrections, set: &[Correction]) -> KnownCorrections {
+    let mut k = KnownCorrections::default();
+    for &what in set {
+        match what {
+            Correction::Traction => {
+                if let Some(t) = &c.traction {
+                    k.traction_slip_per_mps2 = t.slip_per_mps2;
+                }
+            }
+            Correction::Tilt => k.up = c.tilt.as_ref().map(|t| t.up),
+            Correction::Delay(s) => {
+                let i = Stream::ALL.iter().position(|&x| x == s).unwrap_or(0);
+                k.delays_s[i] = c.delays.get(s).delay_s;
+            }
+            Correction::GyroScale => {
+                if let Some(g) = &c.gyro_scale {
+                    k.gyro_scale_error = g.scale_error;
+                }
+            }
+        }
+    }
+    k
+}
+
+/// Marks every estimated correction that is not in `chosen` as measured,
+/// not applied, with the held-back figures as the reason.
+fn mark(c: &mut Corrections, held: &HeldBack, chosen: &[Correction]) {
+    let why = |what: Correction| -> String {
+        match held.decision(what) {
+            None => format!(
+                "measured, not applied: within {:.1} standard errors of none",
+                held.min_z
+            ),
+            Some(_) if held.not_judged.is_some() => format!(
+                "measured, not applied: {}",
+                held.not_judged.as_deref().unwrap_or_default()
+            ),
+            Some(j) => format!(
+                "measured, not applied: held-back GNSS {:.3} m with it, {:.3} m without (paired t {:+.1}, {} windows of {:.0} s)",
+                j.with_m, j.against_m, j.t, held.windows, held.window_s
+            ),
+        }
+    };
+    let unapply = |what: Correction, status: &mut Status| {
+        if status.is_estimated() && !chosen.contains(&what) {
+            *status = Status::NotEstimated(why(what));
+        }
+    };
+    if let Some(t) = &mut c.traction {
+        unapply(Correction::Traction, &mut t.status);
+    }
+    if let Some(t) = &mut c.tilt {
+        unapply(Correction::Tilt, &mut t.status);
+    }
+    for s in Stream::ALL {
+        unapply(Correction::Delay(s), &mut c.delays.get_mut(s).status);
+    }
+    if let Some(g) = &mut c.gyro_scale {
+        unapply(Correction::GyroScale, &mut g.status);
+    }
+}
+
+/// The two folds of held-back windows (module docs): alternate windows
+/// every [`PERIOD_WINDOWS`] window lengths, the first as long after the
+/// vehicle first moves, each ending a second before the last fix and the
+/// last wheel row; the windows [`WINDOW_S`] long, or a sixth of the moving
+/// span where that is shorter (not under [`MIN_WINDOW_S`]).
+pub fn windows(drive: &Drive) -> [Vec<(f64, f64)>; 2] {
+    let mut folds = [Vec::new(), Vec::new()];
+    let n = drive.wheels.len();
+    let (Some(first), Some(last)) = (drive.gnss.first(), drive.gnss.last()) else {
+        return folds;
+    };
+    if n == 0 {
+        return folds;
+    }
+    let (w0, w1) = (drive.wheels.t_s(0), drive.wheels.t_s(n - 1));
+    // The first fix moving faster than a walk.
+    let moving = drive
+        .gnss
+        .windows(2)
+        .find(|p| {
+            let dt = p[1].t_s - p[0].t_s;
+            dt > 0.0
+                && ((p[1].east_m - p[0].east_m).hypot(p[1].north_m - p[0].north_m) / dt)
+                    > outage::MOVING_MPS
+        })
+        .map(|p| p[0].t_s)
+        .unwrap_or(first.t_s)
+        .max(w0);
+    let end = last.t_s.min(w1) - 1.0;
+    let window_s = ((end - moving) / 6.0).clamp(MIN_WINDOW_S, WINDOW_S);
+    let period_s = PERIOD_WINDOWS * window_s;
+    let mut a = moving + period_s;
+    let mut k = 0;
+    while a + window_s <= end {
+        folds[k % 2].push((a, a + window_s));
+        a += period_s;
+        k += 1;
+    }
+    folds
+}
+
+/// The error at each window's end against its hidden fix, m, with the
+/// window's start, s.
+type WindowErrors = Vec<(f64, f64)>;
+
+/// The error at each window's end against the hidden fix, m, keyed by the
+/// window's start: for each fold, the car calibrated with the fold's fixes
+/// hidden (from `initial`), then dead-reckoned through the fold's windows.
+fn held_back_errors(
+    drive: &Drive,
+    copts: &CalibrationOptions,
+    initial: Option<Params>,
+    folds: &[Vec<(f64, f64)>; 2],
+) -> Result<WindowErrors, Error> {
+    let mut errors = Vec::new();
+    for fold in folds.iter().filter(|f| !f.is_empty()) {
+        let mut o = copts.clone();
+        o.filter.gnss_outages.extend_from_slice(fold);
+        if initial.is_some() {
+            o.initial = initial;
+        }
+        let params = match calibrate::calibrate(drive, &o) {
+            Ok(c) => c.estimate.params,
+            // A fold the calibration cannot take: judge with the start.
+            Err(_) => match initial {
+                Some(p) => p,
+                None => continue,
+            },
+        };
+        let ev = outage::through_windows_against_fixes(drive, &params, fold, &copts.filter)?;
+        errors.extend(ev.windows.iter().map(|w| (w.start_s, w.final_m())));
+    }
+    Ok(errors)
+}
+
+/// The mean of `errors`, m (NaN when empty).
+fn mean(errors: &[(f64, f64)]) -> f64 {
+    errors.iter().map(|e| e.1).sum::<f64>() / errors.len() as f64
+}
+
+/// The paired comparison of `with` against `without` over the windows both
+/// have: the mean difference, m, and its t statistic (NaN with fewer than
+/// two windows or no spread).
+fn paired(with: &[(f64, f64)], without: &[(f64, f64)]) -> (f64, f64) {
+    let d: Vec<f64> = with
+        .iter()
+        .filter_map(|&(t, e)| {
+            without
+                .iter()
+                .find(|w| (w.0 - t).abs() < 1e-9)
+                .map(|w| e - w.1)
+        })
+        .collect();
+    let n = d.len() as f64;
+    if d.len() < 2 {
+        return (f64::NAN, f64::NAN);
+    }
+    let m = d.iter().sum::<f64>() / n;
+    let var = d.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0);
+    (m, m / (var / n).sqrt())
+}
