@@ -58,7 +58,7 @@ pub fn run(a: CalibrateArgs, load: &common::Loader) -> Result<()> {
     };
     if a.json {
         let mut v = cc.json();
-        v["shape"] = found.json();
+        v["shape_found"] = found.json();
         common::print_json(load, v)?;
     } else {
         outln!("drive: {}", load.checks().span_text());
@@ -104,12 +104,12 @@ fn run_kinematic(
         // A tricycle log is not read through the plausibility checks.
         (true, true) => {
             let mut v = c.json();
-            v["shape"] = found.json();
+            v["shape_found"] = found.json();
             common::print_pretty(&v)
         }
         (true, false) => {
             let mut v = c.json();
-            v["shape"] = found.json();
+            v["shape_found"] = found.json();
             common::print_json(load, v)
         }
         (false, _) => {

@@ -61,7 +61,7 @@ pub fn run(a: CompareArgs, load: &common::Loader) -> Result<()> {
     if a.json {
         let mut v = deadreckon_api::json::comparison_json(&c);
         v["params_source"] = source.into();
-        v["shape"] = found.json();
+        v["shape_found"] = found.json();
         common::print_json(load, v)?;
     } else {
         outln!("drive: {}", load.checks().span_text());

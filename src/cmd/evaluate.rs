@@ -51,7 +51,7 @@ pub fn run(a: EvaluateArgs, load: &common::Loader) -> Result<()> {
     let ev = evaluate::measure(&drive, chosen, a.timing.into(), a.metric())?;
     if a.json {
         let mut v = ev.json();
-        v["shape"] = found.json();
+        v["shape_found"] = found.json();
         common::print_json(load, v)
     } else {
         common::print_lines(ev.lines())
@@ -113,7 +113,7 @@ fn run_kinematic(
     };
     let log = deadreckon_api::shape::of_path(&a.dir).is_some();
     let mut v = ev.json();
-    v["shape"] = found.json();
+    v["shape_found"] = found.json();
     match (a.json, log) {
         // A tricycle log is not read through the plausibility checks.
         (true, true) => common::print_pretty(&v),

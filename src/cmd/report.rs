@@ -24,7 +24,10 @@ pub fn run(a: ReportArgs, quiet: bool, load: &common::Loader) -> Result<()> {
         outage_s: a.outage,
         step_s: a.step,
         corrections: a.corrections.into(),
+        shape: a.shape.map(Into::into),
     };
+    let found = deadreckon_api::shape::detect(&a.dir, Some(&drive), o.shape);
+    outln!("{}", found.line());
     deadreckon_api::report::write(&drive, &o, &a.out, &steps, &common::footer())?;
     steps.finish();
     outln!("wrote {}", a.out.display());

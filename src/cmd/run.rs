@@ -79,7 +79,7 @@ pub fn run(a: RunArgs, load: &common::Loader) -> Result<()> {
     };
     let mut v = written.json();
     v["params_source"] = source.clone().into();
-    v["shape"] = found.json();
+    v["shape_found"] = found.json();
     match (a.json, log) {
         // A tricycle log is not read through the plausibility checks.
         (true, true) => common::print_pretty(&v),

@@ -197,8 +197,8 @@ pub fn check_circumferences(spec: &str, p: &Params, vehicle: &Vehicle) -> Result
             };
             return Err(format!(
                 "{spec}: {name} = {c} m is {:+.1} % from the vehicle's nominal \
-                 wheel_circumference_m = {nominal} m, more than the {} % a tyre \
-                 varies{hint}",
+                 wheel_circumference_m = {nominal} m{hint}, more than the {} % a \
+                 tyre varies",
                 100.0 * (factor - 1.0),
                 100.0 * MAX_CIRCUMFERENCE_DEVIATION
             ));

@@ -11,7 +11,7 @@ use deadreckon_core::kinematics::diff_drive::{
     self, calibrate_diff_drive, evaluate_diff_drive, DiffDriveDrive, DiffDriveOptions,
     DiffDriveOutages, OutageStart, YawSource,
 };
-use deadreckon_core::kinematics::tricycle::{TricycleDrive, TricycleParams};
+use deadreckon_core::kinematics::tricycle::{TricycleDrive, TricycleGeometry, TricycleParams};
 use deadreckon_core::kinematics::{
     self, KinematicCalibration, KinematicModel, KinematicOptions, KinematicOutages, Shape,
 };
@@ -77,7 +77,9 @@ pub fn load_tricycle_from(
     check_range(from, until)?;
     let d = match drive {
         Some(drive) => {
-            tricycle_of_drive(drive).doing(|| format!("{} as a tricycle", path.display()))?
+            let file = read_tricycle_file(path)?;
+            tricycle_of_drive(drive, file.as_ref())
+                .doing(|| format!("{} as a tricycle", path.display()))?
         }
         None => {
             let o = deadreckon_import::tricycle::TricycleOptions::default();
@@ -110,18 +112,108 @@ pub fn load_tricycle_from(
 /// encoder has 8192 counts, 4e-4 rad).
 pub const DRIVE_STEER_COUNTS_PER_REV: u32 = 1 << 24;
 
+/// The file `import tricycle` writes beside the drive: the log header's
+/// encoder geometry and nominal parameters, the tracker's mounting
+/// included (the drive's truth is the base, moved from the tracker by it).
+pub const TRICYCLE_FILE: &str = "tricycle.toml";
+
+/// What [`TRICYCLE_FILE`] holds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TricycleFile {
+    /// The encoders' ticks and counts per turn.
+    pub geometry: TricycleGeometry,
+    /// The header's nominal parameters, the tracker's mounting included.
+    pub nominal: TricycleParams,
+}
+
+impl TricycleFile {
+    /// The header of the tricycle log at `log` ([`TRICYCLE_FILE`]'s content).
+    pub fn of_log(log: &Path) -> Result<TricycleFile, Error> {
+        let o = deadreckon_import::tricycle::TricycleOptions::default();
+        let d =
+            deadreckon_import::tricycle::read_tricycle_kinematic(log, &o).map_err(|source| {
+                Error::Tricycle {
+                    path: log.to_path_buf(),
+                    source,
+                }
+            })?;
+        Ok(TricycleFile {
+            geometry: d.geometry,
+            nominal: d.nominal,
+        })
+    }
+
+    /// The TOML text.
+    pub fn to_toml(&self) -> Result<String, Error> {
+        let mut t = toml::Table::new();
+        let value = |v: Result<toml::Value, toml::ser::Error>| {
+            v.map_err(|e| Error::Invalid(format!("{TRICYCLE_FILE}: {e}")))
+        };
+        t.insert(
+            "geometry".into(),
+            value(toml::Value::try_from(self.geometry))?,
+        );
+        t.insert(
+            "nominal".into(),
+            value(toml::Value::try_from(self.nominal))?,
+        );
+        let body =
+            toml::to_string(&t).map_err(|e| Error::Invalid(format!("{TRICYCLE_FILE}: {e}")))?;
+        Ok(format!(
+            "# The tricycle log's header (deadreckon import tricycle): encoder geometry and\n\
+             # nominal parameters; truth.csv holds the base, moved from the tracker by nominal.mount.\n{body}"
+        ))
+    }
+}
+
+/// The [`TRICYCLE_FILE`] of the drive directory `dir`, if it has one.
+pub fn read_tricycle_file(dir: &Path) -> Result<Option<TricycleFile>, Error> {
+    let p = dir.join(TRICYCLE_FILE);
+    if !dir.is_dir() || !p.is_file() {
+        return Ok(None);
+    }
+    let text =
+        std::fs::read_to_string(&p).map_err(|e| Error::Invalid(format!("{}: {e}", p.display())))?;
+    let bad = |e: String| Error::Invalid(format!("{}: {e}", p.display()));
+    let t: toml::Table = text
+        .parse()
+        .map_err(|e: toml::de::Error| bad(e.to_string()))?;
+    let get = |k: &str| {
+        t.get(k)
+            .cloned()
+            .ok_or_else(|| bad(format!("missing `{k}`")))
+    };
+    let f = TricycleFile {
+        geometry: get("geometry")?
+            .try_into()
+            .map_err(|e: toml::de::Error| bad(e.to_string()))?,
+        nominal: get("nominal")?
+            .try_into()
+            .map_err(|e: toml::de::Error| bad(e.to_string()))?,
+    };
+    f.nominal.validate().map_err(|e| bad(e.to_string()))?;
+    Ok(Some(f))
+}
+
 /// A drive as a tricycle (what `import tricycle` writes: the traction
 /// wheel's ticks in its one present wheel column, the steering stream as
-/// the encoder angle over `steering_ratio` = 1/Ksteer, the truth at the
-/// base). The nominal parameters are the vehicle's: Ktraction its
-/// `wheel_circumference_m` per `ticks_per_rev`, Ksteer 1/`steering_ratio`,
-/// the offset −`steering_offset_rad`·Ksteer, the axle its `wheelbase_m`, the
-/// mounting zero (the truth is the base). Each wheel row is a sample, at the
-/// latest steering reading not after it, with the truth pose at its time as
-/// the reference when there is one.
-pub fn tricycle_of_drive(drive: &Drive) -> Result<TricycleDrive, Error> {
+/// the encoder angle plus the offset over Ksteer, `steering_ratio` =
+/// 1/Ksteer, the truth at the base). With the log header `file`
+/// ([`TRICYCLE_FILE`]) the samples are the log's own: the encoder counts
+/// recovered, the reference moved back to the tracker by its mounting, the
+/// nominal parameters the header's. Without it the nominal parameters are
+/// the vehicle's (Ktraction its `wheel_circumference_m`, Ksteer
+/// 1/`steering_ratio`, the offset −`steering_offset_rad`·Ksteer, the axle its
+/// `wheelbase_m`, the mounting zero: the truth is the base) and the
+/// steering angles are read on a grid of [`DRIVE_STEER_COUNTS_PER_REV`].
+/// Each wheel row is a sample, at the latest steering reading not after
+/// it, with the truth pose at its time as the reference when there is one.
+pub fn tricycle_of_drive(
+    drive: &Drive,
+    file: Option<&TricycleFile>,
+) -> Result<TricycleDrive, Error> {
     use deadreckon_core::drive::Wheels;
-    use deadreckon_core::kinematics::tricycle::{TricycleGeometry, TricycleSample};
+    use deadreckon_core::kinematics::tricycle::TricycleSample;
     use deadreckon_core::kinematics::Pose2;
     let v = &drive.vehicle;
     let Wheels::Ticks(rows) = &drive.wheels else {
@@ -138,26 +230,46 @@ pub fn tricycle_of_drive(drive: &Drive) -> Result<TricycleDrive, Error> {
     }
     let wheel = v.wheels_present.iter().position(|p| *p).unwrap_or(0);
     let ksteer = 1.0 / v.steering_ratio;
-    let nominal = TricycleParams {
-        ktraction_m: v.wheel_circumference_m,
-        ksteer,
-        steer_offset_rad: -v.steering_offset_rad * ksteer,
-        axle_length_m: v.wheelbase_m,
-        mount: Pose2::new(0.0, 0.0, 0.0),
+    let (geometry, nominal, stream_offset) = match file {
+        // The stream is 2π·s/counts + offset·steering_ratio.
+        Some(f) => (
+            f.geometry,
+            f.nominal,
+            f.nominal.steer_offset_rad * v.steering_ratio,
+        ),
+        None => (
+            TricycleGeometry {
+                ticks_per_rev: v.ticks_per_rev,
+                steer_counts_per_rev: DRIVE_STEER_COUNTS_PER_REV,
+            },
+            TricycleParams {
+                ktraction_m: v.wheel_circumference_m,
+                ksteer,
+                steer_offset_rad: -v.steering_offset_rad * ksteer,
+                axle_length_m: v.wheelbase_m,
+                mount: Pose2::new(0.0, 0.0, 0.0),
+            },
+            0.0,
+        ),
     };
-    let counts_per_rad = f64::from(DRIVE_STEER_COUNTS_PER_REV) / std::f64::consts::TAU;
+    let m = nominal.mount;
+    let counts_per_rad = f64::from(geometry.steer_counts_per_rev) / std::f64::consts::TAU;
     let mut ticks = 0i64;
     let mut samples = Vec::with_capacity(rows.len());
     for r in rows {
         ticks += [r.fl, r.fr, r.rl, r.rr][wheel];
         let k = drive.steering.partition_point(|s| s.t_s <= r.t_s);
-        let steer = drive.steering[k.saturating_sub(1)].value;
+        let steer = drive.steering[k.saturating_sub(1)].value - stream_offset;
         let j = drive.truth.partition_point(|p| p.t_s < r.t_s);
-        let reference = drive
-            .truth
-            .get(j)
-            .filter(|p| p.t_s == r.t_s)
-            .map(|p| Pose2::new(p.east_m, p.north_m, p.yaw_rad));
+        // The measured point: the base moved by the mounting.
+        let reference = drive.truth.get(j).filter(|p| p.t_s == r.t_s).map(|p| {
+            let (c, s) = (p.yaw_rad.cos(), p.yaw_rad.sin());
+            Pose2::new(
+                p.east_m + c * m.x_m - s * m.y_m,
+                p.north_m + s * m.x_m + c * m.y_m,
+                p.yaw_rad + m.yaw_rad,
+            )
+        });
         samples.push(TricycleSample {
             t_s: r.t_s,
             ticks,
@@ -166,10 +278,7 @@ pub fn tricycle_of_drive(drive: &Drive) -> Result<TricycleDrive, Error> {
         });
     }
     let d = TricycleDrive {
-        geometry: TricycleGeometry {
-            ticks_per_rev: v.ticks_per_rev,
-            steer_counts_per_rev: DRIVE_STEER_COUNTS_PER_REV,
-        },
+        geometry,
         nominal,
         samples,
     };

@@ -61,6 +61,7 @@ pub mod load;
 pub mod model_keys;
 pub mod options;
 pub mod report;
+pub mod report_kinematic;
 pub mod shape;
 pub mod source;
 pub mod stream;

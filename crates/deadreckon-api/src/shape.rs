@@ -34,7 +34,7 @@ impl Found {
         format!("shape: {} ({})", words(self.shape), self.reason)
     }
 
-    /// The `--json` value: `{"name": "diff_drive", "reason": …}`.
+    /// The `--json` value (`"shape_found"`): `{"name": "diff_drive", "reason": …, "asked": false}`.
     pub fn json(&self) -> serde_json::Value {
         serde_json::json!({
             "name": self.shape.name(),
