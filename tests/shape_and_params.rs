@@ -54,8 +54,8 @@ fn husky_without_shape_evaluated_as_a_car() {
 
 /// `import tricycle … --out tri/` wrote a directory nothing could evaluate
 /// ("initialisation from GNSS needs at least one fix"): it is a tricycle and
-/// calibrates and evaluates as the log does, to the last digit (log: mean
-/// 0.271 m over 30 s outages every 1 s).
+/// calibrates and evaluates as the log does, to 1e-9 (log: mean 0.271 m
+/// over 30 s outages every 1 s).
 #[test]
 fn an_imported_tricycle_directory_could_not_be_evaluated() {
     let tmp = tempfile::tempdir().unwrap();
@@ -66,7 +66,9 @@ fn an_imported_tricycle_directory_could_not_be_evaluated() {
     let (from_log, from_dir) = (args(TRICYCLE), args(d));
     assert_eq!(from_dir["shape_found"]["name"], "tricycle", "{from_dir}");
     let mean = |v: &serde_json::Value| v["final_error_m"]["mean"].as_f64().unwrap();
-    assert_eq!(mean(&from_log), mean(&from_dir));
+    // The same samples; the reference moved to the base and back rounds at
+    // 1e-16 m (measured: 0.27052920746101894 and …916).
+    assert!((mean(&from_log) - mean(&from_dir)).abs() < 1e-9);
     assert!(
         (mean(&from_dir) - 0.271).abs() < 0.0005,
         "{}",
@@ -74,7 +76,15 @@ fn an_imported_tricycle_directory_could_not_be_evaluated() {
     );
     let cal = |src: &str| json(&["calibrate", src, "--json"]);
     let (a, b) = (cal(TRICYCLE), cal(d));
-    assert_eq!(a["params"], b["params"]);
+    let params = a["params"].as_object().unwrap();
+    assert_eq!(params.len(), 7, "{a}");
+    for (name, p) in params {
+        let (x, y) = (
+            p["value"].as_f64().unwrap(),
+            b["params"][name]["value"].as_f64().unwrap(),
+        );
+        assert!((x - y).abs() < 1e-9, "{name}: {x} against {y}");
+    }
     // Its tracks are the tricycle's own (no car filter, no GNSS needed).
     let out = tmp.path().join("t.csv");
     let w = json(&["run", d, "--out", out.to_str().unwrap(), "--json"]);

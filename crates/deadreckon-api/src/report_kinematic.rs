@@ -114,6 +114,10 @@ pub fn write(
         fit: table.last().cloned().unwrap_or_default(),
     });
     input.trajectories = Some(traj);
+    if let Some(m) = o.model {
+        steps.step("TedriS");
+        input.tedris = Some(crate::report::tedris_section(drive, m, o.outage_s)?);
+    }
     input.outages = evaluated.map(|e| rp::OutageEvaluation {
         window_s: Some(e.length_s),
         methods: vec![rp::MethodSample {
