@@ -28,9 +28,6 @@ pub fn run(a: CalibrateArgs, load: &common::Loader) -> Result<()> {
     };
     // The shape found from the data, read once (deadreckon_api::shape).
     let (drive, found) = deadreckon_api::shape::load(load, &a.dir, &read, a.shape.map(Into::into))?;
-    if !a.json {
-        outln!("{}", found.line());
-    }
     if found.shape != Shape::FourWheel {
         return run_kinematic(&a, load, drive, &found);
     }
@@ -62,6 +59,7 @@ pub fn run(a: CalibrateArgs, load: &common::Loader) -> Result<()> {
         common::print_json(load, v)?;
     } else {
         outln!("drive: {}", load.checks().span_text());
+        outln!("{}", found.line());
         for l in cc.lines(&a.state.to_string(), &a.iteration.to_string()) {
             outln!("{l}");
         }
@@ -113,6 +111,7 @@ fn run_kinematic(
             common::print_json(load, v)
         }
         (false, _) => {
+            outln!("{}", found.line());
             common::print_lines(c.lines())?;
             common::print_lines(a.out.iter().map(|o| format!("wrote {}", o.display())))
         }

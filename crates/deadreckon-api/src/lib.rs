@@ -19,7 +19,9 @@
 //!   found from the data with its reason, the one rule every command
 //!   applies (`--shape` overrides).
 //! - [`tracks`]: `run`'s tracks chosen and written for other tools.
-//! - [`demo`], [`report`], [`stream`]: those commands whole.
+//! - [`demo`], [`report`], [`stream`]: those commands whole
+//!   ([`report_kinematic`]: the report of a tricycle or a differential
+//!   drive).
 //!
 //! - [`source`]: a drive from any source the tool reads: a drive directory
 //!   (`deadreckon-io`), a comma2k19 segment, a ROS1 bag or ROS2 MCAP (with a
