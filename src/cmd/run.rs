@@ -43,7 +43,7 @@ pub fn run(a: RunArgs, load: &common::Loader) -> Result<()> {
         (w, source)
     } else {
         if found.shape == Shape::DiffDrive {
-            note!("note: run writes the four-wheel filter's tracks: a differential drive's own are not written yet (--shape car says so and stops this note)");
+            note!("note: run writes the four-wheel filter's tracks: a differential drive's own are not written yet (--shape car runs it as a car without this note)");
         }
         let drive = match drive {
             Some(d) => d,
