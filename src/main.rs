@@ -27,6 +27,11 @@ struct Cli {
     /// error; with only one, that one is read).
     #[arg(long, global = true, value_enum)]
     wheels: Option<args::WheelsArg>,
+    /// Apply a params.toml calibrated for another vehicle than the drive's,
+    /// or whose circumferences are implausible for it (more than 5 % from
+    /// its nominal, millimetres for metres): refused without this option.
+    #[arg(long, global = true)]
+    params_for_other_vehicle: bool,
     #[command(subcommand)]
     command: Command,
 }
@@ -123,7 +128,7 @@ fn message(e: &anyhow::Error) -> String {
 fn run(cli: Cli) -> anyhow::Result<()> {
     cmd::set_quiet(cli.quiet);
     // The global reading options, passed to each command (no global state).
-    let load = cmd::Loader::new(
+    let mut load = cmd::Loader::new(
         cli.mapping,
         cli.skip_checks,
         cli.wheels.map(Into::into),
@@ -133,6 +138,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             }
         }),
     );
+    load.params_for_other_vehicle = cli.params_for_other_vehicle;
     match cli.command {
         Command::Simulate(a) => cmd::simulate::run(a),
         Command::Calibrate(a) => cmd::calibrate::run(a, &load),

@@ -120,6 +120,7 @@ fn the_report_ignored_the_corrections_of_its_params_and_estimated_none() {
             outage_s: None,
             step_s: None,
             corrections,
+            shape: None,
         }
     }
 

@@ -331,7 +331,8 @@ fn husky_report_drew_no_dead_reckoned_track_and_no_tedris_outage() {
     );
     let html = tmp.path().join("h.html");
     let st = bin()
-        .args(["report", husky, "--model"])
+        // The car's report (a differential drive's has no DR (RTS) track).
+        .args(["report", husky, "--shape", "car", "--model"])
         .arg(&model)
         .arg("--out")
         .arg(&html)
@@ -731,9 +732,15 @@ fn evaluate_used_nominal_for_metrics_but_rts_for_outages() {
         format!("drive: drive clock {t0:.3} to {t1:.3} s ({:.1} s)", t1 - t0),
         "{text}"
     );
+    // The shape found, with its reason (issue 29).
+    assert_eq!(
+        lines.next().unwrap(),
+        "shape: car (the drive has 4 wheel ticks and steering)",
+        "{text}"
+    );
     assert!(
         lines.next().unwrap().starts_with(&format!(
-            "parameters: {label} (without parameters, evaluate calibrates with RTS"
+            "parameters: {label} (without --params, the parameters are calibrated on the drive itself"
         )),
         "{text}"
     );

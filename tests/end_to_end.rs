@@ -534,7 +534,9 @@ const HUSKY: &str = concat!(
 );
 
 /// The Husky bag is read directly by every command (no conversion step), and
-/// dead-reckons through 30 s outages against the hidden GNSS fixes.
+/// dead-reckons through 30 s outages against the hidden GNSS fixes, here
+/// through the car pipeline (`--shape car`: its shape found from the data is
+/// a differential drive, tests/shape_and_params.rs).
 #[test]
 fn husky_bag_read_directly_through_30_s_outages() {
     let tmp = tempfile::tempdir().unwrap();
@@ -542,6 +544,8 @@ fn husky_bag_read_directly_through_30_s_outages() {
     let c = json(&run_ok(&[
         "calibrate",
         HUSKY,
+        "--shape",
+        "car",
         "--min-speed",
         "0.5",
         "--json",
@@ -556,6 +560,8 @@ fn husky_bag_read_directly_through_30_s_outages() {
     let o = json(&run_ok(&[
         "evaluate",
         HUSKY,
+        "--shape",
+        "car",
         "--params",
         params.to_str().unwrap(),
         "--outage",
@@ -577,6 +583,8 @@ fn husky_bag_read_directly_through_30_s_outages() {
     run_ok(&[
         "run",
         HUSKY,
+        "--shape",
+        "car",
         "--params",
         params.to_str().unwrap(),
         "--out",

@@ -132,9 +132,13 @@ fn assert_within(
 }
 
 fn write(drive: &Path, out: &Path, track: &str, sync_with: Option<&str>) {
+    // Nominal, as `ours` evaluates (run without --params calibrates on the
+    // drive, issue 29).
     let mut args = vec![
         "run",
         drive.to_str().unwrap(),
+        "--params",
+        "nominal",
         "--out",
         out.to_str().unwrap(),
         "--track",
@@ -249,6 +253,8 @@ fn compare(drive: &Path, work: &Path, label: &str) -> (f64, f64) {
     run_ok(&[
         "run",
         drive.to_str().unwrap(),
+        "--params",
+        "nominal",
         "--out",
         f("tracks.mcap").to_str().unwrap(),
         "--track",

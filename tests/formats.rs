@@ -60,25 +60,61 @@ fn tum_and_kitti_tracks_chosen_synced_and_refused() {
     let s = |n: &str| p(n).to_str().unwrap().to_string();
 
     // One track per TUM/KITTI file: without --track the error lists them.
-    let e = run_err(&["run", d, "--out", &s("a.tum")]);
+    let e = run_err(&["run", d, "--params", "nominal", "--out", &s("a.tum")]);
     assert!(
         e.contains("holds one track") && e.contains("dead-reckoned, filtered, smoothed, truth"),
         "{e}"
     );
-    let e = run_err(&["run", d, "--out", &s("a.tum"), "--track", "odometry"]);
+    let e = run_err(&[
+        "run",
+        d,
+        "--params",
+        "nominal",
+        "--out",
+        &s("a.tum"),
+        "--track",
+        "odometry",
+    ]);
     assert!(e.contains("no track named `odometry`"), "{e}");
-    let e = run_err(&["run", d, "--out", &s("a.txt")]);
+    let e = run_err(&["run", d, "--params", "nominal", "--out", &s("a.txt")]);
     assert!(
         e.contains("a.txt") && e.contains("unknown track format .txt"),
         "{e}"
     );
-    let e = run_err(&["run", d, "--out", &s("a.csv"), "--sync-with", "truth"]);
+    let e = run_err(&[
+        "run",
+        d,
+        "--params",
+        "nominal",
+        "--out",
+        &s("a.csv"),
+        "--sync-with",
+        "truth",
+    ]);
     assert!(e.contains("--sync-with is for TUM and KITTI"), "{e}");
     assert!(!p("a.tum").exists() && !p("a.txt").exists() && !p("a.csv").exists());
 
     // The truth is a track: at its own 100 Hz, as the dead-reckoned one at the wheels' 50 Hz.
-    run_ok(&["run", d, "--out", &s("truth.tum"), "--track", "truth"]);
-    run_ok(&["run", d, "--out", &s("dr.tum"), "--track", "dead-reckoned"]);
+    run_ok(&[
+        "run",
+        d,
+        "--params",
+        "nominal",
+        "--out",
+        &s("truth.tum"),
+        "--track",
+        "truth",
+    ]);
+    run_ok(&[
+        "run",
+        d,
+        "--params",
+        "nominal",
+        "--out",
+        &s("dr.tum"),
+        "--track",
+        "dead-reckoned",
+    ]);
     let (truth, dr) = (data_lines(&p("truth.tum")), data_lines(&p("dr.tum")));
     assert_eq!((truth.len(), dr.len()), (67296, 33647));
     assert!(truth[1].starts_with("0.010000000 "), "{}", truth[1]);
@@ -87,6 +123,8 @@ fn tum_and_kitti_tracks_chosen_synced_and_refused() {
     run_ok(&[
         "run",
         d,
+        "--params",
+        "nominal",
         "--out",
         &s("dr.kitti"),
         "--track",
@@ -97,6 +135,8 @@ fn tum_and_kitti_tracks_chosen_synced_and_refused() {
     run_ok(&[
         "run",
         d,
+        "--params",
+        "nominal",
         "--out",
         &s("truth.kitti"),
         "--track",
@@ -122,6 +162,8 @@ fn tum_and_kitti_tracks_chosen_synced_and_refused() {
     run_ok(&[
         "run",
         d,
+        "--params",
+        "nominal",
         "--out",
         &s("two.csv"),
         "--track",

@@ -106,8 +106,10 @@ fn a_gnss_outlier_a_kilometre_off_is_warned_about_and_gated() {
     assert!(rejected >= 1, "{filter}");
 }
 
+/// A circumference in millimetres was taken (issue 29): refused, naming the
+/// file, the key and both values.
 #[test]
-fn a_circumference_in_millimetres_in_params_toml_is_refused_naming_file_key_and_values() {
+fn a_circumference_in_millimetres_is_refused() {
     let tmp = tempfile::tempdir().unwrap();
     let d = simulated(tmp.path(), "d", "300");
     let p = tmp.path().join("p.toml");

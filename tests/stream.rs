@@ -285,6 +285,9 @@ fn stream_reproduces_run(walk: Option<f64>) -> (Vec<(f64, f64, f64, f64)>, Vec<(
     let st = bin()
         .arg("run")
         .arg(&dir)
+        // The nominal parameters, as `stream` without --params (`run`
+        // without them calibrates on the drive, issue 29).
+        .args(["--params", "nominal"])
         .arg("--out")
         .arg(&track)
         .output()

@@ -237,18 +237,24 @@ def run(
     timing: str = "wheel",
     init_pose: Optional[Tuple[float, float, float]] = None,
     mapping: Optional[PathLike] = None,
+    corrections: str = "auto",
 ) -> Dict[str, pd.DataFrame]:
     """The drive's tracks as DataFrames: ``dead-reckoned``, and with GNSS
     ``filtered`` and ``smoothed``, and with truth ``truth``.
 
-    ``params``: ``"nominal"`` (default), a ``params.toml`` path, or a dict with
-    the six parameters (such as :func:`calibrate`'s result). Columns: those of
+    ``params``: ``"nominal"``, a ``params.toml`` path (bound to its vehicle:
+    another vehicle's file is refused, and the corrections it stores are
+    applied), or a dict with the six parameters (such as :func:`calibrate`'s
+    result). Without it the drive is calibrated on itself first (RTS after
+    the ``corrections`` of :func:`calibrate`), as ``deadreckon run`` does. Columns: those of
     ``deadreckon run --out track.csv`` but ``track``: ``t_s, east_m, north_m,
     yaw_rad, speed_mps, yaw_rate_rps, std_east_m, std_north_m, std_yaw_rad,
     cov_en_m2``. ``init_pose``: (east_m, north_m, yaw_rad) of the dead
     reckoning's start (default the truth, else the smoothed GNSS track).
     """
-    tracks = _native.run_tracks(_source(drive), _params(params), timing, init_pose, _opt_path(mapping))
+    tracks = _native.run_tracks(
+        _source(drive), _params(params), timing, init_pose, _opt_path(mapping), corrections
+    )
     return {name: pd.DataFrame(cols) for name, cols in tracks.items()}
 
 
@@ -271,8 +277,15 @@ def evaluate(
     mapping: Optional[PathLike] = None,
     corrections: str = "auto",
     skip_checks: bool = False,
+    shape: Optional[str] = None,
 ) -> Dict[str, Any]:
     """Dead-reckoning accuracy; returns ``deadreckon evaluate --json``'s object.
+
+    ``shape``: ``car``, ``diff-drive`` or ``tricycle``; by default found from
+    the data as the command finds it (a tricycle or a differential drive is
+    evaluated over sliding ``outage`` windows through its own kinematics,
+    ``shape_found`` saying which and why). ``params_source`` says which
+    parameters were applied.
 
     ``metric``: ``drift`` (per ``segment_m``), ``reset-1m`` (at
     ``threshold_m``), ``rpe`` (evo's relative pose error per ``delta_m`` of
@@ -305,6 +318,7 @@ def evaluate(
         _opt_path(mapping),
         corrections,
         skip_checks,
+        shape,
     )
 
 

@@ -114,6 +114,7 @@ def run_tracks(
     timing: str = "wheel",
     init_pose: Optional[Tuple[float, float, float]] = None,
     mapping: Optional[str] = None,
+    corrections: str = "auto",
 ) -> Dict[str, Columns]: ...
 def evaluate(
     source: Union[Drive, str],
@@ -133,6 +134,7 @@ def evaluate(
     mapping: Optional[str] = None,
     corrections: str = "auto",
     skip_checks: bool = False,
+    shape: Optional[str] = None,
 ) -> Dict[str, Any]: ...
 def tedris_train(
     source: Union[Drive, str],

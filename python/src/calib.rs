@@ -137,13 +137,20 @@ pub fn params_arg(
             deadreckon_api::chain_text(&e)
         ))
     })?;
+    // Bound to their vehicle, as the command line's --params
+    // (deadreckon_api::binding): another vehicle's file is refused.
+    let (_, extra) = deadreckon_io::read_params_with_extra(&spec).map_err(to_py_err)?;
+    let record =
+        deadreckon_api::binding::VehicleRecord::from_extra(&label, &extra).map_err(to_py_err)?;
+    deadreckon_api::binding::check(&label, record.as_ref(), &read.params, vehicle, false)
+        .map_err(to_py_err)?;
     Ok((read.params, label))
 }
 
 /// Every track of a drive (dead-reckoned, filtered, smoothed, and truth),
 /// as `{name: {column: array}}` with the track CSV's columns.
 #[pyfunction]
-#[pyo3(signature = (source, params=None, timing="wheel", init_pose=None, mapping=None))]
+#[pyo3(signature = (source, params=None, timing="wheel", init_pose=None, mapping=None, corrections="auto"))]
 pub fn run_tracks<'py>(
     py: Python<'py>,
     source: &Bound<'py, PyAny>,
@@ -151,11 +158,23 @@ pub fn run_tracks<'py>(
     timing: &str,
     init_pose: Option<(f64, f64, f64)>,
     mapping: Option<PathBuf>,
+    corrections: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let which = corrections_which(corrections)?;
     let drive = drive_arg(py, source, &Default::default(), mapping)?;
-    let params = match params {
-        Some(p) => params_arg(p, &drive.vehicle)?.0,
-        None => Params::nominal(&drive.vehicle),
+    // The one rule for no params (deadreckon_api::evaluate::RULE): calibrated
+    // on the drive itself, as `run` does; a file's stored corrections applied.
+    let (params, drive) = match params {
+        Some(p) => {
+            let params = params_arg(p, &drive.vehicle)?.0;
+            (params, with_stored(Some(p), (*drive).clone())?)
+        }
+        None => {
+            let (c, d) = py
+                .detach(|| deadreckon_api::evaluate::default_parameters(&drive, which))
+                .map_err(to_py_err)?;
+            (c.params, d)
+        }
     };
     if let Some((e, n, y)) = init_pose {
         if !(e.is_finite() && n.is_finite() && y.is_finite()) {
@@ -200,7 +219,7 @@ pub fn track_columns<'py>(py: Python<'py>, t: &track::Track) -> PyResult<Bound<'
 
 /// `evaluate --json` as a dict; the options are the command's.
 #[pyfunction]
-#[pyo3(signature = (source, params=None, metric="drift", outage=None, step=None, warmup=5.0, segment_m=100.0, threshold_m=1.0, track="dead-reckoned", reference="truth", delta_m=100.0, pairs_from="estimate", max_diff_s=evo::DEFAULT_MAX_DIFF_S, timing="wheel", mapping=None, corrections="auto", skip_checks=false))]
+#[pyo3(signature = (source, params=None, metric="drift", outage=None, step=None, warmup=5.0, segment_m=100.0, threshold_m=1.0, track="dead-reckoned", reference="truth", delta_m=100.0, pairs_from="estimate", max_diff_s=evo::DEFAULT_MAX_DIFF_S, timing="wheel", mapping=None, corrections="auto", skip_checks=false, shape=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn evaluate(
     py: Python<'_>,
@@ -221,11 +240,19 @@ pub fn evaluate(
     mapping: Option<PathBuf>,
     corrections: &str,
     skip_checks: bool,
+    shape: Option<&str>,
 ) -> PyResult<Py<PyAny>> {
     let which = corrections_which(corrections)?;
     let drive = drive_arg(py, source, &Default::default(), mapping)?;
     let checks = checked(source, &drive, skip_checks)?;
     let timing = parse_timing(timing).map_err(to_py_err)?;
+    // The shape found from the data, as the commands find it
+    // (deadreckon_api::shape); `shape` overrides it.
+    if let Some(v) = kinematic_evaluate(py, source, &drive, params, outage, step, shape)? {
+        let mut v = v;
+        checks.annotate(&mut v);
+        return to_py(py, &v);
+    }
     if outage.is_none() && !["drift", "reset-1m", "rpe", "ape"].contains(&metric) {
         return Err(err(format!(
             "unknown metric `{metric}` (drift, reset-1m, rpe, ape)"
@@ -235,13 +262,13 @@ pub fn evaluate(
     // command applies it.
     let given = params.map(|p| params_arg(p, &drive.vehicle)).transpose()?;
     let stored = with_stored(params, (*drive).clone())?;
-    let (params, label, drive, corr) = py.detach(|| -> PyResult<_> {
+    let (params, label, drive, corr, params_source) = py.detach(|| -> PyResult<_> {
         Ok(match given {
-            Some((p, l)) => (p, l, stored, None),
+            Some((p, l)) => (p, l.clone(), stored, None, l),
             None => {
                 let (c, d) = deadreckon_api::evaluate::default_parameters(&drive, which)
                     .map_err(to_py_err)?;
-                (c.params, c.label, d, c.corrections)
+                (c.params, c.label, d, c.corrections, c.source)
             }
         })
     })?;
@@ -264,6 +291,7 @@ pub fn evaluate(
             if let Some(c) = &corr {
                 v["corrections"] = deadreckon_api::corrections::corrections_json(c);
             }
+            v["params_source"] = params_source.clone().into();
             Ok(v)
         })?;
         checks.annotate(&mut v);
@@ -299,9 +327,79 @@ pub fn evaluate(
         }
     })?;
     v["params"] = label.into();
+    v["params_source"] = params_source.into();
     if let Some(c) = &corr {
         v["corrections"] = deadreckon_api::corrections::corrections_json(c);
     }
     checks.annotate(&mut v);
     to_py(py, &v)
+}
+
+/// `evaluate` of a drive whose shape (found from the data, or `shape`) is a
+/// tricycle or a differential drive, as the command runs it; `None` for a
+/// car.
+fn kinematic_evaluate(
+    py: Python<'_>,
+    source: &Bound<'_, PyAny>,
+    drive: &deadreckon_core::Drive,
+    params: Option<&Bound<'_, PyAny>>,
+    outage: Option<f64>,
+    step: Option<f64>,
+    shape: Option<&str>,
+) -> PyResult<Option<serde_json::Value>> {
+    use deadreckon_api::{kinematic, shape as sh};
+    use deadreckon_core::kinematics::diff_drive::{OutageStart, DEFAULT_WARMUP_S};
+    use deadreckon_core::kinematics::Shape;
+    let asked = match shape {
+        None => None,
+        Some("car") => Some(Shape::FourWheel),
+        Some("diff-drive") => Some(Shape::DiffDrive),
+        Some("tricycle") => Some(Shape::Tricycle),
+        Some(other) => {
+            return Err(err(format!(
+                "unknown shape `{other}` (car, diff-drive, tricycle)"
+            )))
+        }
+    };
+    let path = source
+        .extract::<PathBuf>()
+        .unwrap_or_else(|_| PathBuf::from("the drive"));
+    let found = sh::detect(&path, Some(drive), asked);
+    if found.shape == Shape::FourWheel {
+        return Ok(None);
+    }
+    let Some(len) = outage else {
+        return Err(err(format!(
+            "a {} is evaluated over sliding outages: give outage=LEN (and step=S)",
+            sh::words(found.shape)
+        )));
+    };
+    let spec: Option<String> = params.map(|p| p.extract()).transpose()?;
+    let step = step.unwrap_or(len / 2.0);
+    let ev = py
+        .detach(|| match found.shape {
+            Shape::Tricycle => {
+                // A tricycle log is read through its own kinematics.
+                let own = sh::of_path(&path).is_none().then_some(drive);
+                kinematic::evaluate_tricycle(&path, own, spec.as_deref(), len, step, None, None)
+            }
+            _ => {
+                let yaw = kinematic::diff_yaw(spec.as_deref(), None);
+                kinematic::evaluate_diff(
+                    drive,
+                    spec.as_deref(),
+                    yaw,
+                    len,
+                    step,
+                    DEFAULT_WARMUP_S,
+                    &OutageStart::Filter(Default::default()),
+                    None,
+                    None,
+                )
+            }
+        })
+        .map_err(to_py_err)?;
+    let mut v = ev.json();
+    v["shape_found"] = found.json();
+    Ok(Some(v))
 }

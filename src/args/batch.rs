@@ -16,6 +16,11 @@ pub struct BatchArgs {
     /// Drives: drive directories, directories of drive directories, recordings, or glob patterns.
     #[arg(required = true)]
     pub inputs: Vec<String>,
+    /// The vehicle shape (default: found from each drive's data; batch
+    /// calibrates cars, and a drive found to be another shape fails with
+    /// the reason unless --shape car).
+    #[arg(long, value_enum, help = super::kinematic::SHAPE_HELP)]
+    pub shape: Option<super::kinematic::ShapeArg>,
     /// The results CSV, one row per drive (written atomically; must not be an input).
     #[arg(long)]
     pub out: PathBuf,

@@ -65,9 +65,9 @@ pub struct CalibrateArgs {
     /// rts (smoothed states, needs GNSS), zupt (standstill gyro bias), truth (needs truth.csv); a tricycle: truth (its tracker); a differential drive: gnss (default: rts, truth, gnss by shape).
     #[arg(long, value_enum)]
     pub method: Option<super::MethodArg>,
-    /// The vehicle shape: car (four wheels, the default) or diff-drive (odometry twist, calibrated against GNSS). A tricycle log is recognised by itself.
-    #[arg(long, value_enum, default_value_t = ShapeArg::Car)]
-    pub shape: ShapeArg,
+    /// The vehicle shape (default: found from the data).
+    #[arg(long, value_enum, help = super::kinematic::SHAPE_HELP)]
+    pub shape: Option<ShapeArg>,
     /// Differential drive: the yaw rate integrated, gyro or odometry.
     #[arg(long, value_enum, default_value_t = YawArg::Gyro)]
     pub yaw: YawArg,

@@ -18,6 +18,10 @@ pub struct CompareArgs {
     /// TedriS model (model.json); default: trained on the drive with the outages hidden.
     #[arg(long)]
     pub model: Option<PathBuf>,
+    /// The vehicle shape (default: found from the data); compare runs the
+    /// four-wheel filter and TedriS, so only a car is compared.
+    #[arg(long, value_enum, help = super::kinematic::SHAPE_HELP)]
+    pub shape: Option<super::kinematic::ShapeArg>,
     /// Print JSON instead of a table.
     #[arg(long)]
     pub json: bool,

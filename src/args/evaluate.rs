@@ -47,7 +47,7 @@ pub enum PairsFromArg {
 pub struct EvaluateArgs {
     /// The drive directory or recording (a tricycle `dataset.txt` is dead-reckoned through its own kinematics).
     pub dir: PathBuf,
-    /// `nominal` or a params.toml. Without it, `--outage` calibrates with RTS on the drive itself.
+    /// `nominal` or a params.toml. Without it, the parameters are calibrated on the drive itself (RTS for a car, against GNSS for a differential drive, against the tracker for a tricycle).
     #[arg(long)]
     pub params: Option<String>,
     /// drift (reset to the truth every 100 m), reset-1m (reset when the error
@@ -91,9 +91,9 @@ pub struct EvaluateArgs {
     /// Print JSON instead of text.
     #[arg(long)]
     pub json: bool,
-    /// The vehicle shape: car (the default) or diff-drive (outages start from the GNSS-aided filter, or with --start align from the alignment of the preceding --align seconds of dead reckoning to the fixes). A tricycle log is recognised by itself.
-    #[arg(long, value_enum, default_value_t = ShapeArg::Car)]
-    pub shape: ShapeArg,
+    /// The vehicle shape (default: found from the data). A differential drive's outages start from the GNSS-aided filter, or with --start align from the alignment of the preceding --align seconds of dead reckoning to the fixes.
+    #[arg(long, value_enum, help = super::kinematic::SHAPE_HELP)]
+    pub shape: Option<ShapeArg>,
     /// Differential drive: the yaw rate integrated, gyro or odometry (default: the params file's, else gyro).
     #[arg(long, value_enum)]
     pub yaw: Option<YawArg>,

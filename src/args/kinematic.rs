@@ -1,13 +1,28 @@
 //! The kinematic shapes' arguments (`--shape`, `--yaw`).
 
-/// `--shape`.
+/// `--shape` (default: found from the data, `deadreckon_api::shape`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum ShapeArg {
     /// Four wheels, front-steered (the paper's car).
     Car,
     /// Left/right wheels or an odometry twist.
     DiffDrive,
+    /// One steered traction wheel and a passive rear axle.
+    Tricycle,
 }
+
+impl From<ShapeArg> for deadreckon_core::kinematics::Shape {
+    fn from(s: ShapeArg) -> Self {
+        match s {
+            ShapeArg::Car => Self::FourWheel,
+            ShapeArg::DiffDrive => Self::DiffDrive,
+            ShapeArg::Tricycle => Self::Tricycle,
+        }
+    }
+}
+
+/// The help of `--shape`, the same in every command.
+pub const SHAPE_HELP: &str = "The vehicle shape: car, diff-drive or tricycle (default: found from the data and printed with the reason: body velocity or two wheels and no steering is a differential drive, a tricycle log or one steered wheel a tricycle, else a car)";
 
 /// `--yaw` of a differential drive.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]

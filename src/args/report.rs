@@ -7,7 +7,7 @@ use clap::Args;
 /// Arguments of `report`.
 #[derive(Args, Debug)]
 pub struct ReportArgs {
-    /// The drive directory.
+    /// The drive directory (or a recording read directly).
     pub dir: PathBuf,
     /// Extra parameters to show and dead-reckon with (a params.toml), beside the calibrations made on the drive.
     #[arg(long)]
@@ -27,6 +27,10 @@ pub struct ReportArgs {
     /// applies those instead.
     #[arg(long, value_enum, default_value_t = super::CorrectionsArg::Auto)]
     pub corrections: super::CorrectionsArg,
+    /// The vehicle shape (default: found from the data). A tricycle or a
+    /// differential drive gets its kinematic calibration's sections.
+    #[arg(long, value_enum, help = super::kinematic::SHAPE_HELP)]
+    pub shape: Option<super::kinematic::ShapeArg>,
     /// Output HTML file.
     #[arg(long)]
     pub out: PathBuf,

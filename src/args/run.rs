@@ -8,11 +8,20 @@ use deadreckon_core::evo;
 /// Arguments of `run`.
 #[derive(Args, Debug)]
 pub struct RunArgs {
-    /// The drive directory.
+    /// The drive directory (or a recording read directly).
     pub dir: PathBuf,
-    /// `nominal` or a params.toml.
-    #[arg(long, default_value = "nominal")]
-    pub params: String,
+    /// `nominal` or a params.toml. Without it, the parameters are calibrated
+    /// on the drive itself, as `evaluate` does (RTS for a car, against the
+    /// tracker for a tricycle).
+    #[arg(long)]
+    pub params: Option<String>,
+    /// Without --params: the timing and mounting corrections estimated and
+    /// applied before calibrating on the drive (as `evaluate --corrections`).
+    #[arg(long, value_enum, default_value_t = super::CorrectionsArg::Auto)]
+    pub corrections: super::CorrectionsArg,
+    /// The vehicle shape (default: found from the data).
+    #[arg(long, value_enum, help = super::kinematic::SHAPE_HELP)]
+    pub shape: Option<super::kinematic::ShapeArg>,
     /// Output file, by extension: .csv, .geojson, .mcap (every track), .tum or
     /// .kitti (one track; KITTI's timestamps go to <stem>.times.txt).
     #[arg(long)]

@@ -32,10 +32,22 @@ pub fn run(a: BatchArgs, quiet: bool, loader: &common::Loader) -> Result<()> {
     } else {
         read.without_truth()
     };
+    // Each drive's shape found from its data (deadreckon_api::shape): batch
+    // calibrates cars.
+    let asked = a.shape.map(Into::into);
     let load = |p: &std::path::Path| {
-        loader
+        let d = loader
             .drive_with(p, &read)
-            .map_err(|e| deadreckon_api::chain_text(&e))
+            .map_err(|e| deadreckon_api::chain_text(&e))?;
+        let found = deadreckon_api::shape::detect(p, Some(&d), asked);
+        if found.shape != deadreckon_core::kinematics::Shape::FourWheel {
+            return Err(format!(
+                "a {} ({}): batch calibrates cars (--shape car to calibrate it as one)",
+                deadreckon_api::shape::words(found.shape),
+                found.reason
+            ));
+        }
+        Ok(d)
     };
     let progress = super::progress::drives_bar(drives.len(), quiet);
     let start = Instant::now();

@@ -3,11 +3,10 @@
 //! calibration of its seven parameters against the tracker.
 
 use anyhow::Result;
-use deadreckon_core::calibrate::Method;
 
 use super::common;
-use crate::args::kinematic::ShapeArg;
 use deadreckon_api::kinematic;
+use deadreckon_core::kinematics::Shape;
 
 use crate::args::calibrate::*;
 
@@ -19,19 +18,25 @@ pub fn run(a: CalibrateArgs, load: &common::Loader) -> Result<()> {
     if let (Some(out), OutFormat::Params) = (&a.out, a.format) {
         common::check_output(out, &[&a.dir])?;
     }
-    let tricycle = kinematic::is_tricycle_log(&a.dir);
-    if tricycle || a.shape == ShapeArg::DiffDrive {
-        return run_kinematic(&a, load, tricycle);
-    }
-    let (method_name, opts) = a.car_options()?;
-    // Only the truth calibration reads truth.csv.
+    // Only the truth calibration reads truth.csv (a tricycle's drive is read
+    // again with it: its tracker is the reference).
     let read = deadreckon_io::ReadOptions::default();
-    let read = if opts.method == Method::Truth {
+    let read = if a.method == Some(common::MethodArg::Truth) {
         read
     } else {
         read.without_truth()
     };
-    let drive = deadreckon_api::load::cut(load.drive_with(&a.dir, &read)?, a.from_s, a.until_s)?;
+    // The shape found from the data, read once (deadreckon_api::shape).
+    let (drive, found) = deadreckon_api::shape::load(load, &a.dir, &read, a.shape.map(Into::into))?;
+    if found.shape != Shape::FourWheel {
+        return run_kinematic(&a, load, drive, &found);
+    }
+    let (method_name, opts) = a.car_options()?;
+    let drive = match drive {
+        Some(d) => d,
+        None => load.drive_with(&a.dir, &read)?,
+    };
+    let drive = deadreckon_api::load::cut(drive, a.from_s, a.until_s)?;
     let cc = deadreckon_api::calibrate::calibrate_car(
         &drive,
         &method_name,
@@ -49,9 +54,12 @@ pub fn run(a: CalibrateArgs, load: &common::Loader) -> Result<()> {
         None => Vec::new(),
     };
     if a.json {
-        common::print_json(load, cc.json())?;
+        let mut v = cc.json();
+        v["shape_found"] = found.json();
+        common::print_json(load, v)?;
     } else {
         outln!("drive: {}", load.checks().span_text());
+        outln!("{}", found.line());
         for l in cc.lines(&a.state.to_string(), &a.iteration.to_string()) {
             outln!("{l}");
         }
@@ -62,9 +70,14 @@ pub fn run(a: CalibrateArgs, load: &common::Loader) -> Result<()> {
     Ok(())
 }
 
-/// A tricycle log against its tracker, or a differential drive against its
-/// GNSS fixes (`deadreckon_api::kinematic`).
-fn run_kinematic(a: &CalibrateArgs, load: &common::Loader, tricycle: bool) -> Result<()> {
+/// A tricycle against its tracker (its log, or its drive directory), or a
+/// differential drive against its GNSS fixes (`deadreckon_api::kinematic`).
+fn run_kinematic(
+    a: &CalibrateArgs,
+    load: &common::Loader,
+    drive: Option<deadreckon_core::Drive>,
+    found: &deadreckon_api::shape::Found,
+) -> Result<()> {
     let o = kinematic::CalibrateOptions {
         method: a.method.map(common::MethodArg::name),
         window_s: a.window,
@@ -72,20 +85,33 @@ fn run_kinematic(a: &CalibrateArgs, load: &common::Loader, tricycle: bool) -> Re
         from_s: a.from_s,
         until_s: a.until_s,
     };
-    let c = if tricycle {
-        kinematic::calibrate_tricycle(&a.dir, &o)?
+    let c = if found.shape == Shape::Tricycle {
+        kinematic::calibrate_tricycle(&a.dir, drive.as_ref(), &o)?
     } else {
-        let drive = load.drive(&a.dir)?;
+        let drive = match drive {
+            Some(d) => d,
+            None => load.drive(&a.dir)?,
+        };
         kinematic::calibrate_diff(&drive, &a.dir, a.yaw.into(), &o)?
     };
     if let Some(out) = &a.out {
         c.write(out)?;
     }
-    match (a.json, tricycle) {
+    let log = deadreckon_api::shape::of_path(&a.dir).is_some();
+    match (a.json, log) {
         // A tricycle log is not read through the plausibility checks.
-        (true, true) => common::print_pretty(&c.json()),
-        (true, false) => common::print_json(load, c.json()),
+        (true, true) => {
+            let mut v = c.json();
+            v["shape_found"] = found.json();
+            common::print_pretty(&v)
+        }
+        (true, false) => {
+            let mut v = c.json();
+            v["shape_found"] = found.json();
+            common::print_json(load, v)
+        }
         (false, _) => {
+            outln!("{}", found.line());
             common::print_lines(c.lines())?;
             common::print_lines(a.out.iter().map(|o| format!("wrote {}", o.display())))
         }

@@ -23,8 +23,12 @@ pub fn run(a: ImportArgs, load: &super::common::Loader) -> Result<()> {
         );
     }
     let (format, options) = a.options(load.mapping.clone())?;
-    let Imported { drive, report } = import(format, &a.source, &options)?;
-    deadreckon_api::import::write(&a.out, &drive)?;
+    let Imported {
+        drive,
+        report,
+        files,
+    } = import(format, &a.source, &options)?;
+    deadreckon_api::import::write_with(&a.out, &drive, &files)?;
     outln!("{}", report.trim_end_matches('\n'));
     outln!("{}", deadreckon_api::import::counts_line(&drive));
     outln!("wrote {}", a.out.display());

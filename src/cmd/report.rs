@@ -24,7 +24,19 @@ pub fn run(a: ReportArgs, quiet: bool, load: &common::Loader) -> Result<()> {
         outage_s: a.outage,
         step_s: a.step,
         corrections: a.corrections.into(),
+        shape: a.shape.map(Into::into),
     };
+    let found = deadreckon_api::shape::detect(&a.dir, Some(&drive), o.shape);
+    outln!("{}", found.line());
+    // The one rule for "no --params" (deadreckon_api::evaluate::RULE): the
+    // report calibrates on the drive, and shows a given file beside.
+    outln!(
+        "parameters: {}{}",
+        deadreckon_api::evaluate::CALIBRATED_HERE,
+        a.params
+            .as_deref()
+            .map_or(String::new(), |p| format!(", and {p} as given"))
+    );
     deadreckon_api::report::write(&drive, &o, &a.out, &steps, &common::footer())?;
     steps.finish();
     outln!("wrote {}", a.out.display());

@@ -5,28 +5,60 @@
 use std::path::Path;
 
 use anyhow::Result;
-use deadreckon_api::{kinematic, tracks};
+use deadreckon_api::{evaluate, tracks};
 use deadreckon_core::ekf::FilterOptions;
+use deadreckon_core::kinematics::Shape;
 
 use super::common;
 use crate::args::run::RunArgs;
 
 /// Runs `run`.
 pub fn run(a: RunArgs, load: &common::Loader) -> Result<()> {
-    common::check_output(&a.out, &[&a.dir, Path::new(&a.params)])?;
-    let tricycle = kinematic::is_tricycle_log(&a.dir);
-    let written = if tricycle {
+    let params_path = a.params.as_deref().map(Path::new);
+    let inputs: Vec<&Path> = std::iter::once(a.dir.as_path())
+        .chain(params_path)
+        .collect();
+    common::check_output(&a.out, &inputs)?;
+    // The shape found from the data, read once (deadreckon_api::shape).
+    let read = deadreckon_io::ReadOptions::default();
+    let (drive, found) = deadreckon_api::shape::load(load, &a.dir, &read, a.shape.map(Into::into))?;
+    if !a.json {
+        outln!("{}", found.line());
+    }
+    let log = deadreckon_api::shape::of_path(&a.dir).is_some();
+    let (written, source) = if found.shape == Shape::Tricycle {
         // The tricycle is dead-reckoned through its own kinematics (the car
         // filter's wheel and steering observations oscillate at its steering
         // angles near 1.1 rad), from the first tracker pose.
         anyhow::ensure!(
             a.init_pose.is_none(),
-            "a tricycle log starts from its first tracker pose: --init-pose is not used"
+            "a tricycle starts from its first tracker pose: --init-pose is not used"
         );
-        tracks::write_tricycle(&a.dir, &a.params, &a.out, &a.selection(), a.mcap.into())?
+        let (tracks, source) = deadreckon_api::kinematic::tricycle_tracks(
+            &a.dir,
+            drive.as_ref(),
+            a.params.as_deref(),
+        )?;
+        let w = tracks::write_tracks(&tracks, &a.out, &a.selection(), a.mcap.into())?;
+        (w, source)
     } else {
-        let drive = load.drive(&a.dir)?;
-        let (params, drive) = deadreckon_api::load::params_corrected(&a.params, drive)?;
+        if found.shape == Shape::DiffDrive {
+            note!("note: run writes the four-wheel filter's tracks: a differential drive's own are not written yet (--shape car runs it as a car without this note)");
+        }
+        let drive = match drive {
+            Some(d) => d,
+            None => load.drive(&a.dir)?,
+        };
+        // One rule for "no --params" (deadreckon_api::evaluate::RULE).
+        let (chosen, drive) = evaluate::parameters(
+            a.params.as_deref(),
+            drive,
+            a.corrections.into(),
+            load.params_for_other_vehicle,
+        )?;
+        if let Some(n) = &chosen.note {
+            note!("note: {n}");
+        }
         let init_pose = a.init_pose()?;
         let opts = FilterOptions {
             timing: a.timing.into(),
@@ -34,12 +66,27 @@ pub fn run(a: RunArgs, load: &common::Loader) -> Result<()> {
             ..Default::default()
         };
         let s = a.selection();
-        tracks::write_car(&drive, &params, &opts, init_pose, &a.out, &s, a.mcap.into())?
+        let w = tracks::write_car(
+            &drive,
+            &chosen.params,
+            &opts,
+            init_pose,
+            &a.out,
+            &s,
+            a.mcap.into(),
+        )?;
+        (w, chosen.source)
     };
-    match (a.json, tricycle) {
+    let mut v = written.json();
+    v["params_source"] = source.clone().into();
+    v["shape_found"] = found.json();
+    match (a.json, log) {
         // A tricycle log is not read through the plausibility checks.
-        (true, true) => common::print_pretty(&written.json()),
-        (true, false) => common::print_json(load, written.json()),
-        (false, _) => common::print_lines(written.lines()),
+        (true, true) => common::print_pretty(&v),
+        (true, false) => common::print_json(load, v),
+        (false, _) => {
+            outln!("parameters: {source}");
+            common::print_lines(written.lines())
+        }
     }
 }

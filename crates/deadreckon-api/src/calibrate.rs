@@ -33,6 +33,9 @@ pub struct CarCalibration {
     /// The streams the drive had none of (named when a parameter is not
     /// estimated).
     pub absent: crate::json::Absent,
+    /// The vehicle calibrated for, recorded in params.toml
+    /// ([`crate::binding`]).
+    pub vehicle: crate::binding::VehicleRecord,
 }
 
 /// Estimates and applies the corrections `which` asks for, then calibrates
@@ -64,6 +67,7 @@ pub fn calibrate_car(
         which,
         steering,
         absent: crate::json::Absent::of(&drive),
+        vehicle: crate::binding::VehicleRecord::of(&drive.vehicle),
     })
 }
 
@@ -113,6 +117,7 @@ impl CarCalibration {
         if self.which != Which::None {
             extra.extend(crate::corrections::corrections_toml(&self.corrections));
         }
+        extra.insert("vehicle".into(), self.vehicle.to_toml().into());
         extra
     }
 

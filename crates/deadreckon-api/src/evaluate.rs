@@ -13,10 +13,18 @@ use deadreckon_core::{track, Drive, Params};
 
 use crate::Error;
 
-/// The rule, as the commands print it.
-pub const RULE: &str = "without parameters, evaluate calibrates with RTS on the drive itself \
-     (in-sample: calibrate on another drive or part for a held-out figure), or takes the \
-     nominal ones when the drive has no GNSS fix";
+/// The one rule for "no --params" (issue 29, item 6), the same in `run`,
+/// `evaluate`, `report`, `compare` and Python, as the commands print it:
+/// nominal circumferences are off by a few per cent on real cars
+/// (comma2k19's dead-reckoned track ends 1 km from the filtered one with
+/// them), so the drive is calibrated on itself.
+pub const RULE: &str = "without --params, the parameters are calibrated on the drive itself \
+     (RTS with its GNSS for a car, against its GNSS for a differential drive, against its \
+     tracker for a tricycle; in-sample: calibrate on another drive or part for a held-out \
+     figure), or nominal when the drive has no GNSS fix; --params nominal for the nominal ones";
+
+/// What `"params_source"` says of parameters calibrated on the drive.
+pub const CALIBRATED_HERE: &str = "calibrated on this drive";
 
 /// Parameters to evaluate and where they come from.
 #[derive(Debug, Clone)]
@@ -28,6 +36,28 @@ pub struct Parameters {
     /// The timing and mounting corrections estimated and applied before
     /// the calibration (`None`: none estimated here).
     pub corrections: Option<Corrections>,
+    /// Which parameters are applied, as `"params_source"` says it: the
+    /// file, `nominal`, or [`CALIBRATED_HERE`] with the method.
+    pub source: String,
+    /// What the parameters' binding to the vehicle let through, or that
+    /// the file names no vehicle ([`crate::binding`]).
+    pub note: Option<String>,
+}
+
+/// The one function every command calls for its parameters ([`RULE`]):
+/// `spec` (`nominal` or a params.toml, bound to the drive's vehicle unless
+/// `allow_other`) with the corrections it stores applied, or without it
+/// the calibration on the drive itself ([`default_parameters`]).
+pub fn parameters(
+    spec: Option<&str>,
+    drive: Drive,
+    which: Which,
+    allow_other: bool,
+) -> Result<(Parameters, Drive), Error> {
+    match spec {
+        Some(p) => given_parameters_bound(p, drive, allow_other),
+        None => default_parameters(&drive, which),
+    }
 }
 
 /// [`RULE`]: the RTS calibration on `drive` after the corrections `which`
@@ -40,6 +70,8 @@ pub fn default_parameters(drive: &Drive, which: Which) -> Result<(Parameters, Dr
                 params: Params::nominal(&drive.vehicle),
                 label: "nominal (no GNSS fix to calibrate on)".into(),
                 corrections: None,
+                source: "nominal (no GNSS fix to calibrate on)".into(),
+                note: None,
             },
             drive.clone(),
         ));
@@ -55,6 +87,8 @@ pub fn default_parameters(drive: &Drive, which: Which) -> Result<(Parameters, Dr
             params: c.estimate.params,
             label: format!("rts ({} passes)", c.iterations),
             corrections: Some(corrections),
+            source: format!("{CALIBRATED_HERE}: rts ({} passes)", c.iterations),
+            note: None,
         },
         drive,
     ))
@@ -117,13 +151,26 @@ pub fn evo_metric(
 /// `params.toml` or `nominal` given by the user, with the drive the
 /// corrections the file stores were applied to.
 pub fn given_parameters(spec: &str, drive: Drive) -> Result<(Parameters, Drive), Error> {
+    given_parameters_bound(spec, drive, false)
+}
+
+/// [`given_parameters`], another vehicle's file taken when `allow_other`
+/// ([`crate::load::params_bound`]).
+pub fn given_parameters_bound(
+    spec: &str,
+    drive: Drive,
+    allow_other: bool,
+) -> Result<(Parameters, Drive), Error> {
+    let (params, drive, note) = crate::load::params_corrected_bound(spec, drive, allow_other)?;
     Ok((
         Parameters {
-            params: crate::load::params(spec, &drive)?,
+            params,
             label: spec.to_string(),
             corrections: None,
+            source: spec.to_string(),
+            note,
         },
-        crate::load::apply_stored(spec, drive)?,
+        drive,
     ))
 }
 
@@ -171,6 +218,9 @@ pub enum Measured<'a> {
 pub struct Evaluation<'a> {
     /// Where the parameters come from.
     pub source: String,
+    /// Which parameters were applied (`"params_source"`,
+    /// [`Parameters::source`]).
+    pub params_source: String,
     /// The corrections estimated before the calibration, if any.
     pub corrections: Option<Corrections>,
     /// The result.
@@ -212,6 +262,7 @@ pub fn measure<'a>(
     };
     Ok(Evaluation {
         source: parameters.label,
+        params_source: parameters.source,
         corrections: parameters.corrections,
         measured,
     })
@@ -232,6 +283,7 @@ impl Evaluation<'_> {
         if let Some(c) = &self.corrections {
             v["corrections"] = crate::corrections::corrections_json(c);
         }
+        v["params_source"] = self.params_source.clone().into();
         v
     }
 

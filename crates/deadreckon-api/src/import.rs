@@ -52,6 +52,9 @@ pub struct Imported {
     pub drive: Drive,
     /// The report, printable.
     pub report: String,
+    /// Files written into the drive directory beside the drive, by name
+    /// (a tricycle's [`crate::kinematic::TRICYCLE_FILE`]).
+    pub files: Vec<(String, String)>,
 }
 
 /// Reads `source` as `format` into a drive.
@@ -71,6 +74,7 @@ pub fn import(format: ImportFormat, source: &Path, o: &ImportOptions) -> Result<
             Imported {
                 drive: i.drive,
                 report: i.report.to_string(),
+                files: Vec::new(),
             }
         }
         ImportFormat::Can => {
@@ -107,6 +111,7 @@ pub fn import(format: ImportFormat, source: &Path, o: &ImportOptions) -> Result<
             Imported {
                 drive: i.drive,
                 report: format!("{} frames read\n{}", frames.len(), i.report),
+                files: Vec::new(),
             }
         }
         ImportFormat::Tricycle => {
@@ -116,9 +121,13 @@ pub fn import(format: ImportFormat, source: &Path, o: &ImportOptions) -> Result<
                 ..Default::default()
             };
             let i = deadreckon_import::tricycle::read_tricycle(source, &opts).map_err(err)?;
+            // The header's geometry and mounting, which the drive's streams
+            // do not carry, so the directory is read as the log is.
+            let header = crate::kinematic::TricycleFile::of_log(source)?.to_toml()?;
             Imported {
                 drive: i.drive,
                 report: i.report.to_string(),
+                files: vec![(crate::kinematic::TRICYCLE_FILE.to_string(), header)],
             }
         }
         ImportFormat::Ros => {
@@ -134,6 +143,7 @@ pub fn import(format: ImportFormat, source: &Path, o: &ImportOptions) -> Result<
             Imported {
                 drive,
                 report: format!("{said}\n{report}\n"),
+                files: Vec::new(),
             }
         }
     })
@@ -143,9 +153,24 @@ pub fn import(format: ImportFormat, source: &Path, o: &ImportOptions) -> Result<
 /// temporary name, then renamed): a failure leaves the old drive or
 /// nothing, never a mixture.
 pub fn write(out: &Path, drive: &Drive) -> Result<(), Error> {
+    write_with(out, drive, &[])
+}
+
+/// [`write`] with `files` (name, content) written into the directory
+/// beside the drive, in the same whole write.
+pub fn write_with(out: &Path, drive: &Drive, files: &[(String, String)]) -> Result<(), Error> {
     use crate::error::While;
-    deadreckon_io::write_drive_whole(out, drive, |_| Ok(()))
-        .doing(|| format!("writing drive {}", out.display()))
+    deadreckon_io::write_drive_whole(out, drive, |tmp| {
+        for (name, text) in files {
+            let p = tmp.join(name);
+            std::fs::write(&p, text).map_err(|source| deadreckon_io::IoError::Io {
+                path: p.clone(),
+                source,
+            })?;
+        }
+        Ok(())
+    })
+    .doing(|| format!("writing drive {}", out.display()))
 }
 
 /// The line `import` prints of what the drive holds.

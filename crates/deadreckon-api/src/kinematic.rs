@@ -11,7 +11,7 @@ use deadreckon_core::kinematics::diff_drive::{
     self, calibrate_diff_drive, evaluate_diff_drive, DiffDriveDrive, DiffDriveOptions,
     DiffDriveOutages, OutageStart, YawSource,
 };
-use deadreckon_core::kinematics::tricycle::{TricycleDrive, TricycleParams};
+use deadreckon_core::kinematics::tricycle::{TricycleDrive, TricycleGeometry, TricycleParams};
 use deadreckon_core::kinematics::{
     self, KinematicCalibration, KinematicModel, KinematicOptions, KinematicOutages, Shape,
 };
@@ -62,14 +62,35 @@ pub fn load_tricycle(
     from: Option<f64>,
     until: Option<f64>,
 ) -> Result<TricycleDrive, Error> {
+    load_tricycle_from(path, None, from, until)
+}
+
+/// A tricycle cut to `[from, until)`: `drive` (a drive directory, as
+/// `import tricycle` writes one) through [`tricycle_of_drive`], or without
+/// it the tricycle log at `path` read through its own kinematics.
+pub fn load_tricycle_from(
+    path: &Path,
+    drive: Option<&Drive>,
+    from: Option<f64>,
+    until: Option<f64>,
+) -> Result<TricycleDrive, Error> {
     check_range(from, until)?;
-    let o = deadreckon_import::tricycle::TricycleOptions::default();
-    let d = deadreckon_import::tricycle::read_tricycle_kinematic(path, &o).map_err(|source| {
-        Error::Tricycle {
-            path: path.to_path_buf(),
-            source,
+    let d = match drive {
+        Some(drive) => {
+            let file = read_tricycle_file(path)?;
+            tricycle_of_drive(drive, file.as_ref())
+                .doing(|| format!("{} as a tricycle", path.display()))?
         }
-    })?;
+        None => {
+            let o = deadreckon_import::tricycle::TricycleOptions::default();
+            deadreckon_import::tricycle::read_tricycle_kinematic(path, &o).map_err(|source| {
+                Error::Tricycle {
+                    path: path.to_path_buf(),
+                    source,
+                }
+            })?
+        }
+    };
     let cut = d.time_range(from, until);
     if cut.samples.len() < 2 {
         invalid!(
@@ -83,6 +104,186 @@ pub fn load_tricycle(
         );
     }
     Ok(cut)
+}
+
+/// Steering-encoder counts per turn a drive directory's steering stream is
+/// read at ([`tricycle_of_drive`]): the stream holds angles, so any fine
+/// grid will do; 2^24 rounds them by at most 2e-7 rad (the log's own
+/// encoder has 8192 counts, 4e-4 rad).
+pub const DRIVE_STEER_COUNTS_PER_REV: u32 = 1 << 24;
+
+/// The file `import tricycle` writes beside the drive: the log header's
+/// encoder geometry and nominal parameters, the tracker's mounting
+/// included (the drive's truth is the base, moved from the tracker by it).
+pub const TRICYCLE_FILE: &str = "tricycle.toml";
+
+/// What [`TRICYCLE_FILE`] holds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TricycleFile {
+    /// The encoders' ticks and counts per turn.
+    pub geometry: TricycleGeometry,
+    /// The header's nominal parameters, the tracker's mounting included.
+    pub nominal: TricycleParams,
+}
+
+impl TricycleFile {
+    /// The header of the tricycle log at `log` ([`TRICYCLE_FILE`]'s content).
+    pub fn of_log(log: &Path) -> Result<TricycleFile, Error> {
+        let o = deadreckon_import::tricycle::TricycleOptions::default();
+        let d =
+            deadreckon_import::tricycle::read_tricycle_kinematic(log, &o).map_err(|source| {
+                Error::Tricycle {
+                    path: log.to_path_buf(),
+                    source,
+                }
+            })?;
+        Ok(TricycleFile {
+            geometry: d.geometry,
+            nominal: d.nominal,
+        })
+    }
+
+    /// The TOML text.
+    pub fn to_toml(&self) -> Result<String, Error> {
+        let mut t = toml::Table::new();
+        let value = |v: Result<toml::Value, toml::ser::Error>| {
+            v.map_err(|e| Error::Invalid(format!("{TRICYCLE_FILE}: {e}")))
+        };
+        t.insert(
+            "geometry".into(),
+            value(toml::Value::try_from(self.geometry))?,
+        );
+        t.insert(
+            "nominal".into(),
+            value(toml::Value::try_from(self.nominal))?,
+        );
+        let body =
+            toml::to_string(&t).map_err(|e| Error::Invalid(format!("{TRICYCLE_FILE}: {e}")))?;
+        Ok(format!(
+            "# The tricycle log's header (deadreckon import tricycle): encoder geometry and\n\
+             # nominal parameters; truth.csv holds the base, moved from the tracker by nominal.mount.\n{body}"
+        ))
+    }
+}
+
+/// The [`TRICYCLE_FILE`] of the drive directory `dir`, if it has one.
+pub fn read_tricycle_file(dir: &Path) -> Result<Option<TricycleFile>, Error> {
+    let p = dir.join(TRICYCLE_FILE);
+    if !dir.is_dir() || !p.is_file() {
+        return Ok(None);
+    }
+    let text =
+        std::fs::read_to_string(&p).map_err(|e| Error::Invalid(format!("{}: {e}", p.display())))?;
+    let bad = |e: String| Error::Invalid(format!("{}: {e}", p.display()));
+    let t: toml::Table = text
+        .parse()
+        .map_err(|e: toml::de::Error| bad(e.to_string()))?;
+    let get = |k: &str| {
+        t.get(k)
+            .cloned()
+            .ok_or_else(|| bad(format!("missing `{k}`")))
+    };
+    let f = TricycleFile {
+        geometry: get("geometry")?
+            .try_into()
+            .map_err(|e: toml::de::Error| bad(e.to_string()))?,
+        nominal: get("nominal")?
+            .try_into()
+            .map_err(|e: toml::de::Error| bad(e.to_string()))?,
+    };
+    f.nominal.validate().map_err(|e| bad(e.to_string()))?;
+    Ok(Some(f))
+}
+
+/// A drive as a tricycle (what `import tricycle` writes: the traction
+/// wheel's ticks in its one present wheel column, the steering stream as
+/// the encoder angle plus the offset over Ksteer, `steering_ratio` =
+/// 1/Ksteer, the truth at the base). With the log header `file`
+/// ([`TRICYCLE_FILE`]) the samples are the log's own: the encoder counts
+/// recovered, the reference moved back to the tracker by its mounting, the
+/// nominal parameters the header's. Without it the nominal parameters are
+/// the vehicle's (Ktraction its `wheel_circumference_m`, Ksteer
+/// 1/`steering_ratio`, the offset −`steering_offset_rad`·Ksteer, the axle its
+/// `wheelbase_m`, the mounting zero: the truth is the base) and the
+/// steering angles are read on a grid of [`DRIVE_STEER_COUNTS_PER_REV`].
+/// Each wheel row is a sample, at the latest steering reading not after
+/// it, with the truth pose at its time as the reference when there is one.
+pub fn tricycle_of_drive(
+    drive: &Drive,
+    file: Option<&TricycleFile>,
+) -> Result<TricycleDrive, Error> {
+    use deadreckon_core::drive::Wheels;
+    use deadreckon_core::kinematics::tricycle::TricycleSample;
+    use deadreckon_core::kinematics::Pose2;
+    let v = &drive.vehicle;
+    let Wheels::Ticks(rows) = &drive.wheels else {
+        invalid!("a tricycle's drive has wheel ticks (its traction encoder), not wheel speeds");
+    };
+    if drive.steering.is_empty() {
+        invalid!("a tricycle's drive needs its steering stream (steering.csv)");
+    }
+    if !(v.steering_ratio.is_finite() && v.steering_ratio != 0.0) {
+        invalid!(
+            "a tricycle's steering_ratio (1/Ksteer) must be finite and not 0, got {}",
+            v.steering_ratio
+        );
+    }
+    let wheel = v.wheels_present.iter().position(|p| *p).unwrap_or(0);
+    let ksteer = 1.0 / v.steering_ratio;
+    let (geometry, nominal, stream_offset) = match file {
+        // The stream is 2π·s/counts + offset·steering_ratio.
+        Some(f) => (
+            f.geometry,
+            f.nominal,
+            f.nominal.steer_offset_rad * v.steering_ratio,
+        ),
+        None => (
+            TricycleGeometry {
+                ticks_per_rev: v.ticks_per_rev,
+                steer_counts_per_rev: DRIVE_STEER_COUNTS_PER_REV,
+            },
+            TricycleParams {
+                ktraction_m: v.wheel_circumference_m,
+                ksteer,
+                steer_offset_rad: -v.steering_offset_rad * ksteer,
+                axle_length_m: v.wheelbase_m,
+                mount: Pose2::new(0.0, 0.0, 0.0),
+            },
+            0.0,
+        ),
+    };
+    let m = nominal.mount;
+    let counts_per_rad = f64::from(geometry.steer_counts_per_rev) / std::f64::consts::TAU;
+    let mut ticks = 0i64;
+    let mut samples = Vec::with_capacity(rows.len());
+    for r in rows {
+        ticks += [r.fl, r.fr, r.rl, r.rr][wheel];
+        let k = drive.steering.partition_point(|s| s.t_s <= r.t_s);
+        let steer = drive.steering[k.saturating_sub(1)].value - stream_offset;
+        let j = drive.truth.partition_point(|p| p.t_s < r.t_s);
+        // The measured point: the base moved by the mounting.
+        let reference = drive.truth.get(j).filter(|p| p.t_s == r.t_s).map(|p| {
+            let (c, s) = (p.yaw_rad.cos(), p.yaw_rad.sin());
+            Pose2::new(
+                p.east_m + c * m.x_m - s * m.y_m,
+                p.north_m + s * m.x_m + c * m.y_m,
+                p.yaw_rad + m.yaw_rad,
+            )
+        });
+        samples.push(TricycleSample {
+            t_s: r.t_s,
+            ticks,
+            steer_counts: (steer * counts_per_rad).round() as i64,
+            reference,
+        });
+    }
+    let d = TricycleDrive {
+        geometry,
+        nominal,
+        samples,
+    };
+    d.validate()?;
+    Ok(d)
 }
 
 /// `nominal` or a kinematic params.toml, as the model's vector and a
@@ -243,11 +444,17 @@ pub struct CalibrateOptions<'a> {
     pub until_s: Option<f64>,
 }
 
-/// Calibrates a tricycle log against its tracker.
-pub fn calibrate_tricycle(path: &Path, o: &CalibrateOptions) -> Result<Calibrated, Error> {
+/// Calibrates a tricycle against its tracker: the log at `path`, or
+/// `drive` read from it (an imported tricycle directory,
+/// [`load_tricycle_from`]).
+pub fn calibrate_tricycle(
+    path: &Path,
+    drive: Option<&Drive>,
+    o: &CalibrateOptions,
+) -> Result<Calibrated, Error> {
     let shape = Shape::Tricycle;
     let method = method_for(shape, o.method)?;
-    let drive = load_tricycle(path, o.from_s, o.until_s)?;
+    let drive = load_tricycle_from(path, drive, o.from_s, o.until_s)?;
     let opts = KinematicOptions {
         window_s: o.window_s.unwrap_or(2.0),
         min_speed_mps: o.min_speed_mps.unwrap_or(shape.default_min_speed_mps()),
@@ -311,6 +518,7 @@ impl Evaluated {
     /// The `--json` object.
     pub fn json(&self) -> serde_json::Value {
         let mut v = crate::json::kinematic_outages_json(self.shape, &self.evaluation, &self.source);
+        v["params_source"] = self.source.clone().into();
         if let Some(align) = self.align_s {
             v["align_s"] = align.into();
         }
@@ -368,11 +576,14 @@ impl Evaluated {
     }
 }
 
-/// A tricycle log over sliding outages from the tracker pose, scored at the
-/// tracked point with the calibrated mounting; without `params`, calibrated
-/// on the evaluated range itself (said in the source).
+/// A tricycle (the log at `path`, or `drive` read from it) over sliding
+/// outages from the tracker pose, scored at the tracked point with the
+/// calibrated mounting; without `params`, calibrated on the evaluated range
+/// itself (said in the source).
+#[allow(clippy::too_many_arguments)]
 pub fn evaluate_tricycle(
     path: &Path,
+    drive: Option<&Drive>,
     params: Option<&str>,
     length_s: f64,
     step_s: f64,
@@ -380,7 +591,7 @@ pub fn evaluate_tricycle(
     until_s: Option<f64>,
 ) -> Result<Evaluated, Error> {
     let shape = Shape::Tricycle;
-    let drive = load_tricycle(path, from_s, until_s)?;
+    let drive = load_tricycle_from(path, drive, from_s, until_s)?;
     let (params, source) = match params {
         Some(p) => load_params(p, shape, &drive)?,
         None => {
@@ -392,7 +603,10 @@ pub fn evaluate_tricycle(
                 .doing(|| "calibrating against the tracker".to_string())?;
             (
                 c.values(),
-                "truth (calibrated on the evaluated range)".to_string(),
+                format!(
+                    "{} (truth: the tracker, over the evaluated range)",
+                    crate::evaluate::CALIBRATED_HERE
+                ),
             )
         }
     };
@@ -423,7 +637,9 @@ pub fn diff_yaw(params: Option<&str>, asked: Option<YawSource>) -> YawSource {
     }
 }
 
-/// A differential drive over sliding GNSS outages, the first `align_s` in,
+/// A differential drive over sliding GNSS outages (with `params`, else
+/// calibrated against the fixes of the evaluated range, as
+/// [`crate::evaluate::RULE`] says), the first `align_s` in,
 /// each started as `start` says (the alignment spans the preceding
 /// `align_s`; the filter's priors on the scales and the bias are the
 /// params file's standard errors where it states them) and scored against
@@ -440,24 +656,42 @@ pub fn evaluate_diff(
     from_s: Option<f64>,
     until_s: Option<f64>,
 ) -> Result<Evaluated, Error> {
-    let spec = params.unwrap_or("nominal");
     let LoadedParams {
         values: params,
         std,
         source,
-    } = if spec == "nominal" {
-        LoadedParams {
+    } = match params {
+        // The one rule for no parameters (crate::evaluate::RULE): calibrated
+        // against the fixes of the evaluated range itself.
+        None => {
+            let o = CalibrateOptions {
+                from_s,
+                until_s,
+                ..Default::default()
+            };
+            let c = calibrate_diff(drive, Path::new("the drive"), yaw, &o)?;
+            LoadedParams {
+                values: c.calibration.values(),
+                std: c
+                    .calibration
+                    .params
+                    .iter()
+                    .map(|p| if p.estimated { p.std } else { None })
+                    .collect(),
+                source: format!("{} (gnss)", crate::evaluate::CALIBRATED_HERE),
+            }
+        }
+        Some("nominal") => LoadedParams {
             values: DiffDriveDrive::nominal(),
             std: vec![None; diff_drive::N_PARAMS],
             source: "nominal".to_string(),
-        }
-    } else {
-        load_params_file_with_std(
+        },
+        Some(spec) => load_params_file_with_std(
             spec,
             Shape::DiffDrive,
             &diff_drive::NAMES,
             Some(yaw_name(yaw)),
-        )?
+        )?,
     };
     // The filter refines the scales and the bias from their stated
     // standard errors (the defaults where none is stated).
@@ -477,11 +711,34 @@ pub fn evaluate_diff(
     })
 }
 
-/// A tricycle log's tracks (dead-reckoned through its own kinematics from
-/// the first tracker pose, and the tracker's) with `params`.
-pub fn tricycle_tracks(path: &Path, params: &str) -> Result<Vec<Track>, Error> {
-    let drive = load_tricycle(path, None, None)?;
-    let (p, _) = load_params(params, Shape::Tricycle, &drive)?;
+/// A tricycle's tracks (dead-reckoned through its own kinematics from the
+/// first tracker pose, and the tracker's) with `params`, or without them
+/// calibrated against the tracker ([`crate::evaluate::RULE`]); and which
+/// parameters were applied (`"params_source"`).
+pub fn tricycle_tracks(
+    path: &Path,
+    drive: Option<&Drive>,
+    params: Option<&str>,
+) -> Result<(Vec<Track>, String), Error> {
+    let drive = load_tricycle_from(path, drive, None, None)?;
+    let (p, source) = match params {
+        Some(spec) => (
+            load_params(spec, Shape::Tricycle, &drive)?.0,
+            spec.to_string(),
+        ),
+        None => {
+            let o = KinematicOptions {
+                min_speed_mps: Shape::Tricycle.default_min_speed_mps(),
+                ..Default::default()
+            };
+            let c = kinematics::calibrate(&drive, &o)
+                .doing(|| "calibrating against the tracker".to_string())?;
+            (
+                c.values(),
+                format!("{} (truth: the tracker)", crate::evaluate::CALIBRATED_HERE),
+            )
+        }
+    };
     let params = TricycleParams::from_slice(&p)?;
-    Ok(drive.tracks(&params)?)
+    Ok((drive.tracks(&params)?, source))
 }

@@ -9,11 +9,19 @@
 //!   plausibility checks), parameters (`nominal` or a params.toml with its
 //!   stored corrections), the one `--from`/`--until` rule, scenarios and
 //!   simulated drives written to disk.
+//! - [`binding`]: parameters bound to their vehicle (params.toml's
+//!   `[vehicle]` record; another vehicle's file or an implausible
+//!   circumference refused).
 //! - [`kinematic`]: the tricycle and differential-drive shapes calibrated
 //!   and evaluated over sliding outages (a differential drive's started from
 //!   its GNSS-aided filter, or aligned), with their tables and JSON.
+//! - [`shape`]: the vehicle's shape (car, tricycle, differential drive)
+//!   found from the data with its reason, the one rule every command
+//!   applies (`--shape` overrides).
 //! - [`tracks`]: `run`'s tracks chosen and written for other tools.
-//! - [`demo`], [`report`], [`stream`]: those commands whole.
+//! - [`demo`], [`report`], [`stream`]: those commands whole
+//!   ([`report_kinematic`]: the report of a tricycle or a differential
+//!   drive).
 //!
 //! - [`source`]: a drive from any source the tool reads: a drive directory
 //!   (`deadreckon-io`), a comma2k19 segment, a ROS1 bag or ROS2 MCAP (with a
@@ -42,6 +50,7 @@
 //! exception's text read the same.
 #![deny(missing_docs)]
 
+pub mod binding;
 pub mod calibrate;
 pub mod checks;
 pub mod corrections;
@@ -54,6 +63,8 @@ pub mod load;
 pub mod model_keys;
 pub mod options;
 pub mod report;
+pub mod report_kinematic;
+pub mod shape;
 pub mod source;
 pub mod stream;
 pub mod tedris;

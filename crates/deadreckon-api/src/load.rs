@@ -11,6 +11,7 @@ use deadreckon_core::{Drive, Params, ParamsWithStd};
 use deadreckon_io::{ReadOptions, WheelFile};
 use deadreckon_sim::{Scenario, SimOutput};
 
+use crate::binding;
 use crate::checks::Checks;
 use crate::error::{invalid, While};
 use crate::Error;
@@ -29,6 +30,10 @@ pub struct Loader {
     /// line prints them on standard error); `None`: kept in
     /// [`Loader::checks`] only.
     pub on_warning: Option<fn(&Path, &Finding)>,
+    /// Apply a params.toml to a drive of another vehicle, or with values
+    /// implausible for the drive's vehicle (`--params-for-other-vehicle`;
+    /// [`crate::binding`]): a note instead of an error.
+    pub params_for_other_vehicle: bool,
     /// What the checks said of the last drive read.
     checks: Mutex<Checks>,
 }
@@ -46,8 +51,14 @@ impl Loader {
             skip_checks,
             wheels,
             on_warning,
+            params_for_other_vehicle: false,
             checks: Default::default(),
         }
+    }
+
+    /// [`params_bound`] with this loader's `params_for_other_vehicle`.
+    pub fn params(&self, spec: &str, drive: &Drive) -> Result<(Params, binding::Note), Error> {
+        params_bound(spec, drive, self.params_for_other_vehicle)
     }
 
     /// Reads a drive from a drive directory or a recording a reader
@@ -97,22 +108,49 @@ pub fn params_file(spec: &str) -> Result<ParamsWithStd, Error> {
 }
 
 /// `nominal` (the vehicle's) or a params.toml's parameters, checked
-/// against the drive's vehicle ([`check_against_vehicle`]).
+/// against the drive's vehicle ([`params_bound`], refusing another
+/// vehicle's).
 pub fn params(spec: &str, drive: &Drive) -> Result<Params, Error> {
+    params_bound(spec, drive, false).map(|(p, _)| p)
+}
+
+/// `nominal` (the vehicle's) or a params.toml's parameters bound to the
+/// drive's vehicle ([`binding::check`]): another vehicle's file, or a
+/// circumference implausible for this one, is refused unless
+/// `allow_other`; the note says what was let through, or that the file
+/// names no vehicle.
+pub fn params_bound(
+    spec: &str,
+    drive: &Drive,
+    allow_other: bool,
+) -> Result<(Params, binding::Note), Error> {
     if spec == "nominal" {
-        return Ok(Params::nominal(&drive.vehicle));
+        return Ok((Params::nominal(&drive.vehicle), None));
     }
-    let p = params_file(spec)?.params;
-    check_against_vehicle(spec, &p, &drive.vehicle)?;
-    Ok(p)
+    let (p, extra) = deadreckon_io::read_params_with_extra(Path::new(spec))
+        .doing(|| format!("reading parameters {spec}"))?;
+    p.params
+        .validate()
+        .doing(|| format!("parameters in {spec}"))?;
+    let record = binding::VehicleRecord::from_extra(spec, &extra)?;
+    let note = binding::check(
+        spec,
+        record.as_ref(),
+        &p.params,
+        &drive.vehicle,
+        allow_other,
+    )?;
+    Ok((p.params, note))
 }
 
 /// A calibrated circumference further than this factor from the vehicle's
-/// nominal one is a unit mistake or another vehicle's file (tyres differ
-/// from their nominal size by a few per cent).
+/// nominal one is a unit mistake (the hint names millimetres or
+/// centimetres); the bound a circumference must keep is the tighter
+/// [`binding::MAX_CIRCUMFERENCE_DEVIATION`].
 pub const MAX_CIRCUMFERENCE_FACTOR: f64 = 1.5;
 
-/// Refuses parameters whose circumferences are far from `vehicle`'s nominal
+/// Refuses parameters whose circumferences are further than
+/// [`binding::MAX_CIRCUMFERENCE_DEVIATION`] from `vehicle`'s nominal
 /// `wheel_circumference_m` (millimetres, or another vehicle's file), naming
 /// the file, the key and both values.
 pub fn check_against_vehicle(
@@ -120,24 +158,7 @@ pub fn check_against_vehicle(
     p: &Params,
     vehicle: &deadreckon_core::Vehicle,
 ) -> Result<(), Error> {
-    let nominal = vehicle.wheel_circumference_m;
-    for (name, c) in Params::NAMES[2..].iter().zip(p.circumferences()) {
-        let factor = c / nominal;
-        if !(1.0 / MAX_CIRCUMFERENCE_FACTOR..=MAX_CIRCUMFERENCE_FACTOR).contains(&factor) {
-            let hint = if (factor / 1000.0 - 1.0).abs() < 0.5 {
-                " (millimetres?)"
-            } else if (factor / 100.0 - 1.0).abs() < 0.5 {
-                " (centimetres?)"
-            } else {
-                " (another vehicle's parameters?)"
-            };
-            return Err(Error::Invalid(format!(
-                "{spec}: {name} = {c} m is {factor:.3} times the vehicle's nominal \
-                 wheel_circumference_m = {nominal} m{hint}"
-            )));
-        }
-    }
-    Ok(())
+    binding::check_circumferences(spec, p, vehicle).map_err(Error::Invalid)
 }
 
 /// The drive with the corrections stored in the params.toml `spec`
@@ -152,11 +173,20 @@ pub fn apply_stored(spec: &str, drive: Drive) -> Result<Drive, Error> {
 /// parameters were calibrated on the corrected streams, and on the raw ones
 /// they are wrong (a tilted, scaled gyro turns the track).
 pub fn params_corrected(spec: &str, drive: Drive) -> Result<(Params, Drive), Error> {
-    let params = params(spec, &drive)?;
+    params_corrected_bound(spec, drive, false).map(|(p, d, _)| (p, d))
+}
+
+/// [`params_corrected`] with [`params_bound`]'s `allow_other` and note.
+pub fn params_corrected_bound(
+    spec: &str,
+    drive: Drive,
+    allow_other: bool,
+) -> Result<(Params, Drive, binding::Note), Error> {
+    let (params, note) = params_bound(spec, &drive, allow_other)?;
     if spec == "nominal" {
-        return Ok((params, drive));
+        return Ok((params, drive, note));
     }
-    Ok((params, apply_stored(spec, drive)?))
+    Ok((params, apply_stored(spec, drive)?, note))
 }
 
 /// A built-in scenario by name, or a scenario file (`.toml`).

@@ -37,6 +37,9 @@ pub struct ReportOptions<'a> {
     pub step_s: Option<f64>,
     /// The corrections estimated on the drive when `params` stores none.
     pub corrections: deadreckon_core::timing::Which,
+    /// The shape asked for (`--shape`; `None`: found from the data,
+    /// [`crate::shape`]).
+    pub shape: Option<deadreckon_core::kinematics::Shape>,
 }
 
 /// The drive with the corrections every section uses applied, and their
@@ -83,6 +86,10 @@ pub fn write(
     steps: &dyn Progress,
     footer: &rp::Footer,
 ) -> Result<(), Error> {
+    let found = crate::shape::detect(o.dir, Some(drive), o.shape);
+    if found.shape != deadreckon_core::kinematics::Shape::FourWheel {
+        return crate::report_kinematic::write(drive, &found, o, out, steps, footer);
+    }
     let (corrected, corrections) = corrected(drive, o, steps)?;
     let drive = &corrected;
     let mut methods = calibrations(drive, steps);

@@ -174,18 +174,31 @@ pub fn write_car(
     })
 }
 
-/// Writes a tricycle log's chosen tracks (dead-reckoned through its own
-/// kinematics from the first tracker pose, and the tracker's).
+/// Writes a tricycle's chosen tracks (dead-reckoned through its own
+/// kinematics from the first tracker pose, and the tracker's): the log at
+/// `log`, or `drive` read from it (an imported tricycle directory).
 pub fn write_tricycle(
     log: &Path,
-    params: &str,
+    drive: Option<&Drive>,
+    params: Option<&str>,
     out: &Path,
     s: &Selection,
     mcap: deadreckon_ros::McapOptions,
 ) -> Result<Written, Error> {
-    let all = crate::kinematic::tricycle_tracks(log, params)?;
+    let (all, _) = crate::kinematic::tricycle_tracks(log, drive, params)?;
+    write_tracks(&all, out, s, mcap)
+}
+
+/// Writes the chosen tracks of `all` (no wheel health: a kinematic
+/// shape's tracks).
+pub fn write_tracks(
+    all: &[Track],
+    out: &Path,
+    s: &Selection,
+    mcap: deadreckon_ros::McapOptions,
+) -> Result<Written, Error> {
     let format = TrackFormat::from_path(out)?;
-    let t = select(&all, s, out, format)?;
+    let t = select(all, s, out, format)?;
     write(out, format, &t, mcap)?;
     Ok(Written {
         path: out.to_path_buf(),

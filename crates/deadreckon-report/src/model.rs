@@ -32,6 +32,9 @@ pub struct ReportInput {
     pub tedris: Option<Tedris>,
     /// Final errors of sliding simulated GNSS outages.
     pub outages: Option<OutageEvaluation>,
+    /// A kinematic shape's calibration (a tricycle, a differential drive),
+    /// shown instead of the car's circumference table.
+    pub kinematic: Option<Kinematic>,
     /// What the report could not compute, and why (a calibration a drive
     /// does not support, a failed step): shown first, never dropped.
     pub not_computed: Vec<NotComputed>,
@@ -506,4 +509,35 @@ pub struct OutageEvaluation {
     pub window_s: Option<f64>,
     /// One entry per method.
     pub methods: Vec<MethodSample>,
+}
+
+/// A kinematic shape's calibration (a tricycle against its tracker, a
+/// differential drive against its GNSS fixes): its own parameters, not a
+/// car's circumferences.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Kinematic {
+    /// The shape and why it was chosen (`differential drive (the log has
+    /// body velocity …)`).
+    pub shape: String,
+    /// What it was calibrated against (`gnss`, `truth`).
+    pub method: String,
+    /// One row per parameter, in the shape's order.
+    pub params: Vec<KinematicParam>,
+    /// The fit in words (windows used, residual at the window ends).
+    pub fit: String,
+}
+
+/// One parameter of a kinematic calibration.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct KinematicParam {
+    /// Name with unit (`speed_scale`, `yaw_bias_rps`).
+    pub name: String,
+    /// The value: fitted, or nominal when not estimated.
+    pub value: f64,
+    /// Its standard error, when estimated.
+    pub std: Option<f64>,
+    /// `estimated`, or why not.
+    pub status: String,
 }

@@ -504,6 +504,7 @@ pub fn sample_input(duration_s: f64) -> ReportInput {
         health: Some(health),
         tedris: Some(tedris),
         outages: Some(outages),
+        kinematic: None,
         not_computed: vec![NotComputed {
             what: "ZUPT calibration".into(),
             reason: "insufficient data: no standstill of 2 s to take the gyro bias from".into(),

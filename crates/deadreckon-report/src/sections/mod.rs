@@ -6,6 +6,7 @@ mod calibration;
 mod caption_colours;
 mod drift;
 mod health;
+mod kinematic;
 mod outages;
 mod tedris;
 mod trajectories;
@@ -43,6 +44,9 @@ pub(crate) fn render_all(input: &ReportInput) -> Result<Vec<SectionView>, Report
     };
     if let Some(t) = &input.trajectories {
         push(trajectories::section(t, &mut palette)?);
+    }
+    if let Some(k) = &input.kinematic {
+        push(Some(kinematic::section(k)));
     }
     if let Some(c) = &input.calibration {
         push(calibration::section(c, &mut palette)?);
