@@ -31,7 +31,8 @@ pub fn run(a: EvaluateArgs, load: &common::Loader) -> Result<()> {
     if a.params.is_none() && !a.json {
         outln!("parameters: {} ({})", chosen.label, evaluate::RULE);
     }
-    let ev = evaluate::measure(&drive, chosen, a.timing.into(), a.metric())?;
+    let mut ev = evaluate::measure(&drive, chosen, a.timing.into(), a.metric())?;
+    ev.alert_m = a.alert_m;
     if a.json {
         common::print_json(load, ev.json())
     } else {

@@ -33,6 +33,11 @@ pub struct CarCalibration {
     /// The streams the drive had none of (named when a parameter is not
     /// estimated).
     pub absent: crate::json::Absent,
+    /// The 95 % error bound's factor, fitted on the drive's own hidden
+    /// fixes with the calibrated parameters (`[bound]` in params.toml).
+    pub bound: deadreckon_core::bound::BoundFit,
+    /// When that bound reaches 1 m in the fit's windows.
+    pub bound_reach_1m: Option<deadreckon_core::bound::Reach>,
 }
 
 /// Estimates and applies the corrections `which` asks for, then calibrates
@@ -56,6 +61,17 @@ pub fn calibrate_car(
         })?
         // The RTS calibration's fit against its smoothed states.
         .or_else(|| calibration.steering.clone());
+    let (bound, fit_windows) = deadreckon_core::bound::fit_on_drive_with_windows(
+        &drive,
+        &calibration.estimate.params,
+        &deadreckon_core::ekf::FilterOptions {
+            timing: options.filter.timing,
+            ..Default::default()
+        },
+    );
+    let bound_reach_1m = fit_windows
+        .as_ref()
+        .and_then(|ev| deadreckon_core::bound::reach(ev, &bound, 1.0));
     Ok(CarCalibration {
         method_name: method_name.to_string(),
         options,
@@ -64,6 +80,8 @@ pub fn calibrate_car(
         which,
         steering,
         absent: crate::json::Absent::of(&drive),
+        bound,
+        bound_reach_1m,
     })
 }
 
@@ -84,6 +102,7 @@ impl CarCalibration {
             self.steering.as_ref(),
         );
         v["corrections"] = crate::corrections::corrections_json(&self.corrections);
+        v["bound"] = crate::bound::bound_json(&self.bound);
         v
     }
 
@@ -113,6 +132,7 @@ impl CarCalibration {
         if self.which != Which::None {
             extra.extend(crate::corrections::corrections_toml(&self.corrections));
         }
+        extra.insert("bound".into(), crate::bound::bound_toml(&self.bound).into());
         extra
     }
 
@@ -180,6 +200,10 @@ impl CarCalibration {
         if let Some(h) = &c.wheel_health {
             out.extend(crate::text::wheel_health_lines(h));
         }
+        out.extend(crate::bound::calibrate_lines(
+            &self.bound,
+            self.bound_reach_1m.as_ref(),
+        ));
         if let Some(mv) = &c.manoeuvres {
             out.push(format!(
                 "drive: {:.0} s, {:.0} s above {} m/s ({:.0} s left turns, {:.0} s right turns, {:.0} s straight), {} stops ({:.0} s)",

@@ -42,6 +42,7 @@
 //! exception's text read the same.
 #![deny(missing_docs)]
 
+pub mod bound;
 pub mod calibrate;
 pub mod checks;
 pub mod corrections;
