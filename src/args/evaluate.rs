@@ -85,6 +85,10 @@ pub struct EvaluateArgs {
     /// GNSS-aided time before the first outage window, s.
     #[arg(long, default_value_t = 5.0, value_parser = super::non_negative)]
     pub warmup: f64,
+    /// With --outage: an alert limit, m; prints when the 95 % error bound
+    /// reaches it in each window (time and distance into the outage).
+    #[arg(long = "alert-m", value_parser = super::positive)]
+    pub alert_m: Option<f64>,
     /// Filter timing: wheel or each.
     #[arg(long, value_enum, default_value_t = super::TimingArg::Wheel)]
     pub timing: super::TimingArg,

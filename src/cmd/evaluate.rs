@@ -48,7 +48,8 @@ pub fn run(a: EvaluateArgs, load: &common::Loader) -> Result<()> {
     } else if !a.json {
         outln!("parameters: {}", chosen.source);
     }
-    let ev = evaluate::measure(&drive, chosen, a.timing.into(), a.metric())?;
+    let mut ev = evaluate::measure(&drive, chosen, a.timing.into(), a.metric())?;
+    ev.alert_m = a.alert_m;
     if a.json {
         let mut v = ev.json();
         v["shape_found"] = found.json();

@@ -36,6 +36,11 @@ pub struct CarCalibration {
     /// The vehicle calibrated for, recorded in params.toml
     /// ([`crate::binding`]).
     pub vehicle: crate::binding::VehicleRecord,
+    /// The 95 % error bound's factor, fitted on the drive's own hidden
+    /// fixes with the calibrated parameters (`[bound]` in params.toml).
+    pub bound: deadreckon_core::bound::BoundFit,
+    /// When that bound reaches 1 m in the fit's windows.
+    pub bound_reach_1m: Option<deadreckon_core::bound::Reach>,
 }
 
 /// Estimates and applies the corrections `which` asks for, then calibrates
@@ -59,6 +64,17 @@ pub fn calibrate_car(
         })?
         // The RTS calibration's fit against its smoothed states.
         .or_else(|| calibration.steering.clone());
+    let (bound, fit_windows) = deadreckon_core::bound::fit_on_drive_with_windows(
+        &drive,
+        &calibration.estimate.params,
+        &deadreckon_core::ekf::FilterOptions {
+            timing: options.filter.timing,
+            ..Default::default()
+        },
+    );
+    let bound_reach_1m = fit_windows
+        .as_ref()
+        .and_then(|ev| deadreckon_core::bound::reach(ev, &bound, 1.0));
     Ok(CarCalibration {
         method_name: method_name.to_string(),
         options,
@@ -68,6 +84,8 @@ pub fn calibrate_car(
         steering,
         absent: crate::json::Absent::of(&drive),
         vehicle: crate::binding::VehicleRecord::of(&drive.vehicle),
+        bound,
+        bound_reach_1m,
     })
 }
 
@@ -88,6 +106,7 @@ impl CarCalibration {
             self.steering.as_ref(),
         );
         v["corrections"] = crate::corrections::corrections_json(&self.corrections);
+        v["bound"] = crate::bound::bound_json(&self.bound);
         v
     }
 
@@ -118,6 +137,7 @@ impl CarCalibration {
             extra.extend(crate::corrections::corrections_toml(&self.corrections));
         }
         extra.insert("vehicle".into(), self.vehicle.to_toml().into());
+        extra.insert("bound".into(), crate::bound::bound_toml(&self.bound).into());
         extra
     }
 
@@ -185,6 +205,10 @@ impl CarCalibration {
         if let Some(h) = &c.wheel_health {
             out.extend(crate::text::wheel_health_lines(h));
         }
+        out.extend(crate::bound::calibrate_lines(
+            &self.bound,
+            self.bound_reach_1m.as_ref(),
+        ));
         if let Some(mv) = &c.manoeuvres {
             out.push(format!(
                 "drive: {:.0} s, {:.0} s above {} m/s ({:.0} s left turns, {:.0} s right turns, {:.0} s straight), {} stops ({:.0} s)",

@@ -42,6 +42,9 @@ pub struct Parameters {
     /// What the parameters' binding to the vehicle let through, or that
     /// the file names no vehicle ([`crate::binding`]).
     pub note: Option<String>,
+    /// The 95 % error bound's factor: the file's `[bound]`, or fitted on
+    /// the drive itself with the parameters calibrated on it (in-sample).
+    pub bound: deadreckon_core::bound::BoundFit,
 }
 
 /// The one function every command calls for its parameters ([`RULE`]):
@@ -72,6 +75,7 @@ pub fn default_parameters(drive: &Drive, which: Which) -> Result<(Parameters, Dr
                 corrections: None,
                 source: "nominal (no GNSS fix to calibrate on)".into(),
                 note: None,
+                bound: deadreckon_core::bound::BoundFit::FILTER,
             },
             drive.clone(),
         ));
@@ -82,6 +86,8 @@ pub fn default_parameters(drive: &Drive, which: Which) -> Result<(Parameters, Dr
         what: "RTS calibration with GNSS",
         source,
     })?;
+    let bound =
+        deadreckon_core::bound::fit_on_drive(&drive, &c.estimate.params, &FilterOptions::default());
     Ok((
         Parameters {
             params: c.estimate.params,
@@ -89,6 +95,7 @@ pub fn default_parameters(drive: &Drive, which: Which) -> Result<(Parameters, Dr
             corrections: Some(corrections),
             source: format!("{CALIBRATED_HERE}: rts ({} passes)", c.iterations),
             note: None,
+            bound,
         },
         drive,
     ))
@@ -169,6 +176,7 @@ pub fn given_parameters_bound(
             corrections: None,
             source: spec.to_string(),
             note,
+            bound: crate::bound::stored_bound(spec)?,
         },
         drive,
     ))
@@ -225,6 +233,10 @@ pub struct Evaluation<'a> {
     pub corrections: Option<Corrections>,
     /// The result.
     pub measured: Measured<'a>,
+    /// The 95 % error bound's factor (outages).
+    pub bound: deadreckon_core::bound::BoundFit,
+    /// The user's alert limit: when the bound reaches it in each outage, m.
+    pub alert_m: Option<f64>,
 }
 
 /// Measures `metric` on `drive` with `parameters` (their drive: corrected
@@ -265,6 +277,8 @@ pub fn measure<'a>(
         params_source: parameters.source,
         corrections: parameters.corrections,
         measured,
+        bound: parameters.bound,
+        alert_m: None,
     })
 }
 
@@ -272,7 +286,11 @@ impl Evaluation<'_> {
     /// The `--json` object.
     pub fn json(&self) -> serde_json::Value {
         let mut v = match &self.measured {
-            Measured::Outages(len, ev) => crate::json::outage_json(*len, &self.source, ev),
+            Measured::Outages(len, ev) => {
+                let mut v = crate::json::outage_json(*len, &self.source, ev);
+                crate::bound::add_outage_bound(&mut v, ev, &self.bound, self.alert_m);
+                v
+            }
             Measured::Drift(r, seg) => crate::json::drift_json(r, *seg),
             Measured::Reset(r, th) => crate::json::reset_json(r, *th),
             Measured::Evo(q, r) => crate::json::evo_json(q, r),
@@ -292,7 +310,14 @@ impl Evaluation<'_> {
         let gated = |g| format!("rejected by the χ² gates: {}", crate::text::gated_text(g));
         match &self.measured {
             Measured::Outages(_, ev) => {
-                crate::text::outage_lines(ev, &self.source, self.corrections.as_ref())
+                let mut out =
+                    crate::text::outage_lines(ev, &self.source, self.corrections.as_ref());
+                // The bound's row ends the summary table (the title, the
+                // table's header and four rows), its lines follow.
+                let at = 6.min(out.len());
+                let lines = crate::bound::outage_bound_lines(ev, &self.bound, self.alert_m);
+                out.splice(at..at, lines);
+                out
             }
             Measured::Drift(r, seg) => {
                 let s = Summary::of(&r.errors_pct());

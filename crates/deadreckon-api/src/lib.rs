@@ -51,6 +51,7 @@
 #![deny(missing_docs)]
 
 pub mod binding;
+pub mod bound;
 pub mod calibrate;
 pub mod checks;
 pub mod corrections;

@@ -160,6 +160,14 @@ pub struct OutageResult {
     /// The filter's yaw standard deviation where the dead reckoning started,
     /// rad (`None` when the estimator has none).
     pub start_yaw_std_rad: Option<f64>,
+    /// The horizontal covariance the error bound is made of at each error,
+    /// m² (empty when the estimator has none): the estimator's covariance
+    /// of the compared point plus the declared accuracy of the last fix
+    /// before the outage ([`crate::bound`]).
+    pub covariances_m2: Vec<crate::bound::Cov2>,
+    /// The reference's own covariance at each error, m² (a hidden fix's
+    /// noise; zero for the truth; empty with `covariances_m2`).
+    pub reference_m2: Vec<crate::bound::Cov2>,
 }
 
 impl OutageResult {
@@ -183,6 +191,8 @@ impl OutageResult {
             travelled_m,
             distance_m,
             start_yaw_std_rad: None,
+            covariances_m2: Vec::new(),
+            reference_m2: Vec::new(),
         }
     }
 

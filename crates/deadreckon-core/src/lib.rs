@@ -23,6 +23,7 @@
 #![deny(missing_docs)]
 
 pub mod angle;
+pub mod bound;
 pub mod calibrate;
 pub mod checkpoint;
 pub mod chords;

@@ -23,6 +23,7 @@
 //! it): leaving out the windows where the filter is unsure would flatter the
 //! figures.
 
+use crate::bound::Cov2;
 use crate::compared::{Antenna, Position, RearAxle};
 use crate::drive::Drive;
 use crate::ekf::{self, EpochHook, EpochOut, FilterOptions};
@@ -204,22 +205,50 @@ pub fn evaluate(
     warmup_s: f64,
     base: &FilterOptions,
 ) -> Result<OutageEvaluation, Error> {
+    evaluate_with(drive, params, outage_s, step_s, warmup_s, base, true)
+}
+
+/// [`evaluate`] against the hidden GNSS fixes even where the drive has a
+/// truth: what a user's drive can tell, as the error bound's fit
+/// ([`crate::bound`]) sees it during calibration.
+pub fn evaluate_against_fixes(
+    drive: &Drive,
+    params: &Params,
+    outage_s: f64,
+    step_s: f64,
+    warmup_s: f64,
+    base: &FilterOptions,
+) -> Result<OutageEvaluation, Error> {
+    evaluate_with(drive, params, outage_s, step_s, warmup_s, base, false)
+}
+
+/// [`evaluate`] against the truth when `use_truth` and the drive has one,
+/// else against the hidden fixes.
+fn evaluate_with(
+    drive: &Drive,
+    params: &Params,
+    outage_s: f64,
+    step_s: f64,
+    warmup_s: f64,
+    base: &FilterOptions,
+    use_truth: bool,
+) -> Result<OutageEvaluation, Error> {
     let n = &drive.vehicle.noise;
     match (
         n.gnss_wander_std_m > 0.0,
         n.gyro_bias_walk_rps_per_sqrt_s > 0.0,
     ) {
         (false, false) => {
-            evaluate_in::<CarLayout, 5>(drive, params, outage_s, step_s, warmup_s, base)
+            evaluate_in::<CarLayout, 5>(drive, params, outage_s, step_s, warmup_s, base, use_truth)
         }
         (true, false) => evaluate_in::<CarWanderLayout, N_WANDER>(
-            drive, params, outage_s, step_s, warmup_s, base,
+            drive, params, outage_s, step_s, warmup_s, base, use_truth,
         ),
-        (false, true) => {
-            evaluate_in::<CarBiasLayout, N_BIAS>(drive, params, outage_s, step_s, warmup_s, base)
-        }
+        (false, true) => evaluate_in::<CarBiasLayout, N_BIAS>(
+            drive, params, outage_s, step_s, warmup_s, base, use_truth,
+        ),
         (true, true) => evaluate_in::<CarWanderBiasLayout, N_WANDER_BIAS>(
-            drive, params, outage_s, step_s, warmup_s, base,
+            drive, params, outage_s, step_s, warmup_s, base, use_truth,
         ),
     }
 }
@@ -232,13 +261,18 @@ fn evaluate_in<L: Layout<N>, const N: usize>(
     step_s: f64,
     warmup_s: f64,
     base: &FilterOptions,
+    use_truth: bool,
 ) -> Result<OutageEvaluation, Error> {
     if !(outage_s > 0.0 && step_s > 0.0) {
         return Err(Error::InvalidParams(
             "outage length and step must be positive".into(),
         ));
     }
-    let truth = Reference::from_truth(&drive.truth);
+    let truth = if use_truth {
+        Reference::from_truth(&drive.truth)
+    } else {
+        None
+    };
     let reference = if truth.is_some() {
         Against::Truth
     } else {
@@ -282,6 +316,7 @@ fn evaluate_in<L: Layout<N>, const N: usize>(
         )));
     };
     let first_t = aided.first_t;
+    let fix_std_m = crate::bound::fix_scatter_std_m(&drive.gnss);
     let heading_limit = aided.heading_limit();
     let heading_known_t = aided.heading_known_t(heading_limit);
     drop(aided.yaw_var);
@@ -320,9 +355,11 @@ fn evaluate_in<L: Layout<N>, const N: usize>(
         fd.dead_reckon();
         let mut states: Vec<(f64, State)> = Vec::new();
         let mut wander: Vec<[f64; 2]> = Vec::new();
+        let mut covs: Vec<[[f64; 3]; 3]> = Vec::new();
         let mut keep = |g: &mut Filter<L, N>, _: EpochOut<'_, N>| {
             states.push((g.time_s(), g.car_state()));
             wander.push(g.wander_m());
+            covs.push(pose_block(g.covariance()));
         };
         while let Some(ev) = next.filter(|e| e.t_s <= end) {
             fd.push(&mut g, ev, &mut keep)?;
@@ -330,8 +367,24 @@ fn evaluate_in<L: Layout<N>, const N: usize>(
         }
         fd.finish(&mut g, &mut keep)?;
         gates.add(&g.gates().since(&before));
-        if let Some(mut w) = window_errors(drive, truth.as_ref(), &states, &wander, t0, start, end)
-        {
+        // The bound's floor: the declared accuracy of the last fix handed over.
+        let handed = drive.gnss.partition_point(|g| g.t_s <= start);
+        let receiver = Cov2::circular(
+            handed
+                .checked_sub(1)
+                .map_or(0.0, |i| crate::bound::receiver_std_m(&drive.gnss[i])),
+        );
+        if let Some(mut w) = window_errors(
+            drive,
+            truth.as_ref(),
+            &states,
+            &wander,
+            &covs,
+            (fix_std_m, receiver),
+            t0,
+            start,
+            end,
+        ) {
             w.start_yaw_std_rad = Some(yaw_std);
             if heading_known_t.is_none_or(|k| start < k) {
                 unsettled.push(w);
@@ -379,22 +432,49 @@ fn evaluate_in<L: Layout<N>, const N: usize>(
     })
 }
 
+/// The `(X, Y, YAW)` block of a filter covariance.
+fn pose_block<const N: usize>(p: &SMatrix<f64, N, N>) -> [[f64; 3]; 3] {
+    let i = [X, Y, YAW];
+    let mut b = [[0.0; 3]; 3];
+    for (r, &a) in i.iter().enumerate() {
+        for (c, &d) in i.iter().enumerate() {
+            b[r][c] = p[(a, d)];
+        }
+    }
+    b
+}
+
 /// The errors of dead-reckoned `states` (from `t0`, the start of dead reckoning)
 /// over the window `[start, end)`, against the truth or, without it, the GNSS
 /// fixes of the window (compared at the antenna, plus the receiver's wander
 /// the filter still expects, `wander[k]` at `states[k]`, when given: the
-/// fixes carry it). `None` when nothing compares.
+/// fixes carry it). With `covs` (the pose covariance at each state) each
+/// error also gets the covariance the error bound is made of (the point
+/// compared, plus `receiver`: the declared accuracy of the last fix before
+/// the outage, [`crate::bound`]) and the reference's (a fix's is
+/// `fix_std_m` per axis). `None` when nothing compares.
+#[allow(clippy::too_many_arguments)]
 fn window_errors(
     drive: &Drive,
     truth: Option<&Reference>,
     states: &[(f64, State)],
     wander: &[[f64; 2]],
+    covs: &[[[f64; 3]; 3]],
+    (fix_std_m, receiver): (f64, Cov2),
     t0: f64,
     start: f64,
     end: f64,
 ) -> Option<OutageResult> {
     let lever = drive.vehicle.gnss_lever_arm_m;
     let inside = |s: &(f64, State)| s.0 >= t0 && s.0 <= end;
+    let covs: Vec<[[f64; 3]; 3]> = states
+        .iter()
+        .zip(covs)
+        .filter(|(s, _)| inside(s))
+        .map(|(_, c)| *c)
+        .collect();
+    let mut cov_at = Vec::new();
+    let mut reference_at = Vec::new();
     // The antenna the fixes see: the car's plus the wander expected.
     let seen: Vec<(f64, State)> = states
         .iter()
@@ -413,13 +493,17 @@ fn window_errors(
     let mut errors = Vec::new();
     match truth {
         Some(t) => {
-            for (ts, x) in &states {
+            for (k, (ts, x)) in states.iter().enumerate() {
                 if let Some(r) = t.state_at(*ts) {
                     let (est, truth) = (
                         Position::<RearAxle>::new(x[X], x[Y]),
                         Position::<RearAxle>::new(r[X], r[Y]),
                     );
                     errors.push((*ts - t0, est.distance_to(&truth)));
+                    if let Some(c) = covs.get(k) {
+                        cov_at.push(Cov2::rear_axle(c).scaled_plus(1.0, &receiver));
+                        reference_at.push(Cov2::circular(0.0));
+                    }
                 }
             }
         }
@@ -434,6 +518,12 @@ fn window_errors(
                     let antenna = Position::<RearAxle>::new(x[X], x[Y]).antenna(x[YAW], lever);
                     let fix = Position::<Antenna>::new(g.east_m, g.north_m);
                     errors.push((g.t_s - t0, antenna.distance_to(&fix)));
+                    // The covariance of the last epoch at or before the fix.
+                    let k = states.partition_point(|s| s.0 <= g.t_s).saturating_sub(1);
+                    if let Some(c) = covs.get(k) {
+                        cov_at.push(Cov2::ahead(c, x[YAW], lever).scaled_plus(1.0, &receiver));
+                        reference_at.push(Cov2::circular(fix_std_m));
+                    }
                 }
             }
         }
@@ -451,14 +541,19 @@ fn window_errors(
         dist[k.saturating_sub(1).min(dist.len() - 1)]
     };
     let travelled = errors.iter().map(|e| dist_at(e.0)).collect();
-    Some(match truth {
+    let mut out = match truth {
         Some(_) => {
             OutageResult::new::<RearAxle>(start, end, Against::Truth, errors, travelled, distance_m)
         }
         None => {
             OutageResult::new::<Antenna>(start, end, Against::Gnss, errors, travelled, distance_m)
         }
-    })
+    };
+    if cov_at.len() == out.errors.len() {
+        out.covariances_m2 = cov_at;
+        out.reference_m2 = reference_at;
+    }
+    Some(out)
 }
 
 /// The GNSS-aided filter run once with GNSS hidden in every window of
@@ -515,7 +610,17 @@ fn through_windows_in(
         // Dead reckoning starts at the last epoch before the window.
         let i = hook.0.partition_point(|s| s.0 < a);
         let t0 = hook.0.get(i.saturating_sub(1)).map(|s| s.0).unwrap_or(a);
-        if let Some(w) = window_errors(drive, truth.as_ref(), &hook.0, &[], t0, a, b) {
+        if let Some(w) = window_errors(
+            drive,
+            truth.as_ref(),
+            &hook.0,
+            &[],
+            &[],
+            (0.0, Cov2::circular(0.0)),
+            t0,
+            a,
+            b,
+        ) {
             out.push(w);
         }
     }

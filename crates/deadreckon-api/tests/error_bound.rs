@@ -1,0 +1,140 @@
+//! Issue 31: the 95 % error bound validated on drives that did not tune
+//! it. Each family car ([`CarFamily`]) is calibrated as `calibrate` does it
+//! (`calibrate_car`: the default corrections, RTS, then the bound's factor
+//! fitted on the calibration drive's own hidden fixes), and evaluated as
+//! `evaluate --params` does it (the stored corrections applied) on a second
+//! drive of the same car: 30 s outages every 10 s against the truth. Per
+//! window, is the final error within `bound_95_m`; per set, the coverage and
+//! the sharpness (median bound over median final error).
+//!
+//! Cars: development 301–306 (the method's choices were made on them, in
+//! CI); held-out 401–424 (not used for any choice, `#[ignore]`d):
+//!
+//! ```text
+//! cargo test --profile ci -p deadreckon-api --test error_bound -- --nocapture
+//! cargo test --profile ci -p deadreckon-api --test error_bound -- --ignored --nocapture
+//! ```
+
+use rayon::prelude::*;
+
+use deadreckon_api::calibrate::calibrate_car;
+use deadreckon_api::corrections::stored_corrections;
+use deadreckon_core::calibrate::CalibrationOptions;
+use deadreckon_core::ekf::FilterOptions;
+use deadreckon_core::metrics::Summary;
+use deadreckon_core::outage::evaluate;
+use deadreckon_core::timing::Which;
+use deadreckon_sim::family::CarFamily;
+use deadreckon_sim::simulate;
+
+/// One car's windows: (final error, bound at the end, within), and its factor.
+struct Car {
+    seed: u64,
+    k: f64,
+    fitted_on: usize,
+    windows: Vec<(f64, f64, bool)>,
+}
+
+fn car(seed: u64, drive_s: f64) -> Result<Car, String> {
+    let family = CarFamily::draw(seed);
+    let cal = simulate(&family.drive(1000 + seed, drive_s), 1000 + seed)
+        .map_err(|e| format!("calibration drive: {e}"))?;
+    let ev = simulate(&family.drive(2000 + seed, drive_s), 2000 + seed)
+        .map_err(|e| format!("evaluation drive: {e}"))?;
+    let c = calibrate_car(
+        &cal.drive,
+        "rts",
+        CalibrationOptions::default(),
+        Which::Gnss,
+        "cal",
+    )
+    .map_err(|e| format!("calibration: {e}"))?;
+    let stored = stored_corrections(&c.params_extra()).map_err(|e| format!("stored: {e}"))?;
+    let drive = stored.apply(&ev.drive);
+    let out = evaluate(
+        &drive,
+        &c.calibration.estimate.params,
+        30.0,
+        10.0,
+        5.0,
+        &FilterOptions::default(),
+    )
+    .map_err(|e| format!("evaluation: {e}"))?;
+    let fit = c.bound;
+    Ok(Car {
+        seed,
+        k: fit.k,
+        fitted_on: fit.windows,
+        windows: out
+            .windows
+            .iter()
+            .map(|w| {
+                (
+                    w.final_m(),
+                    w.bound_95_m(&fit).unwrap_or(f64::NAN),
+                    w.within_bound(&fit).unwrap_or(false),
+                )
+            })
+            .collect(),
+    })
+}
+
+/// Coverage and sharpness over `cars`, printed per car.
+fn measure(cars: &[u64], drive_s: f64) -> (f64, f64, usize) {
+    let got: Vec<Result<Car, String>> = cars.par_iter().map(|&s| car(s, drive_s)).collect();
+    let (mut errors, mut bounds, mut within) = (Vec::new(), Vec::new(), 0);
+    for r in got {
+        match r {
+            Ok(c) => {
+                let e: Vec<f64> = c.windows.iter().map(|w| w.0).collect();
+                let b: Vec<f64> = c.windows.iter().map(|w| w.1).collect();
+                let n_in = c.windows.iter().filter(|w| w.2).count();
+                println!(
+                    "car {}: k {:.3} (fitted on {} windows); {} of {} windows within; median \
+                     bound {:.3} m, median final error {:.3} m",
+                    c.seed,
+                    c.k,
+                    c.fitted_on,
+                    n_in,
+                    c.windows.len(),
+                    Summary::of(&b).median,
+                    Summary::of(&e).median
+                );
+                within += n_in;
+                errors.extend(e);
+                bounds.extend(b);
+            }
+            Err(e) => println!("failed: {e}"),
+        }
+    }
+    let n = errors.len();
+    let coverage = within as f64 / n as f64;
+    let sharpness = Summary::of(&bounds).median / Summary::of(&errors).median;
+    println!("coverage {within}/{n} = {coverage:.3}, sharpness {sharpness:.2}");
+    (coverage, sharpness, n)
+}
+
+#[test]
+fn the_bound_covers_95_percent_of_outages_on_development_cars() {
+    let (coverage, sharpness, n) = measure(&(301..=306).collect::<Vec<_>>(), 300.0);
+    // Measured: 166 of 177 windows within (0.938), median bound / median
+    // final error 2.64 (k 0.52–1.79 per car, fitted on 29–53 windows). The
+    // filter's covariance alone, without the receiver's declared accuracy:
+    // 150 of 177 (0.847), 2.77.
+    assert_eq!(n, 177);
+    assert!((0.92..=0.96).contains(&coverage), "{coverage}");
+    assert!((2.4..=2.9).contains(&sharpness), "{sharpness}");
+}
+
+#[test]
+#[ignore]
+fn the_bound_covers_95_percent_of_outages_on_held_out_cars_401_to_424() {
+    let (coverage, sharpness, n) = measure(&(401..=424).collect::<Vec<_>>(), 300.0);
+    // Measured (run once, after every choice was made on cars 301–306):
+    // 763 of 782 windows within (0.976), median bound / median final error
+    // 3.37 (k 0.43–4.29 per car). The issue's coverage (90–99 %) is met;
+    // its sharpness (at most 3) is not: pinned here as measured.
+    assert_eq!(n, 782);
+    assert!((0.95..=0.99).contains(&coverage), "{coverage}");
+    assert!((3.1..=3.6).contains(&sharpness), "{sharpness}");
+}
