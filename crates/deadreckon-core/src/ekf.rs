@@ -738,6 +738,8 @@ impl Feeder {
                     Measurement::YawRate { .. } => use_.gyro,
                     Measurement::Speed { .. } => use_.speed,
                     Measurement::Steering { .. } => use_.steering,
+                    // Online's input only (crate::live_corrections).
+                    Measurement::Gyro { .. } | Measurement::Accel { .. } => false,
                     Measurement::Gnss { .. } => {
                         if use_.gnss && self.hidden(t) {
                             self.stats.gnss_hidden += 1;
@@ -796,6 +798,8 @@ impl Feeder {
                             self.gnss_update(f, &fix)?;
                         }
                     }
+                    // Not `used` (above).
+                    Measurement::Gyro { .. } | Measurement::Accel { .. } => {}
                 }
                 self.stats.epochs += 1;
                 epoch(

@@ -75,11 +75,12 @@ impl DrFilter {
         self.in_call
     }
 
-    /// Runs what waits at the end of a stream.
+    /// Runs what waits at the end of a stream, what the stored corrections
+    /// hold back included ([`Online::end`]).
     pub(crate) fn finish(&mut self) -> Result<(), Fail> {
         let (poses, latest) = (&mut self.poses, &mut self.latest);
         self.online
-            .finish(&mut |p| {
+            .end(&mut |p| {
                 *latest = Some(p);
                 poses.push_back(p);
             })
