@@ -527,7 +527,12 @@ impl Feeder {
         f: &mut Filter<L, N>,
         epoch: &mut dyn FnMut(&mut Filter<L, N>, EpochOut<'_, N>),
     ) -> Result<(), Error> {
-        self.process_batch(f, epoch)
+        self.process_batch(f, epoch)?;
+        // The epochs' scratch (not serialised): a feeder that has finished
+        // equals its saved and loaded copy.
+        self.updates.clear();
+        self.gated_fix_t_s = None;
+        Ok(())
     }
 
     fn hidden(&self, t: f64) -> bool {
