@@ -26,7 +26,8 @@ pub struct DrFilter {
     last_t_s: Option<f64>,
     /// Lines given to `dr_push_line`, for the line number in its errors.
     pub(crate) lines: u64,
-    /// The warning of the params.toml (corrections `stream` does not apply).
+    /// The warning of the params.toml (a slip stored without its mean force,
+    /// which a stream cannot apply).
     pub(crate) warning: Option<CString>,
     /// True while a call runs: still true at the next call only if a panic
     /// left the previous one half done.
