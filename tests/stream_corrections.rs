@@ -345,3 +345,43 @@ fn online_corrections_equal_the_batch_filter_on_the_corrected_drive_bit_for_bit(
     println!("the slip moves the final point {moved:.3} m");
     assert!(moved > 0.004, "{moved} m");
 }
+
+/// Parameters learned on corrected events belong to the corrected streams:
+/// `--params-out` writes the corrections beside them, read back as they
+/// were given, so that the next stream started from the file applies them.
+#[test]
+fn learned_parameters_keep_the_corrections_they_were_learned_under() {
+    use deadreckon_core::timing::KnownCorrections;
+    let tmp = tempfile::tempdir().unwrap();
+    let known = KnownCorrections {
+        delays_s: [0.021, -0.013, 0.0, 0.0775],
+        up: Some([
+            0.052,
+            -0.0435,
+            (1.0f64 - 0.052 * 0.052 - 0.0435 * 0.0435).sqrt(),
+        ]),
+        gyro_scale_error: 0.0079,
+        traction_slip_per_mps2: -0.004,
+        traction_mean_force_mps2: Some(0.31),
+    };
+    let p = deadreckon_core::Params {
+        gyro_bias_rps: 0.0014,
+        speed_scale: 1.008,
+        circumference_fl_m: 1.934,
+        circumference_fr_m: 1.933,
+        circumference_rl_m: 1.934,
+        circumference_rr_m: 1.929,
+    };
+    let learned = deadreckon_core::online::Learned {
+        params: p,
+        std: deadreckon_api::stream::default_prior(),
+        valid: false,
+        calibrated_pct: 40.0,
+    };
+    let path = tmp.path().join("learned.toml");
+    deadreckon_api::stream::save_learned(&path, &learned, &known).unwrap();
+    let back = deadreckon_api::corrections::stored_in_file(&path).unwrap();
+    assert_eq!(back, known);
+    let read = deadreckon_io::read_params(&path).unwrap();
+    assert_eq!(read.params, p);
+}

@@ -256,7 +256,7 @@ pub fn run(
         if let (Some(every), Some(path)) = (o.save_every_s, &o.params_out) {
             if last_save.is_none_or(|t| ev.t_s - t >= every) {
                 if let Some(l) = online.learned(&targets) {
-                    save_learned(path, &l)?;
+                    save_learned(path, &l, online.corrections().known())?;
                     last_save = Some(ev.t_s);
                 }
             }
@@ -281,7 +281,7 @@ pub fn run(
             save_state(path, online)?;
         }
         if let (Some(l), Some(path)) = (&learned, &o.params_out) {
-            save_learned(path, l)?;
+            save_learned(path, l, online.corrections().known())?;
         }
     }
     Ok(StreamSummary {
@@ -317,10 +317,58 @@ pub fn state_from_text(text: &str, name: &str) -> Result<Online, Error> {
     serde_json::from_str::<Online>(text).doing(|| format!("state {name}"))
 }
 
+/// The params.toml tables of stored corrections, as
+/// [`crate::corrections::stored_corrections`] reads them back (the zero
+/// ones left out): what a file of parameters learned on corrected events
+/// carries on, so that the next stream given it applies them too.
+pub fn stored_toml(stored: &crate::corrections::Stored) -> toml::Table {
+    use deadreckon_core::timing::Stream;
+    let mut out = toml::Table::new();
+    let mut delays = toml::Table::new();
+    for (st, d) in Stream::ALL.iter().zip(stored.delays_s) {
+        if d != 0.0 {
+            let mut t = toml::Table::new();
+            t.insert("delay_s".into(), d.into());
+            delays.insert(st.name().into(), t.into());
+        }
+    }
+    if !delays.is_empty() {
+        out.insert("delays".into(), delays.into());
+    }
+    if let Some(up) = stored.up {
+        let mut t = toml::Table::new();
+        t.insert(
+            "up".into(),
+            toml::Value::Array(up.iter().map(|&u| u.into()).collect()),
+        );
+        out.insert("imu".into(), t.into());
+    }
+    if stored.gyro_scale_error != 0.0 {
+        let mut t = toml::Table::new();
+        t.insert("scale_error".into(), stored.gyro_scale_error.into());
+        out.insert("gyro_scale".into(), t.into());
+    }
+    if stored.traction_slip_per_mps2 != 0.0 {
+        let mut t = toml::Table::new();
+        t.insert("slip_per_mps2".into(), stored.traction_slip_per_mps2.into());
+        if let Some(m) = stored.traction_mean_force_mps2 {
+            t.insert("mean_force_mps2".into(), m.into());
+        }
+        out.insert("traction".into(), t.into());
+    }
+    out
+}
+
 /// Writes learned parameters as a params.toml (method `online`, whether
-/// they are valid yet, the percentage calibrated).
-pub fn save_learned(path: &Path, l: &Learned) -> Result<(), Error> {
-    let mut extra = toml::Table::new();
+/// they are valid yet, the percentage calibrated), with the stored
+/// corrections the events were corrected with (the parameters belong to
+/// the corrected streams: [`stored_toml`]).
+pub fn save_learned(
+    path: &Path,
+    l: &Learned,
+    corrections: &crate::corrections::Stored,
+) -> Result<(), Error> {
+    let mut extra = stored_toml(corrections);
     extra.insert("method".into(), "online".into());
     extra.insert("valid".into(), l.valid.into());
     extra.insert("calibrated_pct".into(), l.calibrated_pct.into());
