@@ -188,8 +188,8 @@ fn stream_names_the_streams_of_the_stored_delays() {
     let warning = r
         .stderr
         .lines()
-        .find(|l| l.contains("stores corrections"))
-        .unwrap_or_else(|| panic!("no warning:\n{}", r.stderr));
+        .find(|l| l.contains("applying the corrections"))
+        .unwrap_or_else(|| panic!("no note of the corrections:\n{}", r.stderr));
     assert!(warning.contains("gnss delay"), "{warning}");
     assert!(
         !warning.contains('[') && !warning.contains("Some("),

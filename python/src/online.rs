@@ -40,7 +40,8 @@ fn poses<'py>(py: Python<'py>, p: &[TrackPoint]) -> PyResult<Bound<'py, PyDict>>
 #[pymethods]
 impl Online {
     /// An online filter for `vehicle` (a Drive, a dict of vehicle.toml's keys
-    /// or its path), starting from GNSS, as `deadreckon stream` does.
+    /// or its path), starting from GNSS, as `deadreckon stream` does; a
+    /// params.toml path's stored corrections are applied to the events.
     #[new]
     #[pyo3(signature = (vehicle, params=None, timing="wheel", learn=false, prior_std=None))]
     fn new(
@@ -51,6 +52,16 @@ impl Online {
         prior_std: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let vehicle = vehicle_of(vehicle)?;
+        // A params.toml's stored corrections (delays, IMU tilt, gyro scale,
+        // slip) are applied to the events, as `deadreckon stream` does.
+        let stored = match params {
+            Some(p) if p.cast::<PyDict>().is_err() => {
+                let spec: std::path::PathBuf = p.extract()?;
+                deadreckon_api::corrections::stored_in_file(&spec)
+                    .map_err(DeadreckonError::new_err)?
+            }
+            _ => Default::default(),
+        };
         let params = match params {
             Some(p) => params_arg(p, &vehicle)?.0,
             None => Params::nominal(&vehicle),
@@ -69,6 +80,7 @@ impl Online {
             CoreOnline::new(&vehicle, &params, &opts, Start::Gnss)
         }
         .map_err(to_py_err)?;
+        let inner = inner.with_corrections(&stored).map_err(to_py_err)?;
         Ok(Online { inner, lines: 0 })
     }
 
@@ -99,10 +111,12 @@ impl Online {
         poses(py, &out)
     }
 
-    /// Ends the stream: the poses of the last epochs.
+    /// Ends the stream: the poses of the last epochs, those of the events
+    /// a params.toml's stored delays or slip held back included (save the
+    /// state with `to_json` before this to resume, not after).
     fn finish<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let mut out = Vec::new();
-        self.inner.finish(&mut |p| out.push(p)).map_err(to_py_err)?;
+        self.inner.end(&mut |p| out.push(p)).map_err(to_py_err)?;
         poses(py, &out)
     }
 

@@ -51,6 +51,11 @@ pub struct StreamArgs {
     /// Resume from this state file if it exists, and write the state to it at the end.
     #[arg(long)]
     pub state: Option<PathBuf>,
+    /// With --state: this input is the stream's last part; release at its end
+    /// the events the params.toml's stored delays or slip hold back (without
+    /// it they stay in the state for the next part).
+    #[arg(long, requires = "state")]
+    pub last_part: bool,
     /// What to do with a line that is not a valid event.
     #[arg(long, value_enum, default_value = "refuse")]
     pub on_bad_line: OnBadLine,

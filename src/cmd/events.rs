@@ -4,7 +4,7 @@
 use std::io::Write;
 
 use anyhow::Result;
-use deadreckon_core::ekf::DriveEvents;
+use deadreckon_core::live_corrections::input_events;
 
 use super::common;
 
@@ -16,7 +16,10 @@ pub fn run(a: EventsArgs, load: &common::Loader) -> Result<()> {
     let stdout = std::io::stdout();
     let mut w = std::io::BufWriter::new(stdout.lock());
     let result = (|| -> std::io::Result<()> {
-        for ev in DriveEvents::all(&drive) {
+        // Every reading, the three-axis gyro, the accelerometer and those
+        // after the last wheel row included: `stream --params` applies the
+        // stored corrections to them as `run --params` does to the drive.
+        for ev in input_events(&drive) {
             w.write_all(deadreckon_io::events::to_line(&ev).as_bytes())?;
             w.write_all(b"\n")?;
         }

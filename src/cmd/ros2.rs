@@ -24,10 +24,13 @@ pub fn run(a: Ros2Args, load: &common::Loader, stop: &AtomicBool) -> Result<()> 
         params_out: None,
         save_every_s: None,
         skip_bad_lines: false,
+        last_part: false,
     };
     let (vehicle, mut online, warning) = stream::start(&a.start.vehicle, &a.start.params, &o)?;
+    if let Some(n) = stream::corrections_note(&a.start.params, &online) {
+        note!("{n}");
+    }
     if let Some(w) = warning {
-        // Live messages cannot be re-timed or re-projected here: say so.
         note!("warning: {w}");
     }
     mapping.vehicle = vehicle;

@@ -23,10 +23,13 @@ pub fn run(a: StreamArgs) -> Result<()> {
         params_out: a.params_out.clone(),
         save_every_s: a.save_every_s,
         skip_bad_lines: a.on_bad_line == OnBadLine::Skip,
+        last_part: a.last_part,
     };
     let (_, mut online, warning) = stream::start(&a.start.vehicle, &a.start.params, &o)?;
+    if let Some(n) = stream::corrections_note(&a.start.params, &online) {
+        note!("{n}");
+    }
     if let Some(w) = warning {
-        // Live events cannot be re-timed or re-projected here: say so.
         note!("warning: {w}");
     }
     let s = stream::run(
@@ -42,6 +45,18 @@ pub fn run(a: StreamArgs) -> Result<()> {
     }
     if let Some(st) = s.stats {
         note!("{st}");
+    }
+    if s.hold_s > 0.0 {
+        note!(
+            "stored corrections: poses {:.3} s of stream time behind the events",
+            s.hold_s
+        );
+    }
+    if s.held_in_state > 0 {
+        note!(
+            "{} events held back by the corrections kept in the state for the next run",
+            s.held_in_state
+        );
     }
     if s.skipped > 0 {
         note!("{} bad lines skipped", s.skipped);

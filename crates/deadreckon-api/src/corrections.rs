@@ -131,6 +131,9 @@ pub fn corrections_toml(c: &Corrections) -> toml::Table {
             t.insert("slip_per_mps2".into(), tr.slip_per_mps2.into());
             t.insert("std".into(), tr.std.into());
             t.insert("axle".into(), tr.axle.name().into());
+            if tr.mean_force_mps2.is_finite() {
+                t.insert("mean_force_mps2".into(), tr.mean_force_mps2.into());
+            }
         } else if let Some(r) = tr.status.reason() {
             t.insert("not_estimated".into(), r.into());
         }
@@ -304,6 +307,17 @@ pub fn stored_corrections(extra: &toml::Table) -> Result<Stored, String> {
                 ));
             }
             s.traction_slip_per_mps2 = v;
+        }
+        if let Some(v) = t.get("mean_force_mps2") {
+            let v = v
+                .as_float()
+                .ok_or("`traction.mean_force_mps2` must be a number")?;
+            if !(v.is_finite() && v.abs() < 100.0) {
+                return Err(format!(
+                    "`traction.mean_force_mps2` = {v} is not a plausible mean forward specific force (|f| < 100 m/s²)"
+                ));
+            }
+            s.traction_mean_force_mps2 = Some(v);
         }
     }
     if let Some(g) = extra.get("gyro_scale") {

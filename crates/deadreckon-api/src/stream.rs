@@ -1,7 +1,9 @@
 //! `deadreckon stream`: the four-wheel filter on JSON-line events
 //! (`docs/events.md`), one JSON pose per filter epoch out, resumable from a
 //! state file, optionally learning the six parameters and saving them as it
-//! goes.
+//! goes. The corrections a params.toml stores (delays, IMU tilt, gyro
+//! scale, driven-axle slip) are applied to the events as `run --params`
+//! applies them to a drive ([`deadreckon_core::live_corrections`]).
 
 use std::io::{BufRead, Write};
 use std::path::{Path, PathBuf};
@@ -19,36 +21,40 @@ pub fn default_prior() -> Params {
     deadreckon_core::calibrate::CalibrationOptions::default().prior_std
 }
 
-/// The starting parameters and the learning prior: `nominal` (the
-/// vehicle's, the default prior) or a params.toml (its values; its `[std]`
-/// where positive — a std of 0 would freeze a parameter —, else the default
-/// prior). The third value is a warning when the file stores corrections
-/// (delays, driven-axle slip, IMU tilt, gyro scale) that live events cannot
-/// be given.
+/// The starting parameters, the learning prior and the corrections to
+/// apply: `nominal` (the vehicle's, the default prior, none) or a
+/// params.toml (its values; its `[std]` where positive — a std of 0 would
+/// freeze a parameter —, else the default prior; the corrections it stores,
+/// read as `--params` reads them for every other command:
+/// [`crate::corrections::stored_corrections`]).
 pub fn start_params(
     spec: &str,
     vehicle: &Vehicle,
-) -> Result<(Params, Params, Option<String>), Error> {
+) -> Result<(Params, Params, crate::corrections::Stored), Error> {
     if spec == "nominal" {
-        return Ok((Params::nominal(vehicle), default_prior(), None));
+        return Ok((
+            Params::nominal(vehicle),
+            default_prior(),
+            Default::default(),
+        ));
     }
     let p = crate::load::params_file(spec)?;
     crate::load::check_against_vehicle(spec, &p.params, vehicle)?;
     let stored = crate::corrections::stored_in_file(Path::new(spec)).map_err(Error::Invalid)?;
-    Ok(started_from(spec, &p, &stored))
+    Ok(started_from(&p, stored))
 }
 
 /// [`start_params`] on the text of a params.toml (the C API is handed text);
-/// `name` names it in errors and in the warning.
+/// `name` names it in errors.
 pub fn start_params_from_text(
     text: &str,
     name: &str,
-) -> Result<(Params, Params, Option<String>), Error> {
+) -> Result<(Params, Params, crate::corrections::Stored), Error> {
     let (p, extra) = deadreckon_io::parse_params_with_extra(text, Path::new(name))
         .doing(|| format!("reading parameters {name}"))?;
     let stored = crate::corrections::stored_corrections(&extra)
         .map_err(|e| Error::Invalid(format!("parameters {name}: {e}")))?;
-    Ok(started_from(name, &p, &stored))
+    Ok(started_from(&p, stored))
 }
 
 /// Stored corrections in words: each stream's delay by its name, the IMU's
@@ -68,24 +74,52 @@ fn stored_words(stored: &crate::corrections::Stored) -> String {
     text
 }
 
-/// The starting parameters, the prior and the warning of a read params.toml.
-fn started_from(
-    name: &str,
-    p: &ParamsWithStd,
-    stored: &crate::corrections::Stored,
-) -> (Params, Params, Option<String>) {
-    let warning = (*stored != Default::default()).then(|| {
+/// What the filter does with the corrections of the params.toml `name`, in
+/// words for stderr (`None` when it stores none): which it applies and the
+/// latency their reorder buffer adds.
+pub fn corrections_note(name: &str, online: &Online) -> Option<String> {
+    let c = online.corrections();
+    if c.known().is_empty() {
+        return None;
+    }
+    Some(format!(
+        "applying the corrections {name} stores ({}): poses {}",
+        stored_words(c.known()),
+        latency_words(online.hold_s())
+    ))
+}
+
+/// The latency the corrections add, in words.
+fn latency_words(hold_s: f64) -> String {
+    if hold_s > 0.0 {
+        format!("held back {hold_s:.3} s of stream time (events reordered on corrected time)")
+    } else {
+        "not held back (no positive delay, no slip)".into()
+    }
+}
+
+/// The warning of a params.toml whose stored corrections the filter cannot
+/// apply as `run` does: a driven-axle slip without the mean forward
+/// specific force it is applied at (files written before it).
+pub fn corrections_warning(name: &str, online: &Online) -> Option<String> {
+    online.corrections().slip_left_out().then(|| {
         format!(
-            "{name} stores corrections that `stream` does not apply to the events ({}); its parameters were calibrated on corrected streams (calibrate --corrections none gives parameters for raw events)",
-            stored_words(stored)
+            "{name} stores a driven-axle slip without `traction.mean_force_mps2` (written before it): a stream cannot know the drive's mean forward specific force, so the slip is not applied (`run` applies it at each drive's own mean); calibrate again to store it"
         )
-    });
+    })
+}
+
+/// The starting parameters and the prior of a read params.toml.
+fn started_from(
+    p: &ParamsWithStd,
+    stored: crate::corrections::Stored,
+) -> (Params, Params, crate::corrections::Stored) {
     let d = default_prior().to_array();
     let s = p.std.to_array();
     let prior = Params::from_array(std::array::from_fn(
         |i| if s[i] > 0.0 { s[i] } else { d[i] },
     ));
-    (p.params, prior, warning)
+    (p.params, prior, stored)
 }
 
 /// How a stream runs.
@@ -105,6 +139,11 @@ pub struct StreamOptions {
     pub save_every_s: Option<f64>,
     /// Skip (and count) bad lines instead of refusing them.
     pub skip_bad_lines: bool,
+    /// With `state`: this input is the stream's last part, so what the
+    /// stored corrections hold back is released at its end (without it the
+    /// held-back events stay in the state for the next part). Without
+    /// `state` everything is always released at the end.
+    pub last_part: bool,
 }
 
 /// What a stream did.
@@ -119,31 +158,45 @@ pub struct StreamSummary {
     /// The writing of the poses failed (a closed pipe): the stream stopped
     /// there, and neither the state nor the learned parameters were written.
     pub write_error: Option<std::io::Error>,
+    /// How long the stored corrections held events back, s of stream time
+    /// (the latency they add to every pose; 0 without delays or slip).
+    pub hold_s: f64,
+    /// Events still held back at the end and kept in the state file (with
+    /// `--state`: the resumed stream releases them; without, everything is
+    /// released at the end and this is 0).
+    pub held_in_state: usize,
 }
 
-/// The filter: resumed from `o.state` if that file exists, else started
-/// from GNSS with `params` (learning from `prior` with `o.learn`).
+/// The filter: resumed from `o.state` if that file exists (with the
+/// corrections, and the events they held back, saved in it), else started
+/// from GNSS with `params` (learning from `prior` with `o.learn`), applying
+/// the stored `corrections` to the events
+/// ([`deadreckon_core::online::Online::with_corrections`]).
 pub fn open(
     vehicle: &Vehicle,
     params: &Params,
     prior: &Params,
+    corrections: &crate::corrections::Stored,
     o: &StreamOptions,
 ) -> Result<Online, Error> {
-    Ok(match o.state.as_ref().filter(|p| p.exists()) {
+    let fresh = match o.state.as_ref().filter(|p| p.exists()) {
         Some(path) => {
             let text = std::fs::read_to_string(path)
                 .doing(|| format!("reading state {}", path.display()))?;
-            state_from_text(&text, &path.display().to_string())?
+            return state_from_text(&text, &path.display().to_string());
         }
         None if o.learn => Online::learning(vehicle, params, prior, &o.filter, Start::Gnss)?,
         None => Online::new(vehicle, params, &o.filter, Start::Gnss)?,
-    })
+    };
+    fresh
+        .with_corrections(corrections)
+        .map_err(|e| Error::Invalid(format!("stored corrections: {e}")))
 }
 
 /// What a live filter starts from: the vehicle read from `vehicle`, the
 /// filter ([`open`]: resumed from `o.state`, else started with the
-/// parameters `params` names, [`start_params`]) and the warning of a
-/// params.toml with corrections live events cannot be given.
+/// parameters and corrections `params` names, [`start_params`]) and what to
+/// tell of the corrections ([`corrections_note`], [`corrections_warning`]).
 pub fn start(
     vehicle: &Path,
     params: &str,
@@ -151,8 +204,9 @@ pub fn start(
 ) -> Result<(Vehicle, Online, Option<String>), Error> {
     let v =
         deadreckon_io::read_vehicle(vehicle).doing(|| format!("reading {}", vehicle.display()))?;
-    let (p, prior, warning) = start_params(params, &v)?;
-    let online = open(&v, &p, &prior, o)?;
+    let (p, prior, stored) = start_params(params, &v)?;
+    let online = open(&v, &p, &prior, &stored, o)?;
+    let warning = corrections_warning(params, &online);
     Ok((v, online, warning))
 }
 
@@ -202,7 +256,7 @@ pub fn run(
         if let (Some(every), Some(path)) = (o.save_every_s, &o.params_out) {
             if last_save.is_none_or(|t| ev.t_s - t >= every) {
                 if let Some(l) = online.learned(&targets) {
-                    save_learned(path, &l)?;
+                    save_learned(path, &l, online.corrections().known())?;
                     last_save = Some(ev.t_s);
                 }
             }
@@ -212,7 +266,13 @@ pub fn run(
         }
     }
     if write_error.borrow().is_none() {
-        online.finish(&mut emit)?;
+        if o.state.is_some() && !o.last_part {
+            // The stream may be resumed: what the corrections hold back
+            // stays in the state, and the resumed stream releases it.
+            online.finish(&mut emit)?;
+        } else {
+            online.end(&mut emit)?;
+        }
     }
     let write_error = write_error.take();
     let learned = online.learned(&targets);
@@ -221,7 +281,7 @@ pub fn run(
             save_state(path, online)?;
         }
         if let (Some(l), Some(path)) = (&learned, &o.params_out) {
-            save_learned(path, l)?;
+            save_learned(path, l, online.corrections().known())?;
         }
     }
     Ok(StreamSummary {
@@ -229,6 +289,12 @@ pub fn run(
         skipped,
         learned,
         write_error,
+        hold_s: online.hold_s(),
+        held_in_state: if o.state.is_some() && !o.last_part {
+            online.corrections().held()
+        } else {
+            0
+        },
     })
 }
 
@@ -251,10 +317,58 @@ pub fn state_from_text(text: &str, name: &str) -> Result<Online, Error> {
     serde_json::from_str::<Online>(text).doing(|| format!("state {name}"))
 }
 
+/// The params.toml tables of stored corrections, as
+/// [`crate::corrections::stored_corrections`] reads them back (the zero
+/// ones left out): what a file of parameters learned on corrected events
+/// carries on, so that the next stream given it applies them too.
+pub fn stored_toml(stored: &crate::corrections::Stored) -> toml::Table {
+    use deadreckon_core::timing::Stream;
+    let mut out = toml::Table::new();
+    let mut delays = toml::Table::new();
+    for (st, d) in Stream::ALL.iter().zip(stored.delays_s) {
+        if d != 0.0 {
+            let mut t = toml::Table::new();
+            t.insert("delay_s".into(), d.into());
+            delays.insert(st.name().into(), t.into());
+        }
+    }
+    if !delays.is_empty() {
+        out.insert("delays".into(), delays.into());
+    }
+    if let Some(up) = stored.up {
+        let mut t = toml::Table::new();
+        t.insert(
+            "up".into(),
+            toml::Value::Array(up.iter().map(|&u| u.into()).collect()),
+        );
+        out.insert("imu".into(), t.into());
+    }
+    if stored.gyro_scale_error != 0.0 {
+        let mut t = toml::Table::new();
+        t.insert("scale_error".into(), stored.gyro_scale_error.into());
+        out.insert("gyro_scale".into(), t.into());
+    }
+    if stored.traction_slip_per_mps2 != 0.0 {
+        let mut t = toml::Table::new();
+        t.insert("slip_per_mps2".into(), stored.traction_slip_per_mps2.into());
+        if let Some(m) = stored.traction_mean_force_mps2 {
+            t.insert("mean_force_mps2".into(), m.into());
+        }
+        out.insert("traction".into(), t.into());
+    }
+    out
+}
+
 /// Writes learned parameters as a params.toml (method `online`, whether
-/// they are valid yet, the percentage calibrated).
-pub fn save_learned(path: &Path, l: &Learned) -> Result<(), Error> {
-    let mut extra = toml::Table::new();
+/// they are valid yet, the percentage calibrated), with the stored
+/// corrections the events were corrected with (the parameters belong to
+/// the corrected streams: [`stored_toml`]).
+pub fn save_learned(
+    path: &Path,
+    l: &Learned,
+    corrections: &crate::corrections::Stored,
+) -> Result<(), Error> {
+    let mut extra = stored_toml(corrections);
     extra.insert("method".into(), "online".into());
     extra.insert("valid".into(), l.valid.into());
     extra.insert("calibrated_pct".into(), l.calibrated_pct.into());

@@ -59,10 +59,10 @@ fn the_loader_keeps_the_checks_verdict_and_the_span_of_the_last_drive() {
 fn a_stream_prior_keeps_the_default_where_the_file_fixes_a_parameter() {
     let dir = tempfile::tempdir().unwrap();
     let d = drive(&dir.path().join("d"));
-    let (p, prior, warning) = stream::start_params("nominal", &d.vehicle).unwrap();
+    let (p, prior, stored) = stream::start_params("nominal", &d.vehicle).unwrap();
     assert_eq!(p, deadreckon_core::Params::nominal(&d.vehicle));
     assert_eq!(prior, stream::default_prior());
-    assert!(warning.is_none());
+    assert!(stored.is_empty());
     // A file whose gyro bias std is 0 and speed-scale std is 1e-4.
     let mut std = deadreckon_core::Params::from_array([0.0; 6]);
     std.speed_scale = 1e-4;

@@ -527,7 +527,12 @@ impl Feeder {
         f: &mut Filter<L, N>,
         epoch: &mut dyn FnMut(&mut Filter<L, N>, EpochOut<'_, N>),
     ) -> Result<(), Error> {
-        self.process_batch(f, epoch)
+        self.process_batch(f, epoch)?;
+        // The epochs' scratch (not serialised): a feeder that has finished
+        // equals its saved and loaded copy.
+        self.updates.clear();
+        self.gated_fix_t_s = None;
+        Ok(())
     }
 
     fn hidden(&self, t: f64) -> bool {
@@ -738,6 +743,8 @@ impl Feeder {
                     Measurement::YawRate { .. } => use_.gyro,
                     Measurement::Speed { .. } => use_.speed,
                     Measurement::Steering { .. } => use_.steering,
+                    // Online's input only (crate::live_corrections).
+                    Measurement::Gyro { .. } | Measurement::Accel { .. } => false,
                     Measurement::Gnss { .. } => {
                         if use_.gnss && self.hidden(t) {
                             self.stats.gnss_hidden += 1;
@@ -796,6 +803,8 @@ impl Feeder {
                             self.gnss_update(f, &fix)?;
                         }
                     }
+                    // Not `used` (above).
+                    Measurement::Gyro { .. } | Measurement::Accel { .. } => {}
                 }
                 self.stats.epochs += 1;
                 epoch(

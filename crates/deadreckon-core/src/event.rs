@@ -50,6 +50,30 @@ pub enum Measurement {
         /// rad, left positive.
         steering_wheel_rad: f64,
     },
+    /// A three-axis gyro reading, rad/s, about the sensor's own axes (x
+    /// forward, y left, z up as mounted): the drive format's three-axis
+    /// `yaw_rate.csv`. The filter does not take it; [`crate::online::Online`]
+    /// projects it on a stored IMU vertical ([`crate::live_corrections`]).
+    Gyro {
+        /// About x, rad/s.
+        x_rps: f64,
+        /// About y, rad/s.
+        y_rps: f64,
+        /// About z, rad/s.
+        z_rps: f64,
+    },
+    /// An accelerometer reading, m/s², specific force in the gyro's axes
+    /// (`accel.csv`). The filter does not take it; [`crate::online::Online`]
+    /// uses its x for a stored driven-axle slip correction
+    /// ([`crate::live_corrections`]).
+    Accel {
+        /// Forward, m/s².
+        x_mps2: f64,
+        /// Left, m/s².
+        y_mps2: f64,
+        /// Up, m/s².
+        z_mps2: f64,
+    },
     /// A GNSS fix of the antenna.
     Gnss {
         /// m east of the origin.
@@ -112,6 +136,10 @@ impl Event {
             Measurement::Speed { .. } => 2,
             Measurement::Steering { .. } => 3,
             Measurement::Gnss { .. } => 4,
+            // Never fed to the filter: Online turns a three-axis reading
+            // into a yaw rate and consumes the accelerometer.
+            Measurement::Gyro { .. } => 1,
+            Measurement::Accel { .. } => 5,
         }
     }
 
@@ -185,6 +213,18 @@ impl<'a> DriveEvents<'a> {
     /// Every event of `drive`.
     pub fn all(drive: &'a Drive) -> Self {
         Self::new(drive, f64::NEG_INFINITY)
+    }
+
+    /// Every event of `drive`, the readings after the last wheel row
+    /// included (what a live stream delivers:
+    /// [`crate::live_corrections::input_events`]).
+    pub fn new_uncut(drive: &'a Drive) -> Self {
+        let mut e = Self::new(drive, f64::NEG_INFINITY);
+        e.t_end = f64::INFINITY;
+        for k in 0..5 {
+            e.next_t[k] = e.time(k).unwrap_or(f64::INFINITY);
+        }
+        e
     }
 
     fn time(&self, stream: usize) -> Option<f64> {

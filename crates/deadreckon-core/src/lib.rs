@@ -45,6 +45,7 @@ pub mod imu;
 pub mod init;
 pub mod kalman;
 pub mod kinematics;
+pub mod live_corrections;
 pub mod metrics;
 pub mod model;
 pub mod observability;

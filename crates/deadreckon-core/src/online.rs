@@ -11,12 +11,22 @@
 //!
 //! Memory is constant once the filter has started; before, the events since the
 //! first GNSS fix are kept (the vehicle has to move 10 m).
+//!
+//! [`Online::with_corrections`] applies the corrections a params.toml stores
+//! (delays, IMU tilt, gyro scale, driven-axle slip) to the events before the
+//! filter, through a reorder buffer on corrected time
+//! ([`crate::live_corrections`]), so that the output equals the batch filter
+//! on the corrected drive; the poses then come out
+//! [`Online::hold_s`] seconds of stream time later. [`Online::finish`]
+//! keeps what is held back in the state (a resumed stream releases it);
+//! [`Online::end`] releases everything at the end of a stream.
 
 use serde::{Deserialize, Serialize};
 
 use crate::ekf::{Event, Feeder, FilterOptions, FilterStats, GnssInit};
 use crate::filter::{AugmentedFilter, CarFilter, Filter};
 use crate::gyro_drift::{CarBiasLayout, N_BIAS};
+use crate::live_corrections::LiveCorrections;
 use crate::model::{Mat, State};
 use crate::track::{car_point, TrackPoint};
 use crate::vehicle::{Params, Vehicle};
@@ -109,6 +119,10 @@ pub struct Online {
     prior_std: Option<Params>,
     opts: FilterOptions,
     stage: Stage,
+    /// The stored corrections and their reorder buffer (absent from states
+    /// written before them: none).
+    #[serde(default)]
+    live: LiveCorrections,
 }
 
 /// A dead-reckoning start for [`Online::new`].
@@ -170,6 +184,7 @@ impl Online {
                 init: GnssInit::new(vehicle.gnss_lever_arm_m),
                 buffer: Vec::new(),
             },
+            live: LiveCorrections::default(),
         };
         if let Start::Given(t, x, p) = start {
             o.stage = o.started(t, x, p)?;
@@ -218,9 +233,73 @@ impl Online {
         !matches!(self.stage, Stage::Waiting { .. })
     }
 
+    /// The filter applying `known` to the events before filtering them
+    /// ([`crate::live_corrections`]); given before the first event.
+    pub fn with_corrections(
+        mut self,
+        known: &crate::timing::KnownCorrections,
+    ) -> Result<Self, Error> {
+        self.live = LiveCorrections::new(known)?;
+        Ok(self)
+    }
+
+    /// The stored corrections applied and their reorder buffer.
+    pub fn corrections(&self) -> &LiveCorrections {
+        &self.live
+    }
+
+    /// How long the corrections hold events back, s of stream time (0
+    /// without delays or slip): the latency they add to every pose.
+    pub fn hold_s(&self) -> f64 {
+        self.live.hold_s()
+    }
+
     /// Takes one event (time order); calls `out` with the state after every
-    /// epoch it completes.
+    /// epoch it completes. The stored corrections are applied first; an
+    /// epoch runs once no later event can change it.
     pub fn push(&mut self, ev: Event, out: &mut dyn FnMut(TrackPoint)) -> Result<(), Error> {
+        let mut live = std::mem::take(&mut self.live);
+        let r = live.push(ev, &mut |e| self.feed(e, out));
+        self.live = live;
+        r?;
+        self.settle(out)
+    }
+
+    /// Runs what no later event can change and keeps what the corrections
+    /// hold back (in the state: a stream resumed from it, with later
+    /// events, continues as if never cut). With nothing held back, all that
+    /// is waiting runs.
+    pub fn finish(&mut self, out: &mut dyn FnMut(TrackPoint)) -> Result<(), Error> {
+        let mut live = std::mem::take(&mut self.live);
+        let r = live.pause(&mut |e| self.feed(e, out));
+        self.live = live;
+        r?;
+        self.settle(out)?;
+        self.waiting_error()
+    }
+
+    /// The end of the stream: releases and runs everything the corrections
+    /// held back; readings after the last wheel row are dropped, as the
+    /// batch filter never uses them.
+    pub fn end(&mut self, out: &mut dyn FnMut(TrackPoint)) -> Result<(), Error> {
+        let mut live = std::mem::take(&mut self.live);
+        let r = live.end(&mut |e| self.feed(e, out));
+        self.live = live;
+        r?;
+        self.settle(out)?;
+        self.waiting_error()
+    }
+
+    fn waiting_error(&self) -> Result<(), Error> {
+        match &self.stage {
+            Stage::Waiting { init, .. } => Err(init.why_not()),
+            _ => Ok(()),
+        }
+    }
+
+    /// One corrected event, in corrected time order, to the start or the
+    /// filter.
+    fn feed(&mut self, ev: Event, out: &mut dyn FnMut(TrackPoint)) -> Result<(), Error> {
         match &mut self.stage {
             Stage::Waiting { init, buffer } => {
                 let hidden = |t: f64| crate::drive::in_windows(t, &self.opts.gnss_outages);
@@ -245,7 +324,7 @@ impl Online {
                     let events = std::mem::take(buffer);
                     self.stage = self.started(t0, x0, p0)?;
                     for e in events {
-                        self.push(e, out)?;
+                        self.feed(e, out)?;
                     }
                 }
                 Ok(())
@@ -262,10 +341,11 @@ impl Online {
         }
     }
 
-    /// Runs what is still waiting at the end of a stream.
-    pub fn finish(&mut self, out: &mut dyn FnMut(TrackPoint)) -> Result<(), Error> {
+    /// Runs the filter's epoch of the last time fed: every event released
+    /// so far is earlier than any still to come.
+    fn settle(&mut self, out: &mut dyn FnMut(TrackPoint)) -> Result<(), Error> {
         match &mut self.stage {
-            Stage::Waiting { init, .. } => Err(init.why_not()),
+            Stage::Waiting { .. } => Ok(()),
             Stage::Car { filter, feeder } => feeder.finish(filter.as_mut(), &mut |f, _| {
                 out(car_point(f.time_s(), f.state(), f.covariance()))
             }),

@@ -1102,6 +1102,13 @@ pub struct KnownCorrections {
     /// models and files written before it: 0.
     #[serde(default)]
     pub traction_slip_per_mps2: f64,
+    /// The mean forward specific force, m/s², of the drive the slip was
+    /// estimated on ([`crate::traction::TractionSlip::mean_force_mps2`]),
+    /// the level the wheel speeds are corrected to. `None` (files written
+    /// before it): each drive's own mean, which a live stream cannot know
+    /// ([`crate::live_corrections`] then leaves the slip out).
+    #[serde(default)]
+    pub traction_mean_force_mps2: Option<f64>,
 }
 
 impl KnownCorrections {
@@ -1110,7 +1117,11 @@ impl KnownCorrections {
     pub fn apply(&self, drive: &Drive) -> Drive {
         let slipped;
         let drive = if self.traction_slip_per_mps2 != 0.0 {
-            slipped = crate::traction::apply(drive, self.traction_slip_per_mps2);
+            slipped = crate::traction::apply_at(
+                drive,
+                self.traction_slip_per_mps2,
+                self.traction_mean_force_mps2,
+            );
             &slipped
         } else {
             drive
@@ -1153,6 +1164,13 @@ impl KnownCorrections {
                 "`traction.slip_per_mps2` = {k} is not a plausible tyre slip (|κ| ≤ {} per m/s²)",
                 crate::traction::MAX_SLIP_PER_MPS2
             ));
+        }
+        if let Some(m) = self.traction_mean_force_mps2 {
+            if !(m.is_finite() && m.abs() < 100.0) {
+                return Err(format!(
+                    "`traction.mean_force_mps2` = {m} is not a plausible mean forward specific force (|f| < 100 m/s²)"
+                ));
+            }
         }
         Ok(())
     }

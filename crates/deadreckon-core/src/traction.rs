@@ -87,6 +87,12 @@ pub struct TractionSlip {
     pub blocks: usize,
     /// Estimated, or why not.
     pub status: Status,
+    /// `f̄`: the mean forward specific force while moving, m/s², the level
+    /// [`apply`] corrects the wheel speeds to ([`mean_force_mps2`]; NaN when
+    /// not estimated). Stored in params.toml so that a live stream, which
+    /// cannot know a drive's mean before its end, applies the same
+    /// correction ([`apply_at`]).
+    pub mean_force_mps2: f64,
 }
 
 impl TractionSlip {
@@ -97,6 +103,7 @@ impl TractionSlip {
             axle: Axle::Front,
             blocks,
             status: Status::NotEstimated(reason),
+            mean_force_mps2: f64::NAN,
         }
     }
     /// True when estimated (and so applied).
@@ -220,6 +227,7 @@ pub fn estimate(drive: &Drive) -> Option<TractionSlip> {
         slip_per_mps2: k,
         std,
         axle: if k > 0.0 { Axle::Front } else { Axle::Rear },
+        mean_force_mps2: mean_force_mps2(drive).unwrap_or(f64::NAN),
         blocks: n,
         status,
     })
@@ -231,19 +239,38 @@ pub fn estimate(drive: &Drive) -> Option<TractionSlip> {
 /// Unchanged without an accelerometer, with wheel ticks or with `κ = 0`;
 /// a reading with no accelerometer sample within ±0.5 s is left as read.
 pub fn apply(drive: &Drive, slip_per_mps2: f64) -> Drive {
+    apply_at(drive, slip_per_mps2, None)
+}
+
+/// `f̄` of [`apply`]: the mean over the one-second blocks of driving of
+/// their mean forward specific force (over every accelerometer sample when
+/// there is no such block), m/s²; `None` without an accelerometer.
+pub fn mean_force_mps2(drive: &Drive) -> Option<f64> {
     let f = forward_force(drive);
-    let mut d = drive.clone();
-    let Wheels::Speeds(ws) = &mut d.wheels else {
-        return d;
-    };
-    if f.is_empty() || slip_per_mps2 == 0.0 {
-        return d;
+    if f.is_empty() {
+        return None;
     }
     let b = blocks(drive, &f);
-    let mean = if b.is_empty() {
+    Some(if b.is_empty() {
         f.iter().map(|s| s.1).sum::<f64>() / f.len() as f64
     } else {
         b.iter().map(|r| r.1).sum::<f64>() / b.len() as f64
+    })
+}
+
+/// [`apply`] with `f̄` given (`Some`: the level of the drive the slip was
+/// estimated on, as params.toml stores it) or the drive's own (`None`).
+pub fn apply_at(drive: &Drive, slip_per_mps2: f64, mean_mps2: Option<f64>) -> Drive {
+    let f = forward_force(drive);
+    let mut d = drive.clone();
+    if !matches!(d.wheels, Wheels::Speeds(_)) || f.is_empty() || slip_per_mps2 == 0.0 {
+        return d;
+    }
+    let Some(mean) = mean_mps2.or_else(|| mean_force_mps2(drive)) else {
+        return d;
+    };
+    let Wheels::Speeds(ws) = &mut d.wheels else {
+        return d;
     };
     // Running sums for the ±0.5 s means.
     let mut cum = Vec::with_capacity(f.len() + 1);

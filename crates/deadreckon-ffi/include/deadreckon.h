@@ -231,10 +231,11 @@ DrStatus dr_filter_free(struct DrFilter *filter);
 // free it.
 const char *dr_last_error(void);
 
-// The warning of the params.toml the filter was made with (it stores
-// corrections — delays, IMU tilt, gyro scale, axle slip — that live events
-// are not given; `deadreckon stream` prints the same), or null. Valid as
-// long as the handle.
+// The warning of the params.toml the filter was made with (a driven-axle
+// slip stored without the mean forward specific force it is applied at,
+// which a stream cannot apply; `deadreckon stream` prints the same), or
+// null. The other stored corrections (delays, IMU tilt, gyro scale) are
+// applied to the events. Valid as long as the handle.
 //
 // # Safety
 // `filter` is null or a live handle.
@@ -267,6 +268,31 @@ DrStatus dr_push_wheel_speeds(struct DrFilter *filter,
 // # Safety
 // `filter` is null or a live handle used by this thread only.
 DrStatus dr_push_yaw_rate(struct DrFilter *filter, double t_s, double yaw_rate_rps);
+
+// A three-axis gyro reading, rad/s about the sensor's x (forward), y
+// (left), z (up), at `t_s` (s): the yaw rate when the params.toml stores an
+// IMU tilt (projected on its vertical; one-axis yaw rates are then dropped
+// from the first of these on), ignored otherwise.
+//
+// # Safety
+// `filter` is null or a live handle used by this thread only.
+DrStatus dr_push_gyro3(struct DrFilter *filter,
+                       double t_s,
+                       double x_rps,
+                       double y_rps,
+                       double z_rps);
+
+// An accelerometer reading, m/s² of specific force along the gyro's x, y,
+// z, at `t_s` (s): used for a driven-axle slip the params.toml stores,
+// ignored otherwise.
+//
+// # Safety
+// `filter` is null or a live handle used by this thread only.
+DrStatus dr_push_accel(struct DrFilter *filter,
+                       double t_s,
+                       double x_mps2,
+                       double y_mps2,
+                       double z_mps2);
 
 // The CAN vehicle speed, m/s, at `t_s` (s).
 //
@@ -346,9 +372,11 @@ DrStatus dr_learned(const struct DrFilter *filter, struct DrLearned *out);
 // As `dr_next_pose`.
 DrStatus dr_gate_counts(const struct DrFilter *filter, struct DrGateCounts *out);
 
-// Ends the stream: runs the epochs still waiting for later events (their
-// poses are queued for `dr_next_pose`). A stream that never started (no
-// GNSS start) is `DR_STATUS_FILTER`, saying why.
+// Ends the stream: runs the epochs still waiting for later events, those
+// of the events a params.toml's stored delays or slip hold back included
+// (their poses are queued for `dr_next_pose`; save a state to resume from
+// before this, not after). A stream that never started (no GNSS start) is
+// `DR_STATUS_FILTER`, saying why.
 //
 // # Safety
 // As `dr_next_pose`.

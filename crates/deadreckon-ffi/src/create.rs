@@ -50,12 +50,12 @@ fn config_fail(e: &(dyn std::error::Error + 'static)) -> Fail {
 /// The filter `deadreckon stream` opens with these options (no state file).
 fn open(
     vehicle: &Vehicle,
-    start: (Params, Params, Option<String>),
+    start: (Params, Params, deadreckon_api::corrections::Stored),
     options: *const DrOptions,
 ) -> Result<DrFilter, Fail> {
     // SAFETY: null or a valid DrOptions (the callers' contract).
     let options = unsafe { options.as_ref() }.copied().unwrap_or_default();
-    let (params, prior, warning) = start;
+    let (params, prior, stored) = start;
     let o = StreamOptions {
         filter: FilterOptions {
             timing: options.timing()?,
@@ -66,8 +66,11 @@ fn open(
         params_out: None,
         save_every_s: None,
         skip_bad_lines: false,
+        last_part: false,
     };
-    let online = stream::open(vehicle, &params, &prior, &o).map_err(|e| config_fail(&e))?;
+    let online =
+        stream::open(vehicle, &params, &prior, &stored, &o).map_err(|e| config_fail(&e))?;
+    let warning = stream::corrections_warning("params.toml", &online);
     Ok(DrFilter::new(online, warning))
 }
 
@@ -254,10 +257,11 @@ pub extern "C" fn dr_last_error() -> *const c_char {
     last_error_ptr()
 }
 
-/// The warning of the params.toml the filter was made with (it stores
-/// corrections — delays, IMU tilt, gyro scale, axle slip — that live events
-/// are not given; `deadreckon stream` prints the same), or null. Valid as
-/// long as the handle.
+/// The warning of the params.toml the filter was made with (a driven-axle
+/// slip stored without the mean forward specific force it is applied at,
+/// which a stream cannot apply; `deadreckon stream` prints the same), or
+/// null. The other stored corrections (delays, IMU tilt, gyro scale) are
+/// applied to the events. Valid as long as the handle.
 ///
 /// # Safety
 /// `filter` is null or a live handle.

@@ -26,7 +26,8 @@ pub struct DrFilter {
     last_t_s: Option<f64>,
     /// Lines given to `dr_push_line`, for the line number in its errors.
     pub(crate) lines: u64,
-    /// The warning of the params.toml (corrections `stream` does not apply).
+    /// The warning of the params.toml (a slip stored without its mean force,
+    /// which a stream cannot apply).
     pub(crate) warning: Option<CString>,
     /// True while a call runs: still true at the next call only if a panic
     /// left the previous one half done.
@@ -75,11 +76,12 @@ impl DrFilter {
         self.in_call
     }
 
-    /// Runs what waits at the end of a stream.
+    /// Runs what waits at the end of a stream, what the stored corrections
+    /// hold back included ([`Online::end`]).
     pub(crate) fn finish(&mut self) -> Result<(), Fail> {
         let (poses, latest) = (&mut self.poses, &mut self.latest);
         self.online
-            .finish(&mut |p| {
+            .end(&mut |p| {
                 *latest = Some(p);
                 poses.push_back(p);
             })

@@ -35,8 +35,8 @@ pub use create::{
 };
 pub use handle::DrFilter;
 pub use push::{
-    dr_push_gnss, dr_push_line, dr_push_speed, dr_push_steering, dr_push_wheel_speeds,
-    dr_push_wheel_ticks, dr_push_yaw_rate, push_typed,
+    dr_push_accel, dr_push_gnss, dr_push_gyro3, dr_push_line, dr_push_speed, dr_push_steering,
+    dr_push_wheel_speeds, dr_push_wheel_ticks, dr_push_yaw_rate, push_typed,
 };
 pub use query::{
     dr_finish, dr_gate_counts, dr_is_started, dr_latest_pose, dr_learned, dr_next_pose,

@@ -104,6 +104,53 @@ pub unsafe extern "C" fn dr_push_yaw_rate(
     unsafe { push_event(filter, "dr_push_yaw_rate", m, t_s) }
 }
 
+/// A three-axis gyro reading, rad/s about the sensor's x (forward), y
+/// (left), z (up), at `t_s` (s): the yaw rate when the params.toml stores an
+/// IMU tilt (projected on its vertical; one-axis yaw rates are then dropped
+/// from the first of these on), ignored otherwise.
+///
+/// # Safety
+/// `filter` is null or a live handle used by this thread only.
+#[no_mangle]
+pub unsafe extern "C" fn dr_push_gyro3(
+    filter: *mut DrFilter,
+    t_s: f64,
+    x_rps: f64,
+    y_rps: f64,
+    z_rps: f64,
+) -> DrStatus {
+    let m = Measurement::Gyro {
+        x_rps,
+        y_rps,
+        z_rps,
+    };
+    // SAFETY: the caller's contract, passed on.
+    unsafe { push_event(filter, "dr_push_gyro3", m, t_s) }
+}
+
+/// An accelerometer reading, m/s² of specific force along the gyro's x, y,
+/// z, at `t_s` (s): used for a driven-axle slip the params.toml stores,
+/// ignored otherwise.
+///
+/// # Safety
+/// `filter` is null or a live handle used by this thread only.
+#[no_mangle]
+pub unsafe extern "C" fn dr_push_accel(
+    filter: *mut DrFilter,
+    t_s: f64,
+    x_mps2: f64,
+    y_mps2: f64,
+    z_mps2: f64,
+) -> DrStatus {
+    let m = Measurement::Accel {
+        x_mps2,
+        y_mps2,
+        z_mps2,
+    };
+    // SAFETY: the caller's contract, passed on.
+    unsafe { push_event(filter, "dr_push_accel", m, t_s) }
+}
+
 /// The CAN vehicle speed, m/s, at `t_s` (s).
 ///
 /// # Safety
@@ -239,6 +286,16 @@ pub unsafe fn push_typed(filter: *mut DrFilter, ev: &Event) -> DrStatus {
                 rr_mps,
             } => dr_push_wheel_speeds(filter, t, fl_mps, fr_mps, rl_mps, rr_mps),
             Measurement::YawRate { yaw_rate_rps } => dr_push_yaw_rate(filter, t, yaw_rate_rps),
+            Measurement::Gyro {
+                x_rps,
+                y_rps,
+                z_rps,
+            } => dr_push_gyro3(filter, t, x_rps, y_rps, z_rps),
+            Measurement::Accel {
+                x_mps2,
+                y_mps2,
+                z_mps2,
+            } => dr_push_accel(filter, t, x_mps2, y_mps2, z_mps2),
             Measurement::Speed { speed_mps } => dr_push_speed(filter, t, speed_mps),
             Measurement::Steering { steering_wheel_rad } => {
                 dr_push_steering(filter, t, steering_wheel_rad)

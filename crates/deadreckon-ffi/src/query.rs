@@ -154,9 +154,11 @@ pub unsafe extern "C" fn dr_gate_counts(
     })
 }
 
-/// Ends the stream: runs the epochs still waiting for later events (their
-/// poses are queued for `dr_next_pose`). A stream that never started (no
-/// GNSS start) is `DR_STATUS_FILTER`, saying why.
+/// Ends the stream: runs the epochs still waiting for later events, those
+/// of the events a params.toml's stored delays or slip hold back included
+/// (their poses are queued for `dr_next_pose`; save a state to resume from
+/// before this, not after). A stream that never started (no GNSS start) is
+/// `DR_STATUS_FILTER`, saying why.
 ///
 /// # Safety
 /// As `dr_next_pose`.

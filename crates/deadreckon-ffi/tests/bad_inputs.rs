@@ -332,33 +332,41 @@ fn a_buffer_too_small_gets_the_size_and_no_bytes() {
     free(f);
 }
 
+/// A params.toml's stored delays are applied (issue 29: no warning any
+/// more); a slip stored without its mean forward force (an older file)
+/// cannot be, and the filter's warning says so, as `stream` does.
 #[test]
 fn a_params_file_with_stored_corrections_gives_stream_s_warning() {
     let d = drive(30.0);
     let v = vehicle_toml(&d);
-    let params = "gyro_bias_rps = 0.0\nspeed_scale = 1.0\ncircumference_fl_m = 1.9\n\
-                  circumference_fr_m = 1.9\ncircumference_rl_m = 1.9\ncircumference_rr_m = 1.9\n\
-                  [delays.gnss]\ndelay_s = 0.1\n";
-    let mut f = null_mut();
-    // SAFETY: valid text, writable out.
-    let s = unsafe {
-        dr_filter_new(
-            v.as_ptr().cast(),
-            v.len(),
-            params.as_ptr().cast(),
-            params.len(),
-            null(),
-            &mut f,
-        )
-    };
-    assert_eq!(s, DrStatus::Ok, "{}", last_error());
-    // SAFETY: a live handle; the warning lives as long.
-    let w = unsafe { std::ffi::CStr::from_ptr(dr_filter_warning(f)) }
-        .to_string_lossy()
-        .into_owned();
-    assert!(
-        w.starts_with("params.toml stores corrections that `stream` does not apply"),
-        "{w}"
-    );
-    free(f);
+    let base = "gyro_bias_rps = 0.0\nspeed_scale = 1.0\ncircumference_fl_m = 1.9\n\
+                circumference_fr_m = 1.9\ncircumference_rl_m = 1.9\ncircumference_rr_m = 1.9\n\
+                [delays.gnss]\ndelay_s = 0.1\n";
+    let old_slip = format!("{base}[traction]\nslip_per_mps2 = 0.003\n");
+    for (params, warned) in [(base.to_string(), false), (old_slip, true)] {
+        let mut f = null_mut();
+        // SAFETY: valid text, writable out.
+        let s = unsafe {
+            dr_filter_new(
+                v.as_ptr().cast(),
+                v.len(),
+                params.as_ptr().cast(),
+                params.len(),
+                null(),
+                &mut f,
+            )
+        };
+        assert_eq!(s, DrStatus::Ok, "{}", last_error());
+        // SAFETY: a live handle; the warning lives as long.
+        let w = unsafe { dr_filter_warning(f) };
+        assert_eq!(!w.is_null(), warned, "{params}");
+        if warned {
+            // SAFETY: not null, NUL-terminated, lives as long as the handle.
+            let w = unsafe { std::ffi::CStr::from_ptr(w) }
+                .to_string_lossy()
+                .into_owned();
+            assert!(w.contains("mean_force_mps2"), "{w}");
+        }
+        free(f);
+    }
 }

@@ -27,13 +27,14 @@ fn stream_options(o: &DrOptions) -> StreamOptions {
         params_out: None,
         save_every_s: None,
         skip_bad_lines: false,
+        last_part: false,
     }
 }
 
 /// The filter `stream` opens (nominal parameters, default prior).
 fn rust_online(d: &Drive, o: &DrOptions) -> Result<Online, deadreckon_api::Error> {
-    let (p, prior, _) = stream::start_params("nominal", &d.vehicle).unwrap();
-    stream::open(&d.vehicle, &p, &prior, &stream_options(o))
+    let (p, prior, stored) = stream::start_params("nominal", &d.vehicle).unwrap();
+    stream::open(&d.vehicle, &p, &prior, &stored, &stream_options(o))
 }
 
 fn rust_poses(online: &mut Online, events: &[Event], finish: bool) -> Vec<DrPose> {

@@ -51,6 +51,16 @@ pub fn values_ok(ev: &Event) -> bool {
             Measurement::YawRate { yaw_rate_rps } => finite(yaw_rate_rps),
             Measurement::Speed { speed_mps } => finite(speed_mps),
             Measurement::Steering { steering_wheel_rad } => finite(steering_wheel_rad),
+            Measurement::Gyro {
+                x_rps,
+                y_rps,
+                z_rps,
+            } => [x_rps, y_rps, z_rps].into_iter().all(finite),
+            Measurement::Accel {
+                x_mps2,
+                y_mps2,
+                z_mps2,
+            } => [x_mps2, y_mps2, z_mps2].into_iter().all(finite),
             Measurement::Gnss {
                 east_m,
                 north_m,
