@@ -40,7 +40,7 @@ use crate::ekf::{self, FilterOptions, Init, SensorSet};
 use crate::imu::{interp, wheel_speed};
 use crate::model::{V, X, Y, YAW, YAW_RATE};
 use crate::reference::Reference;
-use crate::{rts, Error, Params};
+use crate::{Error, Params};
 
 /// Speed above which the steering is compared with the curvature, m/s.
 pub const MIN_CURVATURE_SPEED_MPS: f64 = 2.0;
@@ -348,13 +348,15 @@ impl<'a> Integral<'a> {
         }
         Integral { s, cum, cum2 }
     }
-    /// First and second integral up to `t`.
-    fn at(&self, t: f64) -> Option<(f64, f64)> {
+    /// First and second integral up to `t`; the segment is searched from
+    /// `cursor` (the last call's), which is left at this one's.
+    fn at(&self, t: f64, cursor: &mut usize) -> Option<(f64, f64)> {
         let n = self.s.len();
         if n < 2 || !(t >= self.s[0].0 && t <= self.s[n - 1].0) {
             return None;
         }
-        let i = self.s.partition_point(|p| p.0 <= t).clamp(1, n - 1);
+        *cursor = crate::cursor::partition_from(n, |i| self.s[i].0, t, *cursor);
+        let i = (*cursor).clamp(1, n - 1);
         let (a, b) = (self.s[i - 1], self.s[i]);
         let h = b.0 - a.0;
         let tau = t - a.0;
@@ -366,11 +368,14 @@ impl<'a> Integral<'a> {
             + m * tau * tau * tau / 6.0;
         Some((c1, c2))
     }
-    /// The triangle-weighted mean over `[t − w, t + w]` and its derivative in `t`.
-    fn smooth(&self, t: f64, w: f64) -> Option<(f64, f64)> {
-        let (p1, p2) = self.at(t + w)?;
-        let (c1, c2) = self.at(t)?;
-        let (m1, m2) = self.at(t - w)?;
+    /// The triangle-weighted mean over `[t − w, t + w]` and its derivative
+    /// in `t`; `cursors` are those of the three ends (`t + w`, `t`, `t − w`)
+    /// in the last call, so that a pass at increasing `t` searches little.
+    fn smooth(&self, t: f64, w: f64, cursors: &mut [usize; 3]) -> Option<(f64, f64)> {
+        let [cp, cc, cm] = cursors;
+        let (p1, p2) = self.at(t + w, cp)?;
+        let (c1, c2) = self.at(t, cc)?;
+        let (m1, m2) = self.at(t - w, cm)?;
         Some((
             (p2 - 2.0 * c2 + m2) / (w * w),
             (p1 - 2.0 * c1 + m1) / (w * w),
@@ -416,9 +421,10 @@ pub fn scalar_delay(
     // (t, smoothed reference, its derivative)
     let mut pts: Vec<(f64, f64, f64)> = Vec::new();
     let mut t = start;
+    let mut cursors = [0; 3];
     while t <= end {
         if keep(t) {
-            if let Some((m, dm)) = iref.smooth(t, w) {
+            if let Some((m, dm)) = iref.smooth(t, w, &mut cursors) {
                 pts.push((t, m, dm));
             }
         }
@@ -433,8 +439,12 @@ pub fn scalar_delay(
     }
     let x: Vec<f64> = pts.iter().map(|s| s.1).collect();
     let ys = |d: f64| -> Vec<(f64, f64)> {
+        let mut cursors = [0; 3];
         pts.iter()
-            .map(|&(t, _, _)| isig.smooth(t + d, w).unwrap_or((f64::NAN, 0.0)))
+            .map(|&(t, _, _)| {
+                isig.smooth(t + d, w, &mut cursors)
+                    .unwrap_or((f64::NAN, 0.0))
+            })
             .collect()
     };
     // Per lag of the grid and per block of consecutive points, the sums of a
@@ -658,19 +668,21 @@ pub fn gnss_delay(
         let mut shifted = shift(drive, [0.0, 0.0, 0.0, d]);
         let cal = calibrate::calibrate(&shifted, copts)?;
         let params = cal.estimate.params;
-        let f = ekf::run(
+        // Only the smoothed start is used: smoothed in O(√N) memory
+        // (checkpointed re-runs), equal to the first of `rts::smooth` over
+        // the recorded run.
+        let fopts = FilterOptions {
+            record_epochs: true,
+            ..copts.filter.clone()
+        };
+        let s0 = crate::checkpoint::smoothed_start(
             &shifted,
-            &params,
-            &FilterOptions {
-                record_epochs: true,
-                ..copts.filter.clone()
-            },
-            &mut (),
+            ekf::car_filter(&shifted, &params, &fopts)?,
+            &fopts,
         )?;
-        let sm = rts::smooth(&f.epochs)?;
         // Dead reckoning (no GNSS) from the smoothed start: a reference the
         // fixes' timing cannot pull along, its drift taken out per window.
-        let Some(s0) = sm.first() else {
+        let Some(s0) = s0 else {
             return Ok((Delay::not_estimated("no smoothed track"), None));
         };
         // The reference integrates the yaw with the trapezoid: with eq. 3's
@@ -680,7 +692,7 @@ pub fn gnss_delay(
         // (The calibration and the smoothing above are done with `shifted`;
         // only its fixes are read below.)
         shifted.vehicle.noise.yaw_integration = crate::vehicle::YawIntegration::Trapezoidal;
-        let dr = ekf::run(
+        let reference = states_at_fixes(
             &shifted,
             &params,
             &FilterOptions {
@@ -693,12 +705,7 @@ pub fn gnss_delay(
                 sensors: SensorSet::dead_reckoning(),
                 ..copts.filter.clone()
             },
-            &mut (),
         )?;
-        let reference = Reference::from_states(
-            dr.epochs.iter().map(|e| e.t_s).collect(),
-            dr.epochs.iter().map(|e| e.x).collect(),
-        );
         let Some((delta, std, n)) = regress_gnss(&shifted.gnss, &reference, lever, o.gnss_window_s)
         else {
             return Ok((
@@ -739,6 +746,64 @@ pub fn gnss_delay(
     let delay = status_of(d, std, n, o);
     let params = delay.status.is_estimated().then_some(params);
     Ok((delay, params))
+}
+
+/// The car filter run over `drive` with `opts`, its states interpolated at
+/// the GNSS fixes' times inside its span as [`Reference::state_at`] would
+/// interpolate the recorded epochs (linear between the epochs around each
+/// fix; the last epoch's state at its own time), as the reference of the
+/// fixes' times only: the epochs stream past, none is kept.
+pub fn states_at_fixes(
+    drive: &Drive,
+    params: &Params,
+    opts: &FilterOptions,
+) -> Result<Reference, Error> {
+    let mut f = ekf::car_filter(drive, params, opts)?;
+    let (mut feeder, events) = ekf::feed(drive, opts, f.time_s());
+    let fixes = &drive.gnss;
+    let (mut t_out, mut x_out) = (Vec::new(), Vec::new());
+    // The next fix not yet placed, and the previous epoch.
+    let mut next = 0;
+    let mut prev: Option<(f64, crate::model::State)> = None;
+    let mut epoch = |f: &mut crate::filter::Filter<crate::filter::CarLayout, 5>,
+                     e: ekf::EpochOut<'_, 5>| {
+        if e.prediction.is_none() {
+            return;
+        }
+        let (t1, x1) = (f.time_s(), *f.state());
+        match prev {
+            // Fixes before the first epoch are outside the span.
+            None => {
+                while next < fixes.len() && fixes[next].t_s < t1 {
+                    next += 1;
+                }
+            }
+            // Fixes in [t0, t1): between the two epochs.
+            Some((t0, x0)) => {
+                while next < fixes.len() && fixes[next].t_s < t1 {
+                    let t = fixes[next].t_s;
+                    let a = if t1 > t0 { (t - t0) / (t1 - t0) } else { 0.0 };
+                    t_out.push(t);
+                    x_out.push(x0 * (1.0 - a) + x1 * a);
+                    next += 1;
+                }
+            }
+        }
+        prev = Some((t1, x1));
+    };
+    let end = opts.end_s.unwrap_or(f64::INFINITY);
+    for ev in events.take_while(|e| e.t_s <= end) {
+        feeder.push(&mut f, ev, &mut epoch)?;
+    }
+    feeder.finish(&mut f, &mut epoch)?;
+    // A fix at the last epoch's time takes its state.
+    if let Some((t1, x1)) = prev {
+        if next < fixes.len() && fixes[next].t_s == t1 {
+            t_out.push(t1);
+            x_out.push(x1);
+        }
+    }
+    Ok(Reference::from_states(t_out, x_out))
 }
 
 /// One regression step of the GNSS delay: the fixes' residuals against the
