@@ -666,7 +666,9 @@ pub fn gnss_delay(
     let mut prev: Option<(f64, f64)> = None;
     for _ in 0..o.gnss_iterations.max(1) {
         let mut shifted = shift(drive, [0.0, 0.0, 0.0, d]);
-        let cal = calibrate::calibrate(&shifted, copts)?;
+        // The parameters only: the wheel health, the manoeuvres, the side
+        // slip and the steering are not read here.
+        let cal = calibrate::calibrate_parameters(&shifted, copts)?;
         let params = cal.estimate.params;
         // Only the smoothed start is used: smoothed in O(√N) memory
         // (checkpointed re-runs), equal to the first of `rts::smooth` over
@@ -1063,7 +1065,7 @@ pub fn prepare_with(
     // the gyro does not change its bias), else of a calibration here.
     let params = match params {
         Some(p) => Some(p),
-        None => calibrate::calibrate(&out, copts)
+        None => calibrate::calibrate_parameters(&out, copts)
             .ok()
             .map(|c| c.estimate.params),
     };
