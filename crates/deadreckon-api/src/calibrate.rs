@@ -44,12 +44,20 @@ pub fn calibrate_car(
     which: Which,
     name: &str,
 ) -> Result<CarCalibration, Error> {
-    let (drive, corrections) = crate::corrections::estimate_and_apply(drive, &options, which)?;
-    let calibration = calibrate::calibrate(&drive, &options).map_err(|source| Error::Step {
+    // Without corrections the drive is calibrated as it is, not a copy.
+    let corrected;
+    let (drive, corrections) = if which == Which::None {
+        (drive, Corrections::none())
+    } else {
+        let (d, c) = crate::corrections::estimate_and_apply(drive, &options, which)?;
+        corrected = d;
+        (&corrected, c)
+    };
+    let calibration = calibrate::calibrate(drive, &options).map_err(|source| Error::Step {
         step: format!("calibrating {name}"),
         source,
     })?;
-    let steering = crate::json::car_steering(&drive, options.method, options.min_speed_mps)
+    let steering = crate::json::car_steering(drive, options.method, options.min_speed_mps)
         .map_err(|source| Error::Step {
             step: "calibrating the steering".into(),
             source,
@@ -63,7 +71,7 @@ pub fn calibrate_car(
         corrections,
         which,
         steering,
-        absent: crate::json::Absent::of(&drive),
+        absent: crate::json::Absent::of(drive),
     })
 }
 

@@ -650,6 +650,17 @@ pub fn gnss_delay(
     copts: &CalibrationOptions,
     o: &DelayOptions,
 ) -> Result<(Delay, Option<Params>), Error> {
+    gnss_delay_of(drive.clone(), copts, o)
+}
+
+/// [`gnss_delay`] of a drive it may change: its fixes are moved to each
+/// step's delay in place (one copy of the drive, not one per step).
+fn gnss_delay_of(
+    mut shifted: Drive,
+    copts: &CalibrationOptions,
+    o: &DelayOptions,
+) -> Result<(Delay, Option<Params>), Error> {
+    let drive = &shifted;
     if drive.gnss.len() < o.min_samples {
         return Ok((
             Delay::not_estimated(format!(
@@ -661,11 +672,18 @@ pub fn gnss_delay(
         ));
     }
     let lever = drive.vehicle.gnss_lever_arm_m;
+    // The fixes' own times and the vehicle, which each step starts from.
+    let fix_times: Vec<f64> = drive.gnss.iter().map(|g| g.t_s).collect();
+    let vehicle = drive.vehicle.clone();
     let mut d = 0.0;
     let mut last = None;
     let mut prev: Option<(f64, f64)> = None;
     for _ in 0..o.gnss_iterations.max(1) {
-        let mut shifted = shift(drive, [0.0, 0.0, 0.0, d]);
+        // As `shift(drive, [0, 0, 0, d])`, in place.
+        for (g, &t) in shifted.gnss.iter_mut().zip(&fix_times) {
+            g.t_s = t - d;
+        }
+        shifted.vehicle = vehicle.clone();
         // The parameters only: the wheel health, the manoeuvres, the side
         // slip and the steering are not read here.
         let cal = calibrate::calibrate_parameters(&shifted, copts)?;
@@ -972,7 +990,7 @@ pub fn estimate_with_params(
         gnss: Delay::not_estimated("not estimated"),
     };
     let partly = delays.apply(drive);
-    let (g, params) = gnss_delay(&partly, copts, o)?;
+    let (g, params) = gnss_delay_of(partly, copts, o)?;
     delays.gnss = g;
     Ok((delays, params))
 }
@@ -1005,6 +1023,19 @@ pub struct Corrections {
     /// The gyro's scale error (`None` when not attempted: no GNSS delay, so
     /// no calibration to take the bias from).
     pub gyro_scale: Option<crate::gyro_scale::GyroScale>,
+}
+
+impl Corrections {
+    /// Nothing estimated or applied: what [`prepare_with`] returns with
+    /// [`Which::None`] (the drive then unchanged).
+    pub fn none() -> Corrections {
+        Corrections {
+            traction: None,
+            tilt: None,
+            delays: Delays::none(),
+            gyro_scale: None,
+        }
+    }
 }
 
 /// Estimates the driven axle's slip ([`crate::traction`], correcting its
