@@ -170,7 +170,14 @@ impl Delays {
     }
     /// The drive with every estimated delay removed (timestamps moved back).
     pub fn apply(&self, drive: &Drive) -> Drive {
-        shift(
+        let mut d = drive.clone();
+        self.apply_in_place(&mut d);
+        d
+    }
+
+    /// [`Delays::apply`] to a drive in place (no copy).
+    pub fn apply_in_place(&self, drive: &mut Drive) {
+        shift_in_place(
             drive,
             [
                 self.gyro.applied_s(),
@@ -185,14 +192,19 @@ impl Delays {
 /// The drive with the gyro (one- and three-axis), speed, steering and GNSS
 /// timestamps moved back by the given delays, s, in [`Stream::ALL`] order.
 pub fn shift(drive: &Drive, delays_s: [f64; 4]) -> Drive {
-    let [g, s, st, gn] = delays_s;
     let mut d = drive.clone();
+    shift_in_place(&mut d, delays_s);
+    d
+}
+
+/// [`shift`] in place (no copy).
+pub fn shift_in_place(d: &mut Drive, delays_s: [f64; 4]) {
+    let [g, s, st, gn] = delays_s;
     d.yaw_rate.iter_mut().for_each(|x| x.t_s -= g);
     d.imu.gyro.iter_mut().for_each(|x| x.t_s -= g);
     d.speed.iter_mut().for_each(|x| x.t_s -= s);
     d.steering.iter_mut().for_each(|x| x.t_s -= st);
     d.gnss.iter_mut().for_each(|x| x.t_s -= gn);
-    d
 }
 
 /// Options of the delay estimation.
@@ -1091,7 +1103,9 @@ pub fn prepare_with(
             }
         }
     }
-    let out = delays.apply(&levelled);
+    // The levelled drive becomes the output (moved, not copied).
+    let mut out = levelled;
+    delays.apply_in_place(&mut out);
     // The bias of the calibration at the final GNSS delay (a time shift of
     // the gyro does not change its bias), else of a calibration here.
     let params = match params {
@@ -1101,10 +1115,9 @@ pub fn prepare_with(
             .map(|c| c.estimate.params),
     };
     let gyro_scale = params.map(|p| crate::gyro_scale::estimate(&out, p.gyro_bias_rps));
-    let out = match &gyro_scale {
-        Some(g) if g.is_estimated() => crate::gyro_scale::apply(&out, g.scale_error),
-        _ => out,
-    };
+    if let Some(g) = gyro_scale.as_ref().filter(|g| g.is_estimated()) {
+        crate::gyro_scale::apply_in_place(&mut out, g.scale_error);
+    }
     Ok((
         out,
         Corrections {
