@@ -52,12 +52,20 @@ pub fn calibrate_car(
     which: Which,
     name: &str,
 ) -> Result<CarCalibration, Error> {
-    let (drive, corrections) = crate::corrections::estimate_and_apply(drive, &options, which)?;
-    let calibration = calibrate::calibrate(&drive, &options).map_err(|source| Error::Step {
+    // Without corrections the drive is calibrated as it is, not a copy.
+    let corrected;
+    let (drive, corrections) = if which == Which::None {
+        (drive, Corrections::none())
+    } else {
+        let (d, c) = crate::corrections::estimate_and_apply(drive, &options, which)?;
+        corrected = d;
+        (&corrected, c)
+    };
+    let calibration = calibrate::calibrate(drive, &options).map_err(|source| Error::Step {
         step: format!("calibrating {name}"),
         source,
     })?;
-    let steering = crate::json::car_steering(&drive, options.method, options.min_speed_mps)
+    let steering = crate::json::car_steering(drive, options.method, options.min_speed_mps)
         .map_err(|source| Error::Step {
             step: "calibrating the steering".into(),
             source,
@@ -65,7 +73,7 @@ pub fn calibrate_car(
         // The RTS calibration's fit against its smoothed states.
         .or_else(|| calibration.steering.clone());
     let (bound, fit_windows) = deadreckon_core::bound::fit_on_drive_with_windows(
-        &drive,
+        drive,
         &calibration.estimate.params,
         &deadreckon_core::ekf::FilterOptions {
             timing: options.filter.timing,
@@ -82,7 +90,7 @@ pub fn calibrate_car(
         corrections,
         which,
         steering,
-        absent: crate::json::Absent::of(&drive),
+        absent: crate::json::Absent::of(drive),
         vehicle: crate::binding::VehicleRecord::of(&drive.vehicle),
         bound,
         bound_reach_1m,

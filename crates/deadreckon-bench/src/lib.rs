@@ -1,9 +1,14 @@
 //! # deadreckon-bench
 //!
 //! Benchmarks only (`cargo bench -p deadreckon-bench`): one EKF epoch, one RTS
-//! epoch and a whole 1-hour drive calibration, on simulated drives. Kept in its
-//! own crate so that test builds do not compile criterion.
+//! epoch and a whole 1-hour drive calibration, on simulated drives (the
+//! kernel, `benches/estimation.rs`); the commands' own library path, reading
+//! included ([`command`], `benches/command.rs`, and the `command_cost`
+//! example for the whole process's peak memory). Kept in its own crate so
+//! that test builds do not compile criterion.
 #![deny(missing_docs)]
+
+pub mod command;
 
 use deadreckon_core::Drive;
 

@@ -291,6 +291,28 @@ fn units(nominal_circumference: f64) -> [f64; 6] {
 
 /// Runs a calibration.
 pub fn calibrate(drive: &Drive, opts: &CalibrationOptions) -> Result<Calibration, Error> {
+    calibrate_with(drive, opts, true)
+}
+
+/// [`calibrate`] without what is only reported: no wheel-health run (the
+/// monitor still acts in the filter when the options have one), no
+/// manoeuvres, no side slip and no steering fit (`None`). The parameters,
+/// their standard errors, the passes and the filter's counters are
+/// [`calibrate`]'s bit for bit: what the corrections' steps need of their
+/// calibrations (`timing::gnss_delay`'s each step).
+pub fn calibrate_parameters(
+    drive: &Drive,
+    opts: &CalibrationOptions,
+) -> Result<Calibration, Error> {
+    calibrate_with(drive, opts, false)
+}
+
+/// [`calibrate`] (`report`) or [`calibrate_parameters`] (not `report`).
+fn calibrate_with(
+    drive: &Drive,
+    opts: &CalibrationOptions,
+    report: bool,
+) -> Result<Calibration, Error> {
     drive.validate()?;
     if !(opts.min_speed_mps.is_finite() && opts.min_speed_mps >= 0.0) {
         // `--min-speed nan` calibrated on no epoch at all.
@@ -330,9 +352,12 @@ pub fn calibrate(drive: &Drive, opts: &CalibrationOptions) -> Result<Calibration
                 steering: None,
             })
         }
-        Method::Rts => rts_calibration(drive, opts, start),
+        Method::Rts => rts_calibration(drive, opts, start, report),
     }
     .map(|mut c| {
+        if !report {
+            return c;
+        }
         c.manoeuvres = Some(crate::observability::manoeuvres(drive, opts.min_speed_mps));
         if opts.filter.wheel_monitor.is_some() {
             c.wheel_health = crate::wheel_health::check_drive(
@@ -353,6 +378,56 @@ pub fn calibrate(drive: &Drive, opts: &CalibrationOptions) -> Result<Calibration
 /// One pass: filter with `p`, smooth, least squares on the smoothed states,
 /// their distance-scale errors widened by the GNSS chords.
 pub fn smoothing_pass(drive: &Drive, p: &Params, opts: &CalibrationOptions) -> Result<Pass, Error> {
+    let (fit, reference) = fitting_pass(drive, p, opts)?;
+    let (side_slip, steering) = reported_fits(drive, &reference, &fit.estimate, opts)?;
+    Ok(Pass {
+        estimate: fit.estimate,
+        samples: fit.samples,
+        stats: fit.stats,
+        chords: fit.chords,
+        side_slip,
+        steering,
+    })
+}
+
+/// What a pass fits the parameters with ([`Pass`] without the reported
+/// side slip and steering).
+struct Fit {
+    estimate: ParamsWithStd,
+    samples: [usize; 6],
+    stats: ekf::FilterStats,
+    chords: Option<ChordScale>,
+}
+
+/// The side slip and the steering against a pass's smoothed states: only
+/// reported, so [`rts_calibration`] fits them on its last pass only.
+fn reported_fits(
+    drive: &Drive,
+    reference: &Reference,
+    estimate: &ParamsWithStd,
+    opts: &CalibrationOptions,
+) -> Result<(SideSlip, Option<SteeringCalibration>), Error> {
+    let side_slip = crate::side_slip::estimate(drive, reference, estimate.params.gyro_bias_rps);
+    let steering = if drive.steering.is_empty() {
+        None
+    } else {
+        Some(calibrate_steering_understeer(
+            drive,
+            reference,
+            opts.min_speed_mps
+                .max(crate::kinematics::steering::SMOOTHED_MIN_SPEED_MPS),
+        )?)
+    };
+    Ok((side_slip, steering))
+}
+
+/// [`smoothing_pass`]'s filter, smoother, least squares and chords, with
+/// the smoothed states.
+fn fitting_pass(
+    drive: &Drive,
+    p: &Params,
+    opts: &CalibrationOptions,
+) -> Result<(Fit, Reference), Error> {
     let mut fopts = opts.filter.clone();
     fopts.record_epochs = true;
     if matches!(fopts.init, Init::Truth) {
@@ -377,31 +452,22 @@ pub fn smoothing_pass(drive: &Drive, p: &Params, opts: &CalibrationOptions) -> R
     if let Some(c) = chords {
         widen_for_chords(&mut est, c.std);
     }
-    let side_slip = crate::side_slip::estimate(drive, &reference, est.params.gyro_bias_rps);
-    let steering = if drive.steering.is_empty() {
-        None
-    } else {
-        Some(calibrate_steering_understeer(
-            drive,
-            &reference,
-            opts.min_speed_mps
-                .max(crate::kinematics::steering::SMOOTHED_MIN_SPEED_MPS),
-        )?)
-    };
-    Ok(Pass {
-        estimate: est,
-        samples,
-        stats,
-        chords,
-        side_slip,
-        steering,
-    })
+    Ok((
+        Fit {
+            estimate: est,
+            samples,
+            stats,
+            chords,
+        },
+        reference,
+    ))
 }
 
 fn rts_calibration(
     drive: &Drive,
     opts: &CalibrationOptions,
     start: Params,
+    report: bool,
 ) -> Result<Calibration, Error> {
     if drive.gnss.len() < 2 {
         return Err(Error::Insufficient(
@@ -426,16 +492,26 @@ fn rts_calibration(
     let mut last = None;
     let mut converged = false;
     let memory = 3;
-    for _ in 0..opts.max_iterations.max(1) {
-        let pass = smoothing_pass(drive, &p, opts)?;
+    let passes = opts.max_iterations.max(1);
+    for i in 0..passes {
+        let (pass, reference) = fitting_pass(drive, &p, opts)?;
         let g = pass.estimate;
         history.push(g.params);
         let x = scale(&p);
         let gx = scale(&g.params);
         let change = (&gx - &x).amax();
-        last = Some(pass);
-        if change < opts.tolerance {
-            converged = true;
+        converged = change < opts.tolerance;
+        // The side slip and the steering of the last pass only (reported,
+        // not iterated on).
+        let reported = if report && (converged || i + 1 == passes) {
+            let (side_slip, steering) = reported_fits(drive, &reference, &g, opts)?;
+            (Some(side_slip), steering)
+        } else {
+            (None, None)
+        };
+        drop(reference);
+        last = Some((pass, reported));
+        if converged {
             break;
         }
         xs.push(x);
@@ -455,7 +531,8 @@ fn rts_calibration(
             g.params
         };
     }
-    let last = last.ok_or_else(|| Error::Insufficient("no calibration pass ran".into()))?;
+    let (last, (side_slip, steering)) =
+        last.ok_or_else(|| Error::Insufficient("no calibration pass ran".into()))?;
     if let Some(c) = last.chords.filter(|c| c.disagrees()) {
         let st = &last.stats;
         let circ = last.estimate.params.circumferences();
@@ -493,8 +570,8 @@ fn rts_calibration(
         wheel_health: None,
         manoeuvres: None,
         gnss_chords: last.chords,
-        side_slip: Some(last.side_slip),
-        steering: last.steering,
+        side_slip,
+        steering,
     })
 }
 

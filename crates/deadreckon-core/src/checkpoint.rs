@@ -18,6 +18,7 @@ use crate::drive::Drive;
 use crate::ekf::{self, DriveEvents, Epoch, Feeder, FilterOptions, FilterStats};
 use crate::filter::{Filter, Layout};
 use crate::model::State;
+use crate::rts::Smoothed;
 use crate::Error;
 
 /// Smallest segment length, epochs.
@@ -31,13 +32,14 @@ struct Checkpoint<'a, L: Layout<N>, const N: usize> {
     epochs_before: usize,
 }
 
-/// Runs `f` over `drive` and returns the smoothed car states `(t, x)` of every
-/// epoch, with the filter's counters.
-pub fn smooth_car_states<L: Layout<N>, const N: usize>(
-    drive: &Drive,
+/// The forward pass: `f` run over `drive` keeping only a checkpoint every
+/// about √N epochs. Returns the checkpoints, the number of epochs and the
+/// filter's counters.
+fn forward<'a, L: Layout<N>, const N: usize>(
+    drive: &'a Drive,
     f: Filter<L, N>,
     opts: &FilterOptions,
-) -> Result<(Vec<(f64, State)>, FilterStats), Error> {
+) -> Result<(Vec<Checkpoint<'a, L, N>>, usize, FilterStats), Error> {
     let (mut feeder, events) = ekf::feed(drive, opts, f.time_s());
     // The forward pass keeps no predictions; the re-runs do.
     feeder.keep_predictions(false);
@@ -48,7 +50,6 @@ pub fn smooth_car_states<L: Layout<N>, const N: usize>(
         + drive.gnss.len();
     let segment = ((total_events as f64).sqrt() as usize).max(MIN_SEGMENT);
 
-    // Forward: checkpoints only.
     let mut cps = vec![Checkpoint {
         filter: f.clone(),
         feeder: feeder.clone(),
@@ -75,20 +76,18 @@ pub fn smooth_car_states<L: Layout<N>, const N: usize>(
     if cps.last().is_some_and(|c| c.epochs_before == total) && cps.len() > 1 {
         cps.pop();
     }
+    Ok((cps, total, stats))
+}
 
-    if total == 0 {
-        return Ok((Vec::new(), stats));
-    }
-    // Backward, segment by segment.
-    let mut out = vec![(0.0, State::zeros()); total];
-    // The first epoch of the following segment and its smoothed state.
-    let mut next: Option<(Epoch<N>, SVector<f64, N>)> = None;
-    let mut buf: Vec<Epoch<N>> = Vec::with_capacity(segment + 8);
-    for j in (0..cps.len()).rev() {
-        let end = cps.get(j + 1).map_or(total, |c| c.epochs_before);
-        let cp = &cps[j];
-        let (mut f, mut feeder, mut events) =
-            (cp.filter.clone(), cp.feeder.clone(), cp.events.clone());
+impl<L: Layout<N>, const N: usize> Checkpoint<'_, L, N> {
+    /// Re-runs the filter from this checkpoint to epoch `end` (exclusive),
+    /// recording the epochs into `buf` (cleared first).
+    fn rerun(&self, end: usize, buf: &mut Vec<Epoch<N>>) -> Result<(), Error> {
+        let (mut f, mut feeder, mut events) = (
+            self.filter.clone(),
+            self.feeder.clone(),
+            self.events.clone(),
+        );
         feeder.keep_predictions(true);
         buf.clear();
         let mut record = |f: &mut Filter<L, N>, e: ekf::EpochOut<'_, N>| {
@@ -105,12 +104,36 @@ pub fn smooth_car_states<L: Layout<N>, const N: usize>(
                 }
             }
         }
-        if cp.epochs_before + buf.len() != end {
+        if self.epochs_before + buf.len() != end {
             return Err(Error::Numerical {
                 t_s: f.time_s(),
                 what: "the re-run of a smoothing segment did not reproduce the forward pass".into(),
             });
         }
+        Ok(())
+    }
+}
+
+/// Runs `f` over `drive` and returns the smoothed car states `(t, x)` of every
+/// epoch, with the filter's counters.
+pub fn smooth_car_states<L: Layout<N>, const N: usize>(
+    drive: &Drive,
+    f: Filter<L, N>,
+    opts: &FilterOptions,
+) -> Result<(Vec<(f64, State)>, FilterStats), Error> {
+    let (cps, total, stats) = forward(drive, f, opts)?;
+    if total == 0 {
+        return Ok((Vec::new(), stats));
+    }
+    // Backward, segment by segment.
+    let mut out = vec![(0.0, State::zeros()); total];
+    // The first epoch of the following segment and its smoothed state.
+    let mut next: Option<(Epoch<N>, SVector<f64, N>)> = None;
+    let mut buf: Vec<Epoch<N>> = Vec::new();
+    for j in (0..cps.len()).rev() {
+        let end = cps.get(j + 1).map_or(total, |c| c.epochs_before);
+        let cp = &cps[j];
+        cp.rerun(end, &mut buf)?;
         // Eq. (20), (22) through the segment, from the boundary.
         let mut s1 = match &next {
             None => {
@@ -135,4 +158,45 @@ pub fn smooth_car_states<L: Layout<N>, const N: usize>(
         next = Some(s1);
     }
     Ok((out, stats))
+}
+
+/// Runs `f` over `drive` and returns the smoothed state and covariance of
+/// its first epoch (`None`: no epoch), equal bit for bit to the first of
+/// [`crate::rts::smooth`] over the recorded run ([`crate::rts::step`] through
+/// every epoch, segment by segment), in O(√N) memory instead of every epoch
+/// and every smoothed covariance.
+pub fn smoothed_start<L: Layout<N>, const N: usize>(
+    drive: &Drive,
+    f: Filter<L, N>,
+    opts: &FilterOptions,
+) -> Result<Option<Smoothed<N>>, Error> {
+    let (cps, total, _) = forward(drive, f, opts)?;
+    if total == 0 {
+        return Ok(None);
+    }
+    // The first epoch of the following segment and its smoothed state.
+    let mut next: Option<(Epoch<N>, Smoothed<N>)> = None;
+    let mut buf: Vec<Epoch<N>> = Vec::new();
+    for j in (0..cps.len()).rev() {
+        let end = cps.get(j + 1).map_or(total, |c| c.epochs_before);
+        cps[j].rerun(end, &mut buf)?;
+        let mut s1 = match next {
+            None => {
+                let last = buf.pop().expect("a segment has epochs");
+                let s = Smoothed {
+                    t_s: last.t_s,
+                    x: last.x,
+                    p: last.p,
+                };
+                (last, s)
+            }
+            Some(n) => n,
+        };
+        for k in (0..buf.len()).rev() {
+            let s = crate::rts::step(&buf[k], &s1.0, &s1.1)?;
+            s1 = (buf[k], s);
+        }
+        next = Some(s1);
+    }
+    Ok(next.map(|(_, s)| s))
 }

@@ -143,13 +143,18 @@ pub fn estimate(drive: &Drive, bias_rps: f64) -> GyroScale {
 
 /// The drive with the gyro (one- and three-axis) divided by `1 + scale_error`.
 pub fn apply(drive: &Drive, scale_error: f64) -> Drive {
-    let k = 1.0 + scale_error;
     let mut d = drive.clone();
+    apply_in_place(&mut d, scale_error);
+    d
+}
+
+/// [`apply`] to a drive in place (no copy).
+pub fn apply_in_place(d: &mut Drive, scale_error: f64) {
+    let k = 1.0 + scale_error;
     d.yaw_rate.iter_mut().for_each(|s| s.value /= k);
     for a in &mut d.imu.gyro {
         a.x /= k;
         a.y /= k;
         a.z /= k;
     }
-    d
 }

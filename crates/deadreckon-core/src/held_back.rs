@@ -293,7 +293,7 @@ pub fn prepare(
         // with it in the next round.
         let base_drive = known(&corrections, &base).apply(drive);
         // The calibration of the baseline starts every fold's passes.
-        let initial = calibrate::calibrate(&base_drive, copts)
+        let initial = calibrate::calibrate_parameters(&base_drive, copts)
             .ok()
             .map(|c| c.estimate.params);
         let mut current = held_back_errors(&base_drive, copts, initial, &windows)?;
@@ -516,7 +516,7 @@ fn held_back_errors(
         if initial.is_some() {
             o.initial = initial;
         }
-        let params = match calibrate::calibrate(drive, &o) {
+        let params = match calibrate::calibrate_parameters(drive, &o) {
             Ok(c) => c.estimate.params,
             // A fold the calibration cannot take: judge with the start.
             Err(_) => match initial {

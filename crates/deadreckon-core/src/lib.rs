@@ -29,6 +29,7 @@ pub mod checkpoint;
 pub mod chords;
 pub mod compared;
 pub mod consistency;
+mod cursor;
 pub mod drive;
 pub mod ekf;
 pub mod event;

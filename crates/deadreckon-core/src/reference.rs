@@ -2,16 +2,30 @@
 //! the truth (with speed and yaw rate derived by finite differences where the
 //! file does not give them) and for smoothed estimates.
 
+use std::sync::atomic::{AtomicUsize, Ordering};
+
 use crate::drive::TruthPose;
 use crate::model::{State, X, Y};
 
 /// States at increasing times, linearly interpolated between samples.
-#[derive(Debug, Clone, Default)]
+///
+/// [`Reference::state_at`] searches from where its last call ended (a
+/// pass over a drive asks for increasing times: a step or two instead of a
+/// binary search; any order gives the same answers).
+#[derive(Debug, Default)]
 pub struct Reference {
     /// Sample times, s, strictly increasing.
     pub t: Vec<f64>,
     /// States (yaw continuous, not wrapped).
     pub x: Vec<State>,
+    /// Where the last search ended (a hint only, shared by threads).
+    hint: AtomicUsize,
+}
+
+impl Clone for Reference {
+    fn clone(&self) -> Self {
+        Reference::from_states(self.t.clone(), self.x.clone())
+    }
 }
 
 impl Reference {
@@ -48,15 +62,19 @@ impl Reference {
                 w,
             ]));
         }
-        Some(Reference {
-            t: truth.iter().map(|p| p.t_s).collect(),
+        Some(Reference::from_states(
+            truth.iter().map(|p| p.t_s).collect(),
             x,
-        })
+        ))
     }
 
     /// Builds a reference from states at times (e.g. smoothed epochs).
     pub fn from_states(t: Vec<f64>, x: Vec<State>) -> Reference {
-        Reference { t, x }
+        Reference {
+            t,
+            x,
+            hint: AtomicUsize::new(0),
+        }
     }
 
     /// The interpolated state at `t`, or `None` outside the covered time span.
@@ -65,7 +83,9 @@ impl Reference {
         if n == 0 || !(t >= self.t[0] && t <= self.t[n - 1]) {
             return None;
         }
-        let i = self.t.partition_point(|&ti| ti <= t);
+        let i =
+            crate::cursor::partition_from(n, |k| self.t[k], t, self.hint.load(Ordering::Relaxed));
+        self.hint.store(i, Ordering::Relaxed);
         if i >= n {
             return Some(self.x[n - 1]);
         }

@@ -40,7 +40,7 @@ use crate::ekf::{self, FilterOptions, Init, SensorSet};
 use crate::imu::{interp, wheel_speed};
 use crate::model::{V, X, Y, YAW, YAW_RATE};
 use crate::reference::Reference;
-use crate::{rts, Error, Params};
+use crate::{Error, Params};
 
 /// Speed above which the steering is compared with the curvature, m/s.
 pub const MIN_CURVATURE_SPEED_MPS: f64 = 2.0;
@@ -188,7 +188,14 @@ impl Delays {
     }
     /// The drive with every estimated delay removed (timestamps moved back).
     pub fn apply(&self, drive: &Drive) -> Drive {
-        shift(
+        let mut d = drive.clone();
+        self.apply_in_place(&mut d);
+        d
+    }
+
+    /// [`Delays::apply`] to a drive in place (no copy).
+    pub fn apply_in_place(&self, drive: &mut Drive) {
+        shift_in_place(
             drive,
             [
                 self.gyro.applied_s(),
@@ -203,14 +210,19 @@ impl Delays {
 /// The drive with the gyro (one- and three-axis), speed, steering and GNSS
 /// timestamps moved back by the given delays, s, in [`Stream::ALL`] order.
 pub fn shift(drive: &Drive, delays_s: [f64; 4]) -> Drive {
-    let [g, s, st, gn] = delays_s;
     let mut d = drive.clone();
+    shift_in_place(&mut d, delays_s);
+    d
+}
+
+/// [`shift`] in place (no copy).
+pub fn shift_in_place(d: &mut Drive, delays_s: [f64; 4]) {
+    let [g, s, st, gn] = delays_s;
     d.yaw_rate.iter_mut().for_each(|x| x.t_s -= g);
     d.imu.gyro.iter_mut().for_each(|x| x.t_s -= g);
     d.speed.iter_mut().for_each(|x| x.t_s -= s);
     d.steering.iter_mut().for_each(|x| x.t_s -= st);
     d.gnss.iter_mut().for_each(|x| x.t_s -= gn);
-    d
 }
 
 /// Options of the delay estimation.
@@ -366,13 +378,15 @@ impl<'a> Integral<'a> {
         }
         Integral { s, cum, cum2 }
     }
-    /// First and second integral up to `t`.
-    fn at(&self, t: f64) -> Option<(f64, f64)> {
+    /// First and second integral up to `t`; the segment is searched from
+    /// `cursor` (the last call's), which is left at this one's.
+    fn at(&self, t: f64, cursor: &mut usize) -> Option<(f64, f64)> {
         let n = self.s.len();
         if n < 2 || !(t >= self.s[0].0 && t <= self.s[n - 1].0) {
             return None;
         }
-        let i = self.s.partition_point(|p| p.0 <= t).clamp(1, n - 1);
+        *cursor = crate::cursor::partition_from(n, |i| self.s[i].0, t, *cursor);
+        let i = (*cursor).clamp(1, n - 1);
         let (a, b) = (self.s[i - 1], self.s[i]);
         let h = b.0 - a.0;
         let tau = t - a.0;
@@ -384,11 +398,14 @@ impl<'a> Integral<'a> {
             + m * tau * tau * tau / 6.0;
         Some((c1, c2))
     }
-    /// The triangle-weighted mean over `[t − w, t + w]` and its derivative in `t`.
-    fn smooth(&self, t: f64, w: f64) -> Option<(f64, f64)> {
-        let (p1, p2) = self.at(t + w)?;
-        let (c1, c2) = self.at(t)?;
-        let (m1, m2) = self.at(t - w)?;
+    /// The triangle-weighted mean over `[t − w, t + w]` and its derivative
+    /// in `t`; `cursors` are those of the three ends (`t + w`, `t`, `t − w`)
+    /// in the last call, so that a pass at increasing `t` searches little.
+    fn smooth(&self, t: f64, w: f64, cursors: &mut [usize; 3]) -> Option<(f64, f64)> {
+        let [cp, cc, cm] = cursors;
+        let (p1, p2) = self.at(t + w, cp)?;
+        let (c1, c2) = self.at(t, cc)?;
+        let (m1, m2) = self.at(t - w, cm)?;
         Some((
             (p2 - 2.0 * c2 + m2) / (w * w),
             (p1 - 2.0 * c1 + m1) / (w * w),
@@ -434,9 +451,10 @@ pub fn scalar_delay(
     // (t, smoothed reference, its derivative)
     let mut pts: Vec<(f64, f64, f64)> = Vec::new();
     let mut t = start;
+    let mut cursors = [0; 3];
     while t <= end {
         if keep(t) {
-            if let Some((m, dm)) = iref.smooth(t, w) {
+            if let Some((m, dm)) = iref.smooth(t, w, &mut cursors) {
                 pts.push((t, m, dm));
             }
         }
@@ -451,8 +469,12 @@ pub fn scalar_delay(
     }
     let x: Vec<f64> = pts.iter().map(|s| s.1).collect();
     let ys = |d: f64| -> Vec<(f64, f64)> {
+        let mut cursors = [0; 3];
         pts.iter()
-            .map(|&(t, _, _)| isig.smooth(t + d, w).unwrap_or((f64::NAN, 0.0)))
+            .map(|&(t, _, _)| {
+                isig.smooth(t + d, w, &mut cursors)
+                    .unwrap_or((f64::NAN, 0.0))
+            })
             .collect()
     };
     // Per lag of the grid and per block of consecutive points, the sums of a
@@ -658,6 +680,17 @@ pub fn gnss_delay(
     copts: &CalibrationOptions,
     o: &DelayOptions,
 ) -> Result<(Delay, Option<Params>), Error> {
+    gnss_delay_of(drive.clone(), copts, o)
+}
+
+/// [`gnss_delay`] of a drive it may change: its fixes are moved to each
+/// step's delay in place (one copy of the drive, not one per step).
+fn gnss_delay_of(
+    mut shifted: Drive,
+    copts: &CalibrationOptions,
+    o: &DelayOptions,
+) -> Result<(Delay, Option<Params>), Error> {
+    let drive = &shifted;
     if drive.gnss.len() < o.min_samples {
         return Ok((
             Delay::not_estimated(format!(
@@ -669,26 +702,37 @@ pub fn gnss_delay(
         ));
     }
     let lever = drive.vehicle.gnss_lever_arm_m;
+    // The fixes' own times and the vehicle, which each step starts from.
+    let fix_times: Vec<f64> = drive.gnss.iter().map(|g| g.t_s).collect();
+    let vehicle = drive.vehicle.clone();
     let mut d = 0.0;
     let mut last = None;
     let mut prev: Option<(f64, f64)> = None;
     for _ in 0..o.gnss_iterations.max(1) {
-        let mut shifted = shift(drive, [0.0, 0.0, 0.0, d]);
-        let cal = calibrate::calibrate(&shifted, copts)?;
+        // As `shift(drive, [0, 0, 0, d])`, in place.
+        for (g, &t) in shifted.gnss.iter_mut().zip(&fix_times) {
+            g.t_s = t - d;
+        }
+        shifted.vehicle = vehicle.clone();
+        // The parameters only: the wheel health, the manoeuvres, the side
+        // slip and the steering are not read here.
+        let cal = calibrate::calibrate_parameters(&shifted, copts)?;
         let params = cal.estimate.params;
-        let f = ekf::run(
+        // Only the smoothed start is used: smoothed in O(√N) memory
+        // (checkpointed re-runs), equal to the first of `rts::smooth` over
+        // the recorded run.
+        let fopts = FilterOptions {
+            record_epochs: true,
+            ..copts.filter.clone()
+        };
+        let s0 = crate::checkpoint::smoothed_start(
             &shifted,
-            &params,
-            &FilterOptions {
-                record_epochs: true,
-                ..copts.filter.clone()
-            },
-            &mut (),
+            ekf::car_filter(&shifted, &params, &fopts)?,
+            &fopts,
         )?;
-        let sm = rts::smooth(&f.epochs)?;
         // Dead reckoning (no GNSS) from the smoothed start: a reference the
         // fixes' timing cannot pull along, its drift taken out per window.
-        let Some(s0) = sm.first() else {
+        let Some(s0) = s0 else {
             return Ok((Delay::not_estimated("no smoothed track"), None));
         };
         // The reference integrates the yaw with the trapezoid: with eq. 3's
@@ -698,7 +742,7 @@ pub fn gnss_delay(
         // (The calibration and the smoothing above are done with `shifted`;
         // only its fixes are read below.)
         shifted.vehicle.noise.yaw_integration = crate::vehicle::YawIntegration::Trapezoidal;
-        let dr = ekf::run(
+        let reference = states_at_fixes(
             &shifted,
             &params,
             &FilterOptions {
@@ -711,12 +755,7 @@ pub fn gnss_delay(
                 sensors: SensorSet::dead_reckoning(),
                 ..copts.filter.clone()
             },
-            &mut (),
         )?;
-        let reference = Reference::from_states(
-            dr.epochs.iter().map(|e| e.t_s).collect(),
-            dr.epochs.iter().map(|e| e.x).collect(),
-        );
         let Some((delta, std, n)) = regress_gnss(&shifted.gnss, &reference, lever, o.gnss_window_s)
         else {
             return Ok((
@@ -757,6 +796,64 @@ pub fn gnss_delay(
     let delay = status_of(d, std, n, o);
     let params = delay.status.is_estimated().then_some(params);
     Ok((delay, params))
+}
+
+/// The car filter run over `drive` with `opts`, its states interpolated at
+/// the GNSS fixes' times inside its span as [`Reference::state_at`] would
+/// interpolate the recorded epochs (linear between the epochs around each
+/// fix; the last epoch's state at its own time), as the reference of the
+/// fixes' times only: the epochs stream past, none is kept.
+pub fn states_at_fixes(
+    drive: &Drive,
+    params: &Params,
+    opts: &FilterOptions,
+) -> Result<Reference, Error> {
+    let mut f = ekf::car_filter(drive, params, opts)?;
+    let (mut feeder, events) = ekf::feed(drive, opts, f.time_s());
+    let fixes = &drive.gnss;
+    let (mut t_out, mut x_out) = (Vec::new(), Vec::new());
+    // The next fix not yet placed, and the previous epoch.
+    let mut next = 0;
+    let mut prev: Option<(f64, crate::model::State)> = None;
+    let mut epoch = |f: &mut crate::filter::Filter<crate::filter::CarLayout, 5>,
+                     e: ekf::EpochOut<'_, 5>| {
+        if e.prediction.is_none() {
+            return;
+        }
+        let (t1, x1) = (f.time_s(), *f.state());
+        match prev {
+            // Fixes before the first epoch are outside the span.
+            None => {
+                while next < fixes.len() && fixes[next].t_s < t1 {
+                    next += 1;
+                }
+            }
+            // Fixes in [t0, t1): between the two epochs.
+            Some((t0, x0)) => {
+                while next < fixes.len() && fixes[next].t_s < t1 {
+                    let t = fixes[next].t_s;
+                    let a = if t1 > t0 { (t - t0) / (t1 - t0) } else { 0.0 };
+                    t_out.push(t);
+                    x_out.push(x0 * (1.0 - a) + x1 * a);
+                    next += 1;
+                }
+            }
+        }
+        prev = Some((t1, x1));
+    };
+    let end = opts.end_s.unwrap_or(f64::INFINITY);
+    for ev in events.take_while(|e| e.t_s <= end) {
+        feeder.push(&mut f, ev, &mut epoch)?;
+    }
+    feeder.finish(&mut f, &mut epoch)?;
+    // A fix at the last epoch's time takes its state.
+    if let Some((t1, x1)) = prev {
+        if next < fixes.len() && fixes[next].t_s == t1 {
+            t_out.push(t1);
+            x_out.push(x1);
+        }
+    }
+    Ok(Reference::from_states(t_out, x_out))
 }
 
 /// One regression step of the GNSS delay: the fixes' residuals against the
@@ -923,7 +1020,7 @@ pub fn estimate_with_params(
         gnss: Delay::not_estimated("not estimated"),
     };
     let partly = delays.apply(drive);
-    let (g, params) = gnss_delay(&partly, copts, o)?;
+    let (g, params) = gnss_delay_of(partly, copts, o)?;
     delays.gnss = g;
     Ok((delays, params))
 }
@@ -977,6 +1074,20 @@ pub struct Corrections {
     pub held_back: Option<crate::held_back::HeldBack>,
 }
 
+impl Corrections {
+    /// Nothing estimated or applied: what [`prepare_with`] returns with
+    /// [`Which::None`] (the drive then unchanged).
+    pub fn none() -> Corrections {
+        Corrections {
+            traction: None,
+            tilt: None,
+            delays: Delays::none(),
+            gyro_scale: None,
+            held_back: None,
+        }
+    }
+}
+
 /// Estimates the driven axle's slip ([`crate::traction`], correcting its
 /// wheel speeds when estimated), the IMU tilt (projecting the gyro on the
 /// vertical when estimated), every stream's delay and the gyro scale error
@@ -1001,16 +1112,7 @@ pub fn prepare_with(
     which: Which,
 ) -> Result<(Drive, Corrections), Error> {
     if which == Which::None {
-        return Ok((
-            drive.clone(),
-            Corrections {
-                traction: None,
-                tilt: None,
-                delays: Delays::none(),
-                gyro_scale: None,
-                held_back: None,
-            },
-        ));
+        return Ok((drive.clone(), Corrections::none()));
     }
     if which == Which::Auto {
         return Err(Error::InvalidParams(
@@ -1038,20 +1140,21 @@ pub fn prepare_with(
             }
         }
     }
-    let out = delays.apply(&levelled);
+    // The levelled drive becomes the output (moved, not copied).
+    let mut out = levelled;
+    delays.apply_in_place(&mut out);
     // The bias of the calibration at the final GNSS delay (a time shift of
     // the gyro does not change its bias), else of a calibration here.
     let params = match params {
         Some(p) => Some(p),
-        None => calibrate::calibrate(&out, copts)
+        None => calibrate::calibrate_parameters(&out, copts)
             .ok()
             .map(|c| c.estimate.params),
     };
     let gyro_scale = params.map(|p| crate::gyro_scale::estimate(&out, p.gyro_bias_rps));
-    let out = match &gyro_scale {
-        Some(g) if g.is_estimated() => crate::gyro_scale::apply(&out, g.scale_error),
-        _ => out,
-    };
+    if let Some(g) = gyro_scale.as_ref().filter(|g| g.is_estimated()) {
+        crate::gyro_scale::apply_in_place(&mut out, g.scale_error);
+    }
     Ok((
         out,
         Corrections {

@@ -161,7 +161,10 @@ pub fn calibrate_steering(
     }
     let l = drive.vehicle.wheelbase_m;
     let nominal = drive.vehicle.steering_ratio;
-    let (mut s, mut target) = (Vec::new(), Vec::new());
+    // At most one of each per reading: allocated once (a growing vector
+    // holds up to three times its length while it moves).
+    let n_max = drive.steering.len();
+    let (mut s, mut target) = (Vec::with_capacity(n_max), Vec::with_capacity(n_max));
     for m in &drive.steering {
         let Some(x) = reference.state_at(m.t_s) else {
             continue;
@@ -295,7 +298,8 @@ pub fn calibrate_steering_understeer(
         )));
     }
     let l = drive.vehicle.wheelbase_m;
-    let (mut s, mut rows) = (Vec::new(), Vec::new());
+    let n_max = drive.steering.len();
+    let (mut s, mut rows) = (Vec::with_capacity(n_max), Vec::with_capacity(n_max));
     for m in &drive.steering {
         let Some(x) = reference.state_at(m.t_s) else {
             continue;
@@ -313,6 +317,7 @@ pub fn calibrate_steering_understeer(
     }
     let n = s.len();
     let a = DMatrix::from_fn(n, 3, |i, j| rows[i][j]);
+    drop(rows);
     let y = DVector::from_column_slice(&s);
     // How far a_y is from a multiple of the angle (plus a constant).
     let a2 = a.columns(0, 2).into_owned();
