@@ -1,18 +1,33 @@
 //! What a user gets on the dynamic family (issue 28) with the commands'
-//! defaults: `calibrate` (the RTS calibration after the default corrections,
-//! `--corrections gnss`: the driven axle's slip, the IMU tilt, the GNSS
-//! delay and the gyro scale estimated and applied) on one drive, then
-//! `evaluate --params` on another drive of the same car (the stored
-//! corrections applied to it, 30 s outages, step 10 s), beside the bare
-//! RTS calibration (`--corrections none`) the ablation in
-//! `deadreckon-sim/tests/dynamics_ablation.rs` uses.
+//! corrections: `calibrate` (the RTS calibration after `--corrections none`,
+//! `gnss` — the driven axle's slip, the IMU tilt, the GNSS delay and the
+//! gyro scale estimated and applied — and `auto`, the default since issue
+//! 29: each chosen on held-back GNSS, `deadreckon_core::held_back`) on one
+//! drive, then `evaluate --params` on another drive of the same car (the
+//! stored corrections applied to it, 30 s outages, step 10 s).
 //!
 //! ```text
 //! cargo test --profile ci -p deadreckon-api --test dynamic_family_defaults -- --ignored --nocapture
 //! ```
 //!
-//! Measured (27 min at a load of 7–10 on two cores; mean final error, m,
-//! `none` / `gnss` corrections):
+//! `DEFAULTS_EFFECTS=a,b` picks configurations, `DEFAULTS_CARS=1,2` cars (for
+//! both sets), `DEFAULTS_HELD_OUT=1` runs the held-out cars too,
+//! `DEFAULTS_ONLY_AUTO=1` only `auto`, `DEFAULTS_SAY=1` prints each `auto`
+//! decision.
+//!
+//! Measured with `auto` (mean final error, m, none / gnss / auto; 300 s
+//! drives; the held-out cars run once, after the choice of
+//! `held_back`'s constants):
+//!
+//! | effects | dev cars 1–6 | held-out 101–110 (104 apart) |
+//! |---|---|---|
+//! | none | 0.405 / 0.720 / 0.424 | 0.471 / 0.560 / 0.466 |
+//! | clocks | 0.441 / 0.714 / 0.461 | 0.818 / 0.995 / 0.851 |
+//! | gyro_scale | 0.767 / 0.818 / 0.794 | 0.907 / 0.582 / 0.738 |
+//! | latency | 0.693 / 0.746 / 0.476 | 0.676 / 0.618 / 0.501 |
+//! | all | 3.306 / 2.685 / 3.263 | 2.783 / 2.598 / 2.598 |
+//!
+//! Before `auto` (27 min at a load of 7–10 on two cores; none / gnss):
 //!
 //! | effects | dev cars 1–6 | held-out 101–110 (104 apart) |
 //! |---|---|---|
@@ -30,14 +45,11 @@
 //! | steering_offset | 0.453 / 0.728 | 0.508 / 0.596 |
 //! | all | 3.411 / 2.820 | 2.979 / 2.854 |
 //!
-//! The default corrections cost 0.1–0.3 m wherever their effect is absent,
-//! and help only on the held-out gyro-scale and latency rows and with every
-//! effect on. On the development cars' calibration drives without effects
-//! (true GNSS delay 0, gyro scale exact) the GNSS delay is applied at
-//! −31, −34, −44, +27, −7 and −11 ms (standard errors 9–18 ms) and the
-//! gyro scale at +0.27 %, +0.67 %, +0.68 % and −0.23 % (±0.18–0.30 %) on
-//! the four cars it is estimated on: issue 29's "corrections applied on
-//! evidence of noise", on the family.
+//! The `gnss` corrections cost 0.1–0.3 m wherever their effect is absent:
+//! on the development cars' calibration drives without effects (true GNSS
+//! delay 0, gyro scale exact) the GNSS delay was applied at −31, −34, −44,
+//! +27, −7 and −11 ms (standard errors 9–18 ms): issue 29's "corrections
+//! applied on evidence of noise", on the family.
 
 use rayon::prelude::*;
 
