@@ -218,7 +218,7 @@ fn a_closed_standard_output_ends_quietly() {
 /// Regression (issue 13): `batch` calibrated every drive without the
 /// timing and mounting corrections `calibrate` estimates, and had no column
 /// for them. With `--corrections gnss` each row has the delays (the GNSS
-/// one applied, equal to `calibrate --json`'s on that drive); by default
+/// one applied, equal to `calibrate --json --corrections gnss`'s on that drive); by default
 /// none are estimated and the columns are empty.
 #[test]
 fn batch_had_no_corrections_and_no_columns_for_them() {
@@ -241,7 +241,7 @@ fn batch_had_no_corrections_and_no_columns_for_them() {
     assert_eq!(&r[0][column(&out, "status_delay_gnss")], "applied");
     assert_eq!(&r[0][column(&out, "status_imu_tilt")], "none");
     let delay: f64 = r[0][column(&out, "delay_gnss_s")].parse().expect("number");
-    let c = run(&["calibrate", &d, "--json"]);
+    let c = run(&["calibrate", &d, "--json", "--corrections", "gnss"]);
     assert!(c.status.success());
     let cal: serde_json::Value = serde_json::from_slice(&c.stdout).expect("json");
     assert_eq!(

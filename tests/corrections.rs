@@ -106,7 +106,15 @@ fn the_report_ignored_the_corrections_of_its_params_and_estimated_none() {
     tilted_drive(&dir, 0.0);
     let d = dir.to_str().unwrap();
     let p = tmp.path().join("params.toml");
-    run_ok(&["calibrate", d, "--out", p.to_str().unwrap()]);
+    // `gnss`, so that corrections are stored whatever `auto` would judge.
+    run_ok(&[
+        "calibrate",
+        d,
+        "--corrections",
+        "gnss",
+        "--out",
+        p.to_str().unwrap(),
+    ]);
     let drive = deadreckon_io::read_drive(&dir).unwrap();
     fn options<'a>(
         dir: &'a Path,

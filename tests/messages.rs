@@ -172,7 +172,16 @@ fn stream_names_the_streams_of_the_stored_delays() {
     let tmp = tempfile::tempdir().unwrap();
     let d = simulated(tmp.path(), "d", "300");
     let p = tmp.path().join("p.toml");
-    run_ok(&["calibrate", &d, "--out", p.to_str().unwrap()]);
+    // `gnss`, so that a delay is stored (`auto`, the default, applies none
+    // on this drive without delays).
+    run_ok(&[
+        "calibrate",
+        &d,
+        "--corrections",
+        "gnss",
+        "--out",
+        p.to_str().unwrap(),
+    ]);
     let events = run_ok(&["events", &d]);
     let r = run(
         &[
