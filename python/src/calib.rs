@@ -96,6 +96,8 @@ pub fn calibrate(
         .detach(|| deadreckon_api::calibrate::calibrate_car(&drive, method, opts, which, &what))
         .map_err(to_py_err)?;
     let mut v = cc.json();
+    // Python's calibrate is the car's: the shape found, as the command says it.
+    v["shape_found"] = deadreckon_api::shape::of_drive(&drive).json();
     checks.annotate(&mut v);
     to_py(py, &v)
 }
@@ -248,8 +250,8 @@ pub fn evaluate(
     let timing = parse_timing(timing).map_err(to_py_err)?;
     // The shape found from the data, as the commands find it
     // (deadreckon_api::shape); `shape` overrides it.
-    if let Some(v) = kinematic_evaluate(py, source, &drive, params, outage, step, shape)? {
-        let mut v = v;
+    let (kinematic, found) = kinematic_evaluate(py, source, &drive, params, outage, step, shape)?;
+    if let Some(mut v) = kinematic {
         checks.annotate(&mut v);
         return to_py(py, &v);
     }
@@ -262,13 +264,22 @@ pub fn evaluate(
     // command applies it.
     let given = params.map(|p| params_arg(p, &drive.vehicle)).transpose()?;
     let stored = with_stored(params, (*drive).clone())?;
-    let (params, label, drive, corr, params_source) = py.detach(|| -> PyResult<_> {
+    // The error bound's factor, as the command takes it: the file's
+    // `[bound]`, or fitted with the calibration on the drive.
+    let spec: Option<String> = params.and_then(|p| p.extract().ok());
+    let (params, label, drive, corr, params_source, bound) = py.detach(|| -> PyResult<_> {
         Ok(match given {
-            Some((p, l)) => (p, l.clone(), stored, None, l),
+            Some((p, l)) => {
+                let bound = match &spec {
+                    Some(f) => deadreckon_api::bound::stored_bound(f).map_err(to_py_err)?,
+                    None => deadreckon_core::bound::BoundFit::FILTER,
+                };
+                (p, l.clone(), stored, None, l, bound)
+            }
             None => {
                 let (c, d) = deadreckon_api::evaluate::default_parameters(&drive, which)
                     .map_err(to_py_err)?;
-                (c.params, c.label, d, c.corrections, c.source)
+                (c.params, c.label, d, c.corrections, c.source, c.bound)
             }
         })
     })?;
@@ -288,6 +299,8 @@ pub fn evaluate(
             )
             .map_err(to_py_err)?;
             let mut v = json::outage_json(len, &label, &ev);
+            deadreckon_api::bound::add_outage_bound(&mut v, &ev, &bound, None);
+            v["shape_found"] = found.json();
             if let Some(c) = &corr {
                 v["corrections"] = deadreckon_api::corrections::corrections_json(c);
             }
@@ -328,6 +341,7 @@ pub fn evaluate(
     })?;
     v["params"] = label.into();
     v["params_source"] = params_source.into();
+    v["shape_found"] = found.json();
     if let Some(c) = &corr {
         v["corrections"] = deadreckon_api::corrections::corrections_json(c);
     }
@@ -346,7 +360,7 @@ fn kinematic_evaluate(
     outage: Option<f64>,
     step: Option<f64>,
     shape: Option<&str>,
-) -> PyResult<Option<serde_json::Value>> {
+) -> PyResult<(Option<serde_json::Value>, deadreckon_api::shape::Found)> {
     use deadreckon_api::{kinematic, shape as sh};
     use deadreckon_core::kinematics::diff_drive::{OutageStart, DEFAULT_WARMUP_S};
     use deadreckon_core::kinematics::Shape;
@@ -366,7 +380,7 @@ fn kinematic_evaluate(
         .unwrap_or_else(|_| PathBuf::from("the drive"));
     let found = sh::detect(&path, Some(drive), asked);
     if found.shape == Shape::FourWheel {
-        return Ok(None);
+        return Ok((None, found));
     }
     let Some(len) = outage else {
         return Err(err(format!(
@@ -401,5 +415,5 @@ fn kinematic_evaluate(
         .map_err(to_py_err)?;
     let mut v = ev.json();
     v["shape_found"] = found.json();
-    Ok(Some(v))
+    Ok((Some(v), found))
 }

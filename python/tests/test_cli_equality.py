@@ -101,6 +101,7 @@ def test_evaluate_with_calibrated_params_equals_cli(sim_drive, cli, cli_json, tm
     ours = deadreckon.evaluate(sim_drive, params=cal)
     # Named for where they came from: the file, or a dict given.
     assert (ours.pop("params"), theirs.pop("params")) == ("given", str(plain))
+    assert (ours.pop("params_source"), theirs.pop("params_source")) == ("given", str(plain))
     assert ours == theirs
 
 
