@@ -122,6 +122,19 @@ fn stream_disagreed_with_run_on_stored_delays() {
             tr.insert("slip_per_mps2".into(), (-0.006).into());
             tr.insert("mean_force_mps2".into(), 0.25.into());
             t.insert("traction".into(), tr.into());
+            // Every addition to the paper's model `auto` can store
+            // (issue 28, `deadreckon_core::model_options`).
+            let model: toml::Table = toml::from_str(
+                "rear_slip_gradient_rad_per_mps2 = 0.005\n\
+                 gyro_bias_walk_rps_per_sqrt_s = 3e-6\n\
+                 gnss_recovery_after_s = 10.0\n\
+                 [steering]\n\
+                 steering_ratio = 16.2\n\
+                 steering_offset_rad = 0.01\n\
+                 understeer_gradient_rad_per_mps2 = 0.002\n",
+            )
+            .unwrap();
+            t.insert("model".into(), model.into());
             std::fs::write(params, toml::to_string(&t).unwrap()).unwrap();
         } else {
             run_ok(&["calibrate", d, "--corrections", which, "--out", params]);
@@ -141,6 +154,9 @@ fn stream_disagreed_with_run_on_stored_delays() {
         if which == "edited" {
             assert_eq!(c.traction_slip_per_mps2, -0.006);
             assert_eq!(c.delays_s[1], -0.07);
+            assert_eq!(c.model.rear_slip_gradient_rad_per_mps2, Some(0.005));
+            assert_eq!(c.model.gyro_bias_walk_rps_per_sqrt_s, Some(3e-6));
+            assert_eq!(c.model.steering.map(|s| s.steering_ratio), Some(16.2));
         }
         if c.traction_slip_per_mps2 != 0.0 {
             assert!(c.traction_mean_force_mps2.is_some(), "{stored}");
@@ -300,6 +316,7 @@ fn online_corrections_equal_the_batch_filter_on_the_corrected_drive_bit_for_bit(
         gyro_scale_error: 0.008,
         traction_slip_per_mps2: 0.004,
         traction_mean_force_mps2: Some(0.3),
+        ..Default::default()
     };
     let events = input_events(&drive);
     let mut finals = Vec::new();
@@ -363,6 +380,10 @@ fn learned_parameters_keep_the_corrections_they_were_learned_under() {
         gyro_scale_error: 0.0079,
         traction_slip_per_mps2: -0.004,
         traction_mean_force_mps2: Some(0.31),
+        model: deadreckon_core::model_options::ModelOptions {
+            gyro_bias_walk_rps_per_sqrt_s: Some(3e-6),
+            ..Default::default()
+        },
     };
     let p = deadreckon_core::Params {
         gyro_bias_rps: 0.0014,

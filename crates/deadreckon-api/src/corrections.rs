@@ -105,6 +105,7 @@ pub fn corrections_json(c: &Corrections) -> Value {
         "imu": c.tilt.as_ref().map(tilt_json),
         "gyro_scale": c.gyro_scale.as_ref().map(scale_json),
         "held_back": c.held_back.as_ref().map(held_back_json),
+        "model": serde_json::to_value(c.model).unwrap_or(Value::Null),
     })
 }
 
@@ -192,6 +193,12 @@ pub fn corrections_toml(c: &Corrections) -> toml::Table {
         }
         out.insert("held_back".into(), t.into());
     }
+    if !c.model.is_empty() {
+        // What is applied to the vehicle (read back by `stored_corrections`).
+        if let Ok(t) = toml::Table::try_from(c.model) {
+            out.insert("model".into(), t.into());
+        }
+    }
     out
 }
 
@@ -258,10 +265,17 @@ pub fn stored_in_file(spec: &std::path::Path) -> Result<Stored, String> {
     stored_corrections(&extra).map_err(|e| format!("parameters {}: {e}", spec.display()))
 }
 
-/// Reads the `[delays]`, `[traction]`, `[imu]` and `[gyro_scale]` tables
+/// Reads the `[delays]`, `[traction]`, `[imu]`, `[gyro_scale]` and `[model]` tables
 /// from the extra keys of a params.toml (absent: nothing to apply).
 pub fn stored_corrections(extra: &toml::Table) -> Result<Stored, String> {
     let mut s = Stored::default();
+    if let Some(m) = extra.get("model") {
+        s.model = m
+            .clone()
+            .try_into()
+            .map_err(|e| format!("`model`: {}", e.message()))?;
+        s.model.validate()?;
+    }
     if let Some(d) = extra.get("delays") {
         let d = d.as_table().ok_or("`delays` must be a table")?;
         for (i, st) in Stream::ALL.iter().enumerate() {

@@ -3,9 +3,11 @@
 //! rear-axle side-slip gradient (`[side_slip]`), as `calibrate --out`
 //! writes them ([`crate::calibrate::CarCalibration::params_extra`]). Only
 //! the values marked `estimated = true` are taken. Applying them to a
-//! vehicle ([`StoredModel::apply`]) is the caller's choice: no command does
-//! it by default yet (the default is to be chosen on held-back GNSS; the
-//! vehicle.toml keys of the same names set them by hand).
+//! vehicle ([`StoredModel::apply`]) is the caller's choice: these tables
+//! report what the drive measured. What the commands apply is the `[model]`
+//! table, the additions `--corrections auto` chose on held-back GNSS
+//! ([`deadreckon_core::model_options`]; the vehicle.toml keys of the same
+//! names set them by hand).
 
 use deadreckon_core::kinematics::steering::UNDERSTEER_NAME;
 use deadreckon_core::side_slip::NAME as SLIP_NAME;

@@ -185,12 +185,32 @@ pub fn open(
                 .doing(|| format!("reading state {}", path.display()))?;
             return state_from_text(&text, &path.display().to_string());
         }
-        None if o.learn => Online::learning(vehicle, params, prior, &o.filter, Start::Gnss)?,
-        None => Online::new(vehicle, params, &o.filter, Start::Gnss)?,
+        None if o.learn => Online::learning(
+            &with_model(vehicle, corrections),
+            params,
+            prior,
+            &o.filter,
+            Start::Gnss,
+        )?,
+        None => Online::new(
+            &with_model(vehicle, corrections),
+            params,
+            &o.filter,
+            Start::Gnss,
+        )?,
     };
     fresh
         .with_corrections(corrections)
         .map_err(|e| Error::Invalid(format!("stored corrections: {e}")))
+}
+
+/// `vehicle` with the additions to the paper's model that `corrections`
+/// stores ([`deadreckon_core::model_options`]), as `run` applies them to a
+/// drive's vehicle ([`deadreckon_core::timing::KnownCorrections::apply`]).
+fn with_model(vehicle: &Vehicle, corrections: &crate::corrections::Stored) -> Vehicle {
+    let mut v = vehicle.clone();
+    corrections.model.apply_to(&mut v);
+    v
 }
 
 /// What a live filter starts from: the vehicle read from `vehicle`, the
@@ -355,6 +375,11 @@ pub fn stored_toml(stored: &crate::corrections::Stored) -> toml::Table {
             t.insert("mean_force_mps2".into(), m.into());
         }
         out.insert("traction".into(), t.into());
+    }
+    if !stored.model.is_empty() {
+        if let Ok(t) = toml::Table::try_from(stored.model) {
+            out.insert("model".into(), t.into());
+        }
     }
     out
 }

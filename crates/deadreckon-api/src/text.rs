@@ -766,6 +766,9 @@ pub fn known_corrections_text(c: &deadreckon_core::timing::KnownCorrections) -> 
             100.0 * c.gyro_scale_error
         ));
     }
+    if !c.model.is_empty() {
+        parts.push(c.model.words());
+    }
     parts.join(", ")
 }
 

@@ -13,7 +13,7 @@
 //! `DEFAULTS_EFFECTS=a,b` picks configurations, `DEFAULTS_CARS=1,2` cars (for
 //! both sets), `DEFAULTS_HELD_OUT=1` runs the held-out cars too,
 //! `DEFAULTS_ONLY_AUTO=1` only `auto`, `DEFAULTS_SAY=1` prints each `auto`
-//! decision.
+//! decision and each car's windows (mean final and start errors).
 //!
 //! Measured with `auto` (mean final error, m, none / gnss / auto; 300 s
 //! drives; the held-out cars run once, after the choice of
@@ -100,6 +100,16 @@ fn user_path(
         &FilterOptions::default(),
     )
     .map_err(|e| format!("evaluation: {e}"))?;
+    if std::env::var("DEFAULTS_SAY").is_ok() {
+        let starts: Vec<f64> = out.windows.iter().map(|w| w.start_m()).collect();
+        println!(
+            "car {seed} {which:?}: mean final {:.3} m over {} windows, mean start {:.3} m; finals {:?}",
+            out.final_error().mean,
+            out.windows.len(),
+            starts.iter().sum::<f64>() / starts.len().max(1) as f64,
+            out.windows.iter().map(|w| (w.final_m() * 100.0).round() / 100.0).collect::<Vec<_>>()
+        );
+    }
     Ok(out.final_error().mean)
 }
 

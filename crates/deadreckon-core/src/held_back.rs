@@ -58,6 +58,7 @@
 
 use crate::calibrate::{self, CalibrationOptions};
 use crate::drive::Drive;
+use crate::model_options::{self, ModelOption, ModelOptions};
 use crate::outage;
 use crate::timing::{self, Corrections, DelayOptions, KnownCorrections, Status, Stream, Which};
 use crate::vehicle::Params;
@@ -131,6 +132,8 @@ pub enum Correction {
     Delay(Stream),
     /// The gyro scale error ([`crate::gyro_scale`]).
     GyroScale,
+    /// An addition to the paper's model ([`crate::model_options`]).
+    Model(ModelOption),
 }
 
 impl Correction {
@@ -142,16 +145,19 @@ impl Correction {
             Correction::Tilt => "IMU tilt".into(),
             Correction::Delay(s) => format!("{} delay", s.name()),
             Correction::GyroScale => "gyro scale".into(),
+            Correction::Model(m) => m.name().into(),
         }
     }
 
-    /// A key for JSON and params.toml: `traction`, `imu`, `delay_gnss`, `gyro_scale`.
+    /// A key for JSON and params.toml: `traction`, `imu`, `delay_gnss`,
+    /// `gyro_scale`, or the model option's ([`ModelOption::key`]).
     pub fn key(self) -> String {
         match self {
             Correction::Traction => "traction".into(),
             Correction::Tilt => "imu".into(),
             Correction::Delay(s) => format!("delay_{}", s.name()),
             Correction::GyroScale => "gyro_scale".into(),
+            Correction::Model(m) => m.key().into(),
         }
     }
 }
@@ -229,7 +235,7 @@ pub fn prepare(
     let windows = windows(drive);
     let short = windows[0].len() + windows[1].len() < MIN_WINDOWS;
     let min_z = if short { SHORT_MIN_Z } else { MIN_Z };
-    let candidates = candidates(&corrections, min_z);
+    let mut candidates = candidates(&corrections, min_z);
     let mut held = HeldBack {
         min_z,
         windows: windows[0].len() + windows[1].len(),
@@ -248,6 +254,26 @@ pub fn prepare(
         .map(|(c, _)| *c)
         .collect();
     let base = chosen.clone();
+    // The drive with the GNSS delay (if chosen) and the paper's model, and
+    // its calibration: the start of every fold's passes, and the estimates
+    // of the model's additions (side slip, steering) that are candidates.
+    let base_drive = known(&corrections, &base, &ModelOptions::default()).apply(drive);
+    let base_calibration = calibrate::calibrate(&base_drive, copts).ok();
+    let initial = base_calibration.as_ref().map(|c| c.estimate.params);
+    let model_values = match &base_calibration {
+        Some(c) => {
+            let (m, values) = model_options::candidates(&base_drive, c, min_z);
+            // The settings without an estimate (walk, recovery) need the
+            // held-back fixes: on a drive too short to judge they stay off.
+            candidates.extend(
+                m.into_iter()
+                    .filter(|(_, z)| !short || z.is_finite())
+                    .map(|(o, z)| (Correction::Model(o), z)),
+            );
+            values
+        }
+        None => ModelOptions::default(),
+    };
     let judged: Vec<(Correction, f64)> = candidates
         .iter()
         .copied()
@@ -291,13 +317,7 @@ pub fn prepare(
         // held-back error most, if it does so significantly (paired t at
         // most -MIN_T over the same windows); the others are tried again
         // with it in the next round.
-        let base_drive = known(&corrections, &base).apply(drive);
-        // The calibration of the baseline starts every fold's passes.
-        let initial = calibrate::calibrate_parameters(&base_drive, copts)
-            .ok()
-            .map(|c| c.estimate.params);
         let mut current = held_back_errors(&base_drive, copts, initial, &windows)?;
-        drop(base_drive);
         held.without_m = mean(&current);
         let mut set = base.clone();
         let mut left: Vec<(Correction, f64)> = judged.clone();
@@ -306,7 +326,7 @@ pub fn prepare(
             let mut best: Option<(usize, WindowErrors, f64)> = None;
             for (i, &(c, z)) in left.iter().enumerate() {
                 let with: Vec<Correction> = set.iter().copied().chain([c]).collect();
-                let d = known(&corrections, &with).apply(drive);
+                let d = known(&corrections, &with, &model_values).apply(drive);
                 let errors = held_back_errors(&d, copts, initial, &windows)?;
                 let (diff_m, t) = paired(&errors, &current);
                 let j = Judged {
@@ -345,8 +365,11 @@ pub fn prepare(
         held.judged.extend(tried);
         chosen.extend(won);
     }
+    drop(base_drive);
     mark(&mut corrections, &held, &chosen);
-    let out = known(&corrections, &chosen).apply(drive);
+    let applied = known(&corrections, &chosen, &model_values);
+    let out = applied.apply(drive);
+    corrections.model = applied.model;
     corrections.held_back = Some(held);
     Ok((out, corrections))
 }
@@ -392,8 +415,9 @@ fn candidates(c: &Corrections, min_z: f64) -> Vec<(Correction, f64)> {
     out
 }
 
-/// The corrections of `set`, with the values of `c`.
-fn known(c: &Corrections, set: &[Correction]) -> KnownCorrections {
+/// The corrections of `set`, with the values of `c` and of `model` for
+/// the model's additions.
+fn known(c: &Corrections, set: &[Correction], model: &ModelOptions) -> KnownCorrections {
     let mut k = KnownCorrections::default();
     for &what in set {
         match what {
@@ -412,6 +436,7 @@ fn known(c: &Corrections, set: &[Correction]) -> KnownCorrections {
                     k.gyro_scale_error = g.scale_error;
                 }
             }
+            Correction::Model(m) => k.model = k.model.with(m, model),
         }
     }
     k

@@ -49,6 +49,7 @@ pub mod kinematics;
 pub mod live_corrections;
 pub mod metrics;
 pub mod model;
+pub mod model_options;
 pub mod observability;
 pub mod observation;
 pub mod online;

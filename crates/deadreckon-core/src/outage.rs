@@ -31,7 +31,7 @@ use crate::filter::{CarLayout, Filter, GateCounts, Layout};
 use crate::gnss_error::{CarWanderLayout, N_WANDER};
 use crate::gyro_drift::{CarBiasLayout, CarWanderBiasLayout, N_BIAS, N_WANDER_BIAS};
 use crate::metrics::Summary;
-use crate::model::{Mat, State, V, X, Y, YAW};
+use crate::model::{State, V, X, Y, YAW};
 use crate::reference::Reference;
 use crate::vehicle::Params;
 use crate::Error;
@@ -130,11 +130,12 @@ pub fn check_windows(drive: &Drive, windows: &[(f64, f64)]) -> Result<(), Error>
     Ok(())
 }
 
+/// Every epoch's time and car state (the first five states of any layout).
 struct Collect(Vec<(f64, State)>);
 
-impl EpochHook for Collect {
-    fn after_epoch(&mut self, t: f64, x: &mut State, _p: &mut Mat) {
-        self.0.push((t, *x));
+impl<const N: usize> EpochHook<N> for Collect {
+    fn after_epoch(&mut self, t: f64, x: &mut SVector<f64, N>, _p: &mut SMatrix<f64, N, N>) {
+        self.0.push((t, State::from_fn(|i, _| x[i])));
     }
 }
 
@@ -604,7 +605,19 @@ fn through_windows_in(
         ..base.clone()
     };
     let mut hook = Collect(Vec::new());
-    let run = ekf::run(drive, params, &opts, &mut hook)?;
+    // The gyro bias walks where the vehicle says so, as in `run`'s tracks
+    // and `stream` (the receiver's wander is carried by `evaluate` only).
+    let stats = if drive.vehicle.noise.gyro_bias_walk_rps_per_sqrt_s > 0.0 {
+        ekf::run_filter(
+            drive,
+            ekf::fixed_filter::<CarBiasLayout, N_BIAS>(drive, params, &opts)?,
+            &opts,
+            &mut hook,
+        )?
+        .stats
+    } else {
+        ekf::run(drive, params, &opts, &mut hook)?.stats
+    };
     let mut out = Vec::new();
     for &(a, b) in windows {
         // Dead reckoning starts at the last epoch before the window.
@@ -628,7 +641,7 @@ fn through_windows_in(
         outage_s: windows.iter().map(|w| w.1 - w.0).fold(0.0, f64::max),
         reference,
         windows: out,
-        gates: run.stats.gates,
+        gates: stats.gates,
         unsettled: Vec::new(),
         heading_limit_rad: f64::INFINITY,
     })

@@ -1072,6 +1072,9 @@ pub struct Corrections {
     /// With [`Which::Auto`]: what the held-back GNSS said of each
     /// correction ([`crate::held_back`]).
     pub held_back: Option<crate::held_back::HeldBack>,
+    /// With [`Which::Auto`]: the additions to the paper's model the
+    /// held-back GNSS chose ([`crate::model_options`]; empty otherwise).
+    pub model: crate::model_options::ModelOptions,
 }
 
 impl Corrections {
@@ -1084,6 +1087,7 @@ impl Corrections {
             delays: Delays::none(),
             gyro_scale: None,
             held_back: None,
+            model: Default::default(),
         }
     }
 }
@@ -1163,6 +1167,7 @@ pub fn prepare_with(
             delays,
             gyro_scale,
             held_back: None,
+            model: Default::default(),
         },
     ))
 }
@@ -1212,6 +1217,11 @@ pub struct KnownCorrections {
     /// ([`crate::live_corrections`] then leaves the slip out).
     #[serde(default)]
     pub traction_mean_force_mps2: Option<f64>,
+    /// Additions to the paper's model set on the vehicle
+    /// ([`crate::model_options`]; empty: the vehicle's own). Absent from
+    /// models and files written before them: none.
+    #[serde(default)]
+    pub model: crate::model_options::ModelOptions,
 }
 
 impl KnownCorrections {
@@ -1229,7 +1239,9 @@ impl KnownCorrections {
         } else {
             drive
         };
-        apply_known(drive, self.delays_s, self.up, self.gyro_scale_error)
+        let mut out = apply_known(drive, self.delays_s, self.up, self.gyro_scale_error);
+        self.model.apply_to(&mut out.vehicle);
+        out
     }
 
     /// Whether there is nothing to apply.
@@ -1268,6 +1280,7 @@ impl KnownCorrections {
                 crate::traction::MAX_SLIP_PER_MPS2
             ));
         }
+        self.model.validate()?;
         if let Some(m) = self.traction_mean_force_mps2 {
             if !(m.is_finite() && m.abs() < 100.0) {
                 return Err(format!(
