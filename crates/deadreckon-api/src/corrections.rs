@@ -179,8 +179,12 @@ pub fn corrections_toml(c: &Corrections) -> toml::Table {
         }
         for j in &h.judged {
             let mut e = toml::Table::new();
-            e.insert("z".into(), j.z.into());
-            for (k, v) in [("with_m", j.with_m), ("against_m", j.against_m), ("t", j.t)] {
+            for (k, v) in [
+                ("z", j.z),
+                ("with_m", j.with_m),
+                ("against_m", j.against_m),
+                ("t", j.t),
+            ] {
                 if v.is_finite() {
                     e.insert(k.into(), v.into());
                 }

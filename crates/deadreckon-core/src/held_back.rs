@@ -317,23 +317,34 @@ pub fn prepare(
         // held-back error most, if it does so significantly (paired t at
         // most -MIN_T over the same windows); the others are tried again
         // with it in the next round.
-        let mut current = held_back_errors(&base_drive, copts, initial, &windows)?;
-        held.without_m = mean(&current);
+        let mut current = held_back_errors(&base_drive, copts, initial, &windows, None)?;
+        held.without_m = mean(&current.errors);
+        // A recovery that waits can change nothing where the filter never
+        // recovered: then it is no candidate (and costs no run).
+        let recovery = Correction::Model(ModelOption::GnssRecovery);
+        let mut left: Vec<(Correction, f64)> = judged
+            .iter()
+            .copied()
+            .filter(|(c, _)| *c != recovery || current.recoveries > 0)
+            .collect();
         let mut set = base.clone();
-        let mut left: Vec<(Correction, f64)> = judged.clone();
         let mut tried: Vec<Judged> = Vec::new();
         loop {
-            let mut best: Option<(usize, WindowErrors, f64)> = None;
+            let mut best: Option<(usize, HeldBackRun, f64)> = None;
             for (i, &(c, z)) in left.iter().enumerate() {
                 let with: Vec<Correction> = set.iter().copied().chain([c]).collect();
                 let d = known(&corrections, &with, &model_values).apply(drive);
-                let errors = held_back_errors(&d, copts, initial, &windows)?;
-                let (diff_m, t) = paired(&errors, &current);
+                // The calibration holds the gyro bias constant: with a
+                // walking bias the folds calibrate as without it.
+                let same_calibration =
+                    (c == Correction::Model(ModelOption::GyroWalk)).then_some(&current.params);
+                let run = held_back_errors(&d, copts, initial, &windows, same_calibration)?;
+                let (diff_m, t) = paired(&run.errors, &current.errors);
                 let j = Judged {
                     correction: c,
                     z,
-                    with_m: mean(&errors),
-                    against_m: mean(&current),
+                    with_m: mean(&run.errors),
+                    against_m: mean(&current.errors),
                     t,
                     applied: false,
                     by_significance: false,
@@ -343,24 +354,24 @@ pub fn prepare(
                     None => tried.push(j),
                 }
                 if t <= -MIN_T && best.as_ref().is_none_or(|b| diff_m < b.2) {
-                    best = Some((i, errors, diff_m));
+                    best = Some((i, run, diff_m));
                 }
             }
             match best {
-                Some((i, errors, _)) => {
+                Some((i, run, _)) => {
                     let (c, _) = left.remove(i);
                     set.push(c);
                     won.push(c);
                     if let Some(x) = tried.iter_mut().find(|x| x.correction == c) {
                         x.applied = true;
                     }
-                    current = errors;
+                    current = run;
                 }
                 None => break,
             }
         }
         if !won.is_empty() {
-            held.together_m = Some(mean(&current));
+            held.together_m = Some(mean(&current.errors));
         }
         held.judged.extend(tried);
         chosen.extend(won);
@@ -525,34 +536,63 @@ pub fn windows(drive: &Drive) -> [Vec<(f64, f64)>; 2] {
 /// window's start, s.
 type WindowErrors = Vec<(f64, f64)>;
 
+/// One held-back judgement of a drive: the error at each window's end
+/// against its hidden fix, the parameters each fold was calibrated to, and
+/// how many GNSS recoveries the dead reckoning's filter made.
+struct HeldBackRun {
+    errors: WindowErrors,
+    /// Per fold, the parameters dead-reckoned with (`None`: the fold was
+    /// skipped).
+    params: [Option<Params>; 2],
+    recoveries: u64,
+}
+
 /// The error at each window's end against the hidden fix, m, keyed by the
 /// window's start: for each fold, the car calibrated with the fold's fixes
-/// hidden (from `initial`), then dead-reckoned through the fold's windows.
+/// hidden (from `initial`; or the parameters `calibrated` gives, from a
+/// drive that differs only in what the calibration does not use), then
+/// dead-reckoned through the fold's windows.
 fn held_back_errors(
     drive: &Drive,
     copts: &CalibrationOptions,
     initial: Option<Params>,
     folds: &[Vec<(f64, f64)>; 2],
-) -> Result<WindowErrors, Error> {
-    let mut errors = Vec::new();
-    for fold in folds.iter().filter(|f| !f.is_empty()) {
-        let mut o = copts.clone();
-        o.filter.gnss_outages.extend_from_slice(fold);
-        if initial.is_some() {
-            o.initial = initial;
-        }
-        let params = match calibrate::calibrate_parameters(drive, &o) {
-            Ok(c) => c.estimate.params,
-            // A fold the calibration cannot take: judge with the start.
-            Err(_) => match initial {
+    calibrated: Option<&[Option<Params>; 2]>,
+) -> Result<HeldBackRun, Error> {
+    let mut out = HeldBackRun {
+        errors: Vec::new(),
+        params: [None, None],
+        recoveries: 0,
+    };
+    for (k, fold) in folds.iter().enumerate().filter(|f| !f.1.is_empty()) {
+        let params = match calibrated {
+            Some(c) => match c[k] {
                 Some(p) => p,
                 None => continue,
             },
+            None => {
+                let mut o = copts.clone();
+                o.filter.gnss_outages.extend_from_slice(fold);
+                if initial.is_some() {
+                    o.initial = initial;
+                }
+                match calibrate::calibrate_parameters(drive, &o) {
+                    Ok(c) => c.estimate.params,
+                    // A fold the calibration cannot take: judge with the start.
+                    Err(_) => match initial {
+                        Some(p) => p,
+                        None => continue,
+                    },
+                }
+            }
         };
+        out.params[k] = Some(params);
         let ev = outage::through_windows_against_fixes(drive, &params, fold, &copts.filter)?;
-        errors.extend(ev.windows.iter().map(|w| (w.start_s, w.final_m())));
+        out.recoveries += ev.gates.recovered(crate::filter::SensorKind::Gnss);
+        out.errors
+            .extend(ev.windows.iter().map(|w| (w.start_s, w.final_m())));
     }
-    Ok(errors)
+    Ok(out)
 }
 
 /// The mean of `errors`, m (NaN when empty).
