@@ -21,6 +21,10 @@ pub struct DiffDriveOptions {
     pub stride_s: f64,
     /// Windows slower on average are not used, m/s.
     pub min_speed_mps: f64,
+    /// Which parameters are fitted (in [`NAMES`]' order); the others keep
+    /// their nominal values and are reported as not fitted (default: all;
+    /// the held-back choice, [`super::held_back`], fits subsets).
+    pub fit: [bool; N_PARAMS],
 }
 
 impl Default for DiffDriveOptions {
@@ -29,9 +33,13 @@ impl Default for DiffDriveOptions {
             window_s: 90.0,
             stride_s: 30.0,
             min_speed_mps: 0.05,
+            fit: [true; N_PARAMS],
         }
     }
 }
+
+/// The reason of a parameter [`DiffDriveOptions::fit`] leaves out.
+pub const NOT_FITTED: &str = "not fitted: held at its nominal value";
 
 /// Physical bounds of the five parameters: a fit at one is rejected.
 const BOUNDS: [(f64, f64); N_PARAMS] = [
@@ -167,7 +175,9 @@ pub fn calibrate_diff_drive(
     }
     let nominal = DiffDriveDrive::nominal();
     let (wins, total, fastest) = windows(d, o);
-    let mut reason: Vec<Option<String>> = vec![None; N_PARAMS];
+    let mut reason: Vec<Option<String>> = (0..N_PARAMS)
+        .map(|k| (!o.fit[k]).then(|| NOT_FITTED.to_string()))
+        .collect();
     if wins.is_empty() {
         let why = format!(
             "0 of {total} windows of {} s above the speed threshold {} m/s (the fastest moves at {fastest:.3} m/s)",
@@ -300,5 +310,6 @@ pub fn calibrate_diff_drive(
         evaluations,
         converged: success && cov.is_some() && nf > 0,
         termination,
+        held_back: None,
     })
 }
