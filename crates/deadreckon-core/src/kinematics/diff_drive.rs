@@ -293,4 +293,6 @@ pub use outages::{evaluate_diff_drive, DiffDriveOutages, OutageStart, DEFAULT_WA
 #[cfg(test)]
 mod filter_tests;
 #[cfg(test)]
+mod held_back_tests;
+#[cfg(test)]
 mod tests;
