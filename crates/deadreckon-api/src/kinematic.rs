@@ -432,13 +432,17 @@ pub fn held_back_lines(c: &KinematicCalibration) -> Vec<String> {
         h.chosen_m.map_or("nothing (every parameter nominal)".into(), |v| format!("{v:.3} m")),
     )];
     for j in &h.judged {
+        let t = if j.t.is_finite() {
+            format!("paired t {:+.1}", j.t)
+        } else {
+            "paired t not computed (fewer than two windows)".to_string()
+        };
         out.push(format!(
-            "  {:<14} calibrated {:>10.6}: {:.3} m with it, {:.3} m without, paired t {:+.1}: {}",
+            "  {:<14} calibrated {:>10.6}: {:.3} m with it, {:.3} m without, {t}: {}",
             j.name,
             j.calibrated,
             j.with_m,
             j.without_m,
-            j.t,
             if j.applied {
                 "calibrated value used"
             } else {

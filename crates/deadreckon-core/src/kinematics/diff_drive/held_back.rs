@@ -418,9 +418,14 @@ pub(crate) fn calibrate_held_back_with(
         let std = j
             .calibrated_std
             .map_or(String::new(), |s| format!(" ± {s:.6}"));
+        let t = if j.t.is_finite() {
+            format!("paired t {:+.1}", j.t)
+        } else {
+            "paired t not computed".to_string()
+        };
         p.reason = Some(format!(
-            "held-back GNSS prefers the nominal value: calibrated {:.6}{std} gave {:.3} m, {:.3} m without it (paired t {:+.1}, {} windows of {:.0} s)",
-            j.calibrated, j.with_m, j.without_m, j.t, held.windows, held.window_s
+            "held-back GNSS prefers the nominal value: calibrated {:.6}{std} gave {:.3} m, {:.3} m without it ({t}, {} windows of {:.0} s)",
+            j.calibrated, j.with_m, j.without_m, held.windows, held.window_s
         ));
     }
     for (p, f) in c.params.iter_mut().zip(&full.params) {
