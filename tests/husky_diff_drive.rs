@@ -7,24 +7,28 @@
 //! binary.
 //!
 //! Measured at this commit (mean final error, gyro yaw rate; the filter's
-//! fix-error model identified on the first half's innovations). One choice
-//! was made on this bag's outage errors: the calibration's 90 s window
-//! (`DiffDriveOptions::window_s`, chosen among 30–200 s on the whole drive's
-//! 30 s outages), so the in-sample row below is tuned on what it is judged
-//! on, and the halves saw that choice too (the header used to say nothing
-//! was chosen on outage errors):
+//! fix-error model identified on the first half's innovations). `calibrate`
+//! keeps a parameter nominal unless the drive's held-back GNSS says the
+//! calibrated value is better (`diff_drive::held_back`, issue 29 item 4);
+//! `--every-param` fits every determined parameter as before. The fit's
+//! 90 s window was first chosen on this bag's in-sample outage errors and
+//! since checked on simulated robots; the held-back rule (threshold, folds)
+//! was chosen on simulated robots, the folds after alternating ones let the
+//! first half's gyro bias through (see the module docs).
 //!
 //! | parameters | filter | alignment |
 //! |---|---|---|
-//! | calibrated on the whole drive (in-sample) | 2.848 m | 3.154 m |
-//! | calibrated on the first half, second half evaluated | 3.832 m | 4.015 m |
-//! | calibrated on the second half, first half evaluated | 4.408 m | 5.656 m |
-//! | nominal | 3.307 m | 3.290 m |
+//! | `--every-param` on the whole drive (in-sample) | 2.848 m | 3.154 m |
+//! | default (held-back) on the whole drive: every parameter nominal | 3.307 m | |
+//! | `--every-param` on the first half, second half evaluated | 3.832 m | 4.015 m |
+//! | `--every-param` on the second half, first half evaluated | 4.408 m | 5.656 m |
+//! | default on the first half (antenna x taken), second half evaluated | 2.629 m | |
+//! | default on the second half (every parameter nominal), first half evaluated | 4.196 m | |
+//! | nominal, whole drive / second half / first half | 3.307 / 2.586 / 4.196 m | 3.290 m (whole) |
 //!
-//! The issue's target (under 3.05 m with the parameters calibrated on the
-//! drive) is met by the filter start. The bounds pin these numbers within
-//! about 5% (0.15 m; 0.25 m on the 11-window halves) so that a degradation
-//! shows.
+//! The bounds pin these numbers within about 5% (0.15 m; 0.25 m on the
+//! 11-window halves of `--every-param`, 0.05 m where the default is
+//! compared with nominal) so that a degradation shows.
 
 mod common;
 use common::run_ok;
@@ -80,7 +84,7 @@ fn near(what: &str, got: f64, measured: f64, margin: f64) {
 fn husky_diff_drive_calibrated_against_gnss_through_30_s_outages() {
     let tmp = tempfile::tempdir().unwrap();
     let p = tmp.path().join("husky.toml");
-    let c = calibrate(&p, &[]);
+    let c = calibrate(&p, &["--every-param"]);
     eprintln!("husky diff-drive calibration: {c}");
     assert_eq!(c["shape"], "diff_drive");
     assert_eq!(c["yaw_source"], "gyro");
@@ -104,8 +108,8 @@ fn husky_diff_drive_calibrated_against_gnss_through_30_s_outages() {
         assert_eq!(vf["windows"], v["windows"]);
     }
     assert!(vf["windows"].as_u64().unwrap() >= 30, "{vf}");
-    // The issue's target, and the numbers measured at this commit.
-    assert!(filter < 3.05, "{filter}");
+    // The numbers measured at this commit (in-sample: every parameter
+    // fitted on the drive it is judged on).
     near("calibrated, filter start", filter, 2.848, 0.15);
     near("calibrated, aligned start", aligned, 3.154, 0.15);
     near("nominal gyro, filter start", gyro_filter, 3.307, 0.15);
@@ -137,14 +141,14 @@ fn husky_diff_drive_calibrated_against_gnss_through_30_s_outages() {
 }
 
 #[test]
-fn husky_diff_drive_calibrated_on_one_half_and_evaluated_on_the_other() {
+fn husky_diff_drive_every_param_calibrated_on_one_half_and_evaluated_on_the_other() {
     let tmp = tempfile::tempdir().unwrap();
     let (first, second) = (
         tmp.path().join("first.toml"),
         tmp.path().join("second.toml"),
     );
-    calibrate(&first, &["--until", MIDDLE]);
-    calibrate(&second, &["--from", MIDDLE]);
+    calibrate(&first, &["--until", MIDDLE, "--every-param"]);
+    calibrate(&second, &["--from", MIDDLE, "--every-param"]);
     let (first, second) = (first.to_str().unwrap(), second.to_str().unwrap());
     let (f12, v) = outage_mean(first, &["--from", MIDDLE]);
     let (a12, _) = outage_mean(first, &["--from", MIDDLE, "--start", "align"]);
@@ -159,4 +163,82 @@ fn husky_diff_drive_calibrated_on_one_half_and_evaluated_on_the_other() {
     near("first half -> second, aligned start", a12, 4.015, 0.25);
     near("second half -> first, filter start", f21, 4.408, 0.25);
     near("second half -> first, aligned start", a21, 5.656, 0.25);
+}
+
+/// Issue 29 item 4: the Husky calibrated on one half lost to the nominal
+/// values on the other (3.832 against 2.586 m, 4.408 against 4.196 m).
+/// With the held-back choice (the default) the second half keeps every
+/// parameter nominal (4.196 m, equal to nominal) and the first half takes
+/// only the antenna's x (-0.765 m, paired t -1.0 over 5 windows): 2.629 m
+/// against nominal's 2.586 m, 1.7 % above it (not yet "at least as good").
+#[test]
+fn calibrated_husky_loses_to_nominal_on_the_other_half() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (first, second) = (
+        tmp.path().join("first.toml"),
+        tmp.path().join("second.toml"),
+    );
+    let c1 = calibrate(&first, &["--until", MIDDLE]);
+    let c2 = calibrate(&second, &["--from", MIDDLE]);
+    let (first, second) = (first.to_str().unwrap(), second.to_str().unwrap());
+    let (f12, _) = outage_mean(first, &["--from", MIDDLE]);
+    let (n2, _) = outage_mean("nominal", &["--from", MIDDLE]);
+    let (f21, _) = outage_mean(second, &["--until", MIDDLE]);
+    let (n1, _) = outage_mean("nominal", &["--until", MIDDLE]);
+    eprintln!(
+        "first -> second {f12:.3} m (nominal {n2:.3}); second -> first {f21:.3} m (nominal {n1:.3})"
+    );
+    // Each judgement is in the JSON and the file, both figures per parameter.
+    for c in [&c1, &c2] {
+        let h = &c["held_back"];
+        assert_eq!(h["windows"], 5, "{h}");
+        assert_eq!(h["judged"].as_array().unwrap().len(), 5, "{h}");
+    }
+    let applied = |c: &serde_json::Value| -> Vec<String> {
+        c["held_back"]["judged"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|j| j["applied"] == true)
+            .map(|j| j["name"].as_str().unwrap().to_string())
+            .collect()
+    };
+    assert_eq!(applied(&c1), ["antenna_x_m"], "{c1}");
+    assert!(applied(&c2).is_empty(), "{c2}");
+    let reason = c2["params"]["yaw_scale"]["reason"].as_str().unwrap();
+    assert!(
+        reason.contains("held-back GNSS prefers the nominal value"),
+        "{reason}"
+    );
+    let file = std::fs::read_to_string(second).unwrap();
+    assert!(
+        file.contains("[held_back]") && file.contains("with_m"),
+        "{file}"
+    );
+    // The second half's parameters are the nominal ones: the same figure.
+    assert!((f21 - n1).abs() < 1e-9, "{f21} vs {n1}");
+    near("nominal, second half", n2, 2.586, 0.05);
+    near("nominal, first half", n1, 4.196, 0.05);
+    near("first half -> second", f12, 2.629, 0.05);
+    assert!(f12 < n2 + 0.06, "{f12} vs nominal {n2}");
+}
+
+/// The default calibration of the whole drive keeps every parameter
+/// nominal (no candidate lowers the held-back error: paired t from -0.5 to
+/// +2.0 over 11 windows), so its outages are nominal's, 3.307 m: above the
+/// 2.9 m the in-sample fit of every parameter reached (2.848 m).
+#[test]
+fn husky_whole_drive_default_calibration_keeps_nominal() {
+    let tmp = tempfile::tempdir().unwrap();
+    let p = tmp.path().join("husky.toml");
+    let c = calibrate(&p, &[]);
+    assert_eq!(c["held_back"]["windows"], 11, "{c}");
+    assert!(c["held_back"].get("chosen_m").is_none(), "{c}");
+    for (name, v) in c["params"].as_object().unwrap() {
+        assert_eq!(v["estimated"], false, "{name}: {v}");
+    }
+    let (mean, _) = outage_mean(p.to_str().unwrap(), &[]);
+    let (nominal, _) = outage_mean("nominal", &[]);
+    assert!((mean - nominal).abs() < 1e-9, "{mean} vs {nominal}");
+    near("default calibration, whole drive", mean, 3.307, 0.05);
 }

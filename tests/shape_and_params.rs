@@ -17,8 +17,10 @@ fn json(args: &[&str]) -> serde_json::Value {
 /// The Husky bag without `--shape` ran the car model (3.67 m mean over
 /// 30 s outages every 10 s); it is a differential drive (body velocity, no
 /// four wheel speeds, no steering), calibrated on the drive without
-/// --params. Measured: mean 2.848 m (`deadreckon evaluate husky_gps.bag
-/// --outage 30 --step 10`); the issue's bound is 2.9 m.
+/// --params. Measured: mean 3.307 m (`deadreckon evaluate husky_gps.bag
+/// --outage 30 --step 10`): the calibration keeps every parameter nominal
+/// on held-back GNSS (issue 29 item 4; fitting every parameter in-sample
+/// gave 2.848 m, under the issue's 2.9 m, and lost out of sample).
 #[test]
 fn husky_without_shape_evaluated_as_a_car() {
     let v = json(&[
@@ -37,7 +39,7 @@ fn husky_without_shape_evaluated_as_a_car() {
         .unwrap()
         .starts_with("calibrated on this drive"));
     let mean = v["final_error_m"]["mean"].as_f64().unwrap();
-    assert!((2.80..=2.9).contains(&mean), "{mean}");
+    assert!((3.25..=3.36).contains(&mean), "{mean}");
     // The text says the shape and why.
     let text = run_ok(&["evaluate", HUSKY, "--outage", "30", "--step", "10"]);
     assert!(

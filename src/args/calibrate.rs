@@ -95,6 +95,10 @@ pub struct CalibrateArgs {
     /// Tricycle and differential drive: length of the windows of the fit, s (default 2 for a tricycle, 60 for a differential drive).
     #[arg(long, value_parser = super::positive)]
     pub window: Option<f64>,
+    /// Differential drive: fit every parameter the drive determines, without
+    /// keeping a nominal value where the drive's held-back GNSS prefers it.
+    #[arg(long)]
+    pub every_param: bool,
     /// Write the parameters here: a params.toml, or with --format autoware or
     /// eagleye a directory (created if missing).
     #[arg(long)]

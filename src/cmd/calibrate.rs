@@ -84,6 +84,7 @@ fn run_kinematic(
         min_speed_mps: a.min_speed,
         from_s: a.from_s,
         until_s: a.until_s,
+        every_param: a.every_param,
     };
     let c = if found.shape == Shape::Tricycle {
         kinematic::calibrate_tricycle(&a.dir, drive.as_ref(), &o)?

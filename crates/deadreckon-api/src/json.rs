@@ -431,6 +431,7 @@ pub fn kinematic_calibration_json(
         "min_speed_mps": c.min_speed_mps,
         "rms_position_m": c.rms_position_m,
         "rms_heading_rad": c.rms_heading_rad,
+        "held_back": c.held_back,
     })
 }
 

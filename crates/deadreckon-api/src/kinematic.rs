@@ -8,8 +8,8 @@
 use std::path::Path;
 
 use deadreckon_core::kinematics::diff_drive::{
-    self, calibrate_diff_drive, evaluate_diff_drive, DiffDriveDrive, DiffDriveOptions,
-    DiffDriveOutages, OutageStart, YawSource,
+    self, calibrate_diff_drive, calibrate_held_back, evaluate_diff_drive, DiffDriveDrive,
+    DiffDriveOptions, DiffDriveOutages, FilterNoise, OutageStart, YawSource,
 };
 use deadreckon_core::kinematics::tricycle::{TricycleDrive, TricycleGeometry, TricycleParams};
 use deadreckon_core::kinematics::{
@@ -396,7 +396,9 @@ impl Calibrated {
     /// The table: value, standard error and status per parameter, the
     /// correlation of the estimated ones, the fit.
     pub fn lines(&self) -> Vec<String> {
-        crate::text::kinematic_table(&self.calibration)
+        let mut out = crate::text::kinematic_table(&self.calibration);
+        out.extend(held_back_lines(&self.calibration));
+        out
     }
 
     /// Writes the kinematic params.toml (status, std and reason per
@@ -408,6 +410,47 @@ impl Calibrated {
         deadreckon_io::write_kinematic_params(path, &f)
             .doing(|| format!("writing {}", path.display()))
     }
+}
+
+/// The held-back judgement of a differential drive's parameters in words:
+/// one line for the rule, one per candidate (empty when none was made).
+pub fn held_back_lines(c: &KinematicCalibration) -> Vec<String> {
+    let Some(h) = &c.held_back else {
+        return Vec::new();
+    };
+    if let Some(why) = &h.not_judged {
+        return vec![format!("held-back GNSS: not judged: {why}")];
+    }
+    if h.judged.is_empty() {
+        return vec!["held-back GNSS: no parameter determined by the drive to judge".into()];
+    }
+    let mut out = vec![format!(
+        "held-back GNSS ({} windows of {:.0} s hidden from the fit in two folds): nominal {}, chosen {}",
+        h.windows,
+        h.window_s,
+        h.nominal_m.map_or("not computed".into(), |v| format!("{v:.3} m")),
+        h.chosen_m.map_or("nothing (every parameter nominal)".into(), |v| format!("{v:.3} m")),
+    )];
+    for j in &h.judged {
+        let t = if j.t.is_finite() {
+            format!("paired t {:+.1}", j.t)
+        } else {
+            "paired t not computed (fewer than two windows)".to_string()
+        };
+        out.push(format!(
+            "  {:<14} calibrated {:>10.6}: {:.3} m with it, {:.3} m without, {t}: {}",
+            j.name,
+            j.calibrated,
+            j.with_m,
+            j.without_m,
+            if j.applied {
+                "calibrated value used"
+            } else {
+                "nominal kept"
+            }
+        ));
+    }
+    out
 }
 
 /// The method a shape is calibrated with, or why `given` is refused.
@@ -442,6 +485,10 @@ pub struct CalibrateOptions<'a> {
     pub from_s: Option<f64>,
     /// Drive-clock range end.
     pub until_s: Option<f64>,
+    /// A differential drive: fit every determined parameter, without
+    /// keeping the nominal value where the held-back GNSS prefers it
+    /// (`diff_drive::held_back`; the default is the choice).
+    pub every_param: bool,
 }
 
 /// Calibrates a tricycle against its tracker: the log at `path`, or
@@ -486,8 +533,13 @@ pub fn calibrate_diff(
         min_speed_mps: o.min_speed_mps.unwrap_or(shape.default_min_speed_mps()),
         ..Default::default()
     };
-    let calibration =
-        calibrate_diff_drive(&dd, &opts).doing(|| format!("calibrating {}", path.display()))?;
+    let calibration = if o.every_param {
+        calibrate_diff_drive(&dd, &opts)
+    } else {
+        // Each parameter judged through the filter the outages start from.
+        calibrate_held_back(&dd, &opts, &FilterNoise::default())
+    }
+    .doing(|| format!("calibrating {}", path.display()))?;
     Ok(Calibrated {
         shape,
         method,

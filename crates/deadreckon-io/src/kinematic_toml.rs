@@ -52,6 +52,10 @@ pub struct KinematicParamsFile {
     /// Correlation of the estimated parameters.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub correlation: Option<Correlation>,
+    /// A differential drive's parameters chosen on held-back GNSS: each
+    /// candidate's value, both held-back figures and the decision.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub held_back: Option<deadreckon_core::kinematics::diff_drive::HeldBackParams>,
 }
 
 /// A correlation matrix with the names of its rows.
@@ -79,6 +83,7 @@ impl KinematicParamsFile {
                 names: c.correlated.clone(),
                 matrix: c.correlation.clone(),
             }),
+            held_back: c.held_back.clone(),
         }
     }
 
@@ -194,6 +199,7 @@ mod tests {
                 names: vec!["a_m".into()],
                 matrix: vec![vec![1.0]],
             }),
+            held_back: None,
         }
     }
 

@@ -106,6 +106,11 @@ pub struct KinematicCalibration {
     pub converged: bool,
     /// How the last fit ended.
     pub termination: String,
+    /// A differential drive's parameters chosen on held-back GNSS
+    /// ([`super::diff_drive::held_back`]): each one's two figures and the
+    /// decision (`None` where no such choice was made).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub held_back: Option<super::diff_drive::held_back::HeldBackParams>,
 }
 
 /// How a Levenberg–Marquardt fit ended, in words for people (the solver's
@@ -467,6 +472,7 @@ pub fn calibrate<M: KinematicModel>(
         evaluations,
         converged: success && cov.is_some() && !free.is_empty(),
         termination,
+        held_back: None,
     })
 }
 

@@ -282,13 +282,17 @@ struct Window {
 
 mod calibration;
 pub mod filter;
+pub mod held_back;
 mod outages;
 
-pub use calibration::{calibrate_diff_drive, DiffDriveOptions};
+pub use calibration::{calibrate_diff_drive, DiffDriveOptions, NOT_FITTED};
 pub use filter::{DiffDriveFilter, FilterNoise};
+pub use held_back::{calibrate_held_back, HeldBackParams, JudgedParam};
 pub use outages::{evaluate_diff_drive, DiffDriveOutages, OutageStart, DEFAULT_WARMUP_S};
 
 #[cfg(test)]
 mod filter_tests;
+#[cfg(test)]
+mod held_back_tests;
 #[cfg(test)]
 mod tests;
