@@ -453,7 +453,8 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
     }
     /// The filter with its yaw process noise per `process_step_s` set to
     /// `process_yaw_rad` instead of the vehicle's (the RTS calibration's
-    /// passes: [`crate::calibrate::SMOOTHING_PROCESS_YAW_RAD`]).
+    /// passes with `CalibrationOptions::smoothing_process_yaw_rad`, e.g.
+    /// [`crate::calibrate::SMOOTHING_PROCESS_YAW_RAD`]).
     pub fn with_process_yaw_rad(mut self, process_yaw_rad: f64) -> Self {
         self.noise.process_yaw_rad = process_yaw_rad;
         self

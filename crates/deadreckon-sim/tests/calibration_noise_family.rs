@@ -1,20 +1,21 @@
-//! Issue 36: the RTS calibration's smoothing passes run with table I's yaw
-//! process noise (`calibrate::SMOOTHING_PROCESS_YAW_RAD`, 1e-5), not with
-//! the dead-reckoning filter's five times larger `vehicle::PROCESS_YAW_RAD`
-//! (5e-5, which keeps the dead-reckoned pose covariance honest through
-//! turns). With the larger value the smoother lets the yaw take heading
-//! changes that the yaw rate, and through it the gyro bias, should explain;
-//! how much depends on the gyro: with table II's gyro (0.003 rad/s per
-//! reading) the yaw rate's own freedom dwarfs either value and the bias
-//! hardly moves (family cars 41–64, `calibration_family.rs`), with a better
-//! gyro the yaw noise dominates and the bias reads low.
+//! Issue 36: the RTS calibration's smoothing passes at table I's yaw
+//! process noise (`calibrate::SMOOTHING_PROCESS_YAW_RAD`, 1e-5, an option)
+//! against the vehicle's (the default: the dead-reckoning filter's
+//! `vehicle::PROCESS_YAW_RAD`, 5e-5, five times larger to keep the
+//! dead-reckoned pose covariance honest through turns). With the larger
+//! value the smoother lets the yaw take heading changes that the yaw rate,
+//! and through it the gyro bias, should explain; how much depends on the
+//! gyro: with table II's gyro (0.003 rad/s per reading) the yaw rate's own
+//! freedom dwarfs either value and the bias hardly moves (family cars
+//! 41–64, `calibration_family.rs`), with a better gyro the yaw noise
+//! dominates and the bias reads low.
 //!
 //! The family here: cars 65–88 of [`CarFamily`] (no choice of the project
 //! was made on them), each with a gyro drawn between 0.0003 and 0.003 rad/s
 //! (log-uniform; vehicle.toml declares it), a gyro bias within ±0.005
 //! rad/s, and a CAN speed stream (so the speed scale is calibrated too).
-//! A 600 s calibration drive, calibrated with the default options and with
-//! the vehicle's yaw noise in the passes (the behaviour before issue 36);
+//! A 600 s calibration drive, calibrated with the default options (the
+//! vehicle's yaw noise in the passes) and with table I's in the passes;
 //! the errors of the six parameters in their standard errors; the pose NEES
 //! through 30 s dead-reckoning windows every 60 s of a second 600 s drive
 //! with the calibrated parameters (the dead-reckoning filter at the
@@ -26,7 +27,7 @@
 //! cargo test --profile ci -p deadreckon-sim --test calibration_noise_family -- --nocapture
 //! ```
 
-use deadreckon_core::calibrate::{calibrate, CalibrationOptions};
+use deadreckon_core::calibrate::{calibrate, CalibrationOptions, SMOOTHING_PROCESS_YAW_RAD};
 use deadreckon_core::consistency::{nees_through_windows, windows, Verdict};
 use deadreckon_core::ekf::FilterOptions;
 use deadreckon_core::Params;
@@ -41,11 +42,10 @@ use rayon::prelude::*;
 /// The family members checked.
 const CARS: std::ops::RangeInclusive<u64> = 65..=88;
 
-/// The calibration options of the behaviour before issue 36: the passes at
-/// the vehicle's `noise.process_yaw_rad`.
-fn at_vehicle_yaw_noise() -> CalibrationOptions {
+/// The calibration options with the passes at table I's yaw noise.
+fn at_table_one_yaw_noise() -> CalibrationOptions {
     CalibrationOptions {
-        smoothing_process_yaw_rad: None,
+        smoothing_process_yaw_rad: Some(SMOOTHING_PROCESS_YAW_RAD),
         ..CalibrationOptions::default()
     }
 }
@@ -87,9 +87,9 @@ fn z(est: &Params, std: &Params, truth: &Params) -> [f64; 6] {
 #[derive(Debug, Clone)]
 struct Member {
     gyro_rps: f64,
-    /// The default calibration's errors in standard errors.
+    /// The errors in standard errors with the passes at table I's yaw noise.
     z: [f64; 6],
-    /// The same with the passes at the vehicle's yaw noise.
+    /// The same with the default calibration (the vehicle's yaw noise).
     z_vehicle: [f64; 6],
     /// The pose NEES on the evaluation drive.
     pose: Verdict,
@@ -100,8 +100,8 @@ struct Member {
 fn member(seed: u64) -> Result<Member, String> {
     let (s, gyro_rps) = scenario(seed, 100 + seed);
     let cal = simulate(&s, 100 + seed).map_err(|e| e.to_string())?;
-    let c = calibrate(&cal.drive, &CalibrationOptions::default()).map_err(|e| e.to_string())?;
-    let old = calibrate(&cal.drive, &at_vehicle_yaw_noise()).map_err(|e| e.to_string())?;
+    let c = calibrate(&cal.drive, &at_table_one_yaw_noise()).map_err(|e| e.to_string())?;
+    let old = calibrate(&cal.drive, &CalibrationOptions::default()).map_err(|e| e.to_string())?;
     let nees = |white: bool| -> Result<Verdict, String> {
         let (mut s, _) = scenario(seed, 200 + seed);
         if white {
@@ -136,7 +136,7 @@ fn calibrated_parameters_within_their_error_bars_with_better_gyros() {
         .map(|seed| (seed, member(seed)))
         .collect();
     println!(
-        "car | gyro rad/s | default: z bias, scale, circumferences | passes at the vehicle's 5e-5: the same | pose NEES (white fixes, no latency)"
+        "car | gyro rad/s | passes at table I's 1e-5: z bias, scale, circumferences | default (the vehicle's 5e-5): the same | pose NEES (white fixes, no latency)"
     );
     let f = |z: &[f64; 6]| {
         z.iter()
@@ -169,36 +169,41 @@ fn calibrated_parameters_within_their_error_bars_with_better_gyros() {
         (ms.iter().map(|m| k(m).powi(2)).sum::<f64>() / n as f64).sqrt()
     };
     println!(
-        "default: {ok}/{n} every parameter within 3σ ({bias_ok}/{n} the gyro bias, RMS z {:.2}); \
-         passes at the vehicle's yaw noise: {ok_vehicle}/{n} ({bias_ok_vehicle}/{n}, RMS z {:.2}); \
+        "passes at table I's yaw noise: {ok}/{n} every parameter within 3σ ({bias_ok}/{n} the gyro bias, RMS z {:.2}); \
+         default (the vehicle's): {ok_vehicle}/{n} ({bias_ok_vehicle}/{n}, RMS z {:.2}); \
          pose NEES consistent {consistent}/{n} ({consistent_white}/{n} with white fixes, no latency)",
         rms(&|m| m.z[0]),
         rms(&|m| m.z_vehicle[0]),
     );
-    // Measured (cars 65–88, run once): every parameter within 3σ on 22/24
-    // (car 74: speed scale −3.07σ, circumferences +2.9σ, the distance
-    // scale at either yaw noise; car 80: bias +2.97σ), the gyro bias on
-    // 23/24, RMS z 1.65; with the passes at the vehicle's 5e-5: 20/24, bias
-    // 21/24 (car 82 −3.52σ, car 74's distance scale +3.2σ), RMS z 1.97. The
-    // issue's bar (95 %, 23 of 24) is met by the gyro bias, not by the
-    // distance scale of car 74 (module docs). The pose NEES is
+    // Measured (cars 65–88, run once): at table I's yaw noise every
+    // parameter within 3σ on 22/24 (car 74: speed scale −3.07σ,
+    // circumferences +2.9σ, the distance scale at either yaw noise; car 80:
+    // bias +2.97σ), the gyro bias on 23/24, RMS z 1.65; with the default
+    // (the vehicle's 5e-5): 20/24, bias 21/24 (car 82 −3.52σ, car 74's
+    // distance scale +3.2σ), RMS z 1.97. The issue's bar (95 %, 23 of 24)
+    // is met by the gyro bias at table I's value only, by neither for every
+    // parameter (car 74's distance scale). The pose NEES is
     // over-confident on 24/24 (×1.9–×174; 23/24 with white fixes and no
     // latency, ×1.7–×16): printed, not asserted (the family's receivers,
     // see calibration_family.rs; issue 31's bound is the remedy).
     assert_eq!(n, 24);
     assert!(bias_ok >= 23, "gyro bias within 3σ on {bias_ok}/{n}");
     assert!(ok >= 22, "every parameter within 3σ on {ok}/{n}");
-    assert!(ok >= ok_vehicle && bias_ok >= bias_ok_vehicle);
+    assert!(ok >= ok_vehicle + 2 && bias_ok >= bias_ok_vehicle + 2);
     assert!(rms(&|m| m.z[0]) < 1.8, "RMS z of the bias");
+    assert!(
+        rms(&|m| m.z_vehicle[0]) > 1.85,
+        "RMS z of the bias, default"
+    );
 }
 
 /// Issue 36's case, a new user's drive: the built-in calibration scenario
 /// (600 s, seed 1) with a gyro of 0.0005 rad/s per reading (declared in
 /// vehicle.toml) and a true bias of 0.0041 rad/s. With the passes at the
-/// dead-reckoning filter's 5e-5 the bias read 0.0040942 ± 0.0000020
-/// (−2.93σ); with table I's 1e-5, 0.0041009 (+0.46σ).
+/// dead-reckoning filter's 5e-5 (the default) the bias reads 0.0040942 ±
+/// 0.0000020 (−2.93σ); with table I's 1e-5, 0.0041009 (+0.46σ).
 #[test]
-fn a_good_gyros_bias_is_not_pulled_low_by_the_dead_reckoning_yaw_noise() {
+fn a_good_gyros_bias_read_low_with_the_dead_reckoning_yaw_noise_in_the_passes() {
     let mut s = Scenario::builtin("calibration").unwrap();
     s.duration_s = Some(600.0);
     let truth = 0.0041;
@@ -216,10 +221,42 @@ fn a_good_gyros_bias_is_not_pulled_low_by_the_dead_reckoning_yaw_noise() {
         (e.params.gyro_bias_rps - truth) / e.std.gyro_bias_rps
     };
     let (now, before) = (
+        z(&at_table_one_yaw_noise()),
         z(&CalibrationOptions::default()),
-        z(&at_vehicle_yaw_noise()),
     );
     println!("z: {now:+.2} with table I's yaw noise, {before:+.2} with the vehicle's");
     assert!(now.abs() < 1.0, "{now}");
     assert!(before < -2.5, "{before}");
+}
+
+/// Family car 30 with white fixes (drive 130), whose heading is found late
+/// (13–20° off at the first fixes). With table I's yaw noise as every
+/// calibration's default, the command refused it (its smoothing filter lost
+/// the fixes: distance scale −9.8 % against the GNSS chords,
+/// `tests/edges.rs`), one of the reasons it is not the default; the core
+/// calibration, with the wheel monitor as the command runs it, calibrates
+/// it with either (table I's: z within 1.37, the bias +0.43; the
+/// vehicle's: within 1.46). The difference was not found.
+#[test]
+fn car_30s_late_heading_calibrates_in_the_core_with_either_yaw_noise() {
+    let mut car = CarFamily::draw(30);
+    car.gnss_markov = (0.0, 60.0);
+    let sim = simulate(&car.drive(130, 600.0), 130).unwrap();
+    for mut opts in [at_table_one_yaw_noise(), CalibrationOptions::default()] {
+        // As `calibrate` runs it: with the wheel-health monitor.
+        opts.filter.wheel_monitor = Some(Default::default());
+        let c = calibrate(&sim.drive, &opts).unwrap();
+        let z = z(&c.estimate.params, &c.estimate.std, &sim.truth_params);
+        let chords = c.gnss_chords.map(|ch| ch.std);
+        println!(
+            "{:?}: converged {} after {} passes, z {:?}, chords {chords:?}",
+            opts.smoothing_process_yaw_rad, c.converged, c.iterations, z
+        );
+        assert!(c.converged);
+        // No CAN speed on this car: the speed scale is not estimated (σ 0).
+        assert!(
+            z.iter().filter(|v| v.is_finite()).all(|v| v.abs() <= 3.0),
+            "{z:?}"
+        );
+    }
 }
