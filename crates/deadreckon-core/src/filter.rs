@@ -451,6 +451,14 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
     pub fn noise(&self) -> &Noise {
         &self.noise
     }
+    /// The filter with its yaw process noise per `process_step_s` set to
+    /// `process_yaw_rad` instead of the vehicle's (the RTS calibration's
+    /// passes with `CalibrationOptions::smoothing_process_yaw_rad`, e.g.
+    /// [`crate::calibrate::SMOOTHING_PROCESS_YAW_RAD`]).
+    pub fn with_process_yaw_rad(mut self, process_yaw_rad: f64) -> Self {
+        self.noise.process_yaw_rad = process_yaw_rad;
+        self
+    }
     /// Eq. (6)/(8) at the current state: the ticks wheel `i` should count over
     /// `interval_s`.
     pub fn predicted_wheel_ticks(&self, i: usize, interval_s: f64) -> f64 {

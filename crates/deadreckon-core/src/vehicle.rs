@@ -46,7 +46,9 @@ pub struct Noise {
     /// α_xy: position process noise per reference step, m (table I: 1e-3).
     pub process_xy_m: f64,
     /// α_ψ: yaw process noise per reference step, rad (default
-    /// [`PROCESS_YAW_RAD`], 5e-5; table I: 1e-5).
+    /// [`PROCESS_YAW_RAD`], 5e-5; table I: 1e-5). The RTS calibration's
+    /// passes use it too unless told otherwise
+    /// ([`crate::calibrate::SMOOTHING_PROCESS_YAW_RAD`]).
     pub process_yaw_rad: f64,
     /// α_v: speed process noise per reference step, m/s (table I: 10).
     pub process_speed_mps: f64,
@@ -175,6 +177,12 @@ fn is_default_scale_hold(v: &f64) -> bool {
 /// 7–11 merged over-confident ×1.5 at a quarter of the window only (×1.9 at
 /// 1e-5). On the comma2k19 segment it changes the 20 s outage error by at
 /// most 0.02 m (held-out second half → first: 0.714 → 0.697 m median).
+///
+/// In the RTS calibration's smoother (which uses it by default) the larger
+/// value lets the yaw take what the gyro bias should explain, and a good
+/// gyro's bias reads low (issue 36): table I's value for the passes is an
+/// option, [`crate::calibrate::SMOOTHING_PROCESS_YAW_RAD`], with its
+/// measurements and why it is not the default.
 pub const PROCESS_YAW_RAD: f64 = 5e-5;
 
 /// How the process noise of the yaw rate reaches the yaw over one step.

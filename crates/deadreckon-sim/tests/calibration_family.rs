@@ -9,16 +9,17 @@
 //! options; the errors of the gyro bias and the four circumferences in
 //! their standard errors against the car's truth; then the pose NEES
 //! through 30 s dead-reckoning windows every 60 s of a second 600 s drive
-//! with the calibrated parameters. The same with the calibration's filter
-//! at table I's 1e-5 (the issue's alternative: calibrate with the model's
-//! own noise), printed beside it.
+//! with the calibrated parameters. The same with the calibration's passes
+//! at table I's 1e-5 (`calibrate::SMOOTHING_PROCESS_YAW_RAD`, an option)
+//! printed beside it.
 //!
 //! Measured (24 cars): every parameter within 3σ on 24 of 24 at 5e-5 and
-//! on 24 of 24 at 1e-5 (largest |z| 2.57 and 2.50, car 56's gyro bias):
-//! the gyro bias the issue saw 3.6–4.4σ off on an independently generated
-//! drive is not off on these cars, and calibrating at table I's value
-//! changes no z by more than 0.4 (the yaw noise is not kept from the
-//! calibration on this evidence). The pose NEES, in contrast, reads
+//! on 24 of 24 at 1e-5 (largest |z| 2.57 and 2.50, car 56's gyro bias;
+//! the same with the 1e-5 set in the drive's vehicle.toml, as this test
+//! first did): with these cars' gyro
+//! (table II's 0.003 rad/s) the yaw noise changes no z by more than 0.4;
+//! the family with better gyros where it does is
+//! `calibration_noise_family.rs`. The pose NEES, in contrast, reads
 //! over-confident on 24 of 24 evaluation drives, by ×1.8 to ×254, and still
 //! on 22 of 24 (×1.6 to ×13.5) with white fixes and no receiver latency:
 //! the family's receivers (latency 0–0.15 s, Gauss–Markov wander) and
@@ -30,7 +31,7 @@
 //! cargo test --profile ci -p deadreckon-sim --test calibration_family -- --nocapture
 //! ```
 
-use deadreckon_core::calibrate::{calibrate, CalibrationOptions};
+use deadreckon_core::calibrate::{calibrate, CalibrationOptions, SMOOTHING_PROCESS_YAW_RAD};
 use deadreckon_core::consistency::{nees_through_windows, windows, Verdict};
 use deadreckon_core::ekf::FilterOptions;
 use deadreckon_sim::family::CarFamily;
@@ -55,14 +56,16 @@ struct Member {
 /// A member's figures, or why it has none.
 type Outcome = Result<Member, String>;
 
-fn member(seed: u64, calibration_yaw_rad: Option<f64>) -> Result<Member, String> {
+/// A member calibrated with the default options (`at_table_one`: with the
+/// passes at table I's yaw noise, 1e-5).
+fn member(seed: u64, at_table_one: bool) -> Result<Member, String> {
     let car = CarFamily::draw(seed);
     let cal = simulate(&car.drive(100 + seed, 600.0), 100 + seed).map_err(|e| e.to_string())?;
-    let mut d = cal.drive.clone();
-    if let Some(q) = calibration_yaw_rad {
-        d.vehicle.noise.process_yaw_rad = q;
-    }
-    let c = calibrate(&d, &CalibrationOptions::default()).map_err(|e| e.to_string())?;
+    let opts = CalibrationOptions {
+        smoothing_process_yaw_rad: at_table_one.then_some(SMOOTHING_PROCESS_YAW_RAD),
+        ..CalibrationOptions::default()
+    };
+    let c = calibrate(&cal.drive, &opts).map_err(|e| e.to_string())?;
     let (p, s, t) = (
         c.estimate.params.to_array(),
         c.estimate.std.to_array(),
@@ -100,10 +103,10 @@ fn verdict_text(v: Verdict) -> String {
 fn calibrated_parameters_within_their_error_bars_over_the_family() {
     let rows: Vec<(u64, Outcome, Outcome)> = CARS
         .into_par_iter()
-        .map(|seed| (seed, member(seed, None), member(seed, Some(1e-5))))
+        .map(|seed| (seed, member(seed, false), member(seed, true)))
         .collect();
     let (mut within, mut n, mut consistent, mut within_t1) = (0usize, 0usize, 0usize, 0usize);
-    println!("car | default 5e-5: z bias, z circumferences, pose NEES | table I 1e-5: the same");
+    println!("car | default (passes at the vehicle's 5e-5): z bias, z circumferences, pose NEES | passes at table I's 1e-5: the same");
     for (seed, a, b) in &rows {
         let line = |m: &Result<Member, String>| match m {
             Ok(m) => format!(
@@ -129,7 +132,7 @@ fn calibrated_parameters_within_their_error_bars_over_the_family() {
     }
     println!(
         "default: {within}/{n} with every parameter within 3σ, {consistent}/{n} pose NEES consistent; \
-         calibrated at 1e-5: {within_t1}/{n} within 3σ"
+         passes at table I's 1e-5: {within_t1}/{n} within 3σ"
     );
     // Measured 24/24 (see the module docs); the issue's bar is 95 %.
     assert!(within * 100 >= 95 * n, "{within}/{n}");
