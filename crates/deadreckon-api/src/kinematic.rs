@@ -512,6 +512,10 @@ pub struct Evaluated {
     /// A differential drive's outages: how they started, the filter's fix
     /// counts and predicted errors.
     pub diff: Option<DiffDriveOutages>,
+    /// The 95 % error bound's factor (issue 31): the differential drive's
+    /// filter only (`None`: no covariance to bound, the tricycle's
+    /// kinematics and the alignment start; [`crate::bound::NO_COVARIANCE`]).
+    pub bound: Option<deadreckon_core::bound::BoundFit>,
 }
 
 impl Evaluated {
@@ -543,6 +547,7 @@ impl Evaluated {
                 }
             }
         }
+        crate::bound::add_kinematic_bound(&mut v, self.diff.as_ref(), self.bound.as_ref());
         v
     }
 
@@ -572,6 +577,10 @@ impl Evaluated {
                 ));
             }
         }
+        out.extend(crate::bound::kinematic_bound_lines(
+            self.diff.as_ref(),
+            self.bound.as_ref(),
+        ));
         out
     }
 }
@@ -618,6 +627,7 @@ pub fn evaluate_tricycle(
         align_s: None,
         evaluation,
         diff: None,
+        bound: None,
     })
 }
 
@@ -656,6 +666,7 @@ pub fn evaluate_diff(
     from_s: Option<f64>,
     until_s: Option<f64>,
 ) -> Result<Evaluated, Error> {
+    let (calibrated_here, spec) = (params.is_none(), params);
     let LoadedParams {
         values: params,
         std,
@@ -701,6 +712,7 @@ pub fn evaluate_diff(
     };
     let dd = diff_drive(drive, yaw, from_s, until_s)?;
     let diff = evaluate_diff_drive(&dd, &params, length_s, step_s, align_s, &start)?;
+    let bound = diff_bound(&dd, &params, &start, align_s, calibrated_here, spec)?;
     Ok(Evaluated {
         shape: Shape::DiffDrive,
         length_s,
@@ -708,7 +720,44 @@ pub fn evaluate_diff(
         align_s: Some(align_s),
         evaluation: diff.outages.clone(),
         diff: Some(diff),
+        bound,
     })
+}
+
+/// The differential drive's 95 % bound factor (issue 31): none from the
+/// alignment (no covariance); the `[bound]` table of a params file that
+/// has one, else the filter's covariance alone (`nominal` too); fitted on
+/// the evaluated drive's own windows against its hidden fixes when the
+/// parameters were calibrated on it (in-sample, as a car's `evaluate`
+/// without `--params`: [`deadreckon_core::bound_diff::fit_diff_drive`]).
+fn diff_bound(
+    dd: &DiffDriveDrive,
+    params: &[f64],
+    start: &OutageStart,
+    align_s: f64,
+    calibrated_here: bool,
+    spec: Option<&str>,
+) -> Result<Option<deadreckon_core::bound::BoundFit>, Error> {
+    use deadreckon_core::bound::BoundFit;
+    let OutageStart::Filter(noise) = start else {
+        return Ok(None);
+    };
+    if calibrated_here {
+        return Ok(Some(deadreckon_core::bound_diff::fit_diff_drive(
+            dd, params, noise, align_s,
+        )));
+    }
+    let stored = match spec.filter(|s| *s != "nominal") {
+        Some(file) => {
+            let text = std::fs::read_to_string(file).doing(|| format!("reading {file}"))?;
+            let t: toml::Table =
+                toml::from_str(&text).map_err(|e| Error::Invalid(format!("{file}: {e}")))?;
+            crate::bound::bound_from_extra(&t)
+                .map_err(|e| Error::Invalid(format!("{file}: {e}")))?
+        }
+        None => BoundFit::FILTER,
+    };
+    Ok(Some(stored))
 }
 
 /// A tricycle's tracks (dead-reckoned through its own kinematics from the
