@@ -380,6 +380,10 @@ pub struct Calibrated {
     pub yaw: Option<YawSource>,
     /// The calibration.
     pub calibration: KinematicCalibration,
+    /// A differential drive's 95 % error bound factor, fitted with the
+    /// calibrated parameters on the calibration range's own hidden fixes
+    /// (written as `[bound]`; `None` for the tricycle: no covariance).
+    pub bound: Option<deadreckon_core::bound::BoundFit>,
 }
 
 impl Calibrated {
@@ -390,13 +394,20 @@ impl Calibrated {
         if let Some(y) = self.yaw {
             v["yaw_source"] = yaw_name(y).into();
         }
+        if let Some(b) = &self.bound {
+            v["bound"] = crate::bound::bound_json(b);
+        }
         v
     }
 
     /// The table: value, standard error and status per parameter, the
     /// correlation of the estimated ones, the fit.
     pub fn lines(&self) -> Vec<String> {
-        crate::text::kinematic_table(&self.calibration)
+        let mut out = crate::text::kinematic_table(&self.calibration);
+        if let Some(b) = &self.bound {
+            out.push(format!("95 % error bound: {}", crate::bound::fit_text(b)));
+        }
+        out
     }
 
     /// Writes the kinematic params.toml (status, std and reason per
@@ -405,6 +416,7 @@ impl Calibrated {
         let mut f =
             KinematicParamsFile::from_calibration(self.shape, self.method, &self.calibration);
         f.yaw_source = self.yaw.map(|y| yaw_name(y).to_string());
+        f.bound = self.bound.as_ref().map(crate::bound::bound_toml);
         deadreckon_io::write_kinematic_params(path, &f)
             .doing(|| format!("writing {}", path.display()))
     }
@@ -467,6 +479,7 @@ pub fn calibrate_tricycle(
         method,
         yaw: None,
         calibration,
+        bound: None,
     })
 }
 
@@ -488,11 +501,27 @@ pub fn calibrate_diff(
     };
     let calibration =
         calibrate_diff_drive(&dd, &opts).doing(|| format!("calibrating {}", path.display()))?;
+    // The bound's factor on the calibration range's own outages, started
+    // from the filter as `evaluate` starts them (its priors from the
+    // calibration's standard errors).
+    let std: Vec<Option<f64>> = calibration
+        .params
+        .iter()
+        .map(|p| if p.estimated { p.std } else { None })
+        .collect();
+    let noise = diff_drive::FilterNoise::default().with_param_std(&std);
+    let bound = deadreckon_core::bound_diff::fit_diff_drive(
+        &dd,
+        &calibration.values(),
+        &noise,
+        diff_drive::DEFAULT_WARMUP_S,
+    );
     Ok(Calibrated {
         shape,
         method,
         yaw: Some(yaw),
         calibration,
+        bound: Some(bound),
     })
 }
 

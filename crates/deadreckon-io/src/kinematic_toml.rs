@@ -52,6 +52,11 @@ pub struct KinematicParamsFile {
     /// Correlation of the estimated parameters.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub correlation: Option<Correlation>,
+    /// The 95 % error bound's factor (`[bound]`: `method`, `k`, `windows`,
+    /// `outage_s`, `step_s`; docs/bound.md), when one was fitted (a
+    /// differential drive's calibration).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bound: Option<toml::Table>,
 }
 
 /// A correlation matrix with the names of its rows.
@@ -79,6 +84,7 @@ impl KinematicParamsFile {
                 names: c.correlated.clone(),
                 matrix: c.correlation.clone(),
             }),
+            bound: None,
         }
     }
 
@@ -194,6 +200,7 @@ mod tests {
                 names: vec!["a_m".into()],
                 matrix: vec![vec![1.0]],
             }),
+            bound: None,
         }
     }
 
