@@ -384,6 +384,7 @@ fn comma2k19_held_out_halves() {
     let d = drive.to_str().unwrap();
     run_ok(&["import", "comma2k19", COMMA, "--out", d]);
     let mut got = Vec::new();
+    let mut bound = Vec::new();
     for (cal, eval) in [("--until", "--from"), ("--from", "--until")] {
         let params = tmp
             .path()
@@ -404,7 +405,31 @@ fn comma2k19_held_out_halves() {
             o["unsettled"].as_array().map_or(0, |u| u.len())
         );
         got.push((mean, median));
+        // Issue 31: the 95 % bound with the factor the half's calibration
+        // stored (fitted on its own hidden fixes).
+        let within = o["outages"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|w| w["within_bound_95"] == true)
+            .count();
+        let sharp = o["bound_95_sharpness"].as_f64().unwrap();
+        eprintln!(
+            "  bound: k {} ({}), {within} windows within, sharpness {sharp:.2}",
+            o["bound"]["k"], o["bound"]["method"]
+        );
+        assert_eq!(o["bound"]["method"], "conformal", "{o}");
+        bound.push((within, o["outages"].as_array().unwrap().len(), sharp));
     }
+    // Measured: first half -> second 4 of 4 windows within (k 0.175,
+    // sharpness 1.27), second -> first 2 of 3 (k 0.131, 1.50): 6 of 7
+    // (86 %), the issue's at least 80 %.
+    assert_eq!((bound[0].0, bound[0].1), (4, 4), "{bound:?}");
+    assert_eq!((bound[1].0, bound[1].1), (2, 3), "{bound:?}");
+    assert!(
+        (bound[0].2 - 1.27).abs() < 0.15 && (bound[1].2 - 1.50).abs() < 0.15,
+        "{bound:?}"
+    );
     // Measured: first half -> second 0.773 / 0.807 m (mean / median, 4
     // windows), second -> first 0.593 / 0.511 m (3 windows, the pull-away
     // reported apart): the README's figures. Within about 10 %.
@@ -505,6 +530,18 @@ fn comma2k19_import_calibrate_evaluate_report() {
             // Every window starts with the heading known (yaw standard
             // deviation 0.14-0.48 deg measured).
             assert_eq!(o["unsettled"].as_array().unwrap().len(), 0, "{o}");
+            // Issue 31, the 95 % bound fitted on the drive itself (in-sample,
+            // 20 windows of 18.2 s against its own fixes): measured k 0.148,
+            // 2 of 7 windows within (29 %), sharpness 0.89. The issue's 80 %
+            // is NOT met here: the fit sees the fixes, which share the
+            // u-blox's 0.39 m offset from the reference, so k is small, and
+            // k also scales the receiver floor (the declared 1 m), leaving
+            // it 0.36 m against start errors of 0.32-0.52 m. Pinned so that
+            // a change of the construction shows (docs/bound.md).
+            let k = o["bound"]["k"].as_f64().unwrap();
+            let cover = o["bound_95_coverage"].as_f64().unwrap();
+            assert!((k - 0.148).abs() < 0.02, "k {k}");
+            assert!((cover - 2.0 / 7.0).abs() < 0.01, "coverage {cover}");
         }
     }
     // Bounds on the measured figures (see the closing note of the readers issue).

@@ -119,6 +119,23 @@ fn husky_diff_drive_calibrated_against_gnss_through_30_s_outages() {
     // after 2 s of rejections.
     assert_eq!(vf["fix_jumps"], 1, "{vf}");
     assert!(vf["fixes_rejected"].as_u64().unwrap() <= 10, "{vf}");
+    // Issue 31: the file stores the factor fitted with the calibration on
+    // the bag's own hidden fixes (k 1.428, 31 windows): 31 of 31 within,
+    // median bound / median final error 2.37 (in-sample; with the filter's
+    // covariance alone, k = 1, it was 26 of 31 and 1.66). The alignment
+    // start has no covariance and says so.
+    assert_eq!(vf["bound"]["method"], "conformal", "{vf}");
+    assert_eq!(vf["bound_95_coverage"].as_f64(), Some(1.0), "{vf}");
+    near(
+        "sharpness, stored factor",
+        vf["bound_95_sharpness"].as_f64().unwrap(),
+        2.37,
+        0.15,
+    );
+    assert!(
+        va["bound"].is_null() && va["bound_95_note"].is_string(),
+        "{va}"
+    );
 
     // The params file carries its yaw source: evaluating it with the other is an error.
     let out = Command::new(env!("CARGO_BIN_EXE_deadreckon"))
@@ -140,6 +157,41 @@ fn husky_diff_drive_calibrated_against_gnss_through_30_s_outages() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("--yaw gyro"));
 }
 
+/// Issue 31: with the default options (no --params: calibrated on the bag
+/// and the bound's factor fitted on its own windows against the hidden
+/// fixes, in-sample), the final error of every 30 s outage is within the
+/// 95 % bound. Measured: k 1.428, 31 of 31 windows within, median bound
+/// 6.53 m over median final error 2.75 m (2.37). The issue asks at least
+/// 80 %.
+#[test]
+fn husky_bound_covers_30_s_outages_with_the_default_options() {
+    let v: serde_json::Value = serde_json::from_str(&run_ok(&[
+        "evaluate", HUSKY, "--outage", "30", "--step", "10", "--json",
+    ]))
+    .unwrap();
+    eprintln!(
+        "husky bound: {} coverage {} sharpness {}",
+        v["bound"], v["bound_95_coverage"], v["bound_95_sharpness"]
+    );
+    assert_eq!(v["shape"], "diff_drive", "{v}");
+    assert_eq!(v["bound"]["method"], "conformal", "{v}");
+    let outages = v["outages"].as_array().unwrap();
+    assert_eq!(outages.len(), 31);
+    let within = outages
+        .iter()
+        .filter(|w| w["within_bound_95"] == true)
+        .count();
+    assert!(within >= 30, "{within} of 31 within the bound");
+    assert!(v["bound_95_coverage"].as_f64().unwrap() >= 0.8);
+    near("k", v["bound"]["k"].as_f64().unwrap(), 1.428, 0.1);
+    near(
+        "sharpness",
+        v["bound_95_sharpness"].as_f64().unwrap(),
+        2.37,
+        0.15,
+    );
+}
+
 #[test]
 fn husky_diff_drive_every_param_calibrated_on_one_half_and_evaluated_on_the_other() {
     let tmp = tempfile::tempdir().unwrap();
@@ -152,7 +204,7 @@ fn husky_diff_drive_every_param_calibrated_on_one_half_and_evaluated_on_the_othe
     let (first, second) = (first.to_str().unwrap(), second.to_str().unwrap());
     let (f12, v) = outage_mean(first, &["--from", MIDDLE]);
     let (a12, _) = outage_mean(first, &["--from", MIDDLE, "--start", "align"]);
-    let (f21, _) = outage_mean(second, &["--until", MIDDLE]);
+    let (f21, v21) = outage_mean(second, &["--until", MIDDLE]);
     let (a21, _) = outage_mean(second, &["--until", MIDDLE, "--start", "align"]);
     eprintln!(
         "first -> second: filter {f12:.3} m, aligned {a12:.3} m; second -> first: filter \
@@ -163,6 +215,48 @@ fn husky_diff_drive_every_param_calibrated_on_one_half_and_evaluated_on_the_othe
     near("first half -> second, aligned start", a12, 4.015, 0.25);
     near("second half -> first, filter start", f21, 4.408, 0.25);
     near("second half -> first, aligned start", a21, 5.656, 0.25);
+    // Issue 31, held out: each half's file stores the factor fitted on its
+    // own hidden fixes. Measured: first -> second k 1.38, 11 of 11 within,
+    // sharpness 1.88; second -> first k 1.08, 7 of 11, 1.11: 18 of 22
+    // (82 %), the issue's at least 80 %.
+    let within = |v: &serde_json::Value| {
+        v["outages"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|w| w["within_bound_95"] == true)
+            .count()
+    };
+    let (w12, w21) = (within(&v), within(&v21));
+    eprintln!(
+        "bound: first -> second {w12} of 11 (k {}), second -> first {w21} of 11 (k {})",
+        v["bound"]["k"], v21["bound"]["k"]
+    );
+    assert_eq!((w12, w21), (11, 7));
+    near(
+        "k, first half",
+        v["bound"]["k"].as_f64().unwrap(),
+        1.38,
+        0.1,
+    );
+    near(
+        "k, second half",
+        v21["bound"]["k"].as_f64().unwrap(),
+        1.08,
+        0.1,
+    );
+    near(
+        "sharpness, first -> second",
+        v["bound_95_sharpness"].as_f64().unwrap(),
+        1.88,
+        0.15,
+    );
+    near(
+        "sharpness, second -> first",
+        v21["bound_95_sharpness"].as_f64().unwrap(),
+        1.11,
+        0.15,
+    );
 }
 
 /// Issue 29 item 4: the Husky calibrated on one half lost to the nominal

@@ -37,8 +37,8 @@ fn delayed_tilted_drive(dir: &Path) {
     deadreckon_io::write_drive_whole(dir, &sim.drive, |_| Ok(())).unwrap();
 }
 
-/// `run`'s filtered track: (t, east, north, yaw).
-fn run_filtered(drive: &str, params: &str, timing: &str, tmp: &Path) -> Vec<[f64; 4]> {
+/// `run`'s filtered track: (t, east, north, yaw, bound_95_m).
+fn run_filtered(drive: &str, params: &str, timing: &str, tmp: &Path) -> Vec<[f64; 5]> {
     let out = tmp.join(format!("run-{timing}.csv"));
     run_ok(&[
         "run",
@@ -53,18 +53,41 @@ fn run_filtered(drive: &str, params: &str, timing: &str, tmp: &Path) -> Vec<[f64
     let mut r = csv::Reader::from_path(&out).unwrap();
     let h = r.headers().unwrap().clone();
     let col = |n: &str| h.iter().position(|c| c == n).unwrap();
-    let (t, tr, e, no, y) = (
+    let (t, tr, e, no, y, b) = (
         col("t_s"),
         col("track"),
         col("east_m"),
         col("north_m"),
         col("yaw_rad"),
+        col("bound_95_m"),
     );
     r.records()
         .map(|x| x.unwrap())
         .filter(|x| &x[tr] == "filtered")
-        .map(|x| [t, e, no, y].map(|i| x[i].parse().unwrap()))
+        .map(|x| [t, e, no, y, b].map(|i| x[i].parse().unwrap()))
         .collect()
+}
+
+/// The `bound_95_m` of each of `stream`'s pose lines.
+fn bounds(stdout: &str) -> Vec<f64> {
+    stdout
+        .lines()
+        .map(|l| {
+            let v: serde_json::Value = serde_json::from_str(l).unwrap();
+            v["bound_95_m"].as_f64().expect("bound_95_m")
+        })
+        .collect()
+}
+
+/// The largest relative difference of `stream`'s bounds and `run`'s
+/// `bound_95_m` column, epoch for epoch.
+fn largest_bound_gap(stream: &[f64], run: &[[f64; 5]]) -> f64 {
+    assert_eq!(stream.len(), run.len(), "epochs");
+    stream
+        .iter()
+        .zip(run)
+        .map(|(s, w)| (s - w[4]).abs() / w[4])
+        .fold(0.0, f64::max)
 }
 
 fn poses(stdout: &str) -> Vec<TrackPoint> {
@@ -76,7 +99,7 @@ fn poses(stdout: &str) -> Vec<TrackPoint> {
 
 /// The largest distance between `stream`'s poses and `run`'s track, with
 /// the same number of epochs at the same times.
-fn largest_gap_m(stream: &[TrackPoint], run: &[[f64; 4]]) -> f64 {
+fn largest_gap_m(stream: &[TrackPoint], run: &[[f64; 5]]) -> f64 {
     assert_eq!(stream.len(), run.len(), "epochs");
     let mut worst = 0.0_f64;
     for (p, w) in stream.iter().zip(run) {
@@ -142,6 +165,15 @@ fn stream_disagreed_with_run_on_stored_delays() {
         let stored = std::fs::read_to_string(params).unwrap();
         let extra: toml::Table = toml::from_str(&stored).unwrap();
         let c = deadreckon_api::corrections::stored_corrections(&extra).unwrap();
+        // The bound's factor the stream and run both apply: fitted, so the
+        // comparison below is of k · r(P + σ²I), not of k = 1.
+        let fit = deadreckon_api::bound::bound_from_extra(&extra).unwrap();
+        assert_eq!(
+            fit.method,
+            deadreckon_core::bound::Method::Conformal,
+            "{which}"
+        );
+        println!("{which}: bound factor {:.3}", fit.k);
         // What the file stores (the calibration's estimates of the true
         // 0.03 s, 0.06 s, 0.1 s, tilt and +0.8 %).
         println!("{which}: {c:?}");
@@ -191,6 +223,11 @@ fn stream_disagreed_with_run_on_stored_delays() {
             let gap = largest_gap_m(&poses(&r.stdout), &want);
             println!("{which}, --timing {timing}: largest gap {gap:e} m");
             assert!(gap < 1e-9, "{which} {timing}: {gap} m");
+            // The same 95 % bound on the same epochs (issue 31), from the
+            // factor the file stores: run's CSV has 7 significant digits.
+            let b = largest_bound_gap(&bounds(&r.stdout), &want);
+            println!("{which}, --timing {timing}: largest bound difference {b:e} (relative)");
+            assert!(b < 1e-6, "{which} {timing}: bound {b}");
         }
     }
 }

@@ -92,15 +92,16 @@ static DrStatus push(DrFilter *f, const char *line, long line_no) {
 /* Prints every pose waiting, as `deadreckon stream` does (%.17g: every bit). */
 static void print_poses(DrFilter *f) {
     DrPose p;
+    double bound_95_m;
     DrStatus s;
-    while ((s = dr_next_pose(f, &p)) == DR_STATUS_OK) {
+    while ((s = dr_next_pose_with_bound(f, &p, &bound_95_m)) == DR_STATUS_OK) {
         printf("{\"t_s\":%.17g,\"east_m\":%.17g,\"north_m\":%.17g,\"yaw_rad\":%.17g,"
                "\"speed_mps\":%.17g,\"yaw_rate_rps\":%.17g,\"cov_pose\":[",
                p.t_s, p.east_m, p.north_m, p.yaw_rad, p.speed_mps, p.yaw_rate_rps);
         for (int i = 0; i < 9; i++) printf(i ? ",%.17g" : "%.17g", p.cov_pose[i]);
-        printf("]}\n");
+        printf("],\"bound_95_m\":%.17g}\n", bound_95_m);
     }
-    if (s != DR_STATUS_NO_POSE) fail("dr_next_pose", s);
+    if (s != DR_STATUS_NO_POSE) fail("dr_next_pose_with_bound", s);
 }
 
 /* Saves the state, frees the filter, returns one restored from the bytes. */

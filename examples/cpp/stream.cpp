@@ -25,13 +25,14 @@
 namespace {
 
 // One pose as `deadreckon stream` prints it (%.17g: every bit).
-void print(const deadreckon::Pose& p) {
+void print(const deadreckon::BoundedPose& b) {
+  const deadreckon::Pose& p = b.pose;
   std::printf(
       "{\"t_s\":%.17g,\"east_m\":%.17g,\"north_m\":%.17g,\"yaw_rad\":%.17g,"
       "\"speed_mps\":%.17g,\"yaw_rate_rps\":%.17g,\"cov_pose\":[",
       p.t_s, p.east_m, p.north_m, p.yaw_rad, p.speed_mps, p.yaw_rate_rps);
   for (int i = 0; i < 9; i++) std::printf(i ? ",%.17g" : "%.17g", p.cov_pose[i]);
-  std::printf("]}\n");
+  std::printf("],\"bound_95_m\":%.17g}\n", b.bound_95_m);
 }
 
 int usage(const char* program) {
@@ -71,11 +72,11 @@ int main(int argc, char** argv) {
     while (std::getline(std::cin, line)) {
       line_no++;
       filter.push_line(line);
-      for (const auto& p : filter.take_poses()) print(p);
+      for (const auto& p : filter.take_poses_with_bounds()) print(p);
       if (line_no == restore_at) filter = deadreckon::Filter::restore(filter.save());
     }
     filter.finish();
-    for (const auto& p : filter.take_poses()) print(p);
+    for (const auto& p : filter.take_poses_with_bounds()) print(p);
     if (auto l = filter.learned()) {
       std::fprintf(stderr, "learned: %.0f%% calibrated, %s\n", l->calibrated_pct,
                    l->valid ? "valid" : "not yet valid");

@@ -249,7 +249,8 @@ def run(
     the ``corrections`` of :func:`calibrate`), as ``deadreckon run`` does. Columns: those of
     ``deadreckon run --out track.csv`` but ``track``: ``t_s, east_m, north_m,
     yaw_rad, speed_mps, yaw_rate_rps, std_east_m, std_north_m, std_yaw_rad,
-    cov_en_m2``. ``init_pose``: (east_m, north_m, yaw_rad) of the dead
+    cov_en_m2, bound_95_m`` (the 95 % error bound of the dead-reckoned and
+    filtered positions, NaN elsewhere: docs/bound.md). ``init_pose``: (east_m, north_m, yaw_rad) of the dead
     reckoning's start (default the truth, else the smoothed GNSS track).
     """
     tracks = _native.run_tracks(

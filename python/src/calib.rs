@@ -166,16 +166,24 @@ pub fn run_tracks<'py>(
     let drive = drive_arg(py, source, &Default::default(), mapping)?;
     // The one rule for no params (deadreckon_api::evaluate::RULE): calibrated
     // on the drive itself, as `run` does; a file's stored corrections applied.
-    let (params, drive) = match params {
+    // The 95 % bound's factor as `run` takes it: a file's `[bound]` (a
+    // dict's: the filter's covariance alone), or fitted with the calibration.
+    let (params, drive, bound) = match params {
         Some(p) => {
             let params = params_arg(p, &drive.vehicle)?.0;
-            (params, with_stored(Some(p), (*drive).clone())?)
+            let bound = match p.extract::<PathBuf>() {
+                Ok(f) if p.cast::<PyDict>().is_err() => {
+                    deadreckon_api::bound::stored_bound(&f.to_string_lossy()).map_err(to_py_err)?
+                }
+                _ => deadreckon_core::bound::BoundFit::FILTER,
+            };
+            (params, with_stored(Some(p), (*drive).clone())?, bound)
         }
         None => {
             let (c, d) = py
                 .detach(|| deadreckon_api::evaluate::default_parameters(&drive, which))
                 .map_err(to_py_err)?;
-            (c.params, d)
+            (c.params, d, c.bound)
         }
     };
     if let Some((e, n, y)) = init_pose {
@@ -192,9 +200,18 @@ pub fn run_tracks<'py>(
     let tracks = py
         .detach(|| deadreckon_api::tracks::drive_tracks(&drive, &params, &opts, init_pose))
         .map_err(to_py_err)?;
+    let bounds = deadreckon_api::tracks::bounds_95_m(&drive, &tracks, &bound, &opts, init_pose);
     let out = PyDict::new(py);
-    for t in &tracks {
-        out.set_item(&t.name, track_columns(py, t)?)?;
+    for (t, b) in tracks.iter().zip(&bounds) {
+        let c = track_columns(py, t)?;
+        // The CSV's `bound_95_m`: NaN where it is empty.
+        let b = if b.is_empty() {
+            vec![f64::NAN; t.points.len()]
+        } else {
+            b.clone()
+        };
+        c.set_item("bound_95_m", numpy::PyArray1::from_vec(py, b))?;
+        out.set_item(&t.name, c)?;
     }
     Ok(out)
 }

@@ -2,10 +2,10 @@
 //! (`deadreckon_core::online`): JSON-line events in (docs/events.md), one
 //! pose per completed epoch out, optionally learning the six parameters.
 
+use deadreckon_core::bound_pose::Pose;
 use deadreckon_core::calibrate::CalibrationOptions;
 use deadreckon_core::ekf::FilterOptions;
 use deadreckon_core::online::{LearnTargets, Online as CoreOnline, Start};
-use deadreckon_core::track::TrackPoint;
 use deadreckon_core::Params;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -23,17 +23,18 @@ pub struct Online {
     lines: u64,
 }
 
-fn poses<'py>(py: Python<'py>, p: &[TrackPoint]) -> PyResult<Bound<'py, PyDict>> {
+fn poses<'py>(py: Python<'py>, p: &[Pose]) -> PyResult<Bound<'py, PyDict>> {
     let mut c = ColumnsOut::new(py);
-    c.add("t_s", p, |r| r.t_s)?
-        .add("east_m", p, |r| r.east_m)?
-        .add("north_m", p, |r| r.north_m)?
-        .add("yaw_rad", p, |r| r.yaw_rad)?
-        .add("speed_mps", p, |r| r.speed_mps)?
-        .add("yaw_rate_rps", p, |r| r.yaw_rate_rps)?
-        .add("std_east_m", p, |r| r.std_east_m())?
-        .add("std_north_m", p, |r| r.std_north_m())?
-        .add("std_yaw_rad", p, |r| r.std_yaw_rad())?;
+    c.add("t_s", p, |r| r.point.t_s)?
+        .add("east_m", p, |r| r.point.east_m)?
+        .add("north_m", p, |r| r.point.north_m)?
+        .add("yaw_rad", p, |r| r.point.yaw_rad)?
+        .add("speed_mps", p, |r| r.point.speed_mps)?
+        .add("yaw_rate_rps", p, |r| r.point.yaw_rate_rps)?
+        .add("std_east_m", p, |r| r.point.std_east_m())?
+        .add("std_north_m", p, |r| r.point.std_north_m())?
+        .add("std_yaw_rad", p, |r| r.point.std_yaw_rad())?
+        .add("bound_95_m", p, |r| r.bound_95_m)?;
     Ok(c.finish())
 }
 
@@ -41,7 +42,8 @@ fn poses<'py>(py: Python<'py>, p: &[TrackPoint]) -> PyResult<Bound<'py, PyDict>>
 impl Online {
     /// An online filter for `vehicle` (a Drive, a dict of vehicle.toml's keys
     /// or its path), starting from GNSS, as `deadreckon stream` does; a
-    /// params.toml path's stored corrections are applied to the events.
+    /// params.toml path's stored corrections are applied to the events, and
+    /// its `[bound]` factor gives each pose its `bound_95_m`.
     #[new]
     #[pyo3(signature = (vehicle, params=None, timing="wheel", learn=false, prior_std=None))]
     fn new(
@@ -54,13 +56,16 @@ impl Online {
         let vehicle = vehicle_of(vehicle)?;
         // A params.toml's stored corrections (delays, IMU tilt, gyro scale,
         // slip) are applied to the events, as `deadreckon stream` does.
-        let stored = match params {
+        let (stored, bound) = match params {
             Some(p) if p.cast::<PyDict>().is_err() => {
                 let spec: std::path::PathBuf = p.extract()?;
-                deadreckon_api::corrections::stored_in_file(&spec)
-                    .map_err(DeadreckonError::new_err)?
+                let stored = deadreckon_api::corrections::stored_in_file(&spec)
+                    .map_err(DeadreckonError::new_err)?;
+                let bound = deadreckon_api::stream::start_bound(&spec.to_string_lossy())
+                    .map_err(to_py_err)?;
+                (stored, bound)
             }
-            _ => Default::default(),
+            _ => (Default::default(), deadreckon_core::bound::BoundFit::FILTER),
         };
         let params = match params {
             Some(p) => params_arg(p, &vehicle)?.0,
@@ -80,7 +85,10 @@ impl Online {
             CoreOnline::new(&vehicle, &params, &opts, Start::Gnss)
         }
         .map_err(to_py_err)?;
-        let inner = inner.with_corrections(&stored).map_err(to_py_err)?;
+        let inner = inner
+            .with_corrections(&stored)
+            .map_err(to_py_err)?
+            .with_bound(bound);
         Ok(Online { inner, lines: 0 })
     }
 
@@ -101,12 +109,14 @@ impl Online {
             let ev =
                 deadreckon_io::events::parse_line(line, "events", self.lines).map_err(to_py_err)?;
             let n = self.lines;
-            self.inner.push(ev, &mut |p| out.push(p)).map_err(|e| {
-                DeadreckonError::new_err(format!(
-                    "events: line {n}: {}",
-                    deadreckon_api::chain_text(&e)
-                ))
-            })?;
+            self.inner
+                .push_poses(ev, &mut |p| out.push(p))
+                .map_err(|e| {
+                    DeadreckonError::new_err(format!(
+                        "events: line {n}: {}",
+                        deadreckon_api::chain_text(&e)
+                    ))
+                })?;
         }
         poses(py, &out)
     }
@@ -116,7 +126,9 @@ impl Online {
     /// state with `to_json` before this to resume, not after).
     fn finish<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let mut out = Vec::new();
-        self.inner.end(&mut |p| out.push(p)).map_err(to_py_err)?;
+        self.inner
+            .end_poses(&mut |p| out.push(p))
+            .map_err(to_py_err)?;
         poses(py, &out)
     }
 

@@ -98,7 +98,7 @@ def test_online_on_event_lines_equals_stream(sim_drive, cli):
     c = o.finish()
     ours = {k: np.concatenate([a[k], b[k], c[k]]) for k in a}
     assert len(ours["t_s"]) == len(theirs) > 1000
-    for k in ("t_s", "east_m", "north_m", "yaw_rad", "speed_mps", "yaw_rate_rps"):
+    for k in ("t_s", "east_m", "north_m", "yaw_rad", "speed_mps", "yaw_rate_rps", "bound_95_m"):
         assert np.array_equal(ours[k], np.array([p[k] for p in theirs])), k
     assert o.is_started and o.learned() is None
     with pytest.raises(deadreckon.DeadreckonError, match="line 1"):

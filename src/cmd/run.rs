@@ -74,6 +74,7 @@ pub fn run(a: RunArgs, load: &common::Loader) -> Result<()> {
             &a.out,
             &s,
             a.mcap.into(),
+            &chosen.bound,
         )?;
         (w, chosen.source)
     };

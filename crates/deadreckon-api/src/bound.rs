@@ -224,3 +224,100 @@ pub fn calibrate_lines(
     }
     out
 }
+
+/// Why a kinematic shape's outages have no bound: the tricycle's kinematic
+/// dead reckoning (and the differential drive started from the alignment)
+/// carries no covariance, as TedriS's prediction does not.
+pub const NO_COVARIANCE: &str =
+    "not computed: this dead reckoning carries no covariance (kinematic integration from the reference pose, or started from the alignment), so it gives no uncertainty to bound";
+
+/// Adds the bound to a kinematic shape's `evaluate --outage --json`
+/// object: with `fit` and the differential drive's filter covariances,
+/// `outages[]` (each window's `start_s`, `end_s`, `final_error_m`,
+/// `bound_95_m`, `within_bound_95`), `bound_95_coverage`,
+/// `bound_95_sharpness` and the `bound` used; otherwise those keys null
+/// and `bound_95_note` saying why.
+pub fn add_kinematic_bound(
+    v: &mut Value,
+    diff: Option<&deadreckon_core::kinematics::diff_drive::DiffDriveOutages>,
+    fit: Option<&BoundFit>,
+) {
+    use deadreckon_core::bound_diff;
+    let bounds = diff.zip(fit).and_then(|(d, f)| {
+        bound_diff::window_bounds(d, f).map(|b| (d, f, b, bound_diff::coverage_and_sharpness(d, f)))
+    });
+    match bounds {
+        Some((d, f, b, cs)) => {
+            v["outages"] = d
+                .outages
+                .windows
+                .iter()
+                .zip(&b)
+                .map(|(w, (bound, within))| {
+                    json!({"start_s": w.start_s, "end_s": w.end_s, "final_error_m": w.final_error_m,
+                           "bound_95_m": bound, "within_bound_95": within})
+                })
+                .collect();
+            v["bound_95_coverage"] = json!(cs.map(|c| c.0));
+            v["bound_95_sharpness"] = json!(cs.map(|c| c.1));
+            v["bound"] = bound_json(f);
+        }
+        None => {
+            v["bound_95_coverage"] = Value::Null;
+            v["bound_95_sharpness"] = Value::Null;
+            v["bound"] = Value::Null;
+            v["bound_95_note"] = NO_COVARIANCE.into();
+        }
+    }
+}
+
+/// The text of a kinematic shape's bound, as [`outage_bound_lines`] for a
+/// car: the bound's row, coverage and sharpness, the factor; or why there
+/// is none.
+pub fn kinematic_bound_lines(
+    diff: Option<&deadreckon_core::kinematics::diff_drive::DiffDriveOutages>,
+    fit: Option<&BoundFit>,
+) -> Vec<String> {
+    use deadreckon_core::bound_diff;
+    let Some((d, f)) = diff.zip(fit) else {
+        return vec![format!("95 % error bound: {NO_COVARIANCE}")];
+    };
+    let (Some(b), Some((cover, sharp))) = (
+        bound_diff::window_bounds(d, f),
+        bound_diff::coverage_and_sharpness(d, f),
+    ) else {
+        return vec![format!("95 % error bound: {NO_COVARIANCE}")];
+    };
+    let ends: Vec<f64> = b.iter().map(|x| x.0).collect();
+    let within = b.iter().filter(|x| x.1).count();
+    let mut out = Vec::new();
+    out.extend(
+        crate::text::summary_table(&[(
+            "95 % bound at the end (m)",
+            deadreckon_core::metrics::Summary::of(&ends),
+        )])
+        .pop(),
+    );
+    out.push(format!(
+        "final error within the 95 % bound in {within} of {} windows ({:.0} %); median bound / \
+         median final error {sharp:.2}",
+        b.len(),
+        100.0 * cover
+    ));
+    out.push(format!("  bound: {}", kinematic_fit_text(f)));
+    out
+}
+
+/// A kinematic bound in words (fitted on the evaluated drive's own
+/// windows, or stored).
+fn kinematic_fit_text(fit: &BoundFit) -> String {
+    match fit.method {
+        Method::Conformal => format!(
+            "{} × the filter's 95 % radius, fitted on {} windows of {:.1} s against hidden fixes",
+            fmt_k(fit.k),
+            fit.windows,
+            fit.outage_s
+        ),
+        Method::Filter => fit.method.to_string(),
+    }
+}

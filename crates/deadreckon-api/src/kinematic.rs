@@ -380,6 +380,10 @@ pub struct Calibrated {
     pub yaw: Option<YawSource>,
     /// The calibration.
     pub calibration: KinematicCalibration,
+    /// A differential drive's 95 % error bound factor, fitted with the
+    /// calibrated parameters on the calibration range's own hidden fixes
+    /// (written as `[bound]`; `None` for the tricycle: no covariance).
+    pub bound: Option<deadreckon_core::bound::BoundFit>,
 }
 
 impl Calibrated {
@@ -390,6 +394,9 @@ impl Calibrated {
         if let Some(y) = self.yaw {
             v["yaw_source"] = yaw_name(y).into();
         }
+        if let Some(b) = &self.bound {
+            v["bound"] = crate::bound::bound_json(b);
+        }
         v
     }
 
@@ -398,6 +405,9 @@ impl Calibrated {
     pub fn lines(&self) -> Vec<String> {
         let mut out = crate::text::kinematic_table(&self.calibration);
         out.extend(held_back_lines(&self.calibration));
+        if let Some(b) = &self.bound {
+            out.push(format!("95 % error bound: {}", crate::bound::fit_text(b)));
+        }
         out
     }
 
@@ -407,6 +417,7 @@ impl Calibrated {
         let mut f =
             KinematicParamsFile::from_calibration(self.shape, self.method, &self.calibration);
         f.yaw_source = self.yaw.map(|y| yaw_name(y).to_string());
+        f.bound = self.bound.as_ref().map(crate::bound::bound_toml);
         deadreckon_io::write_kinematic_params(path, &f)
             .doing(|| format!("writing {}", path.display()))
     }
@@ -514,6 +525,7 @@ pub fn calibrate_tricycle(
         method,
         yaw: None,
         calibration,
+        bound: None,
     })
 }
 
@@ -540,11 +552,27 @@ pub fn calibrate_diff(
         calibrate_held_back(&dd, &opts, &FilterNoise::default())
     }
     .doing(|| format!("calibrating {}", path.display()))?;
+    // The bound's factor on the calibration range's own outages, started
+    // from the filter as `evaluate` starts them (its priors from the
+    // calibration's standard errors).
+    let std: Vec<Option<f64>> = calibration
+        .params
+        .iter()
+        .map(|p| if p.estimated { p.std } else { None })
+        .collect();
+    let noise = diff_drive::FilterNoise::default().with_param_std(&std);
+    let bound = deadreckon_core::bound_diff::fit_diff_drive(
+        &dd,
+        &calibration.values(),
+        &noise,
+        diff_drive::DEFAULT_WARMUP_S,
+    );
     Ok(Calibrated {
         shape,
         method,
         yaw: Some(yaw),
         calibration,
+        bound: Some(bound),
     })
 }
 
@@ -564,6 +592,10 @@ pub struct Evaluated {
     /// A differential drive's outages: how they started, the filter's fix
     /// counts and predicted errors.
     pub diff: Option<DiffDriveOutages>,
+    /// The 95 % error bound's factor (issue 31): the differential drive's
+    /// filter only (`None`: no covariance to bound, the tricycle's
+    /// kinematics and the alignment start; [`crate::bound::NO_COVARIANCE`]).
+    pub bound: Option<deadreckon_core::bound::BoundFit>,
 }
 
 impl Evaluated {
@@ -595,6 +627,7 @@ impl Evaluated {
                 }
             }
         }
+        crate::bound::add_kinematic_bound(&mut v, self.diff.as_ref(), self.bound.as_ref());
         v
     }
 
@@ -624,6 +657,10 @@ impl Evaluated {
                 ));
             }
         }
+        out.extend(crate::bound::kinematic_bound_lines(
+            self.diff.as_ref(),
+            self.bound.as_ref(),
+        ));
         out
     }
 }
@@ -670,6 +707,7 @@ pub fn evaluate_tricycle(
         align_s: None,
         evaluation,
         diff: None,
+        bound: None,
     })
 }
 
@@ -708,6 +746,7 @@ pub fn evaluate_diff(
     from_s: Option<f64>,
     until_s: Option<f64>,
 ) -> Result<Evaluated, Error> {
+    let (calibrated_here, spec) = (params.is_none(), params);
     let LoadedParams {
         values: params,
         std,
@@ -753,6 +792,7 @@ pub fn evaluate_diff(
     };
     let dd = diff_drive(drive, yaw, from_s, until_s)?;
     let diff = evaluate_diff_drive(&dd, &params, length_s, step_s, align_s, &start)?;
+    let bound = diff_bound(&dd, &params, &start, align_s, calibrated_here, spec)?;
     Ok(Evaluated {
         shape: Shape::DiffDrive,
         length_s,
@@ -760,7 +800,44 @@ pub fn evaluate_diff(
         align_s: Some(align_s),
         evaluation: diff.outages.clone(),
         diff: Some(diff),
+        bound,
     })
+}
+
+/// The differential drive's 95 % bound factor (issue 31): none from the
+/// alignment (no covariance); the `[bound]` table of a params file that
+/// has one, else the filter's covariance alone (`nominal` too); fitted on
+/// the evaluated drive's own windows against its hidden fixes when the
+/// parameters were calibrated on it (in-sample, as a car's `evaluate`
+/// without `--params`: [`deadreckon_core::bound_diff::fit_diff_drive`]).
+fn diff_bound(
+    dd: &DiffDriveDrive,
+    params: &[f64],
+    start: &OutageStart,
+    align_s: f64,
+    calibrated_here: bool,
+    spec: Option<&str>,
+) -> Result<Option<deadreckon_core::bound::BoundFit>, Error> {
+    use deadreckon_core::bound::BoundFit;
+    let OutageStart::Filter(noise) = start else {
+        return Ok(None);
+    };
+    if calibrated_here {
+        return Ok(Some(deadreckon_core::bound_diff::fit_diff_drive(
+            dd, params, noise, align_s,
+        )));
+    }
+    let stored = match spec.filter(|s| *s != "nominal") {
+        Some(file) => {
+            let text = std::fs::read_to_string(file).doing(|| format!("reading {file}"))?;
+            let t: toml::Table =
+                toml::from_str(&text).map_err(|e| Error::Invalid(format!("{file}: {e}")))?;
+            crate::bound::bound_from_extra(&t)
+                .map_err(|e| Error::Invalid(format!("{file}: {e}")))?
+        }
+        None => BoundFit::FILTER,
+    };
+    Ok(Some(stored))
 }
 
 /// A tricycle's tracks (dead-reckoned through its own kinematics from the

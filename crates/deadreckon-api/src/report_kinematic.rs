@@ -129,6 +129,10 @@ pub fn write(
                 .map(|w| w.final_error_m)
                 .collect(),
         }],
+        // A kinematic shape's windows carry their final error only, so the
+        // bound's curve through time is not drawn (`evaluate` gives the
+        // differential drive's bound at each window's end).
+        bound: None,
     });
     let name = o
         .dir

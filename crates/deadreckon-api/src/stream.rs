@@ -3,7 +3,10 @@
 //! state file, optionally learning the six parameters and saving them as it
 //! goes. The corrections a params.toml stores (delays, IMU tilt, gyro
 //! scale, driven-axle slip) are applied to the events as `run --params`
-//! applies them to a drive ([`deadreckon_core::live_corrections`]).
+//! applies them to a drive ([`deadreckon_core::live_corrections`]). Each
+//! pose carries its 95 % bound (`bound_95_m`, with the factor the
+//! params.toml's `[bound]` stores: [`deadreckon_core::bound_pose`]), equal
+//! to `run`'s on the filtered track.
 
 use std::io::{BufRead, Write};
 use std::path::{Path, PathBuf};
@@ -42,6 +45,35 @@ pub fn start_params(
     crate::load::check_against_vehicle(spec, &p.params, vehicle)?;
     let stored = crate::corrections::stored_in_file(Path::new(spec)).map_err(Error::Invalid)?;
     Ok(started_from(&p, stored))
+}
+
+/// The 95 % bound's factor of the parameters `spec` (`nominal` or a
+/// params.toml): its `[bound]`, else the filter's covariance alone.
+pub fn start_bound(spec: &str) -> Result<deadreckon_core::bound::BoundFit, Error> {
+    crate::bound::stored_bound(spec)
+}
+
+/// [`start_bound`] of the text of a params.toml; `name` names it in errors.
+pub fn start_bound_from_text(
+    text: &str,
+    name: &str,
+) -> Result<deadreckon_core::bound::BoundFit, Error> {
+    let (_, extra) = deadreckon_io::parse_params_with_extra(text, Path::new(name))
+        .doing(|| format!("reading parameters {name}"))?;
+    crate::bound::bound_from_extra(&extra).map_err(|e| Error::Invalid(format!("{name}: {e}")))
+}
+
+/// One pose line of `stream` (without the newline): the pose's keys
+/// (`t_s`, `east_m`, …, `cov_pose`), then `bound_95_m` (null when not a
+/// number).
+pub fn pose_line(p: &deadreckon_core::bound_pose::Pose) -> String {
+    let mut line = serde_json::to_string(&p.point).unwrap_or_default();
+    if line.ends_with('}') {
+        line.pop();
+        let b = serde_json::to_string(&p.bound_95_m).unwrap_or_else(|_| "null".into());
+        line.push_str(&format!(",\"bound_95_m\":{b}}}"));
+    }
+    line
 }
 
 /// [`start_params`] on the text of a params.toml (the C API is handed text);
@@ -217,6 +249,8 @@ fn with_model(vehicle: &Vehicle, corrections: &crate::corrections::Stored) -> Ve
 /// filter ([`open`]: resumed from `o.state`, else started with the
 /// parameters and corrections `params` names, [`start_params`]) and what to
 /// tell of the corrections ([`corrections_note`], [`corrections_warning`]).
+/// A filter not resumed gives its poses the bound `params` stores
+/// ([`start_bound`]); a resumed one keeps its state's.
 pub fn start(
     vehicle: &Path,
     params: &str,
@@ -225,7 +259,11 @@ pub fn start(
     let v =
         deadreckon_io::read_vehicle(vehicle).doing(|| format!("reading {}", vehicle.display()))?;
     let (p, prior, stored) = start_params(params, &v)?;
-    let online = open(&v, &p, &prior, &stored, o)?;
+    let resumed = o.state.as_ref().is_some_and(|p| p.exists());
+    let mut online = open(&v, &p, &prior, &stored, o)?;
+    if !resumed {
+        online = online.with_bound(start_bound(params)?);
+    }
     let warning = corrections_warning(params, &online);
     Ok((v, online, warning))
 }
@@ -243,11 +281,11 @@ pub fn run(
     on_skipped: &mut dyn FnMut(&str),
 ) -> Result<StreamSummary, Error> {
     let write_error: std::cell::RefCell<Option<std::io::Error>> = Default::default();
-    let mut emit = |p: deadreckon_core::TrackPoint| {
+    let mut emit = |p: deadreckon_core::bound_pose::Pose| {
         if write_error.borrow().is_some() {
             return;
         }
-        let line = serde_json::to_string(&p).unwrap_or_default();
+        let line = pose_line(&p);
         if let Err(e) = writeln!(out, "{line}").and_then(|_| out.flush()) {
             *write_error.borrow_mut() = Some(e);
         }
@@ -271,7 +309,7 @@ pub fn run(
             Err(e) => return Err(e.into()),
         };
         online
-            .push(ev, &mut emit)
+            .push_poses(ev, &mut emit)
             .doing(|| format!("{source}: line {line_no}"))?;
         if let (Some(every), Some(path)) = (o.save_every_s, &o.params_out) {
             if last_save.is_none_or(|t| ev.t_s - t >= every) {
@@ -289,9 +327,9 @@ pub fn run(
         if o.state.is_some() && !o.last_part {
             // The stream may be resumed: what the corrections hold back
             // stays in the state, and the resumed stream releases it.
-            online.finish(&mut emit)?;
+            online.finish_poses(&mut emit)?;
         } else {
-            online.end(&mut emit)?;
+            online.end_poses(&mut emit)?;
         }
     }
     let write_error = write_error.take();

@@ -2,10 +2,12 @@
 //! (dead-reckoned, filtered, smoothed, and the truth), those chosen
 //! (optionally time-synced with another, as evo pairs them), written in the
 //! format of the file's extension (CSV, GeoJSON, TUM, KITTI, MCAP), with the
-//! wheel-health verdict of the aided run.
+//! wheel-health verdict of the aided run. The CSV carries the 95 % bound
+//! of the dead-reckoned and filtered poses ([`bounds_95_m`]).
 
 use std::path::{Path, PathBuf};
 
+use deadreckon_core::bound::BoundFit;
 use deadreckon_core::ekf::FilterOptions;
 use deadreckon_core::wheel_health::WheelHealth;
 use deadreckon_core::{evo, track, Drive, Params, Track};
@@ -36,6 +38,52 @@ pub fn drive_tracks(
     let mut t = track::drive_tracks(drive, params, opts, init_pose)?;
     t.extend(Track::from_truth(drive));
     Ok(t)
+}
+
+/// The 95 % bound of each pose of each of `tracks` (those of
+/// [`drive_tracks`] with the same `opts` and `init_pose`), m, empty for a
+/// track without one ([`deadreckon_core::bound_pose`]'s rule): the
+/// filtered track's from its covariance and the last fix given at or
+/// before each pose (what `stream` gives its poses); the dead-reckoned
+/// track's from its covariance and, when it started from the smoothed
+/// GNSS track, the declared accuracy of the last fix at or before its
+/// start (none from the truth or a given pose). The smoothed track, the
+/// truth and tracks without a covariance have none: the factor was fitted
+/// on the causal filter's outages.
+pub fn bounds_95_m(
+    drive: &Drive,
+    tracks: &[Track],
+    fit: &BoundFit,
+    opts: &FilterOptions,
+    init_pose: Option<(f64, f64, f64)>,
+) -> Vec<Vec<f64>> {
+    use deadreckon_core::bound_pose;
+    tracks
+        .iter()
+        .map(|t| {
+            if deadreckon_io::carries_no_covariance(t) {
+                return Vec::new();
+            }
+            match t.name.as_str() {
+                track::names::FILTERED => {
+                    bound_pose::filtered_bounds_m(t, &drive.gnss, &opts.gnss_outages, fit)
+                }
+                track::names::DEAD_RECKONED => {
+                    let from_gnss = init_pose.is_none() && drive.truth.is_empty();
+                    let start = t.points.first().map_or(f64::NEG_INFINITY, |p| p.t_s);
+                    let handed = drive.gnss.partition_point(|g| g.t_s <= start);
+                    let std_m = match handed.checked_sub(1) {
+                        Some(i) if from_gnss => {
+                            deadreckon_core::bound::receiver_std_m(&drive.gnss[i])
+                        }
+                        _ => 0.0,
+                    };
+                    bound_pose::dead_reckoned_bounds_m(t, std_m, fit)
+                }
+                _ => Vec::new(),
+            }
+        })
+        .collect()
 }
 
 /// The tracks to write into `out`: those named, or every estimated track;
@@ -75,16 +123,20 @@ pub fn select(
     Ok(chosen)
 }
 
-/// Writes tracks in `format` (MCAP with `mcap`'s schemas).
+/// Writes tracks in `format` (MCAP with `mcap`'s schemas); a CSV carries
+/// `bounds` (per track, [`bounds_95_m`]; missing or empty: none).
 pub fn write(
     path: &Path,
     format: TrackFormat,
     tracks: &[Track],
+    bounds: &[Vec<f64>],
     mcap: deadreckon_ros::McapOptions,
 ) -> Result<(), Error> {
     let context = || format!("writing {}", path.display());
     match format {
-        TrackFormat::Csv => deadreckon_io::write_track_csv(path, tracks).doing(context),
+        TrackFormat::Csv => {
+            deadreckon_io::write_track_csv_with_bounds(path, tracks, bounds).doing(context)
+        }
         TrackFormat::GeoJson => deadreckon_io::write_track_geojson(path, tracks).doing(context),
         TrackFormat::Tum => deadreckon_io::write_track_tum(path, &tracks[0]).doing(context),
         TrackFormat::Kitti => deadreckon_io::write_track_kitti(path, &tracks[0]).doing(context),
@@ -145,8 +197,10 @@ impl Written {
     }
 }
 
-/// Writes the chosen tracks of a car's drive to `out` and checks the
-/// wheels over the aided run (unless the monitor is off).
+/// Writes the chosen tracks of a car's drive to `out` (a CSV with the
+/// 95 % bound of `bound`'s factor, [`bounds_95_m`]) and checks the wheels
+/// over the aided run (unless the monitor is off).
+#[allow(clippy::too_many_arguments)]
 pub fn write_car(
     drive: &Drive,
     params: &Params,
@@ -155,11 +209,17 @@ pub fn write_car(
     out: &Path,
     s: &Selection,
     mcap: deadreckon_ros::McapOptions,
+    bound: &BoundFit,
 ) -> Result<Written, Error> {
     let format = TrackFormat::from_path(out)?;
     let all = drive_tracks(drive, params, opts, init_pose)?;
     let t = select(&all, s, out, format)?;
-    write(out, format, &t, mcap)?;
+    let bounds = if format == TrackFormat::Csv {
+        bounds_95_m(drive, &t, bound, opts, init_pose)
+    } else {
+        Vec::new()
+    };
+    write(out, format, &t, &bounds, mcap)?;
     // (A drive without GNSS has no aided run: the health is then not checked.)
     let health = match opts.wheel_monitor {
         Some(_) => deadreckon_core::wheel_health::check_drive(drive, params, opts)
@@ -199,7 +259,7 @@ pub fn write_tracks(
 ) -> Result<Written, Error> {
     let format = TrackFormat::from_path(out)?;
     let t = select(all, s, out, format)?;
-    write(out, format, &t, mcap)?;
+    write(out, format, &t, &[], mcap)?;
     Ok(Written {
         path: out.to_path_buf(),
         format,

@@ -115,6 +115,7 @@ impl Command {
                     out,
                     &deadreckon_api::tracks::Selection::default(),
                     deadreckon_ros::McapOptions::FOXGLOVE,
+                    &deadreckon_core::bound::BoundFit::FILTER,
                 )?;
                 std::hint::black_box(written.json());
                 Ok(epochs)

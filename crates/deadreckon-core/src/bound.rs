@@ -233,7 +233,8 @@ pub fn radius(cov: &Cov2) -> f64 {
 }
 
 /// How the bound is made from the filter's covariance.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Method {
     /// `k` fitted by split conformal prediction on the calibration drive's
     /// outage windows against its hidden fixes.
@@ -274,7 +275,7 @@ impl std::fmt::Display for Method {
 }
 
 /// The bound's inflation: `bound = k · r(P)`.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BoundFit {
     /// How `k` was found.
     pub method: Method,

@@ -24,6 +24,8 @@
 
 pub mod angle;
 pub mod bound;
+pub mod bound_diff;
+pub mod bound_pose;
 pub mod calibrate;
 pub mod checkpoint;
 pub mod chords;

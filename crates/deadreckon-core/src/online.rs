@@ -20,9 +20,16 @@
 //! [`Online::hold_s`] seconds of stream time later. [`Online::finish`]
 //! keeps what is held back in the state (a resumed stream releases it);
 //! [`Online::end`] releases everything at the end of a stream.
+//!
+//! Each pose can carry its 95 % bound ([`crate::bound_pose`]):
+//! [`Online::with_bound`] gives the factor, [`Online::push_poses`] (and
+//! `finish_poses`, `end_poses`) the poses with their bounds, equal to
+//! [`crate::bound_pose::filtered_bounds_m`] on `run`'s filtered track.
 
 use serde::{Deserialize, Serialize};
 
+use crate::bound::BoundFit;
+use crate::bound_pose::{point_bound_m, FixFloor, Pose};
 use crate::ekf::{Event, Feeder, FilterOptions, FilterStats, GnssInit};
 use crate::filter::{AugmentedFilter, CarFilter, Filter};
 use crate::gyro_drift::{CarBiasLayout, N_BIAS};
@@ -123,6 +130,17 @@ pub struct Online {
     /// written before them: none).
     #[serde(default)]
     live: LiveCorrections,
+    /// The 95 % bound's factor (states written before it: the filter's
+    /// covariance alone).
+    #[serde(default = "filter_bound")]
+    bound: BoundFit,
+    /// The declared accuracy of the fixes given, for the bound's floor.
+    #[serde(default)]
+    floor: FixFloor,
+}
+
+fn filter_bound() -> BoundFit {
+    BoundFit::FILTER
 }
 
 /// A dead-reckoning start for [`Online::new`].
@@ -185,6 +203,8 @@ impl Online {
                 buffer: Vec::new(),
             },
             live: LiveCorrections::default(),
+            bound: BoundFit::FILTER,
+            floor: FixFloor::default(),
         };
         if let Start::Given(t, x, p) = start {
             o.stage = o.started(t, x, p)?;
@@ -243,6 +263,18 @@ impl Online {
         Ok(self)
     }
 
+    /// The filter whose poses carry the 95 % bound of `fit` (default: the
+    /// filter's covariance alone, [`BoundFit::FILTER`]).
+    pub fn with_bound(mut self, fit: BoundFit) -> Self {
+        self.bound = fit;
+        self
+    }
+
+    /// The 95 % bound's factor the poses carry.
+    pub fn bound(&self) -> &BoundFit {
+        &self.bound
+    }
+
     /// The stored corrections applied and their reorder buffer.
     pub fn corrections(&self) -> &LiveCorrections {
         &self.live
@@ -258,6 +290,11 @@ impl Online {
     /// epoch it completes. The stored corrections are applied first; an
     /// epoch runs once no later event can change it.
     pub fn push(&mut self, ev: Event, out: &mut dyn FnMut(TrackPoint)) -> Result<(), Error> {
+        self.push_poses(ev, &mut |p| out(p.point))
+    }
+
+    /// [`Online::push`] with each pose's 95 % bound.
+    pub fn push_poses(&mut self, ev: Event, out: &mut dyn FnMut(Pose)) -> Result<(), Error> {
         let mut live = std::mem::take(&mut self.live);
         let r = live.push(ev, &mut |e| self.feed(e, out));
         self.live = live;
@@ -270,6 +307,11 @@ impl Online {
     /// events, continues as if never cut). With nothing held back, all that
     /// is waiting runs.
     pub fn finish(&mut self, out: &mut dyn FnMut(TrackPoint)) -> Result<(), Error> {
+        self.finish_poses(&mut |p| out(p.point))
+    }
+
+    /// [`Online::finish`] with each pose's 95 % bound.
+    pub fn finish_poses(&mut self, out: &mut dyn FnMut(Pose)) -> Result<(), Error> {
         let mut live = std::mem::take(&mut self.live);
         let r = live.pause(&mut |e| self.feed(e, out));
         self.live = live;
@@ -282,6 +324,11 @@ impl Online {
     /// held back; readings after the last wheel row are dropped, as the
     /// batch filter never uses them.
     pub fn end(&mut self, out: &mut dyn FnMut(TrackPoint)) -> Result<(), Error> {
+        self.end_poses(&mut |p| out(p.point))
+    }
+
+    /// [`Online::end`] with each pose's 95 % bound.
+    pub fn end_poses(&mut self, out: &mut dyn FnMut(Pose)) -> Result<(), Error> {
         let mut live = std::mem::take(&mut self.live);
         let r = live.end(&mut |e| self.feed(e, out));
         self.live = live;
@@ -299,10 +346,21 @@ impl Online {
 
     /// One corrected event, in corrected time order, to the start or the
     /// filter.
-    fn feed(&mut self, ev: Event, out: &mut dyn FnMut(TrackPoint)) -> Result<(), Error> {
+    fn feed(&mut self, ev: Event, out: &mut dyn FnMut(Pose)) -> Result<(), Error> {
+        let hidden = |t: f64| crate::drive::in_windows(t, &self.opts.gnss_outages);
+        if let Some(fix) = ev.gnss_fix().filter(|g| !hidden(g.t_s)) {
+            self.floor.push(&fix);
+        }
+        let (fit, floor) = (self.bound, &mut self.floor);
+        let mut emit = |p: TrackPoint| {
+            let s = floor.std_at(p.t_s);
+            out(Pose {
+                point: p,
+                bound_95_m: point_bound_m(&fit, &p, s),
+            })
+        };
         match &mut self.stage {
             Stage::Waiting { init, buffer } => {
-                let hidden = |t: f64| crate::drive::in_windows(t, &self.opts.gnss_outages);
                 let mut start = None;
                 if let Some(fix) = ev.gnss_fix().filter(|g| !hidden(g.t_s)) {
                     if !init.has_first() {
@@ -330,30 +388,38 @@ impl Online {
                 Ok(())
             }
             Stage::Car { filter, feeder } => feeder.push(filter.as_mut(), ev, &mut |f, _| {
-                out(car_point(f.time_s(), f.state(), f.covariance()))
+                emit(car_point(f.time_s(), f.state(), f.covariance()))
             }),
             Stage::Walking { filter, feeder } => feeder.push(filter.as_mut(), ev, &mut |f, _| {
-                out(car_point(f.time_s(), f.state(), f.covariance()))
+                emit(car_point(f.time_s(), f.state(), f.covariance()))
             }),
             Stage::Learning { filter, feeder } => feeder.push(filter.as_mut(), ev, &mut |f, _| {
-                out(car_point(f.time_s(), f.state(), f.covariance()))
+                emit(car_point(f.time_s(), f.state(), f.covariance()))
             }),
         }
     }
 
     /// Runs the filter's epoch of the last time fed: every event released
     /// so far is earlier than any still to come.
-    fn settle(&mut self, out: &mut dyn FnMut(TrackPoint)) -> Result<(), Error> {
+    fn settle(&mut self, out: &mut dyn FnMut(Pose)) -> Result<(), Error> {
+        let (fit, floor) = (self.bound, &mut self.floor);
+        let mut emit = |p: TrackPoint| {
+            let s = floor.std_at(p.t_s);
+            out(Pose {
+                point: p,
+                bound_95_m: point_bound_m(&fit, &p, s),
+            })
+        };
         match &mut self.stage {
             Stage::Waiting { .. } => Ok(()),
             Stage::Car { filter, feeder } => feeder.finish(filter.as_mut(), &mut |f, _| {
-                out(car_point(f.time_s(), f.state(), f.covariance()))
+                emit(car_point(f.time_s(), f.state(), f.covariance()))
             }),
             Stage::Walking { filter, feeder } => feeder.finish(filter.as_mut(), &mut |f, _| {
-                out(car_point(f.time_s(), f.state(), f.covariance()))
+                emit(car_point(f.time_s(), f.state(), f.covariance()))
             }),
             Stage::Learning { filter, feeder } => feeder.finish(filter.as_mut(), &mut |f, _| {
-                out(car_point(f.time_s(), f.state(), f.covariance()))
+                emit(car_point(f.time_s(), f.state(), f.covariance()))
             }),
         }
     }

@@ -438,15 +438,27 @@ pub fn four_wheel_input(
         let mut ev = rp::OutageEvaluation {
             window_s: Some(len),
             methods: Vec::new(),
+            bound: None,
         };
-        for m in methods {
+        // The 95 % bound is drawn for the parameters the filter health uses.
+        let bounded = methods
+            .iter()
+            .position(|m| m.source == Source::Rts)
+            .or(methods.len().checked_sub(1));
+        for (i, m) in methods.iter().enumerate() {
             steps.step(&format!("{len} s outages with {}", m.source.name()));
             let step = step_s.unwrap_or(len / 2.0);
             match outage::evaluate(drive, &m.params.params, len, step, 5.0, &opts) {
-                Ok(o) => ev.methods.push(rp::MethodSample {
-                    method: m.source.name().into(),
-                    final_error_m: o.windows.iter().map(|w| w.final_m()).collect(),
-                }),
+                Ok(o) => {
+                    if Some(i) == bounded {
+                        steps.step(&format!("the 95 % bound with {}", m.source.name()));
+                        ev.bound = outage_bound(drive, m, &o, &opts);
+                    }
+                    ev.methods.push(rp::MethodSample {
+                        method: m.source.name().into(),
+                        final_error_m: o.windows.iter().map(|w| w.final_m()).collect(),
+                    })
+                }
                 Err(e) => input.not_computed.push(not_computed(
                     format!("{len} s outages with {}", m.source.name()),
                     &e,
@@ -458,6 +470,53 @@ pub fn four_wheel_input(
         }
     }
     Ok(input)
+}
+
+/// The error and the 95 % bound through the windows of `o` (issue 31),
+/// with the factor fitted on the drive's own hidden fixes with `m`'s
+/// parameters (in-sample, as `evaluate` without `--params` fits it);
+/// `None` without covariances.
+fn outage_bound(
+    drive: &Drive,
+    m: &NamedParams,
+    o: &outage::OutageEvaluation,
+    opts: &FilterOptions,
+) -> Option<rp::OutageBound> {
+    let fit = deadreckon_core::bound::fit_on_drive(drive, &m.params.params, opts);
+    let within = o
+        .windows
+        .iter()
+        .filter(|w| w.within_bound(&fit) == Some(true))
+        .count();
+    let sharpness = o.bound_sharpness(&fit)?;
+    let ws: Vec<_> = o
+        .windows
+        .iter()
+        .filter(|w| w.covariances_m2.len() == w.errors.len())
+        .collect();
+    let factor = match fit.method {
+        deadreckon_core::bound::Method::Conformal => format!(
+            "{:.2} × the filter's 95 % radius (with the last fix's declared accuracy), fitted on \
+             {} windows of {:.1} s of this drive against its own hidden fixes (in-sample)",
+            fit.k, fit.windows, fit.outage_s
+        ),
+        deadreckon_core::bound::Method::Filter => fit.method.to_string(),
+    };
+    Some(rp::OutageBound {
+        method: m.source.name().into(),
+        factor,
+        time_s: ws
+            .iter()
+            .map(|w| w.errors.iter().map(|e| e.0).collect())
+            .collect(),
+        error_m: ws
+            .iter()
+            .map(|w| w.errors.iter().map(|e| e.1).collect())
+            .collect(),
+        bound_m: ws.iter().map(|w| w.bounds_95_m(&fit)).collect(),
+        within,
+        sharpness,
+    })
 }
 
 /// The TedriS sections of a report for a trained model `m`: the

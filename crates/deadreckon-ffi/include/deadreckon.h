@@ -350,6 +350,23 @@ DrStatus dr_next_pose(struct DrFilter *filter, struct DrPose *out);
 // As `dr_next_pose`.
 DrStatus dr_latest_pose(const struct DrFilter *filter, struct DrPose *out);
 
+// Takes the oldest pose not yet taken into `*out` and its 95 % error
+// bound, m, into `*bound_95_m` (`deadreckon stream`'s `bound_95_m`: the
+// filter's covariance inflated by the params.toml's `[bound]` factor,
+// with the last fix's declared accuracy; docs/bound.md); otherwise as
+// `dr_next_pose`. A function of its own so that `DrPose` keeps its layout.
+//
+// # Safety
+// As `dr_next_pose`; `bound_95_m` is null or writable.
+DrStatus dr_next_pose_with_bound(struct DrFilter *filter, struct DrPose *out, double *bound_95_m);
+
+// The 95 % error bound of the newest pose (`dr_latest_pose`'s), m, into
+// `*out`; `DR_STATUS_NOT_AVAILABLE` before the first epoch.
+//
+// # Safety
+// As `dr_next_pose`.
+DrStatus dr_latest_bound(const struct DrFilter *filter, double *out);
+
 // Whether the filter has started (from GNSS: the first fix and the
 // direction of the first 10 m), into `*out`.
 //

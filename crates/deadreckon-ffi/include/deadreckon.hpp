@@ -61,6 +61,12 @@ using Params = DrParams;          // the six parameters (or their standard error
 using Learned = DrLearned;        // params, std, valid, calibrated_pct
 using GateCounts = DrGateCounts;  // accepted/rejected/recovered[DrGateSensor]
 
+// A pose with its 95 % error bound, m (docs/bound.md).
+struct BoundedPose {
+  Pose pose;
+  double bound_95_m;
+};
+
 // The online filter of `deadreckon stream`; see docs/c-api.md.
 class Filter {
  public:
@@ -151,6 +157,25 @@ class Filter {
     std::vector<Pose> out;
     while (auto p = next_pose()) out.push_back(*p);
     return out;
+  }
+  // The oldest pose not yet taken with its 95 % bound, if any.
+  std::optional<BoundedPose> next_pose_with_bound() {
+    BoundedPose p;
+    DrStatus s = dr_next_pose_with_bound(f_, &p.pose, &p.bound_95_m);
+    if (s == DR_STATUS_NO_POSE) return std::nullopt;
+    detail::check(s);
+    return p;
+  }
+  // Every pose not yet taken with its bound, oldest first.
+  std::vector<BoundedPose> take_poses_with_bounds() {
+    std::vector<BoundedPose> out;
+    while (auto p = next_pose_with_bound()) out.push_back(*p);
+    return out;
+  }
+  // The newest pose's 95 % bound, none before the first epoch.
+  std::optional<double> latest_bound() const {
+    double b = 0.0;
+    return available(dr_latest_bound(f_, &b)) ? std::optional<double>(b) : std::nullopt;
   }
   // The newest pose, none before the first epoch.
   std::optional<Pose> latest_pose() const {

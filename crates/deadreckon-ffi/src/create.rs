@@ -51,6 +51,7 @@ fn config_fail(e: &(dyn std::error::Error + 'static)) -> Fail {
 fn open(
     vehicle: &Vehicle,
     start: (Params, Params, deadreckon_api::corrections::Stored),
+    bound: deadreckon_core::bound::BoundFit,
     options: *const DrOptions,
 ) -> Result<DrFilter, Fail> {
     // SAFETY: null or a valid DrOptions (the callers' contract).
@@ -68,8 +69,9 @@ fn open(
         skip_bad_lines: false,
         last_part: false,
     };
-    let online =
-        stream::open(vehicle, &params, &prior, &stored, &o).map_err(|e| config_fail(&e))?;
+    let online = stream::open(vehicle, &params, &prior, &stored, &o)
+        .map_err(|e| config_fail(&e))?
+        .with_bound(bound);
     let warning = stream::corrections_warning("params.toml", &online);
     Ok(DrFilter::new(online, warning))
 }
@@ -130,14 +132,16 @@ pub unsafe extern "C" fn dr_filter_new(
             )?;
             let vehicle = deadreckon_io::parse_vehicle(v, Path::new("vehicle.toml"))
                 .map_err(|e| config_fail(&e))?;
-            let start = if params_toml.is_null() {
+            let (start, bound) = if params_toml.is_null() {
                 stream::start_params("nominal", &vehicle)
+                    .and_then(|s| Ok((s, stream::start_bound("nominal")?)))
             } else {
                 let p = text_arg(params_toml, params_len, "params_toml", DrStatus::BadConfig)?;
                 stream::start_params_from_text(p, "params.toml")
+                    .and_then(|s| Ok((s, stream::start_bound_from_text(p, "params.toml")?)))
             }
             .map_err(|e| config_fail(&e))?;
-            open(&vehicle, start, options)
+            open(&vehicle, start, bound, options)
         })
     }
 }
@@ -169,7 +173,8 @@ pub unsafe extern "C" fn dr_filter_new_from_files(
                 path_arg(params_path, "params_path")?
             };
             let start = stream::start_params(spec, &vehicle).map_err(|e| config_fail(&e))?;
-            open(&vehicle, start, options)
+            let bound = stream::start_bound(spec).map_err(|e| config_fail(&e))?;
+            open(&vehicle, start, bound, options)
         })
     }
 }

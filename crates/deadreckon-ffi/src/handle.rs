@@ -5,9 +5,9 @@
 use std::collections::VecDeque;
 use std::ffi::CString;
 
+use deadreckon_core::bound_pose::Pose;
 use deadreckon_core::ekf::Event;
 use deadreckon_core::online::Online;
-use deadreckon_core::track::TrackPoint;
 
 use crate::status::{DrStatus, Fail};
 
@@ -18,10 +18,11 @@ pub struct DrFilter {
     /// Boxed: the boundary's own fields, read on every call, then share a
     /// cache line or two instead of sitting behind the filter's kilobytes.
     pub(crate) online: Box<Online>,
-    /// Poses emitted and not yet taken by `dr_next_pose`, oldest first.
-    pub(crate) poses: VecDeque<TrackPoint>,
+    /// Poses emitted (with their 95 % bounds) and not yet taken by
+    /// `dr_next_pose`, oldest first.
+    pub(crate) poses: VecDeque<Pose>,
     /// The newest pose emitted.
-    pub(crate) latest: Option<TrackPoint>,
+    pub(crate) latest: Option<Pose>,
     /// The time of the newest event taken (unknown after a restore).
     last_t_s: Option<f64>,
     /// Lines given to `dr_push_line`, for the line number in its errors.
@@ -61,7 +62,7 @@ impl DrFilter {
         }
         let (poses, latest) = (&mut self.poses, &mut self.latest);
         self.online
-            .push(*ev, &mut |p| {
+            .push_poses(*ev, &mut |p| {
                 *latest = Some(p);
                 poses.push_back(p);
             })
@@ -81,7 +82,7 @@ impl DrFilter {
     pub(crate) fn finish(&mut self) -> Result<(), Fail> {
         let (poses, latest) = (&mut self.poses, &mut self.latest);
         self.online
-            .end(&mut |p| {
+            .end_poses(&mut |p| {
                 *latest = Some(p);
                 poses.push_back(p);
             })

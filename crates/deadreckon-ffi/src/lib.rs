@@ -39,7 +39,8 @@ pub use push::{
     dr_push_wheel_speeds, dr_push_wheel_ticks, dr_push_yaw_rate, push_typed,
 };
 pub use query::{
-    dr_finish, dr_gate_counts, dr_is_started, dr_latest_pose, dr_learned, dr_next_pose,
+    dr_finish, dr_gate_counts, dr_is_started, dr_latest_bound, dr_latest_pose, dr_learned,
+    dr_next_pose, dr_next_pose_with_bound,
 };
 pub use status::DrStatus;
 pub use types::{

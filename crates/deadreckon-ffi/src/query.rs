@@ -50,7 +50,7 @@ unsafe fn next_pose(filter: *mut DrFilter, out: *mut DrPose) -> DrStatus {
             let out = output(out)?;
             match f.poses.pop_front() {
                 Some(p) => {
-                    *out = p.into();
+                    *out = p.point.into();
                     Ok(DrStatus::Ok)
                 }
                 None => Ok(DrStatus::NoPose),
@@ -72,6 +72,7 @@ pub unsafe extern "C" fn dr_latest_pose(filter: *const DrFilter, out: *mut DrPos
             let out = output(out)?;
             *out = f
                 .latest
+                .map(|p| p.point)
                 .ok_or_else(|| {
                     Fail::new(
                         DrStatus::NotAvailable,
@@ -79,6 +80,59 @@ pub unsafe extern "C" fn dr_latest_pose(filter: *const DrFilter, out: *mut DrPos
                     )
                 })?
                 .into();
+            Ok(DrStatus::Ok)
+        })
+    })
+}
+
+/// Takes the oldest pose not yet taken into `*out` and its 95 % error
+/// bound, m, into `*bound_95_m` (`deadreckon stream`'s `bound_95_m`: the
+/// filter's covariance inflated by the params.toml's `[bound]` factor,
+/// with the last fix's declared accuracy; docs/bound.md); otherwise as
+/// `dr_next_pose`. A function of its own so that `DrPose` keeps its layout.
+///
+/// # Safety
+/// As `dr_next_pose`; `bound_95_m` is null or writable.
+#[no_mangle]
+pub unsafe extern "C" fn dr_next_pose_with_bound(
+    filter: *mut DrFilter,
+    out: *mut DrPose,
+    bound_95_m: *mut f64,
+) -> DrStatus {
+    // SAFETY: the caller's contract, passed on.
+    guard(|| unsafe {
+        with_filter(filter, |f| {
+            let out = output(out)?;
+            let bound = output(bound_95_m)?;
+            match f.poses.pop_front() {
+                Some(p) => {
+                    *out = p.point.into();
+                    *bound = p.bound_95_m;
+                    Ok(DrStatus::Ok)
+                }
+                None => Ok(DrStatus::NoPose),
+            }
+        })
+    })
+}
+
+/// The 95 % error bound of the newest pose (`dr_latest_pose`'s), m, into
+/// `*out`; `DR_STATUS_NOT_AVAILABLE` before the first epoch.
+///
+/// # Safety
+/// As `dr_next_pose`.
+#[no_mangle]
+pub unsafe extern "C" fn dr_latest_bound(filter: *const DrFilter, out: *mut f64) -> DrStatus {
+    // SAFETY: the caller's contract, passed on; the handle is only read.
+    guard(|| unsafe {
+        with_filter(filter.cast_mut(), |f| {
+            let out = output(out)?;
+            *out = f.latest.map(|p| p.bound_95_m).ok_or_else(|| {
+                Fail::new(
+                    DrStatus::NotAvailable,
+                    "no pose yet: the filter has run no epoch",
+                )
+            })?;
             Ok(DrStatus::Ok)
         })
     })

@@ -211,3 +211,102 @@ fn a_state_file_written_by_stream_resumes_through_the_c_api() {
         "poses differ after resuming stream's state file"
     );
 }
+
+/// Issue 31: the 95 % bound of each pose through the C API
+/// (`dr_next_pose_with_bound`, `dr_latest_bound`) is `stream`'s, from the
+/// `[bound]` factor of the params.toml text, bit for bit.
+#[test]
+fn the_c_api_gives_each_pose_the_bound_of_stream() {
+    let d = drive(90.0);
+    let evs = events(&d);
+    let v = vehicle_toml(&d);
+    let o = options(DR_TIMING_WHEEL, false);
+    // Nominal parameters with a fitted factor of 1.7.
+    let mut extra = toml::Table::new();
+    let fit = deadreckon_core::bound::BoundFit {
+        method: deadreckon_core::bound::Method::Conformal,
+        k: 1.7,
+        windows: 20,
+        outage_s: 30.0,
+        step_s: 10.0,
+    };
+    extra.insert(
+        "bound".into(),
+        deadreckon_api::bound::bound_toml(&fit).into(),
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("params.toml");
+    let nominal = deadreckon_core::ParamsWithStd {
+        params: deadreckon_core::Params::nominal(&d.vehicle),
+        std: stream::default_prior(),
+    };
+    deadreckon_io::write_params(&path, &nominal, Some(&extra)).unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    let (p, prior, stored) = stream::start_params_from_text(&text, "p.toml").unwrap();
+    let mut online = stream::open(&d.vehicle, &p, &prior, &stored, &stream_options(&o))
+        .unwrap()
+        .with_bound(stream::start_bound_from_text(&text, "p.toml").unwrap());
+    let mut want = Vec::new();
+    for ev in &evs {
+        online.push_poses(*ev, &mut |p| want.push(p)).unwrap();
+    }
+    online.end_poses(&mut |p| want.push(p)).unwrap();
+    let mut f = std::ptr::null_mut();
+    // SAFETY: valid texts, options and out.
+    let s = unsafe {
+        dr_filter_new(
+            v.as_ptr().cast(),
+            v.len(),
+            text.as_ptr().cast(),
+            text.len(),
+            &o,
+            &mut f,
+        )
+    };
+    assert_eq!(s, DrStatus::Ok, "{}", last_error());
+    let mut got: Vec<(DrPose, f64)> = Vec::new();
+    let take = |f: *mut DrFilter, got: &mut Vec<(DrPose, f64)>| loop {
+        let mut pose = std::mem::MaybeUninit::<DrPose>::zeroed();
+        let mut b = f64::NAN;
+        // SAFETY: a live handle, writable outputs.
+        match unsafe { dr_next_pose_with_bound(f, pose.as_mut_ptr(), &mut b) } {
+            DrStatus::Ok => got.push((unsafe { pose.assume_init() }, b)),
+            DrStatus::NoPose => break,
+            s => panic!("{s:?}: {}", last_error()),
+        }
+    };
+    for ev in &evs {
+        assert_eq!(push_event(f, ev), DrStatus::Ok, "{}", last_error());
+        take(f, &mut got);
+    }
+    // SAFETY: a live handle.
+    assert_eq!(unsafe { dr_finish(f) }, DrStatus::Ok, "{}", last_error());
+    take(f, &mut got);
+    assert_eq!(got.len(), want.len());
+    assert!(want.len() > 1000, "{} poses", want.len());
+    for (g, w) in got.iter().zip(&want) {
+        assert!(g.0 == DrPose::from(w.point), "pose at {}", w.point.t_s);
+        assert_eq!(
+            g.1.to_bits(),
+            w.bound_95_m.to_bits(),
+            "bound at {}",
+            w.point.t_s
+        );
+    }
+    // The factor is in it: 1.7 times the filter's own bound (with the floor).
+    let plain = deadreckon_core::bound::BoundFit::FILTER;
+    let last = want.last().unwrap();
+    let fix_std = d.gnss.last().unwrap().std_m;
+    let unit = deadreckon_core::bound_pose::point_bound_m(&plain, &last.point, fix_std);
+    assert!(
+        (last.bound_95_m / unit - 1.7).abs() < 1e-12,
+        "{} {unit}",
+        last.bound_95_m
+    );
+    let mut latest = f64::NAN;
+    // SAFETY: a live handle, a writable bound.
+    assert_eq!(unsafe { dr_latest_bound(f, &mut latest) }, DrStatus::Ok);
+    assert_eq!(latest.to_bits(), last.bound_95_m.to_bits());
+    // SAFETY: the handle, freed once.
+    unsafe { dr_filter_free(f) };
+}

@@ -56,6 +56,11 @@ pub struct KinematicParamsFile {
     /// candidate's value, both held-back figures and the decision.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub held_back: Option<deadreckon_core::kinematics::diff_drive::HeldBackParams>,
+    /// The 95 % error bound's factor (`[bound]`: `method`, `k`, `windows`,
+    /// `outage_s`, `step_s`; docs/bound.md), when one was fitted (a
+    /// differential drive's calibration).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bound: Option<toml::Table>,
 }
 
 /// A correlation matrix with the names of its rows.
@@ -84,6 +89,7 @@ impl KinematicParamsFile {
                 matrix: c.correlation.clone(),
             }),
             held_back: c.held_back.clone(),
+            bound: None,
         }
     }
 
@@ -200,6 +206,7 @@ mod tests {
                 matrix: vec![vec![1.0]],
             }),
             held_back: None,
+            bound: None,
         }
     }
 

@@ -63,8 +63,8 @@ pub use toml_files::{
     read_vehicle, write_params, write_truth_params, write_vehicle,
 };
 pub use track_out::{
-    carries_no_covariance, write_track_csv, write_track_geojson, write_track_geojson_with,
-    GeoJsonOptions, TRACK_CSV_COLUMNS,
+    carries_no_covariance, write_track_csv, write_track_csv_with_bounds, write_track_geojson,
+    write_track_geojson_with, GeoJsonOptions, TRACK_CSV_COLUMNS,
 };
 pub use track_text::{
     kitti_line, kitti_times_path, tum_line, write_track_kitti, write_track_tum, TrackFormat,

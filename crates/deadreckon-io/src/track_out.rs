@@ -9,7 +9,7 @@ use geojson::{Feature, FeatureCollection, Geometry, JsonObject, JsonValue, Posit
 use crate::{atomic_write, geo, IoError};
 
 /// The columns of [`write_track_csv`], in order.
-pub const TRACK_CSV_COLUMNS: [&str; 11] = [
+pub const TRACK_CSV_COLUMNS: [&str; 12] = [
     "t_s",
     "track",
     "east_m",
@@ -21,6 +21,7 @@ pub const TRACK_CSV_COLUMNS: [&str; 11] = [
     "std_north_m",
     "std_yaw_rad",
     "cov_en_m2",
+    "bound_95_m",
 ];
 
 /// Writes `tracks` into one CSV file (atomically), track after track, with the
@@ -29,16 +30,29 @@ pub const TRACK_CSV_COLUMNS: [&str; 11] = [
 /// covariance diagonal, and `cov_en_m2` is its east-north term. A track
 /// that carries no uncertainty ([`carries_no_covariance`]: TedriS, the
 /// kinematic shapes' integration, a reference) leaves those four columns
-/// empty rather than writing 0, which would read as certainty.
+/// empty rather than writing 0, which would read as certainty. The
+/// `bound_95_m` column is empty ([`write_track_csv_with_bounds`] fills it).
 pub fn write_track_csv(path: &Path, tracks: &[Track]) -> Result<(), IoError> {
+    write_track_csv_with_bounds(path, tracks, &[])
+}
+
+/// [`write_track_csv`] with the 95 % bound of each pose in `bound_95_m`
+/// (7 significant digits): `bounds[i][k]` for pose `k` of track `i`; a
+/// track without (a missing or empty `bounds[i]`) leaves it empty.
+pub fn write_track_csv_with_bounds(
+    path: &Path,
+    tracks: &[Track],
+    bounds: &[Vec<f64>],
+) -> Result<(), IoError> {
     let mut w = csv::Writer::from_writer(Vec::new());
     let csv_err = |e: csv::Error| IoError::Unwritable {
         path: path.to_path_buf(),
         message: e.to_string(),
     };
     w.write_record(TRACK_CSV_COLUMNS).map_err(csv_err)?;
-    for track in tracks {
+    for (i, track) in tracks.iter().enumerate() {
         let none = carries_no_covariance(track);
+        let bound = bounds.get(i).filter(|b| b.len() == track.points.len());
         let unc = |v: f64| {
             if none {
                 String::new()
@@ -46,7 +60,7 @@ pub fn write_track_csv(path: &Path, tracks: &[Track]) -> Result<(), IoError> {
                 format!("{v:.6e}")
             }
         };
-        for p in &track.points {
+        for (k, p) in track.points.iter().enumerate() {
             // Fixed precision per column (the shortest round-trip form of a
             // tiny number runs to 40 digits): times, positions and angles to
             // 1e-9 (what `events | stream` is checked against), speeds to
@@ -63,6 +77,7 @@ pub fn write_track_csv(path: &Path, tracks: &[Track]) -> Result<(), IoError> {
                 unc(p.std_north_m()),
                 unc(p.std_yaw_rad()),
                 unc(p.cov_pose[1]),
+                bound.map_or(String::new(), |b| format!("{:.6e}", b[k])),
             ])
             .map_err(csv_err)?;
         }

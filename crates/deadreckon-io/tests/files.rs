@@ -243,14 +243,14 @@ fn track_csv_has_the_contract_columns() {
         lines.next(),
         Some(
             "t_s,track,east_m,north_m,yaw_rad,speed_mps,yaw_rate_rps,\
-             std_east_m,std_north_m,std_yaw_rad,cov_en_m2"
+             std_east_m,std_north_m,std_yaw_rad,cov_en_m2,bound_95_m"
         )
     );
     assert_eq!(
         lines.next(),
         Some(
             "0.000000000,smoothed,0.000000000,-0.000000000,0.100000000,20.000000,0.010000000,\
-             2.000000e0,3.000000e0,1.000000e-2,5.000000e-1"
+             2.000000e0,3.000000e0,1.000000e-2,5.000000e-1,"
         )
     );
     assert_eq!(text.lines().count(), 6);

@@ -509,6 +509,30 @@ pub struct OutageEvaluation {
     pub window_s: Option<f64>,
     /// One entry per method.
     pub methods: Vec<MethodSample>,
+    /// The 95 % error bound of one method through the same windows
+    /// (issue 31; absent in reports made before it).
+    pub bound: Option<OutageBound>,
+}
+
+/// Error and 95 % bound against time in outage, over sliding windows, with
+/// the coverage.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct OutageBound {
+    /// The method (parameter set) whose windows these are.
+    pub method: String,
+    /// The bound's factor in words (how it was fitted).
+    pub factor: String,
+    /// Per window: time since the outage start, s.
+    pub time_s: Vec<Vec<f64>>,
+    /// Per window: the horizontal error at each time, m.
+    pub error_m: Vec<Vec<f64>>,
+    /// Per window: the 95 % bound at each time, m.
+    pub bound_m: Vec<Vec<f64>>,
+    /// Windows whose final error is within the bound.
+    pub within: usize,
+    /// The median bound at the windows' ends over the median final error.
+    pub sharpness: f64,
 }
 
 /// A kinematic shape's calibration (a tricycle against its tracker, a

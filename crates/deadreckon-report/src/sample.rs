@@ -488,6 +488,7 @@ pub fn sample_input(duration_s: f64) -> ReportInput {
                 final_error_m: final_errors(2.6),
             },
         ],
+        bound: Some(sample_bound(&mut rng)),
     };
 
     ReportInput {
@@ -509,5 +510,34 @@ pub fn sample_input(duration_s: f64) -> ReportInput {
             what: "ZUPT calibration".into(),
             reason: "insufficient data: no standstill of 2 s to take the gyro bias from".into(),
         }],
+    }
+}
+
+/// Twenty 30 s windows of error growing with time in outage, and a bound
+/// 2.45 times the error's standard deviation (a circle's 95 % radius).
+fn sample_bound(rng: &mut Noise) -> OutageBound {
+    let (mut time_s, mut error_m, mut bound_m) = (Vec::new(), Vec::new(), Vec::new());
+    let mut within = 0;
+    for _ in 0..20 {
+        let t: Vec<f64> = (0..=60).map(|k| 0.5 * k as f64).collect();
+        let scale = (0.3 * rng.gauss()).exp();
+        let e: Vec<f64> = t
+            .iter()
+            .map(|t| scale * (0.3 + 0.02 * t * t / 30.0 + 0.05 * t))
+            .collect();
+        let b: Vec<f64> = t.iter().map(|t| 2.45 * (0.3 + 0.035 * t)).collect();
+        within += usize::from(e.last() <= b.last());
+        time_s.push(t);
+        error_m.push(e);
+        bound_m.push(b);
+    }
+    OutageBound {
+        method: "RTS".into(),
+        factor: "1.40 × the filter's 95 % radius".into(),
+        time_s,
+        error_m,
+        bound_m,
+        within,
+        sharpness: 2.1,
     }
 }

@@ -91,10 +91,11 @@ fn every_section_and_figure_of_a_full_report_draws_data() {
     );
     let figs = figures(&html);
     // 1 trajectory + 6 iteration plots + 2 drift + 3 innovations + 2 NIS
-    // + cross-correlation, heading, repositories, 3 outages + 1 outage evaluation.
+    // + cross-correlation, heading, repositories, 3 outages + 1 outage evaluation
+    // + its 95 % bound (issue 31).
     assert_eq!(
         figs.len(),
-        21,
+        22,
         "{:?}",
         figs.iter().map(|f| &f.0).collect::<Vec<_>>()
     );
@@ -199,6 +200,7 @@ fn empty_sections_are_left_out() {
                 method: "RTS".into(),
                 final_error_m: vec![f64::NAN],
             }],
+            bound: Some(OutageBound::default()),
         }),
         ..Default::default()
     };
@@ -787,4 +789,28 @@ fn a_stored_correction_showed_a_dash_for_its_std() {
     c.rows.retain(|r| r.value.is_none() || r.std.is_some());
     let html = render_html(&input).unwrap();
     assert!(!html.contains("–: no standard error"));
+}
+
+/// Issue 31: the outage section draws error and 95 % bound against time in
+/// outage, in the method's colour and the reference red, and states the
+/// coverage and sharpness in the caption.
+#[test]
+fn the_outage_section_draws_the_error_against_its_bound_with_the_coverage() {
+    let input = sample_input(120.0);
+    let b = input.outages.as_ref().unwrap().bound.clone().unwrap();
+    let html = render_html(&input).unwrap();
+    let fig = figure(&html, "outage-bound");
+    assert!(fig.to_uppercase().contains("#0072B2"), "RTS's colour");
+    let caption = format!(
+        "within the bound in {} of {} windows ({:.0} %)",
+        b.within,
+        b.time_s.len(),
+        100.0 * b.within as f64 / b.time_s.len() as f64
+    );
+    assert!(html.contains(&caption), "no `{caption}` in the page");
+    // (The page escapes the slash of "median bound / median final error".)
+    assert!(html.contains("median final error 2.10"), "sharpness");
+    // The sample's windows: 30 s each, so the time axis ends near 30 s.
+    let top = largest_label(fig);
+    assert!(top >= 30.0, "largest axis label {top}");
 }

@@ -1,10 +1,12 @@
 //! The outage evaluation: the distribution of the final error at the end of
-//! sliding simulated GNSS outages, per method, with a summary table.
+//! sliding simulated GNSS outages, per method, with a summary table; and the
+//! error against the 95 % bound through the windows, with its coverage.
 
 use crate::charts::{histogram_chart, Sample};
-use crate::model::OutageEvaluation;
+use crate::charts::{lines_chart, Line};
+use crate::model::{OutageBound, OutageEvaluation};
 use crate::page::{Block, FigureView, RowView, SectionView, TableView};
-use crate::plot::{fmt_sig, fmt_trim, Palette};
+use crate::plot::{fmt_sig, fmt_trim, Legend, Palette, REFERENCE, WIDTH};
 use crate::stats::summary;
 use crate::ReportError;
 
@@ -80,9 +82,78 @@ pub(crate) fn section(
             svg: svg.svg,
         }));
     }
+    if let Some(b) = &o.bound {
+        blocks.extend(bound_figure(b, &window, palette)?);
+    }
     Ok(Some(SectionView {
         id: "outages",
         title: "Outage evaluation",
         blocks,
     }))
+}
+
+/// The error and the 95 % bound against time in outage, every window's
+/// curves in one colour each (`None` without points).
+fn bound_figure(
+    b: &OutageBound,
+    window: &str,
+    palette: &mut Palette,
+) -> Result<Option<Block>, ReportError> {
+    let n = b.time_s.len();
+    if n == 0 || b.error_m.len() != n || b.bound_m.len() != n {
+        return Ok(None);
+    }
+    // The windows joined, a NaN between two (a break in the line).
+    let joined = |v: &[Vec<f64>]| -> Vec<f64> {
+        v.iter()
+            .flat_map(|w| w.iter().copied().chain(std::iter::once(f64::NAN)))
+            .collect()
+    };
+    let t = joined(&b.time_s);
+    let (e, bound) = (joined(&b.error_m), joined(&b.bound_m));
+    if t.len() != e.len() || t.len() != bound.len() {
+        return Ok(None);
+    }
+    let lines = [
+        Line {
+            name: format!("error ({})", b.method),
+            color: palette.color(&b.method),
+            width: 1,
+            t: &t,
+            v: &e,
+        },
+        Line {
+            name: "95 % bound".into(),
+            color: REFERENCE,
+            width: 1,
+            t: &t,
+            v: &bound,
+        },
+    ];
+    let Some(svg) = lines_chart(
+        "outage-bound",
+        &lines,
+        "time since outage start (s)",
+        "horizontal error (m)",
+        &[],
+        (WIDTH, 320),
+        Legend::Right,
+    )?
+    else {
+        return Ok(None);
+    };
+    Ok(Some(Block::Figure(FigureView {
+        name: "outage-bound".into(),
+        caption: format!(
+            "Horizontal error and its 95 % bound against time in each sliding outage{window} \
+             with {}: the final error is within the bound in {} of {n} windows ({:.0} %); \
+             median bound / median final error {}. The bound: {}.",
+            b.method,
+            b.within,
+            100.0 * b.within as f64 / n as f64,
+            fmt_sig(b.sharpness, 3),
+            b.factor
+        ),
+        svg,
+    })))
 }

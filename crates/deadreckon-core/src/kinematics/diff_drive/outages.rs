@@ -50,6 +50,11 @@ pub struct DiffDriveOutages {
     /// deviation of the final error per axis, m (the root of half the trace
     /// of the predicted fix's covariance plus the fix's white noise).
     pub predicted_std_m: Vec<f64>,
+    /// Filter start only: for each window, the covariance of the fix the
+    /// filter predicts at its end (the state's part, without the fix's
+    /// white noise), m²: what the 95 % bound is made of
+    /// ([`crate::bound_diff`]).
+    pub predicted_cov_m2: Vec<crate::bound::Cov2>,
 }
 
 impl DiffDriveOutages {
@@ -120,6 +125,7 @@ pub fn evaluate_diff_drive(
         .map_or(0, |f| d.fixes.partition_point(|x| x.0 <= f.t_s));
     let mut windows = Vec::new();
     let mut predicted_std_m = Vec::new();
+    let mut predicted_cov_m2 = Vec::new();
     let (mut used, mut rejected, mut jumps) = (0, 0, 0);
     let mut ts = first.t_s + warmup_s;
     while ts + outage_s <= last.t_s {
@@ -174,6 +180,11 @@ pub fn evaluate_diff_drive(
                     OutageStart::Align => 0.0,
                 };
                 predicted_std_m.push((0.5 * cov.trace() + white).sqrt());
+                predicted_cov_m2.push(crate::bound::Cov2 {
+                    ee_m2: cov[(0, 0)],
+                    en_m2: 0.5 * (cov[(0, 1)] + cov[(1, 0)]),
+                    nn_m2: cov[(1, 1)],
+                });
                 [z[0], z[1]]
             }
         };
@@ -207,5 +218,6 @@ pub fn evaluate_diff_drive(
         fixes_rejected: rejected,
         fix_jumps: jumps,
         predicted_std_m,
+        predicted_cov_m2,
     })
 }
