@@ -180,9 +180,9 @@ def calibrate(
     *,
     state: str = "augmented",
     iteration: str = "anderson",
-    max_iterations: int = 60,
+    max_iterations: Optional[int] = None,
     timing: str = "wheel",
-    min_speed: float = 2.0,
+    min_speed: Optional[float] = None,
     mapping: Optional[PathLike] = None,
     corrections: str = "auto",
     skip_checks: bool = False,
@@ -192,8 +192,8 @@ def calibrate(
     ``method``: ``rts`` (smoothed states, needs GNSS), ``zupt`` (standstill
     gyro bias) or ``truth``. The options are ``calibrate``'s: ``state``
     (``augmented`` or ``paper``), ``iteration`` (``anderson`` or ``plain``),
-    ``max_iterations``, ``timing`` (``wheel`` or ``each``), ``min_speed``
-    (m/s), ``corrections`` (``gnss``: estimate the streams' delays, the
+    ``max_iterations`` (default the command's, 60), ``timing`` (``wheel`` or
+    ``each``), ``min_speed`` (m/s, default the command's, 2), ``corrections`` (``gnss``: estimate the streams' delays, the
     driven axle's slip, the IMU tilt and the gyro scale, apply the slip, the
     tilt, the GNSS delay and the scale;
     ``all``: apply every delay too; ``none``). Keys: the six parameters,

@@ -3,6 +3,7 @@
 
 use std::path::PathBuf;
 
+use deadreckon_api::calibration::CalibrationRequest;
 use deadreckon_api::json;
 use deadreckon_api::options::{parse_iteration, parse_pass_state, parse_timing};
 use deadreckon_core::calibrate::{CalibrationOptions, Method};
@@ -48,9 +49,10 @@ fn err(e: impl std::fmt::Display) -> PyErr {
     DeadreckonError::new_err(e.to_string())
 }
 
-/// `calibrate --json` as a dict; the options are the command's.
+/// `calibrate --json` as a dict; the options are the command's, and those
+/// not given (`None`) are [`CalibrationRequest::default`]'s.
 #[pyfunction]
-#[pyo3(signature = (source, method="rts", state="augmented", iteration="anderson", max_iterations=60, timing="wheel", min_speed=2.0, mapping=None, corrections="auto", skip_checks=false))]
+#[pyo3(signature = (source, method="rts", state="augmented", iteration="anderson", max_iterations=None, timing="wheel", min_speed=None, mapping=None, corrections="auto", skip_checks=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn calibrate(
     py: Python<'_>,
@@ -58,26 +60,30 @@ pub fn calibrate(
     method: &str,
     state: &str,
     iteration: &str,
-    max_iterations: usize,
+    max_iterations: Option<usize>,
     timing: &str,
-    min_speed: f64,
+    min_speed: Option<f64>,
     mapping: Option<PathBuf>,
     corrections: &str,
     skip_checks: bool,
 ) -> PyResult<Py<PyAny>> {
-    let which = corrections_which(corrections)?;
+    let d = CalibrationRequest::default().options;
     let m: Method = method.parse().map_err(to_py_err)?;
-    let opts = CalibrationOptions {
-        method: m,
-        state: parse_pass_state(state).map_err(to_py_err)?,
-        iteration: parse_iteration(iteration).map_err(to_py_err)?,
-        max_iterations,
-        min_speed_mps: min_speed,
-        filter: FilterOptions {
-            timing: parse_timing(timing).map_err(to_py_err)?,
-            ..Default::default()
+    let request = CalibrationRequest {
+        options: CalibrationOptions {
+            method: m,
+            state: parse_pass_state(state).map_err(to_py_err)?,
+            iteration: parse_iteration(iteration).map_err(to_py_err)?,
+            max_iterations: max_iterations.unwrap_or(d.max_iterations),
+            min_speed_mps: min_speed.unwrap_or(d.min_speed_mps),
+            filter: FilterOptions {
+                timing: parse_timing(timing).map_err(to_py_err)?,
+                ..d.filter
+            },
+            ..d
         },
-        ..Default::default()
+        corrections: corrections_which(corrections)?,
+        ..CalibrationRequest::default()
     };
     // Only the truth calibration reads truth.csv (as `calibrate` does).
     let read = deadreckon_io::ReadOptions::default();
@@ -93,7 +99,7 @@ pub fn calibrate(
     let drive = drive_arg(py, source, &read, mapping)?;
     let checks = checked(source, &drive, skip_checks)?;
     let cc = py
-        .detach(|| deadreckon_api::calibrate::calibrate_car(&drive, method, opts, which, &what))
+        .detach(|| deadreckon_api::calibration::calibrate(&drive, &request, &what))
         .map_err(to_py_err)?;
     let mut v = cc.json();
     // Python's calibrate is the car's: the shape found, as the command says it.

@@ -3,7 +3,6 @@
 //! line and the Python bindings alike; and the RPE or APE of one of the
 //! drive's tracks against another ([`evo_metric`]).
 
-use deadreckon_core::calibrate::{self, CalibrationOptions};
 use deadreckon_core::ekf::{FilterOptions, Timing};
 use deadreckon_core::evo::{self, TrajectoryError};
 use deadreckon_core::metrics::{self, DriftResult, ResetResult, Summary};
@@ -80,24 +79,19 @@ pub fn default_parameters(drive: &Drive, which: Which) -> Result<(Parameters, Dr
             drive.clone(),
         ));
     }
-    let copts = CalibrationOptions::default();
-    let (drive, corrections) = crate::corrections::estimate_and_apply(drive, &copts, which)?;
-    let c = calibrate::calibrate(&drive, &copts).map_err(|source| Error::Calibration {
-        what: "RTS calibration with GNSS",
-        source,
-    })?;
-    let bound =
-        deadreckon_core::bound::fit_on_drive(&drive, &c.estimate.params, &FilterOptions::default());
+    let request = crate::calibration::CalibrationRequest::with_corrections(which);
+    let (car, corrected) = crate::calibration::calibrate_corrected(drive, &request, "the drive")?;
+    let c = car.calibration;
     Ok((
         Parameters {
             params: c.estimate.params,
             label: format!("rts ({} passes)", c.iterations),
-            corrections: Some(corrections),
+            corrections: Some(car.corrections),
             source: format!("{CALIBRATED_HERE}: rts ({} passes)", c.iterations),
             note: None,
-            bound,
+            bound: car.bound,
         },
-        drive,
+        corrected.unwrap_or_else(|| drive.clone()),
     ))
 }
 

@@ -27,9 +27,13 @@
 //!   (`deadreckon-io`), a comma2k19 segment, a ROS1 bag or ROS2 MCAP (with a
 //!   topic mapping) or a tricycle log, chosen by what the path holds; errors
 //!   name the file and, through their sources, the line and column.
-//! - [`calibrate`]: the car's calibration as `calibrate` and Python run it
-//!   (corrections, the six parameters, the steering) with its `--json`
-//!   object, params.toml keys and text.
+//! - [`calibration`]: the one home of a car calibration: the request
+//!   (method, options, corrections; its `Default` holds every default
+//!   once), the one function `calibrate`, `batch`, Python and `evaluate`
+//!   call, and the status rule of a parameter.
+//! - [`calibrate`]: its result, [`calibrate::CarCalibration`] (corrections,
+//!   the six parameters, the steering, the bound, the vehicle), with its
+//!   `--json` object, params.toml keys and text.
 //! - [`checks`]: the cross-stream plausibility checks applied to a drive
 //!   read (errors refuse it, warnings go to `"checks"` in `--json`).
 //! - [`evaluate`]: the parameters `evaluate` measures when none are given
@@ -53,6 +57,7 @@
 pub mod binding;
 pub mod bound;
 pub mod calibrate;
+pub mod calibration;
 pub mod checks;
 pub mod corrections;
 pub mod demo;

@@ -17,9 +17,7 @@
 
 use rayon::prelude::*;
 
-use deadreckon_api::calibrate::calibrate_car;
 use deadreckon_api::corrections::stored_corrections;
-use deadreckon_core::calibrate::CalibrationOptions;
 use deadreckon_core::ekf::FilterOptions;
 use deadreckon_core::metrics::Summary;
 use deadreckon_core::outage::evaluate;
@@ -41,11 +39,9 @@ fn car(seed: u64, drive_s: f64) -> Result<Car, String> {
         .map_err(|e| format!("calibration drive: {e}"))?;
     let ev = simulate(&family.drive(2000 + seed, drive_s), 2000 + seed)
         .map_err(|e| format!("evaluation drive: {e}"))?;
-    let c = calibrate_car(
+    let c = deadreckon_api::calibration::calibrate(
         &cal.drive,
-        "rts",
-        CalibrationOptions::default(),
-        Which::Gnss,
+        &deadreckon_api::calibration::CalibrationRequest::with_corrections(Which::Gnss),
         "cal",
     )
     .map_err(|e| format!("calibration: {e}"))?;

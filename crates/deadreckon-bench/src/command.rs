@@ -7,7 +7,6 @@
 use std::path::Path;
 
 use deadreckon_api::load::Loader;
-use deadreckon_core::calibrate::CalibrationOptions;
 use deadreckon_core::ekf::FilterOptions;
 use deadreckon_core::timing::Which;
 
@@ -75,11 +74,9 @@ impl Command {
                 } else {
                     Which::None
                 };
-                let cc = deadreckon_api::calibrate::calibrate_car(
+                let cc = deadreckon_api::calibration::calibrate(
                     &drive,
-                    "rts",
-                    CalibrationOptions::default(),
-                    which,
+                    &deadreckon_api::calibration::CalibrationRequest::with_corrections(which),
                     "drive",
                 )?;
                 std::hint::black_box(cc.json());
