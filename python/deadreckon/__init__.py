@@ -265,7 +265,7 @@ def evaluate(
     *,
     outage: Optional[float] = None,
     step: Optional[float] = None,
-    warmup: float = 5.0,
+    warmup: Optional[float] = None,
     segment_m: float = 100.0,
     threshold_m: float = 1.0,
     track: str = "dead-reckoned",
@@ -290,7 +290,8 @@ def evaluate(
     ``metric``: ``drift`` (per ``segment_m``), ``reset-1m`` (at
     ``threshold_m``), ``rpe`` (evo's relative pose error per ``delta_m`` of
     path) or ``ape``. With ``outage`` (s), sliding GNSS outages every
-    ``step`` s (default half the outage) after ``warmup`` s instead. Without
+    ``step`` s (default half the outage) after ``warmup`` s (default the
+    command's, 5) instead. Without
     ``params``, for every metric, the drive is calibrated with RTS first, as
     the command does (in-sample), with the ``corrections`` of
     :func:`calibrate`, or the nominal parameters are taken when it has no

@@ -133,26 +133,14 @@ pub fn params_arg(
     if label == "nominal" {
         return Ok((Params::nominal(vehicle), label));
     }
-    let read = deadreckon_io::read_params(&spec).map_err(|e| {
-        err(format!(
-            "reading parameters {label}: {}",
-            deadreckon_api::chain_text(&e)
-        ))
-    })?;
-    read.params.validate().map_err(|e| {
-        err(format!(
-            "parameters in {label}: {}",
-            deadreckon_api::chain_text(&e)
-        ))
-    })?;
-    // Bound to their vehicle, as the command line's --params
-    // (deadreckon_api::binding): another vehicle's file is refused.
-    let (_, extra) = deadreckon_io::read_params_with_extra(&spec).map_err(to_py_err)?;
-    let record =
-        deadreckon_api::binding::VehicleRecord::from_extra(&label, &extra).map_err(to_py_err)?;
-    deadreckon_api::binding::check(&label, record.as_ref(), &read.params, vehicle, false)
+    // Read and checked once (deadreckon_api::params_file), bound to their
+    // vehicle as the command line's --params (deadreckon_api::binding):
+    // another vehicle's file is refused.
+    let file = deadreckon_api::params_file::ParamsFile::read(&label).map_err(to_py_err)?;
+    let params = file.estimate.params;
+    deadreckon_api::binding::check(&label, file.vehicle.as_ref(), &params, vehicle, false)
         .map_err(to_py_err)?;
-    Ok((read.params, label))
+    Ok((params, label))
 }
 
 /// Every track of a drive (dead-reckoned, filtered, smoothed, and truth),
@@ -227,7 +215,7 @@ pub fn track_columns<'py>(py: Python<'py>, t: &track::Track) -> PyResult<Bound<'
 
 /// `evaluate --json` as a dict; the options are the command's.
 #[pyfunction]
-#[pyo3(signature = (source, params=None, metric="drift", outage=None, step=None, warmup=5.0, segment_m=100.0, threshold_m=1.0, track="dead-reckoned", reference="truth", delta_m=100.0, pairs_from="estimate", max_diff_s=evo::DEFAULT_MAX_DIFF_S, timing="wheel", mapping=None, corrections="auto", skip_checks=false, shape=None))]
+#[pyo3(signature = (source, params=None, metric="drift", outage=None, step=None, warmup=None, segment_m=100.0, threshold_m=1.0, track="dead-reckoned", reference="truth", delta_m=100.0, pairs_from="estimate", max_diff_s=evo::DEFAULT_MAX_DIFF_S, timing="wheel", mapping=None, corrections="auto", skip_checks=false, shape=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn evaluate(
     py: Python<'_>,
@@ -236,7 +224,7 @@ pub fn evaluate(
     metric: &str,
     outage: Option<f64>,
     step: Option<f64>,
-    warmup: f64,
+    warmup: Option<f64>,
     segment_m: f64,
     threshold_m: f64,
     track: &str,
@@ -276,9 +264,13 @@ pub fn evaluate(
     let (params, label, drive, corr, params_source, bound) = py.detach(|| -> PyResult<_> {
         Ok(match given {
             Some((p, l)) => {
-                let bound = match &spec {
-                    Some(f) => deadreckon_api::bound::stored_bound(f).map_err(to_py_err)?,
-                    None => deadreckon_core::bound::BoundFit::FILTER,
+                let bound = match spec.as_deref() {
+                    Some(f) if f != "nominal" => {
+                        deadreckon_api::params_file::ParamsFile::read(f)
+                            .map_err(to_py_err)?
+                            .bound
+                    }
+                    _ => deadreckon_core::bound::BoundFit::FILTER,
                 };
                 (p, l.clone(), stored, None, l, bound)
             }
@@ -300,7 +292,7 @@ pub fn evaluate(
                 &params,
                 len,
                 step.unwrap_or(len / 2.0),
-                warmup,
+                warmup.unwrap_or(deadreckon_api::evaluate::OUTAGE_WARMUP_S),
                 &base,
             )
             .map_err(to_py_err)?;

@@ -57,7 +57,7 @@ pub struct BatchArgs {
     #[arg(long, value_parser = super::positive)]
     pub step: Option<f64>,
     /// GNSS-aided time before the first outage window, s.
-    #[arg(long, default_value_t = 5.0, value_parser = super::non_negative)]
+    #[arg(long, default_value_t = deadreckon_api::evaluate::OUTAGE_WARMUP_S, value_parser = super::non_negative)]
     pub warmup: f64,
     /// The timing and mounting corrections estimated and applied on each drive
     /// before calibrating, as `calibrate --corrections`: all, gnss or none

@@ -22,6 +22,10 @@ pub const RULE: &str = "without --params, the parameters are calibrated on the d
      tracker for a tricycle; in-sample: calibrate on another drive or part for a held-out \
      figure), or nominal when the drive has no GNSS fix; --params nominal for the nominal ones";
 
+/// The GNSS-aided time before the first sliding outage window, s: the
+/// default of `evaluate --warmup`, `batch --warmup` and Python's `warmup`.
+pub const OUTAGE_WARMUP_S: f64 = 5.0;
+
 /// What `"params_source"` says of parameters calibrated on the drive.
 pub const CALIBRATED_HERE: &str = "calibrated on this drive";
 
@@ -162,7 +166,7 @@ pub fn given_parameters_bound(
     drive: Drive,
     allow_other: bool,
 ) -> Result<(Parameters, Drive), Error> {
-    let (params, drive, note) = crate::load::params_corrected_bound(spec, drive, allow_other)?;
+    let (params, drive, note, file) = crate::load::params_file_corrected(spec, drive, allow_other)?;
     Ok((
         Parameters {
             params,
@@ -170,7 +174,7 @@ pub fn given_parameters_bound(
             corrections: None,
             source: spec.to_string(),
             note,
-            bound: crate::bound::stored_bound(spec)?,
+            bound: file.map_or(deadreckon_core::bound::BoundFit::FILTER, |f| f.bound),
         },
         drive,
     ))

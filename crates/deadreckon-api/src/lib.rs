@@ -45,6 +45,9 @@
 //!   `tedris train --json` print, built from the library results.
 //! - [`tedris`]: a TedriS model read from its file and checked.
 //! - [`text`]: the commands' text tables and summary lines.
+//! - [`params_file`]: a car's params.toml read once and checked once
+//!   (parameters, `[std]`, `[vehicle]`, stored corrections, `[bound]`),
+//!   for every `--params`.
 //! - [`options`]: the option words of the commands (`--timing wheel|each`,
 //!   `--state`, `--iteration`) parsed into the library's enums.
 //!
@@ -68,6 +71,7 @@ pub mod kinematic;
 pub mod load;
 pub mod model_keys;
 pub mod options;
+pub mod params_file;
 pub mod report;
 pub mod report_kinematic;
 pub mod shape;

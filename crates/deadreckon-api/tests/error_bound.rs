@@ -1,6 +1,6 @@
 //! Issue 31: the 95 % error bound validated on drives that did not tune
 //! it. Each family car ([`CarFamily`]) is calibrated as `calibrate` does it
-//! (`calibrate_car`: the default corrections, RTS, then the bound's factor
+//! (`calibration::calibrate`: the default corrections, RTS, then the bound's factor
 //! fitted on the calibration drive's own hidden fixes), and evaluated as
 //! `evaluate --params` does it (the stored corrections applied) on a second
 //! drive of the same car: 30 s outages every 10 s against the truth. Per

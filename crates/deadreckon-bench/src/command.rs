@@ -94,7 +94,7 @@ impl Command {
                     evaluate::Metric::Outages {
                         length_s: 30.0,
                         step_s: 10.0,
-                        warmup_s: 5.0,
+                        warmup_s: evaluate::OUTAGE_WARMUP_S,
                     },
                 )?;
                 std::hint::black_box(ev.json());
