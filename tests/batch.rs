@@ -263,3 +263,69 @@ fn batch_had_no_corrections_and_no_columns_for_them() {
     assert_eq!(&r[0][column(&plain, "delay_gnss_s")], "");
     assert_eq!(&r[0][column(&plain, "status_delay_gnss")], "");
 }
+
+/// One car calibration (issue 30): `batch`'s row and `calibrate --json`
+/// on the same drive with the same options are the same numbers (both call
+/// `deadreckon_api::calibration::calibrate`), and the status columns are
+/// the JSON's `not_estimated` rule. Before, `batch` ran its own sequence
+/// with its own rule for "estimated" (`std > 0 && samples > 0`).
+#[test]
+fn batch_row_and_calibrate_json_are_one_calibration() {
+    let t = tempfile::tempdir().expect("temp dir");
+    let d = t.path().join("d");
+    simulate(&d, 5, "car-1", 1);
+    let dir = d.to_string_lossy();
+    for method in ["rts", "zupt"] {
+        let out = t.path().join(format!("{method}.csv"));
+        same_numbers(&dir, &out, method);
+    }
+}
+
+fn same_numbers(dir: &str, out: &Path, method: &str) {
+    let r = run(&[
+        "batch",
+        dir,
+        "--out",
+        &out.to_string_lossy(),
+        "--method",
+        method,
+        "--quiet",
+    ]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    // batch's default corrections are none; calibrate's are auto.
+    let c = run(&[
+        "calibrate",
+        dir,
+        "--json",
+        "--corrections",
+        "none",
+        "--method",
+        method,
+    ]);
+    assert!(c.status.success(), "{}", String::from_utf8_lossy(&c.stderr));
+    let json: serde_json::Value = serde_json::from_slice(&c.stdout).expect("json");
+    let row = &rows(out)[0];
+    let cell = |name: &str| row[column(out, name)].to_string();
+    assert_eq!(cell("iterations"), json["iterations"].to_string());
+    assert_eq!(cell("converged"), json["converged"].to_string());
+    let not_estimated = json["not_estimated"].as_object().expect("object");
+    for (i, name) in deadreckon_core::Params::NAMES.iter().enumerate() {
+        let v: f64 = cell(name).parse().expect("number");
+        let s: f64 = cell(&format!("std_{name}")).parse().expect("number");
+        assert_eq!(v, json[name].as_f64().unwrap(), "{name}");
+        assert_eq!(s, json["std"][name].as_f64().unwrap(), "std {name}");
+        assert_eq!(
+            cell(&format!("samples_{name}")),
+            json["samples"][i].to_string()
+        );
+        let status = if not_estimated.contains_key(*name) {
+            "not-estimated"
+        } else {
+            "estimated"
+        };
+        assert_eq!(cell(&format!("status_{name}")), status, "{name}");
+    }
+    // ZUPT estimates the bias only; RTS all six on this drive.
+    let expected = if method == "zupt" { 5 } else { 0 };
+    assert_eq!(not_estimated.len(), expected, "{method}: {not_estimated:?}");
+}

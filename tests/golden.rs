@@ -139,11 +139,9 @@ fn outputs() -> Vec<(&'static str, String)> {
     // The command's calibration (`calibrate --json` with the default
     // corrections): the corrections estimated and applied, then the RTS
     // calibration, its steering and what it could not estimate.
-    let car = deadreckon_api::calibrate::calibrate_car(
+    let car = deadreckon_api::calibration::calibrate(
         &drive,
-        "rts",
-        CalibrationOptions::default(),
-        deadreckon_core::timing::Which::default(),
+        &deadreckon_api::calibration::CalibrationRequest::default(),
         "the golden drive",
     )
     .unwrap();

@@ -180,9 +180,9 @@ def calibrate(
     *,
     state: str = "augmented",
     iteration: str = "anderson",
-    max_iterations: int = 60,
+    max_iterations: Optional[int] = None,
     timing: str = "wheel",
-    min_speed: float = 2.0,
+    min_speed: Optional[float] = None,
     mapping: Optional[PathLike] = None,
     corrections: str = "auto",
     skip_checks: bool = False,
@@ -192,8 +192,8 @@ def calibrate(
     ``method``: ``rts`` (smoothed states, needs GNSS), ``zupt`` (standstill
     gyro bias) or ``truth``. The options are ``calibrate``'s: ``state``
     (``augmented`` or ``paper``), ``iteration`` (``anderson`` or ``plain``),
-    ``max_iterations``, ``timing`` (``wheel`` or ``each``), ``min_speed``
-    (m/s), ``corrections`` (``gnss``: estimate the streams' delays, the
+    ``max_iterations`` (default the command's, 60), ``timing`` (``wheel`` or
+    ``each``), ``min_speed`` (m/s, default the command's, 2), ``corrections`` (``gnss``: estimate the streams' delays, the
     driven axle's slip, the IMU tilt and the gyro scale, apply the slip, the
     tilt, the GNSS delay and the scale;
     ``all``: apply every delay too; ``none``). Keys: the six parameters,
@@ -266,7 +266,7 @@ def evaluate(
     *,
     outage: Optional[float] = None,
     step: Optional[float] = None,
-    warmup: float = 5.0,
+    warmup: Optional[float] = None,
     segment_m: float = 100.0,
     threshold_m: float = 1.0,
     track: str = "dead-reckoned",
@@ -291,7 +291,8 @@ def evaluate(
     ``metric``: ``drift`` (per ``segment_m``), ``reset-1m`` (at
     ``threshold_m``), ``rpe`` (evo's relative pose error per ``delta_m`` of
     path) or ``ape``. With ``outage`` (s), sliding GNSS outages every
-    ``step`` s (default half the outage) after ``warmup`` s instead. Without
+    ``step`` s (default half the outage) after ``warmup`` s (default the
+    command's, 5) instead. Without
     ``params``, for every metric, the drive is calibrated with RTS first, as
     the command does (in-sample), with the ``corrections`` of
     :func:`calibrate`, or the nominal parameters are taken when it has no

@@ -3,6 +3,7 @@
 
 use std::path::PathBuf;
 
+use deadreckon_api::calibration::CalibrationRequest;
 use deadreckon_api::json;
 use deadreckon_api::options::{parse_iteration, parse_pass_state, parse_timing};
 use deadreckon_core::calibrate::{CalibrationOptions, Method};
@@ -48,9 +49,10 @@ fn err(e: impl std::fmt::Display) -> PyErr {
     DeadreckonError::new_err(e.to_string())
 }
 
-/// `calibrate --json` as a dict; the options are the command's.
+/// `calibrate --json` as a dict; the options are the command's, and those
+/// not given (`None`) are [`CalibrationRequest::default`]'s.
 #[pyfunction]
-#[pyo3(signature = (source, method="rts", state="augmented", iteration="anderson", max_iterations=60, timing="wheel", min_speed=2.0, mapping=None, corrections="auto", skip_checks=false))]
+#[pyo3(signature = (source, method="rts", state="augmented", iteration="anderson", max_iterations=None, timing="wheel", min_speed=None, mapping=None, corrections="auto", skip_checks=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn calibrate(
     py: Python<'_>,
@@ -58,26 +60,30 @@ pub fn calibrate(
     method: &str,
     state: &str,
     iteration: &str,
-    max_iterations: usize,
+    max_iterations: Option<usize>,
     timing: &str,
-    min_speed: f64,
+    min_speed: Option<f64>,
     mapping: Option<PathBuf>,
     corrections: &str,
     skip_checks: bool,
 ) -> PyResult<Py<PyAny>> {
-    let which = corrections_which(corrections)?;
+    let d = CalibrationRequest::default().options;
     let m: Method = method.parse().map_err(to_py_err)?;
-    let opts = CalibrationOptions {
-        method: m,
-        state: parse_pass_state(state).map_err(to_py_err)?,
-        iteration: parse_iteration(iteration).map_err(to_py_err)?,
-        max_iterations,
-        min_speed_mps: min_speed,
-        filter: FilterOptions {
-            timing: parse_timing(timing).map_err(to_py_err)?,
-            ..Default::default()
+    let request = CalibrationRequest {
+        options: CalibrationOptions {
+            method: m,
+            state: parse_pass_state(state).map_err(to_py_err)?,
+            iteration: parse_iteration(iteration).map_err(to_py_err)?,
+            max_iterations: max_iterations.unwrap_or(d.max_iterations),
+            min_speed_mps: min_speed.unwrap_or(d.min_speed_mps),
+            filter: FilterOptions {
+                timing: parse_timing(timing).map_err(to_py_err)?,
+                ..d.filter
+            },
+            ..d
         },
-        ..Default::default()
+        corrections: corrections_which(corrections)?,
+        ..CalibrationRequest::default()
     };
     // Only the truth calibration reads truth.csv (as `calibrate` does).
     let read = deadreckon_io::ReadOptions::default();
@@ -93,7 +99,7 @@ pub fn calibrate(
     let drive = drive_arg(py, source, &read, mapping)?;
     let checks = checked(source, &drive, skip_checks)?;
     let cc = py
-        .detach(|| deadreckon_api::calibrate::calibrate_car(&drive, method, opts, which, &what))
+        .detach(|| deadreckon_api::calibration::calibrate(&drive, &request, &what))
         .map_err(to_py_err)?;
     let mut v = cc.json();
     // Python's calibrate is the car's: the shape found, as the command says it.
@@ -127,26 +133,14 @@ pub fn params_arg(
     if label == "nominal" {
         return Ok((Params::nominal(vehicle), label));
     }
-    let read = deadreckon_io::read_params(&spec).map_err(|e| {
-        err(format!(
-            "reading parameters {label}: {}",
-            deadreckon_api::chain_text(&e)
-        ))
-    })?;
-    read.params.validate().map_err(|e| {
-        err(format!(
-            "parameters in {label}: {}",
-            deadreckon_api::chain_text(&e)
-        ))
-    })?;
-    // Bound to their vehicle, as the command line's --params
-    // (deadreckon_api::binding): another vehicle's file is refused.
-    let (_, extra) = deadreckon_io::read_params_with_extra(&spec).map_err(to_py_err)?;
-    let record =
-        deadreckon_api::binding::VehicleRecord::from_extra(&label, &extra).map_err(to_py_err)?;
-    deadreckon_api::binding::check(&label, record.as_ref(), &read.params, vehicle, false)
+    // Read and checked once (deadreckon_api::params_file), bound to their
+    // vehicle as the command line's --params (deadreckon_api::binding):
+    // another vehicle's file is refused.
+    let file = deadreckon_api::params_file::ParamsFile::read(&label).map_err(to_py_err)?;
+    let params = file.estimate.params;
+    deadreckon_api::binding::check(&label, file.vehicle.as_ref(), &params, vehicle, false)
         .map_err(to_py_err)?;
-    Ok((read.params, label))
+    Ok((params, label))
 }
 
 /// Every track of a drive (dead-reckoned, filtered, smoothed, and truth),
@@ -238,7 +232,7 @@ pub fn track_columns<'py>(py: Python<'py>, t: &track::Track) -> PyResult<Bound<'
 
 /// `evaluate --json` as a dict; the options are the command's.
 #[pyfunction]
-#[pyo3(signature = (source, params=None, metric="drift", outage=None, step=None, warmup=5.0, segment_m=100.0, threshold_m=1.0, track="dead-reckoned", reference="truth", delta_m=100.0, pairs_from="estimate", max_diff_s=evo::DEFAULT_MAX_DIFF_S, timing="wheel", mapping=None, corrections="auto", skip_checks=false, shape=None))]
+#[pyo3(signature = (source, params=None, metric="drift", outage=None, step=None, warmup=None, segment_m=100.0, threshold_m=1.0, track="dead-reckoned", reference="truth", delta_m=100.0, pairs_from="estimate", max_diff_s=evo::DEFAULT_MAX_DIFF_S, timing="wheel", mapping=None, corrections="auto", skip_checks=false, shape=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn evaluate(
     py: Python<'_>,
@@ -247,7 +241,7 @@ pub fn evaluate(
     metric: &str,
     outage: Option<f64>,
     step: Option<f64>,
-    warmup: f64,
+    warmup: Option<f64>,
     segment_m: f64,
     threshold_m: f64,
     track: &str,
@@ -287,9 +281,13 @@ pub fn evaluate(
     let (params, label, drive, corr, params_source, bound) = py.detach(|| -> PyResult<_> {
         Ok(match given {
             Some((p, l)) => {
-                let bound = match &spec {
-                    Some(f) => deadreckon_api::bound::stored_bound(f).map_err(to_py_err)?,
-                    None => deadreckon_core::bound::BoundFit::FILTER,
+                let bound = match spec.as_deref() {
+                    Some(f) if f != "nominal" => {
+                        deadreckon_api::params_file::ParamsFile::read(f)
+                            .map_err(to_py_err)?
+                            .bound
+                    }
+                    _ => deadreckon_core::bound::BoundFit::FILTER,
                 };
                 (p, l.clone(), stored, None, l, bound)
             }
@@ -311,7 +309,7 @@ pub fn evaluate(
                 &params,
                 len,
                 step.unwrap_or(len / 2.0),
-                warmup,
+                warmup.unwrap_or(deadreckon_api::evaluate::OUTAGE_WARMUP_S),
                 &base,
             )
             .map_err(to_py_err)?;

@@ -49,6 +49,28 @@ def test_calibrate_options_equal_cli(sim_drive, cli_json, method, extra):
     assert ours == theirs
 
 
+def test_calibrate_dict_equals_batch_row(sim_drive, cli, tmp_path):
+    # Issue 30: one car calibration. Python's dict and `batch`'s row of the
+    # same drive are the same numbers (batch's corrections default to none),
+    # and Python's defaults are the command's (None: the library's request).
+    import csv
+
+    out = tmp_path / "batch.csv"
+    cli("batch", sim_drive, "--out", out)
+    (row,) = list(csv.DictReader(out.open()))
+    ours = deadreckon.calibrate(sim_drive, corrections="none")
+    assert int(row["iterations"]) == ours["iterations"]
+    assert (row["converged"] == "true") == ours["converged"]
+    names = ["gyro_bias_rps", "speed_scale", "circumference_fl_m", "circumference_fr_m",
+             "circumference_rl_m", "circumference_rr_m"]
+    for i, name in enumerate(names):
+        assert float(row[name]) == ours[name], name
+        assert float(row[f"std_{name}"]) == ours["std"][name], name
+        assert int(row[f"samples_{name}"]) == ours["samples"][i], name
+        status = "not-estimated" if name in ours["not_estimated"] else "estimated"
+        assert row[f"status_{name}"] == status, name
+
+
 def test_calibrate_per_reading_refused_then_equal_to_cli(drive_copy, cli, cli_json):
     # Table I's process noise per reading lets the GNSS fixes set the speed:
     # both refuse it, with the same message.

@@ -4,10 +4,18 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use clap::Args;
+use deadreckon_api::calibration::CalibrationRequest;
 use deadreckon_core::calibrate::CalibrationOptions;
 use deadreckon_core::ekf::FilterOptions;
 use deadreckon_core::Params;
 use deadreckon_fleet::batch::{BatchOptions, OutageOptions};
+
+/// `batch`'s default request ([`BatchOptions::default`]: the one
+/// calibration request's defaults, corrections none): the one place the
+/// options' defaults are read from.
+fn defaults() -> CalibrationRequest {
+    BatchOptions::default().request
+}
 use deadreckon_fleet::history::HistoryOptions;
 
 /// Arguments of `batch`.
@@ -34,13 +42,13 @@ pub struct BatchArgs {
     #[arg(long, value_enum, default_value_t = CarMethodArg::Rts)]
     pub method: CarMethodArg,
     /// Maximum smoothing passes per drive.
-    #[arg(long, default_value_t = 60, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, default_value_t = defaults().options.max_iterations as u32, value_parser = clap::value_parser!(u32).range(1..))]
     pub max_iterations: u32,
     /// Filter timing: wheel or each.
-    #[arg(long, value_enum, default_value_t = super::TimingArg::Wheel)]
+    #[arg(long, value_enum, default_value_t = super::TimingArg::of(defaults().options.filter.timing))]
     pub timing: super::TimingArg,
     /// Speed below which epochs are dropped for speed-dependent parameters, m/s.
-    #[arg(long, default_value_t = 2.0, value_parser = super::non_negative)]
+    #[arg(long, default_value_t = defaults().options.min_speed_mps, value_parser = super::non_negative)]
     pub min_speed: f64,
     /// Also evaluate each drive, with its own parameters, through sliding GNSS outages of this length, s.
     #[arg(long, value_parser = super::positive)]
@@ -49,13 +57,13 @@ pub struct BatchArgs {
     #[arg(long, value_parser = super::positive)]
     pub step: Option<f64>,
     /// GNSS-aided time before the first outage window, s.
-    #[arg(long, default_value_t = 5.0, value_parser = super::non_negative)]
+    #[arg(long, default_value_t = deadreckon_api::evaluate::OUTAGE_WARMUP_S, value_parser = super::non_negative)]
     pub warmup: f64,
     /// The timing and mounting corrections estimated and applied on each drive
     /// before calibrating, as `calibrate --corrections`: all, gnss or none
     /// (default: per-drive delays add variance the history's χ² test does
     /// not know of; see docs/fleet.md).
-    #[arg(long, value_enum, default_value_t = super::CorrectionsArg::None)]
+    #[arg(long, value_enum, default_value_t = super::CorrectionsArg::of(defaults().corrections))]
     pub corrections: super::CorrectionsArg,
     /// Significance level of the history's χ² and change-point tests.
     #[arg(long, default_value_t = 1e-3, value_parser = super::probability)]
@@ -94,18 +102,22 @@ impl BatchArgs {
     pub fn options(&self) -> Result<BatchOptions> {
         let a = self;
         let method = a.method.method();
+        let d = defaults().options;
         let options = BatchOptions {
-            calibration: CalibrationOptions {
-                method,
-                max_iterations: a.max_iterations as usize,
-                min_speed_mps: a.min_speed,
-                filter: FilterOptions {
-                    timing: a.timing.into(),
-                    ..Default::default()
+            request: CalibrationRequest {
+                options: CalibrationOptions {
+                    method,
+                    max_iterations: a.max_iterations as usize,
+                    min_speed_mps: a.min_speed,
+                    filter: FilterOptions {
+                        timing: a.timing.into(),
+                        ..d.filter
+                    },
+                    ..d
                 },
-                ..Default::default()
+                corrections: a.corrections.into(),
+                ..defaults()
             },
-            corrections: a.corrections.into(),
             outage: a.outage.map(|len| OutageOptions {
                 length_s: len,
                 step_s: a.step.unwrap_or(len / 2.0),

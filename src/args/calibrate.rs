@@ -1,8 +1,8 @@
 //! The arguments of `deadreckon calibrate`.
 
+use deadreckon_api::calibration::CalibrationRequest;
 use deadreckon_core::calibrate::{CalibrationOptions, Iteration, PassState};
 use deadreckon_core::ekf::FilterOptions;
-use deadreckon_core::kinematics::Shape;
 
 use std::path::PathBuf;
 
@@ -39,6 +39,26 @@ pub enum IterationArg {
     Plain,
 }
 
+impl StateArg {
+    /// The argument naming `s`.
+    pub fn of(s: PassState) -> StateArg {
+        match s {
+            PassState::Augmented => StateArg::Augmented,
+            PassState::Paper => StateArg::Paper,
+        }
+    }
+}
+
+impl IterationArg {
+    /// The argument naming `i`.
+    pub fn of(i: Iteration) -> IterationArg {
+        match i {
+            Iteration::Anderson => IterationArg::Anderson,
+            Iteration::Plain => IterationArg::Plain,
+        }
+    }
+}
+
 impl std::fmt::Display for StateArg {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(match self {
@@ -72,16 +92,16 @@ pub struct CalibrateArgs {
     #[arg(long, value_enum, default_value_t = YawArg::Gyro)]
     pub yaw: YawArg,
     /// What each smoothing pass carries: augmented (car state + the six parameters) or paper (5-state, parameters fixed).
-    #[arg(long, value_enum, default_value_t = StateArg::Augmented)]
+    #[arg(long, value_enum, default_value_t = StateArg::of(defaults().options.state))]
     pub state: StateArg,
     /// Chaining of the smoothing passes: anderson (accelerated) or plain (the paper's).
-    #[arg(long, value_enum, default_value_t = IterationArg::Anderson)]
+    #[arg(long, value_enum, default_value_t = IterationArg::of(defaults().options.iteration))]
     pub iteration: IterationArg,
     /// Maximum smoothing passes.
-    #[arg(long, default_value_t = 60, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, default_value_t = defaults().options.max_iterations as u32, value_parser = clap::value_parser!(u32).range(1..))]
     pub max_iterations: u32,
     /// Filter timing: wheel (the paper's, one epoch per wheel row) or each (every reading at its time).
-    #[arg(long, value_enum, default_value_t = super::TimingArg::Wheel)]
+    #[arg(long, value_enum, default_value_t = super::TimingArg::of(defaults().options.filter.timing))]
     pub timing: super::TimingArg,
     /// Speed below which epochs (car) or windows (tricycle) are dropped for speed-dependent parameters, m/s (default: 2 for a car, 0.05 for a tricycle).
     #[arg(long, value_parser = super::non_negative)]
@@ -117,7 +137,7 @@ pub struct CalibrateArgs {
     /// calibration), all (driven axle's slip, IMU tilt, every stream's delay,
     /// gyro scale), gnss (as all, the other streams' delays reported, not
     /// applied) or none.
-    #[arg(long, value_enum, default_value_t = super::CorrectionsArg::Auto)]
+    #[arg(long, value_enum, default_value_t = super::CorrectionsArg::of(defaults().corrections))]
     pub corrections: super::CorrectionsArg,
     /// Fuse every wheel reading: no wheel-health monitor (slipping and bad
     /// wheels are then neither dropped nor reported).
@@ -125,13 +145,20 @@ pub struct CalibrateArgs {
     pub no_wheel_monitor: bool,
 }
 
+/// The default request ([`CalibrationRequest::default`]): the one place
+/// the options' defaults are read from.
+fn defaults() -> CalibrationRequest {
+    CalibrationRequest::default()
+}
+
 impl CalibrateArgs {
-    /// The car's calibration: the method as the user named it and the
-    /// options; a stack format without `--out` refused.
-    pub fn car_options(&self) -> anyhow::Result<(String, CalibrationOptions)> {
+    /// The car's calibration request; a stack format without `--out`
+    /// refused.
+    pub fn request(&self) -> anyhow::Result<CalibrationRequest> {
         let a = self;
         let method = a.method.unwrap_or(super::MethodArg::Rts);
-        let opts = CalibrationOptions {
+        let d = defaults().options;
+        let options = CalibrationOptions {
             method: method.car()?,
             state: match a.state {
                 StateArg::Augmented => PassState::Augmented,
@@ -142,15 +169,17 @@ impl CalibrateArgs {
                 IterationArg::Plain => Iteration::Plain,
             },
             max_iterations: a.max_iterations as usize,
-            min_speed_mps: a
-                .min_speed
-                .unwrap_or(Shape::FourWheel.default_min_speed_mps()),
+            min_speed_mps: a.min_speed.unwrap_or(d.min_speed_mps),
             filter: FilterOptions {
                 timing: a.timing.into(),
-                wheel_monitor: (!a.no_wheel_monitor).then(Default::default),
-                ..Default::default()
+                wheel_monitor: if a.no_wheel_monitor {
+                    None
+                } else {
+                    d.filter.wheel_monitor
+                },
+                ..d.filter
             },
-            ..Default::default()
+            ..d
         };
         if a.out.is_none() && a.format != OutFormat::Params {
             anyhow::bail!(
@@ -158,7 +187,11 @@ impl CalibrateArgs {
                 format!("{:?}", a.format).to_lowercase()
             );
         }
-        Ok((method.name().to_string(), opts))
+        Ok(CalibrationRequest {
+            options,
+            corrections: a.corrections.into(),
+            ..defaults()
+        })
     }
 }
 
@@ -169,5 +202,38 @@ impl From<OutFormat> for deadreckon_api::calibrate::Export {
             OutFormat::Autoware => Self::Autoware,
             OutFormat::Eagleye => Self::Eagleye,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        calibrate: CalibrateArgs,
+    }
+
+    #[test]
+    fn the_defaults_of_calibrate_are_the_librarys_request() {
+        let a = Cli::parse_from(["calibrate", "DRIVE"]).calibrate;
+        assert_eq!(a.request().unwrap(), CalibrationRequest::default());
+    }
+
+    #[test]
+    fn the_defaults_of_batch_are_the_fleets_request() {
+        #[derive(Parser)]
+        struct Batch {
+            #[command(flatten)]
+            batch: crate::args::batch::BatchArgs,
+        }
+        let a = Batch::parse_from(["batch", "DRIVE", "--out", "x.csv"]).batch;
+        let o = a.options().unwrap();
+        assert_eq!(
+            o.request,
+            deadreckon_fleet::batch::BatchOptions::default().request
+        );
     }
 }

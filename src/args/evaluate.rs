@@ -83,7 +83,7 @@ pub struct EvaluateArgs {
     #[arg(long, value_parser = super::positive)]
     pub step: Option<f64>,
     /// GNSS-aided time before the first outage window, s.
-    #[arg(long, default_value_t = 5.0, value_parser = super::non_negative)]
+    #[arg(long, default_value_t = deadreckon_api::evaluate::OUTAGE_WARMUP_S, value_parser = super::non_negative)]
     pub warmup: f64,
     /// With --outage: an alert limit, m; prints when the 95 % error bound
     /// reaches it in each window (time and distance into the outage).

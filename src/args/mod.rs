@@ -49,6 +49,16 @@ pub enum TimingArg {
     Each,
 }
 
+impl TimingArg {
+    /// The argument naming `t` (a default read from the library).
+    pub fn of(t: Timing) -> TimingArg {
+        match t {
+            Timing::WheelEpochs => TimingArg::Wheel,
+            Timing::EachMeasurement => TimingArg::Each,
+        }
+    }
+}
+
 impl From<TimingArg> for Timing {
     fn from(t: TimingArg) -> Timing {
         match t {
@@ -158,6 +168,19 @@ pub enum CorrectionsArg {
     Gnss,
     /// None.
     None,
+}
+
+impl CorrectionsArg {
+    /// The argument naming `w` (a default read from the library).
+    pub fn of(w: deadreckon_core::timing::Which) -> CorrectionsArg {
+        use deadreckon_core::timing::Which;
+        match w {
+            Which::Auto => CorrectionsArg::Auto,
+            Which::All => CorrectionsArg::All,
+            Which::Gnss => CorrectionsArg::Gnss,
+            Which::None => CorrectionsArg::None,
+        }
+    }
 }
 
 impl From<CorrectionsArg> for deadreckon_core::timing::Which {

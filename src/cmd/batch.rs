@@ -17,7 +17,7 @@ use crate::args::batch::*;
 pub fn run(a: BatchArgs, quiet: bool, loader: &common::Loader) -> Result<()> {
     let options = a.options()?;
     let hist_opts = a.history_options()?;
-    let method = options.calibration.method;
+    let method = options.request.options.method;
     batch::validate(&options)?;
     let drives = inputs::expand(&a.inputs)?;
     inputs::check_output(&a.out, &drives, "--out")?;

@@ -31,19 +31,14 @@ pub fn run(a: CalibrateArgs, load: &common::Loader) -> Result<()> {
     if found.shape != Shape::FourWheel {
         return run_kinematic(&a, load, drive, &found);
     }
-    let (method_name, opts) = a.car_options()?;
+    let request = a.request()?;
     let drive = match drive {
         Some(d) => d,
         None => load.drive_with(&a.dir, &read)?,
     };
     let drive = deadreckon_api::load::cut(drive, a.from_s, a.until_s)?;
-    let cc = deadreckon_api::calibrate::calibrate_car(
-        &drive,
-        &method_name,
-        opts,
-        a.corrections.into(),
-        &a.dir.display().to_string(),
-    )?;
+    let cc =
+        deadreckon_api::calibration::calibrate(&drive, &request, &a.dir.display().to_string())?;
     let written = match &a.out {
         Some(out) => cc.write(
             out,

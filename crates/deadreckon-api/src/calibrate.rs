@@ -1,31 +1,30 @@
-//! The car's calibration as `deadreckon calibrate` and Python's `calibrate`
-//! run it: the timing and mounting corrections estimated and applied, the
-//! six parameters calibrated, the steering ratio and offset with the truth;
-//! and what both show of it (the `--json` object, the params.toml keys, the
-//! text table). The command line and the bindings each wrote this sequence
-//! out.
+//! The result of a car calibration ([`CarCalibration`], made by
+//! [`crate::calibration::calibrate`]) and what the commands show of it: the
+//! `--json` object (its `Serialize`), the params.toml keys, the text table,
+//! the stack parameter files.
 
-use deadreckon_core::calibrate::{self, Calibration, CalibrationOptions, Method};
+use deadreckon_core::calibrate::{Calibration, Method};
 use deadreckon_core::kinematics::steering::SteeringCalibration;
 use deadreckon_core::timing::{Corrections, Which};
-use deadreckon_core::Drive;
 use serde_json::Value;
 
+use crate::calibration::{CalibrationRequest, ParamStatus};
 use crate::Error;
 
-/// A car calibration with everything the commands show of it.
+/// A car calibration with everything the commands show of it: the one
+/// type behind `calibrate --json`, Python's dict, params.toml, the text
+/// table and `batch`'s CSV row.
 #[derive(Debug, Clone)]
 pub struct CarCalibration {
-    /// The method, as the user named it (`rts`, `zupt`, `truth`).
-    pub method_name: String,
-    /// The options it ran with.
-    pub options: CalibrationOptions,
-    /// The calibration.
+    /// What was asked: the method, its options and the corrections.
+    pub request: CalibrationRequest,
+    /// The calibration: parameters, standard errors, samples, passes, the
+    /// filter's counts and the wheels' health, the manoeuvres and what the
+    /// drive lacked.
     pub calibration: Calibration,
-    /// The corrections estimated (and applied as `which` asked).
+    /// The corrections estimated (and applied as `request.corrections`
+    /// asked), with the held-back judgement.
     pub corrections: Corrections,
-    /// Which corrections were applied.
-    pub which: Which,
     /// The steering ratio and offset (against the truth with the truth
     /// method; with the understeer gradient against the smoothed states with
     /// the RTS method).
@@ -43,73 +42,48 @@ pub struct CarCalibration {
     pub bound_reach_1m: Option<deadreckon_core::bound::Reach>,
 }
 
-/// Estimates and applies the corrections `which` asks for, then calibrates
-/// `drive` with `options`; `name` (the drive's path) goes into the error.
-pub fn calibrate_car(
-    drive: &Drive,
-    method_name: &str,
-    options: CalibrationOptions,
-    which: Which,
-    name: &str,
-) -> Result<CarCalibration, Error> {
-    // Without corrections the drive is calibrated as it is, not a copy.
-    let corrected;
-    let (drive, corrections) = if which == Which::None {
-        (drive, Corrections::none())
-    } else {
-        let (d, c) = crate::corrections::estimate_and_apply(drive, &options, which)?;
-        corrected = d;
-        (&corrected, c)
-    };
-    let calibration = calibrate::calibrate(drive, &options).map_err(|source| Error::Step {
-        step: format!("calibrating {name}"),
-        source,
-    })?;
-    let steering = crate::json::car_steering(drive, options.method, options.min_speed_mps)
-        .map_err(|source| Error::Step {
-            step: "calibrating the steering".into(),
-            source,
-        })?
-        // The RTS calibration's fit against its smoothed states.
-        .or_else(|| calibration.steering.clone());
-    let (bound, fit_windows) = deadreckon_core::bound::fit_on_drive_with_windows(
-        drive,
-        &calibration.estimate.params,
-        &deadreckon_core::ekf::FilterOptions {
-            timing: options.filter.timing,
-            ..Default::default()
-        },
-    );
-    let bound_reach_1m = fit_windows
-        .as_ref()
-        .and_then(|ev| deadreckon_core::bound::reach(ev, &bound, 1.0));
-    Ok(CarCalibration {
-        method_name: method_name.to_string(),
-        options,
-        calibration,
-        corrections,
-        which,
-        steering,
-        absent: crate::json::Absent::of(drive),
-        vehicle: crate::binding::VehicleRecord::of(&drive.vehicle),
-        bound,
-        bound_reach_1m,
-    })
+impl serde::Serialize for CarCalibration {
+    /// The `calibrate --json` object ([`CarCalibration::json`]).
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        self.json().serialize(s)
+    }
+}
+
+impl CarCalibration {
+    /// The method's word (`rts`, `zupt`, `truth`).
+    pub fn method_name(&self) -> &'static str {
+        self.request.method_name()
+    }
+
+    /// Whether each of the six parameters was estimated
+    /// ([`ParamStatus::of_samples`], the one rule).
+    pub fn status(&self) -> [ParamStatus; 6] {
+        self.calibration.samples.map(ParamStatus::of_samples)
+    }
+
+    /// The corrections asked for.
+    pub fn which(&self) -> Which {
+        self.request.corrections
+    }
 }
 
 impl CarCalibration {
     /// The parameters no sample above the speed threshold informed, with why
     /// (they keep their nominal value and are reported as not estimated).
     pub fn not_estimated(&self) -> Vec<(&'static str, String)> {
-        crate::json::not_estimated(&self.calibration, self.options.min_speed_mps, self.absent)
+        crate::json::not_estimated(
+            &self.calibration,
+            self.request.options.min_speed_mps,
+            self.absent,
+        )
     }
 
     /// The `--json` object of `calibrate` (without `"checks"`).
     pub fn json(&self) -> Value {
         let mut v = crate::json::calibrate_json(
-            &self.method_name,
+            self.method_name(),
             &self.calibration,
-            self.options.min_speed_mps,
+            self.request.options.min_speed_mps,
             self.absent,
             self.steering.as_ref(),
         );
@@ -124,7 +98,7 @@ impl CarCalibration {
     pub fn params_extra(&self) -> toml::Table {
         let c = &self.calibration;
         let mut extra = toml::Table::new();
-        extra.insert("method".into(), self.method_name.clone().into());
+        extra.insert("method".into(), self.method_name().into());
         extra.insert("iterations".into(), (c.iterations as i64).into());
         extra.insert("converged".into(), c.converged.into());
         let not_estimated = self.not_estimated();
@@ -141,7 +115,7 @@ impl CarCalibration {
         if let Some(slip) = &self.calibration.side_slip {
             extra.insert("side_slip".into(), side_slip_toml(slip).into());
         }
-        if self.which != Which::None {
+        if self.which() != Which::None {
             extra.extend(crate::corrections::corrections_toml(&self.corrections));
         }
         extra.insert("vehicle".into(), self.vehicle.to_toml().into());
@@ -154,7 +128,7 @@ impl CarCalibration {
         let c = &self.calibration;
         format!(
             "Calibrated on {source} with --method {} ({} passes, {}).",
-            self.method_name,
+            self.method_name(),
             c.iterations,
             if c.converged {
                 "converged"
@@ -172,7 +146,7 @@ impl CarCalibration {
         let c = &self.calibration;
         let mut out = vec![
             crate::text::params_header(),
-            crate::text::params_row(&self.method_name, &c.estimate),
+            crate::text::params_row(self.method_name(), &c.estimate),
         ];
         for (k, why) in self.not_estimated() {
             out.push(format!("{k}: NOT ESTIMATED ({why})"));
@@ -190,7 +164,7 @@ impl CarCalibration {
                 (None, None) => format!("{}: {:.5}", p.name, p.value),
             });
         }
-        if self.options.method == Method::Rts {
+        if self.request.options.method == Method::Rts {
             out.push(format!(
                 "{} smoothing passes ({state} state, {iteration} iteration), {}",
                 c.iterations,
@@ -204,10 +178,10 @@ impl CarCalibration {
         if let Some(st) = &c.filter_stats {
             out.push(crate::text::stats_line(st));
         }
-        if self.options.method == deadreckon_core::calibrate::Method::Rts {
+        if self.request.options.method == Method::Rts {
             out.push(crate::text::chords_line(c.gnss_chords.as_ref()));
         }
-        if self.which != Which::None {
+        if self.which() != Which::None {
             out.extend(crate::text::corrections_lines(&self.corrections));
         }
         if let Some(h) = &c.wheel_health {
@@ -222,7 +196,7 @@ impl CarCalibration {
                 "drive: {:.0} s, {:.0} s above {} m/s ({:.0} s left turns, {:.0} s right turns, {:.0} s straight), {} stops ({:.0} s)",
                 mv.duration_s,
                 mv.above_threshold_s,
-                self.options.min_speed_mps,
+                self.request.options.min_speed_mps,
                 mv.left_turn_s,
                 mv.right_turn_s,
                 mv.straight_s,

@@ -259,14 +259,9 @@ pub fn stored_in_file(spec: &std::path::Path) -> Result<Stored, String> {
     if spec.as_os_str() == "nominal" {
         return Ok(Stored::default());
     }
-    let (_, extra) = deadreckon_io::read_params_with_extra(spec).map_err(|e| {
-        format!(
-            "reading parameters {}: {}",
-            spec.display(),
-            crate::chain_text(&e)
-        )
-    })?;
-    stored_corrections(&extra).map_err(|e| format!("parameters {}: {e}", spec.display()))
+    crate::params_file::ParamsFile::read(&spec.to_string_lossy())
+        .map(|f| f.corrections)
+        .map_err(|e| crate::chain_text(&e))
 }
 
 /// Reads the `[delays]`, `[traction]`, `[imu]`, `[gyro_scale]` and `[model]` tables

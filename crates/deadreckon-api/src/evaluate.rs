@@ -3,7 +3,6 @@
 //! line and the Python bindings alike; and the RPE or APE of one of the
 //! drive's tracks against another ([`evo_metric`]).
 
-use deadreckon_core::calibrate::{self, CalibrationOptions};
 use deadreckon_core::ekf::{FilterOptions, Timing};
 use deadreckon_core::evo::{self, TrajectoryError};
 use deadreckon_core::metrics::{self, DriftResult, ResetResult, Summary};
@@ -22,6 +21,10 @@ pub const RULE: &str = "without --params, the parameters are calibrated on the d
      (RTS with its GNSS for a car, against its GNSS for a differential drive, against its \
      tracker for a tricycle; in-sample: calibrate on another drive or part for a held-out \
      figure), or nominal when the drive has no GNSS fix; --params nominal for the nominal ones";
+
+/// The GNSS-aided time before the first sliding outage window, s: the
+/// default of `evaluate --warmup`, `batch --warmup` and Python's `warmup`.
+pub const OUTAGE_WARMUP_S: f64 = 5.0;
 
 /// What `"params_source"` says of parameters calibrated on the drive.
 pub const CALIBRATED_HERE: &str = "calibrated on this drive";
@@ -80,24 +83,19 @@ pub fn default_parameters(drive: &Drive, which: Which) -> Result<(Parameters, Dr
             drive.clone(),
         ));
     }
-    let copts = CalibrationOptions::default();
-    let (drive, corrections) = crate::corrections::estimate_and_apply(drive, &copts, which)?;
-    let c = calibrate::calibrate(&drive, &copts).map_err(|source| Error::Calibration {
-        what: "RTS calibration with GNSS",
-        source,
-    })?;
-    let bound =
-        deadreckon_core::bound::fit_on_drive(&drive, &c.estimate.params, &FilterOptions::default());
+    let request = crate::calibration::CalibrationRequest::with_corrections(which);
+    let (car, corrected) = crate::calibration::calibrate_corrected(drive, &request, "the drive")?;
+    let c = car.calibration;
     Ok((
         Parameters {
             params: c.estimate.params,
             label: format!("rts ({} passes)", c.iterations),
-            corrections: Some(corrections),
+            corrections: Some(car.corrections),
             source: format!("{CALIBRATED_HERE}: rts ({} passes)", c.iterations),
             note: None,
-            bound,
+            bound: car.bound,
         },
-        drive,
+        corrected.unwrap_or_else(|| drive.clone()),
     ))
 }
 
@@ -168,7 +166,7 @@ pub fn given_parameters_bound(
     drive: Drive,
     allow_other: bool,
 ) -> Result<(Parameters, Drive), Error> {
-    let (params, drive, note) = crate::load::params_corrected_bound(spec, drive, allow_other)?;
+    let (params, drive, note, file) = crate::load::params_file_corrected(spec, drive, allow_other)?;
     Ok((
         Parameters {
             params,
@@ -176,7 +174,7 @@ pub fn given_parameters_bound(
             corrections: None,
             source: spec.to_string(),
             note,
-            bound: crate::bound::stored_bound(spec)?,
+            bound: file.map_or(deadreckon_core::bound::BoundFit::FILTER, |f| f.bound),
         },
         drive,
     ))

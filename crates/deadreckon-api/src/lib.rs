@@ -27,9 +27,13 @@
 //!   (`deadreckon-io`), a comma2k19 segment, a ROS1 bag or ROS2 MCAP (with a
 //!   topic mapping) or a tricycle log, chosen by what the path holds; errors
 //!   name the file and, through their sources, the line and column.
-//! - [`calibrate`]: the car's calibration as `calibrate` and Python run it
-//!   (corrections, the six parameters, the steering) with its `--json`
-//!   object, params.toml keys and text.
+//! - [`calibration`]: the one home of a car calibration: the request
+//!   (method, options, corrections; its `Default` holds every default
+//!   once), the one function `calibrate`, `batch`, Python and `evaluate`
+//!   call, and the status rule of a parameter.
+//! - [`calibrate`]: its result, [`calibrate::CarCalibration`] (corrections,
+//!   the six parameters, the steering, the bound, the vehicle), with its
+//!   `--json` object, params.toml keys and text.
 //! - [`checks`]: the cross-stream plausibility checks applied to a drive
 //!   read (errors refuse it, warnings go to `"checks"` in `--json`).
 //! - [`evaluate`]: the parameters `evaluate` measures when none are given
@@ -41,6 +45,9 @@
 //!   `tedris train --json` print, built from the library results.
 //! - [`tedris`]: a TedriS model read from its file and checked.
 //! - [`text`]: the commands' text tables and summary lines.
+//! - [`params_file`]: a car's params.toml read once and checked once
+//!   (parameters, `[std]`, `[vehicle]`, stored corrections, `[bound]`),
+//!   for every `--params`.
 //! - [`options`]: the option words of the commands (`--timing wheel|each`,
 //!   `--state`, `--iteration`) parsed into the library's enums.
 //!
@@ -53,6 +60,7 @@
 pub mod binding;
 pub mod bound;
 pub mod calibrate;
+pub mod calibration;
 pub mod checks;
 pub mod corrections;
 pub mod demo;
@@ -63,6 +71,7 @@ pub mod kinematic;
 pub mod load;
 pub mod model_keys;
 pub mod options;
+pub mod params_file;
 pub mod report;
 pub mod report_kinematic;
 pub mod shape;

@@ -14,6 +14,7 @@ use deadreckon_sim::{Scenario, SimOutput};
 use crate::binding;
 use crate::checks::Checks;
 use crate::error::{invalid, While};
+use crate::params_file::ParamsFile;
 use crate::Error;
 
 /// How drives are read: the global options `--mapping`, `--skip-checks`
@@ -97,14 +98,10 @@ impl Loader {
     }
 }
 
-/// Reads a params.toml with its standard errors, validated.
+/// Reads a params.toml with its standard errors, validated
+/// ([`ParamsFile::read`]: the file read and checked once).
 pub fn params_file(spec: &str) -> Result<ParamsWithStd, Error> {
-    let p = deadreckon_io::read_params(Path::new(spec))
-        .doing(|| format!("reading parameters {spec}"))?;
-    p.params
-        .validate()
-        .doing(|| format!("parameters in {spec}"))?;
-    Ok(p)
+    Ok(ParamsFile::read(spec)?.estimate)
 }
 
 /// `nominal` (the vehicle's) or a params.toml's parameters, checked
@@ -127,20 +124,20 @@ pub fn params_bound(
     if spec == "nominal" {
         return Ok((Params::nominal(&drive.vehicle), None));
     }
-    let (p, extra) = deadreckon_io::read_params_with_extra(Path::new(spec))
-        .doing(|| format!("reading parameters {spec}"))?;
-    p.params
-        .validate()
-        .doing(|| format!("parameters in {spec}"))?;
-    let record = binding::VehicleRecord::from_extra(spec, &extra)?;
-    let note = binding::check(
-        spec,
-        record.as_ref(),
-        &p.params,
-        &drive.vehicle,
-        allow_other,
-    )?;
-    Ok((p.params, note))
+    bind(spec, &ParamsFile::read(spec)?, drive, allow_other)
+}
+
+/// The parameters of the params.toml `file` (read from `spec`) bound to
+/// the drive's vehicle ([`params_bound`]).
+fn bind(
+    spec: &str,
+    file: &ParamsFile,
+    drive: &Drive,
+    allow_other: bool,
+) -> Result<(Params, binding::Note), Error> {
+    let p = file.estimate.params;
+    let note = binding::check(spec, file.vehicle.as_ref(), &p, &drive.vehicle, allow_other)?;
+    Ok((p, note))
 }
 
 /// A calibrated circumference further than this factor from the vehicle's
@@ -164,8 +161,10 @@ pub fn check_against_vehicle(
 /// The drive with the corrections stored in the params.toml `spec`
 /// applied (none for `nominal` or a file without them).
 pub fn apply_stored(spec: &str, drive: Drive) -> Result<Drive, Error> {
-    let stored = crate::corrections::stored_in_file(Path::new(spec)).map_err(Error::Invalid)?;
-    Ok(stored.apply(&drive))
+    if spec == "nominal" {
+        return Ok(drive);
+    }
+    Ok(ParamsFile::read(spec)?.corrections.apply(&drive))
 }
 
 /// `nominal` or a params.toml, and the drive with the corrections that
@@ -182,11 +181,24 @@ pub fn params_corrected_bound(
     drive: Drive,
     allow_other: bool,
 ) -> Result<(Params, Drive, binding::Note), Error> {
-    let (params, note) = params_bound(spec, &drive, allow_other)?;
+    params_file_corrected(spec, drive, allow_other).map(|(p, d, n, _)| (p, d, n))
+}
+
+/// [`params_corrected_bound`] with the file itself (`None` for
+/// `nominal`): read once, for its parameters, its vehicle, its
+/// corrections and its bound.
+pub fn params_file_corrected(
+    spec: &str,
+    drive: Drive,
+    allow_other: bool,
+) -> Result<(Params, Drive, binding::Note, Option<ParamsFile>), Error> {
     if spec == "nominal" {
-        return Ok((params, drive, note));
+        return Ok((Params::nominal(&drive.vehicle), drive, None, None));
     }
-    Ok((params, apply_stored(spec, drive)?, note))
+    let file = ParamsFile::read(spec)?;
+    let (params, note) = bind(spec, &file, &drive, allow_other)?;
+    let drive = file.corrections.apply(&drive);
+    Ok((params, drive, note, Some(file)))
 }
 
 /// A built-in scenario by name, or a scenario file (`.toml`).

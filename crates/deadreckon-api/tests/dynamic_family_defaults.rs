@@ -82,9 +82,7 @@
 
 use rayon::prelude::*;
 
-use deadreckon_api::calibrate::calibrate_car;
 use deadreckon_api::corrections::stored_corrections;
-use deadreckon_core::calibrate::CalibrationOptions;
 use deadreckon_core::ekf::FilterOptions;
 use deadreckon_core::outage::evaluate;
 use deadreckon_core::timing::Which;
@@ -104,11 +102,9 @@ fn user_path(
         .map_err(|e| format!("calibration drive: {e}"))?;
     let ev = simulate(&car.drive(2000 + seed, drive_s, effects), 2000 + seed)
         .map_err(|e| format!("evaluation drive: {e}"))?;
-    let c = calibrate_car(
+    let c = deadreckon_api::calibration::calibrate(
         &cal.drive,
-        "rts",
-        CalibrationOptions::default(),
-        which,
+        &deadreckon_api::calibration::CalibrationRequest::with_corrections(which),
         "cal",
     )
     .map_err(|e| format!("calibration: {e}"))?;

@@ -1,6 +1,6 @@
 //! Issue 31: the 95 % error bound validated on drives that did not tune
 //! it. Each family car ([`CarFamily`]) is calibrated as `calibrate` does it
-//! (`calibrate_car`: the default corrections, RTS, then the bound's factor
+//! (`calibration::calibrate`: the default corrections, RTS, then the bound's factor
 //! fitted on the calibration drive's own hidden fixes), and evaluated as
 //! `evaluate --params` does it (the stored corrections applied) on a second
 //! drive of the same car: 30 s outages every 10 s against the truth. Per
@@ -17,9 +17,7 @@
 
 use rayon::prelude::*;
 
-use deadreckon_api::calibrate::calibrate_car;
 use deadreckon_api::corrections::stored_corrections;
-use deadreckon_core::calibrate::CalibrationOptions;
 use deadreckon_core::ekf::FilterOptions;
 use deadreckon_core::metrics::Summary;
 use deadreckon_core::outage::evaluate;
@@ -41,11 +39,9 @@ fn car(seed: u64, drive_s: f64) -> Result<Car, String> {
         .map_err(|e| format!("calibration drive: {e}"))?;
     let ev = simulate(&family.drive(2000 + seed, drive_s), 2000 + seed)
         .map_err(|e| format!("evaluation drive: {e}"))?;
-    let c = calibrate_car(
+    let c = deadreckon_api::calibration::calibrate(
         &cal.drive,
-        "rts",
-        CalibrationOptions::default(),
-        Which::Gnss,
+        &deadreckon_api::calibration::CalibrationRequest::with_corrections(Which::Gnss),
         "cal",
     )
     .map_err(|e| format!("calibration: {e}"))?;

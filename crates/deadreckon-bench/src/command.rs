@@ -7,7 +7,6 @@
 use std::path::Path;
 
 use deadreckon_api::load::Loader;
-use deadreckon_core::calibrate::CalibrationOptions;
 use deadreckon_core::ekf::FilterOptions;
 use deadreckon_core::timing::Which;
 
@@ -75,11 +74,9 @@ impl Command {
                 } else {
                     Which::None
                 };
-                let cc = deadreckon_api::calibrate::calibrate_car(
+                let cc = deadreckon_api::calibration::calibrate(
                     &drive,
-                    "rts",
-                    CalibrationOptions::default(),
-                    which,
+                    &deadreckon_api::calibration::CalibrationRequest::with_corrections(which),
                     "drive",
                 )?;
                 std::hint::black_box(cc.json());
@@ -97,7 +94,7 @@ impl Command {
                     evaluate::Metric::Outages {
                         length_s: 30.0,
                         step_s: 10.0,
-                        warmup_s: 5.0,
+                        warmup_s: evaluate::OUTAGE_WARMUP_S,
                     },
                 )?;
                 std::hint::black_box(ev.json());

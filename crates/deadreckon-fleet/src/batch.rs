@@ -4,11 +4,11 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use deadreckon_core::calibrate::{self, CalibrationOptions};
-use deadreckon_core::ekf::{FilterOptions, FilterStats};
+use deadreckon_api::calibration::{self, CalibrationRequest, CarCalibration};
+use deadreckon_core::ekf::FilterOptions;
 use deadreckon_core::metrics::Summary;
-use deadreckon_core::timing::{self, Corrections, Which};
-use deadreckon_core::{outage, Drive, ParamsWithStd};
+use deadreckon_core::timing::Which;
+use deadreckon_core::{outage, Drive};
 use rayon::prelude::*;
 
 use crate::FleetError;
@@ -28,15 +28,13 @@ pub struct OutageOptions {
 /// How a batch runs.
 #[derive(Debug, Clone)]
 pub struct BatchOptions {
-    /// The calibration of every drive.
-    pub calibration: CalibrationOptions,
-    /// The timing and mounting corrections estimated and applied on each
-    /// drive before it is calibrated (as `calibrate --corrections`).
-    /// Default [`Which::None`]: a delay estimated anew on each drive moves
-    /// that drive's gyro bias and speed scale by more than their standard
+    /// The calibration of every drive: the one request of
+    /// [`deadreckon_api::calibration`], whose corrections default here to
+    /// [`Which::None`]: a delay estimated anew on each drive moves that
+    /// drive's gyro bias and speed scale by more than their standard
     /// errors say (they do not include the delay's uncertainty), and the
     /// history then flags an unchanged car (docs/fleet.md).
-    pub corrections: Which,
+    pub request: CalibrationRequest,
     /// Also evaluate each drive through sliding outages.
     pub outage: Option<OutageOptions>,
     /// Worker threads; 0 for one per core.
@@ -46,33 +44,21 @@ pub struct BatchOptions {
 impl Default for BatchOptions {
     fn default() -> Self {
         BatchOptions {
-            calibration: CalibrationOptions::default(),
-            corrections: Which::None,
+            request: CalibrationRequest {
+                // `batch` shows no error bound: not fitted (a second
+                // second per 10-minute drive).
+                fit_bound: false,
+                ..CalibrationRequest::with_corrections(Which::None)
+            },
             outage: None,
             threads: 0,
         }
     }
 }
 
-/// Whether a parameter was estimated on a drive.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ParamStatus {
-    /// Estimated from the drive, with a non-zero standard error.
-    Estimated,
-    /// Kept at its nominal value (standard error 0 or no samples: an absent
-    /// wheel, a ZUPT calibration's speed parameters).
-    NotEstimated,
-}
-
-impl ParamStatus {
-    /// `estimated` or `not-estimated` (the CSV values).
-    pub fn name(self) -> &'static str {
-        match self {
-            ParamStatus::Estimated => "estimated",
-            ParamStatus::NotEstimated => "not-estimated",
-        }
-    }
-}
+/// Whether a parameter was estimated on a drive: the one rule of
+/// [`deadreckon_api::calibration::ParamStatus`].
+pub use deadreckon_api::calibration::ParamStatus;
 
 /// The outage evaluation of one drive.
 #[derive(Debug, Clone)]
@@ -90,24 +76,22 @@ pub struct OutageResult {
 /// What a successful drive gives.
 #[derive(Debug, Clone)]
 pub struct DriveCalibration {
-    /// The six parameters and their standard errors.
-    pub estimate: ParamsWithStd,
-    /// Per parameter, estimated or kept nominal.
-    pub status: [ParamStatus; 6],
-    /// Samples used per parameter.
-    pub samples: [usize; 6],
-    /// Smoothing passes.
-    pub iterations: usize,
-    /// Whether the passes settled.
-    pub converged: bool,
+    /// The car's calibration, as `calibrate` makes it (its parameters,
+    /// standard errors and status, passes, the filter's counts, the
+    /// corrections): the CSV row renders its fields.
+    pub car: CarCalibration,
     /// Length of the drive, s (first to last wheel row).
     pub duration_s: f64,
-    /// The last pass's filter counters (GNSS, gates), when there was a filter.
-    pub filter_stats: Option<FilterStats>,
     /// The outage evaluation, when asked for.
     pub outage: Option<OutageResult>,
-    /// The corrections estimated and applied (`None` with [`Which::None`]).
-    pub corrections: Option<Corrections>,
+}
+
+impl DriveCalibration {
+    /// The corrections estimated and applied (`None` when the request
+    /// asked for none).
+    pub fn corrections(&self) -> Option<&deadreckon_core::timing::Corrections> {
+        (self.car.which() != Which::None).then_some(&self.car.corrections)
+    }
 }
 
 /// One drive of a batch: where, which vehicle, and what came of it.
@@ -151,44 +135,24 @@ pub fn validate(options: &BatchOptions) -> Result<(), FleetError> {
     Ok(())
 }
 
-/// Calibrates one drive already read: the corrections `options` asks for
-/// estimated and applied first, then the calibration and the outages on
-/// the corrected drive.
+/// Calibrates one drive already read with the one function of
+/// [`deadreckon_api::calibration`] (the corrections the request asks for
+/// estimated and applied first), then evaluates the outages on the
+/// corrected drive.
 pub fn calibrate_drive(drive: &Drive, options: &BatchOptions) -> Result<DriveCalibration, String> {
-    let (corrected, corrections) = match options.corrections {
-        Which::None => (None, None),
-        which => {
-            let (d, c) = deadreckon_core::held_back::prepare(
-                drive,
-                &options.calibration,
-                &timing::DelayOptions::default(),
-                which,
-            )
-            .map_err(|e| format!("estimating the streams' delays and the IMU tilt: {e}"))?;
-            (Some(d), Some(c))
-        }
-    };
+    let (car, corrected) = calibration::calibrate_corrected(drive, &options.request, "the drive")
+        .map_err(|e| deadreckon_api::chain_text(&e))?;
     let drive = corrected.as_ref().unwrap_or(drive);
-    let c = calibrate::calibrate(drive, &options.calibration)
-        .map_err(|e| format!("calibrating: {e}"))?;
-    let std = c.estimate.std.to_array();
-    let status = std::array::from_fn(|i| {
-        if std[i] > 0.0 && c.samples[i] > 0 {
-            ParamStatus::Estimated
-        } else {
-            ParamStatus::NotEstimated
-        }
-    });
     let outage = match &options.outage {
         None => None,
         Some(o) => {
             let base = FilterOptions {
-                timing: options.calibration.filter.timing,
+                timing: options.request.options.filter.timing,
                 ..Default::default()
             };
             let ev = outage::evaluate(
                 drive,
-                &c.estimate.params,
+                &car.calibration.estimate.params,
                 o.length_s,
                 o.step_s,
                 o.warmup_s,
@@ -210,15 +174,9 @@ pub fn calibrate_drive(drive: &Drive, options: &BatchOptions) -> Result<DriveCal
         0.0
     };
     Ok(DriveCalibration {
-        estimate: c.estimate,
-        status,
-        samples: c.samples,
-        iterations: c.iterations,
-        converged: c.converged,
+        car,
         duration_s,
-        filter_stats: c.filter_stats,
         outage,
-        corrections,
     })
 }
 

@@ -325,9 +325,9 @@ pub fn histories(
                 Some(HistoryDrive {
                     path: r.path.clone(),
                     recorded_at: r.recorded_at.clone(),
-                    value: c.estimate.params.to_array(),
-                    std: c.estimate.std.to_array(),
-                    estimated: c.status.map(|s| s == ParamStatus::Estimated),
+                    value: c.car.calibration.estimate.params.to_array(),
+                    std: c.car.calibration.estimate.std.to_array(),
+                    estimated: c.car.status().map(|s| s == ParamStatus::Estimated),
                 })
             })
             .collect();

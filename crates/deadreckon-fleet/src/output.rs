@@ -154,17 +154,19 @@ pub fn results_row(r: &DriveResult) -> Vec<String> {
         }
         Ok(c) => {
             row.extend(["ok".into(), String::new(), num(r.elapsed_s)]);
+            let cal = &c.car.calibration;
             row.push(num(c.duration_s));
-            row.push(c.iterations.to_string());
-            row.push(c.converged.to_string());
-            let (v, s) = (c.estimate.params.to_array(), c.estimate.std.to_array());
+            row.push(cal.iterations.to_string());
+            row.push(cal.converged.to_string());
+            let (v, s) = (cal.estimate.params.to_array(), cal.estimate.std.to_array());
+            let status = c.car.status();
             for i in 0..6 {
                 row.push(num(v[i]));
                 row.push(num(s[i]));
-                row.push(c.status[i].name().into());
-                row.push(c.samples[i].to_string());
+                row.push(status[i].name().into());
+                row.push(cal.samples[i].to_string());
             }
-            match &c.filter_stats {
+            match &cal.filter_stats {
                 Some(st) => {
                     for n in [
                         st.gnss_updates,
@@ -193,7 +195,7 @@ pub fn results_row(r: &DriveResult) -> Vec<String> {
                 ]),
                 None => row.extend(std::iter::repeat_n(String::new(), 7)),
             }
-            if let Some(k) = &c.corrections {
+            if let Some(k) = c.corrections() {
                 row.extend(corrections_cells(k));
             }
         }

@@ -71,7 +71,8 @@ impl Shape {
     /// 0.05 m/s (the tricycle log never exceeds 0.6 m/s, the Husky 1 m/s).
     pub fn default_min_speed_mps(self) -> f64 {
         match self {
-            Shape::FourWheel => 2.0,
+            // The car calibration's own default (one place).
+            Shape::FourWheel => crate::calibrate::CalibrationOptions::default().min_speed_mps,
             Shape::Tricycle | Shape::DiffDrive => 0.05,
         }
     }

@@ -1,0 +1,214 @@
+//! The one home of a car calibration: one request ([`CalibrationRequest`],
+//! whose `Default` holds every default once), one function
+//! ([`calibrate`]) and one result ([`CarCalibration`]).
+//!
+//! `deadreckon calibrate`, `batch` (through `deadreckon-fleet`), Python's
+//! `calibrate` and the self-calibration of `evaluate` call [`calibrate`];
+//! the command line's option defaults are read from
+//! [`CalibrationRequest::default`], not restated. The result renders as the
+//! `calibrate --json` object (its `Serialize` is that object, and Python's
+//! dict is the same value), as params.toml ([`CarCalibration::write`]) and
+//! as the text table ([`CarCalibration::lines`]); `batch`'s CSV row reads
+//! its fields, and whether a parameter was estimated is one rule,
+//! [`CarCalibration::status`].
+
+use deadreckon_core::bound::BoundFit;
+use deadreckon_core::calibrate::{self, CalibrationOptions, Method};
+use deadreckon_core::timing::{Corrections, Which};
+use deadreckon_core::Drive;
+
+pub use crate::calibrate::CarCalibration;
+use crate::Error;
+
+/// What to calibrate with: the method and its options, and the timing and
+/// mounting corrections estimated (and applied) before calibrating.
+///
+/// `Default` is the command's default: RTS, augmented state, Anderson
+/// iteration, 60 passes at most, 2 m/s speed threshold, wheel timing, the
+/// wheel-health monitor on (all [`CalibrationOptions::default`]) and
+/// `--corrections auto` ([`Which::default`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CalibrationRequest {
+    /// The method and its options.
+    pub options: CalibrationOptions,
+    /// The corrections estimated and applied before calibrating.
+    pub corrections: Which,
+    /// Fit the 95 % error bound's factor on the drive's own hidden fixes
+    /// (params.toml's `[bound]`); without it the bound is the filter's
+    /// covariance alone ([`BoundFit::FILTER`]). `batch`, which shows no
+    /// bound, skips it: the fit took 1.0 of the 1.7 s of a 10-minute
+    /// simulated drive (`deadreckon batch d1 d2 --threads 1`, elapsed_s).
+    pub fit_bound: bool,
+}
+
+impl Default for CalibrationRequest {
+    fn default() -> Self {
+        CalibrationRequest {
+            options: CalibrationOptions::default(),
+            corrections: Which::default(),
+            fit_bound: true,
+        }
+    }
+}
+
+impl CalibrationRequest {
+    /// The default request with these corrections (`batch`'s default is
+    /// [`Which::None`]).
+    pub fn with_corrections(corrections: Which) -> CalibrationRequest {
+        CalibrationRequest {
+            corrections,
+            ..Default::default()
+        }
+    }
+
+    /// The method's word: `rts`, `zupt` or `truth` (what `--method` and
+    /// Python's `method` take, what params.toml's `method` records).
+    pub fn method_name(&self) -> &'static str {
+        method_name(self.options.method)
+    }
+}
+
+/// `rts`, `zupt` or `truth`: the word [`Method`]'s `FromStr` reads.
+pub fn method_name(m: Method) -> &'static str {
+    match m {
+        Method::Rts => "rts",
+        Method::Zupt => "zupt",
+        Method::Truth => "truth",
+    }
+}
+
+/// Whether a parameter was estimated on the drive: the one rule of the
+/// JSON's `not_estimated`, params.toml's `[not_estimated]` and `batch`'s
+/// `status_*` columns.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ParamStatus {
+    /// Informed by at least one sample (above the speed threshold for the
+    /// speed-dependent parameters).
+    Estimated,
+    /// No sample informed it: kept at its nominal value (a stream the
+    /// drive lacks, a ZUPT calibration's speed parameters, a wheel never
+    /// above the threshold).
+    NotEstimated,
+}
+
+impl ParamStatus {
+    /// The rule: estimated when at least one sample informed it.
+    pub fn of_samples(samples: usize) -> ParamStatus {
+        if samples > 0 {
+            ParamStatus::Estimated
+        } else {
+            ParamStatus::NotEstimated
+        }
+    }
+
+    /// `estimated` or `not-estimated` (`batch`'s CSV values).
+    pub fn name(self) -> &'static str {
+        match self {
+            ParamStatus::Estimated => "estimated",
+            ParamStatus::NotEstimated => "not-estimated",
+        }
+    }
+}
+
+impl std::fmt::Display for ParamStatus {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            ParamStatus::Estimated => "estimated",
+            ParamStatus::NotEstimated => "not estimated",
+        })
+    }
+}
+
+/// Calibrates the car on `drive` as `request` asks: the corrections
+/// estimated and applied (with `auto`, those the held-back GNSS chose), the
+/// six parameters calibrated on the corrected drive, the steering fitted
+/// (truth method; the RTS calibration's own fit otherwise), the 95 % error
+/// bound's factor fitted on the drive's own hidden fixes, the vehicle
+/// recorded. `name` (the drive's path) goes into the error.
+pub fn calibrate(
+    drive: &Drive,
+    request: &CalibrationRequest,
+    name: &str,
+) -> Result<CarCalibration, Error> {
+    calibrate_corrected(drive, request, name).map(|(c, _)| c)
+}
+
+/// [`calibrate`], also returning the drive the corrections were applied to
+/// (`None` when none were asked for: the drive itself), on which the
+/// calibrated parameters hold (`evaluate` and `run` measure on it).
+pub fn calibrate_corrected(
+    drive: &Drive,
+    request: &CalibrationRequest,
+    name: &str,
+) -> Result<(CarCalibration, Option<Drive>), Error> {
+    let options = &request.options;
+    // Without corrections the drive is calibrated as it is, not a copy.
+    let (corrected, corrections) = if request.corrections == Which::None {
+        (None, Corrections::none())
+    } else {
+        let (d, c) = crate::corrections::estimate_and_apply(drive, options, request.corrections)?;
+        (Some(d), c)
+    };
+    let drive = corrected.as_ref().unwrap_or(drive);
+    let calibration = calibrate::calibrate(drive, options).map_err(|source| Error::Step {
+        step: format!("calibrating {name}"),
+        source,
+    })?;
+    let steering = crate::json::car_steering(drive, options.method, options.min_speed_mps)
+        .map_err(|source| Error::Step {
+            step: "calibrating the steering".into(),
+            source,
+        })?
+        // The RTS calibration's fit against its smoothed states.
+        .or_else(|| calibration.steering.clone());
+    let (bound, fit_windows) = if request.fit_bound {
+        deadreckon_core::bound::fit_on_drive_with_windows(
+            drive,
+            &calibration.estimate.params,
+            &deadreckon_core::ekf::FilterOptions {
+                timing: options.filter.timing,
+                ..Default::default()
+            },
+        )
+    } else {
+        (BoundFit::FILTER, None)
+    };
+    let bound_reach_1m = fit_windows
+        .as_ref()
+        .and_then(|ev| deadreckon_core::bound::reach(ev, &bound, 1.0));
+    let car = CarCalibration {
+        request: request.clone(),
+        calibration,
+        corrections,
+        steering,
+        absent: crate::json::Absent::of(drive),
+        vehicle: crate::binding::VehicleRecord::of(&drive.vehicle),
+        bound,
+        bound_reach_1m,
+    };
+    Ok((car, corrected))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_default_request_is_the_cores_defaults_with_auto_corrections() {
+        let r = CalibrationRequest::default();
+        assert_eq!(r.options, CalibrationOptions::default());
+        assert_eq!(r.corrections, Which::Auto);
+        assert!(r.fit_bound);
+        assert_eq!(r.method_name(), "rts");
+        for m in [Method::Rts, Method::Zupt, Method::Truth] {
+            assert_eq!(method_name(m).parse::<Method>().unwrap(), m);
+        }
+    }
+
+    #[test]
+    fn a_parameter_is_estimated_when_a_sample_informed_it() {
+        assert_eq!(ParamStatus::of_samples(0), ParamStatus::NotEstimated);
+        assert_eq!(ParamStatus::of_samples(1), ParamStatus::Estimated);
+        assert_eq!(ParamStatus::NotEstimated.name(), "not-estimated");
+    }
+}
