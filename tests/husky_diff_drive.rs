@@ -160,9 +160,9 @@ fn husky_diff_drive_calibrated_against_gnss_through_30_s_outages() {
 /// Issue 31: with the default options (no --params: calibrated on the bag
 /// and the bound's factor fitted on its own windows against the hidden
 /// fixes, in-sample), the final error of every 30 s outage is within the
-/// 95 % bound. Measured: k 1.428, 31 of 31 windows within, median bound
-/// 6.53 m over median final error 2.75 m (2.37). The issue asks at least
-/// 80 %.
+/// 95 % bound. Measured: k 1.362, 31 of 31 windows within, sharpness 2.668
+/// (the parameters the held-back choice keeps, all nominal; with every
+/// parameter fitted it was k 1.428 and 2.37). The issue asks at least 80 %.
 #[test]
 fn husky_bound_covers_30_s_outages_with_the_default_options() {
     let v: serde_json::Value = serde_json::from_str(&run_ok(&[
@@ -187,7 +187,7 @@ fn husky_bound_covers_30_s_outages_with_the_default_options() {
     near(
         "sharpness",
         v["bound_95_sharpness"].as_f64().unwrap(),
-        2.37,
+        2.668,
         0.15,
     );
 }
