@@ -43,6 +43,14 @@
 //! 10 s windows) while the reference trajectory, which has no such delay,
 //! says the correction takes 20 s outages from 1.48 to 0.59 m.
 //!
+//! The additions to the paper's model ([`crate::model_options`]: the rear
+//! side slip, the steering model, a walking gyro bias, a GNSS recovery that
+//! waits) are candidates in the same selection: the estimated ones at
+//! [`MIN_Z`] standard errors from the vehicle's values, the two settings
+//! without an estimate on the held-back fixes alone (never on a drive too
+//! short to judge; the recovery only where the held-back filter recovered).
+//! What is chosen is [`crate::timing::Corrections::model`].
+//!
 //! A drive too short for [`MIN_WINDOWS`] windows cannot judge: there each
 //! candidate is applied on its significance, and the output says so.
 //!
