@@ -610,8 +610,9 @@ fn mean(errors: &[(f64, f64)]) -> f64 {
 
 /// The paired comparison of `with` against `without` over the windows both
 /// have: the mean difference, m, and its t statistic (NaN with fewer than
-/// two windows or no spread).
-fn paired(with: &[(f64, f64)], without: &[(f64, f64)]) -> (f64, f64) {
+/// two windows or no spread). The car's and the differential drive's
+/// held-back choices both judge with it.
+pub(crate) fn paired(with: &[(f64, f64)], without: &[(f64, f64)]) -> (f64, f64) {
     let d: Vec<f64> = with
         .iter()
         .filter_map(|&(t, e)| {

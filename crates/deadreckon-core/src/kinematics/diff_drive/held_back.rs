@@ -269,28 +269,6 @@ fn mean(errors: &[(f64, f64)]) -> f64 {
     errors.iter().map(|e| e.1).sum::<f64>() / errors.len().max(1) as f64
 }
 
-/// The paired comparison of `with` against `without` over the windows both
-/// have: the mean difference, m, and its t statistic (NaN with fewer than
-/// two windows or no spread).
-fn paired(with: &[(f64, f64)], without: &[(f64, f64)]) -> (f64, f64) {
-    let diffs: Vec<f64> = with
-        .iter()
-        .filter_map(|&(t, e)| {
-            without
-                .iter()
-                .find(|w| (w.0 - t).abs() < 1e-9)
-                .map(|w| e - w.1)
-        })
-        .collect();
-    if diffs.len() < 2 {
-        return (f64::NAN, f64::NAN);
-    }
-    let n = diffs.len() as f64;
-    let m = diffs.iter().sum::<f64>() / n;
-    let var = diffs.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0);
-    (m, m / (var / n).sqrt())
-}
-
 /// Calibrates the differential drive with each parameter chosen on
 /// held-back GNSS (module docs): the fit of the chosen parameters, the
 /// others nominal with the reason, and the judgement in
@@ -350,7 +328,7 @@ pub(crate) fn calibrate_held_back_with(
         for (i, &k) in left.iter().enumerate() {
             let set: Vec<usize> = chosen.iter().copied().chain([k]).collect();
             let errors = held_back_errors(d, noise, &folds, &fits, &set)?;
-            let (diff_m, t) = paired(&errors, &current);
+            let (diff_m, t) = crate::held_back::paired(&errors, &current);
             let j = JudgedParam {
                 name: NAMES[k].to_string(),
                 calibrated: full.params[k].value,
