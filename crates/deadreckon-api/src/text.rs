@@ -152,6 +152,12 @@ pub fn held_back_line(h: &deadreckon_core::held_back::HeldBack) -> String {
                     "{} applied on its significance ({:+.1} standard errors; the held-back fixes share its clock and cannot judge it)",
                     j.correction, j.z
                 )
+            } else if j.with_m.is_finite() && !j.t.is_finite() {
+                // The same error in every window: nothing to test.
+                format!(
+                    "{} {:.3} m, the same in every window (not applied)",
+                    j.correction, j.with_m
+                )
             } else if j.with_m.is_finite() {
                 format!(
                     "{} {:.3} m against {:.3} m, t {:+.1} ({})",
