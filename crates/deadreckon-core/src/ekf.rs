@@ -48,6 +48,37 @@ pub enum Timing {
     EachMeasurement,
 }
 
+/// What a wheel row's reading describes, and so when the filter uses it
+/// ([`Timing::WheelEpochs`] only).
+///
+/// A wheel-speed row at `t_k` is the mean speed over `(t_{k−1}, t_k]` (the
+/// rotation over the last period times the circumference, as ECUs and the
+/// simulator report it), and a tick count is the rotation over that
+/// interval. The paper's step (eq. 3) carries the state from `t_k` to
+/// `t_{k+1}` with the speed the row at `t_k` set, the speed of the interval
+/// *before*: whenever the speed changes, the position trails by a wheel
+/// period, which the GNSS delay estimate read as a negative delay of
+/// 0.7–0.9 wheel periods (−27, −14 and −9 ms at 25, 50 and 100 Hz with a
+/// true delay of 0, issue 28).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum WheelRows {
+    /// The row updates the state at the start of its interval, `t_{k−1}`;
+    /// the step to `t_k` then carries the interval's own speed. Each epoch
+    /// is handed out when the next wheel row (or the end of the stream)
+    /// has arrived, one wheel period later than with [`WheelRows::Instant`].
+    /// Not the default: on the comma2k19 segment it loses (see
+    /// docs/calibration.md, "When a wheel row is used").
+    Interval,
+    /// The row updates the state at its own time (the paper): the step
+    /// after it carries that speed over the next interval.
+    #[default]
+    Instant,
+}
+
+fn instant() -> WheelRows {
+    WheelRows::Instant
+}
+
 /// How the filter's initial state is chosen.
 #[allow(clippy::large_enum_variant)] // a plain value passed once per run
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
@@ -135,6 +166,9 @@ pub struct FilterOptions {
     /// `None` fuses every wheel reading the χ² gate accepts.
     #[serde(default)]
     pub wheel_monitor: Option<WheelMonitorConfig>,
+    /// When a wheel row is used ([`WheelRows`]).
+    #[serde(default)]
+    pub wheel_rows: WheelRows,
 }
 
 impl Default for FilterOptions {
@@ -149,6 +183,7 @@ impl Default for FilterOptions {
             record_innovations: false,
             end_s: None,
             wheel_monitor: Some(WheelMonitorConfig::default()),
+            wheel_rows: WheelRows::default(),
         }
     }
 }
@@ -345,6 +380,49 @@ pub struct Feeder {
     /// The wheel-health monitor, when asked for.
     #[serde(default)]
     monitor: Option<WheelMonitor>,
+    /// When a wheel row is used (a feeder saved before this was chosen
+    /// goes on as it began: [`WheelRows::Instant`]).
+    #[serde(default = "instant")]
+    wheel_rows: WheelRows,
+    /// [`WheelRows::Interval`]: the epoch run but not yet handed out, waiting
+    /// for the next wheel row's update at its time.
+    #[serde(default)]
+    held: Option<HeldEpoch>,
+}
+
+/// An epoch waiting for the next wheel row ([`WheelRows::Interval`]): its
+/// prediction (when the feeder keeps predictions), flattened so the feeder
+/// stays independent of the state's size.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+struct HeldEpoch {
+    /// x̂_{k|k-1}, then P_{k|k-1} column by column, then the car block of F
+    /// column by column; empty without a prediction.
+    prediction: Vec<f64>,
+}
+
+impl HeldEpoch {
+    fn new<const N: usize>(prediction: Option<&Prediction<N>>) -> Self {
+        let mut v = Vec::new();
+        if let Some(p) = prediction {
+            v.reserve(N + N * N + 25);
+            v.extend_from_slice(p.x.as_slice());
+            v.extend_from_slice(p.p.as_slice());
+            v.extend_from_slice(p.f.as_slice());
+        }
+        HeldEpoch { prediction: v }
+    }
+
+    fn prediction<const N: usize>(&self) -> Option<Prediction<N>> {
+        let v = &self.prediction;
+        if v.len() != N + N * N + 25 {
+            return None;
+        }
+        Some(Prediction {
+            x: SVector::from_column_slice(&v[..N]),
+            p: SMatrix::from_column_slice(&v[N..N + N * N]),
+            f: Mat::from_column_slice(&v[N + N * N..]),
+        })
+    }
 }
 
 fn yes() -> bool {
@@ -389,7 +467,38 @@ impl Feeder {
             gated_fix_t_s: None,
             predictions: opts.record_epochs,
             monitor: opts.wheel_monitor.map(WheelMonitor::new),
+            wheel_rows: opts.wheel_rows,
+            held: None,
         }
+    }
+
+    /// Whether an epoch is run but not yet handed out ([`WheelRows::Interval`]),
+    /// and whether it carries its prediction.
+    pub fn holds_epoch(&self) -> Option<bool> {
+        self.held.as_ref().map(|h| !h.prediction.is_empty())
+    }
+
+    /// Hands out the held epoch, if any.
+    fn release<L: Layout<N>, const N: usize>(
+        &mut self,
+        f: &mut Filter<L, N>,
+        epoch: &mut dyn FnMut(&mut Filter<L, N>, EpochOut<'_, N>),
+    ) {
+        let Some(held) = self.held.take() else {
+            return;
+        };
+        let prediction = held.prediction::<N>();
+        self.stats.epochs += 1;
+        epoch(
+            f,
+            EpochOut {
+                prediction: prediction.as_ref(),
+                updates: &self.updates,
+                gated_fix_t_s: self.gated_fix_t_s,
+            },
+        );
+        self.updates.clear();
+        self.gated_fix_t_s = None;
     }
 
     /// Whether the epochs passed to the callback carry their prediction (by
@@ -528,6 +637,7 @@ impl Feeder {
         epoch: &mut dyn FnMut(&mut Filter<L, N>, EpochOut<'_, N>),
     ) -> Result<(), Error> {
         self.process_batch(f, epoch)?;
+        self.release(f, epoch);
         // The epochs' scratch (not serialised): a feeder that has finished
         // equals its saved and loaded copy.
         self.updates.clear();
@@ -646,8 +756,11 @@ impl Feeder {
             return Ok(());
         }
         let use_ = self.sensors;
-        self.updates.clear();
-        self.gated_fix_t_s = None;
+        // A held epoch keeps its updates until it is handed out.
+        if self.held.is_none() {
+            self.updates.clear();
+            self.gated_fix_t_s = None;
+        }
         let supersede = |slot: &mut Option<f64>, v: f64, n: &mut usize| {
             if slot.replace(v).is_some() {
                 *n += 1;
@@ -685,8 +798,24 @@ impl Feeder {
                     let Some((interval, gap)) = self.wheel_interval(t, ticks) else {
                         return Ok(());
                     };
+                    let at_start = self.wheel_rows == WheelRows::Interval;
+                    if at_start {
+                        // The row describes the interval that ends now: it
+                        // updates the state at the interval's start, which
+                        // the step below carries over the interval; the
+                        // epoch there is then complete.
+                        if use_.wheels {
+                            if gap {
+                                self.stats.wheel_gaps += 1;
+                            } else {
+                                self.wheel_updates(f, &ev.measurement, interval)?;
+                                self.monitor_wheels(f, &ev.measurement, interval);
+                            }
+                        }
+                        self.release(f, epoch);
+                    }
                     let prediction = self.predict(f, t);
-                    if use_.wheels {
+                    if use_.wheels && !at_start {
                         if gap {
                             self.stats.wheel_gaps += 1;
                         } else {
@@ -711,6 +840,10 @@ impl Feeder {
                     }
                     if let Some(fix) = self.pending_gnss.take() {
                         self.gnss_update(f, &fix)?;
+                    }
+                    if at_start {
+                        self.held = Some(HeldEpoch::new(prediction.as_ref()));
+                        return Ok(());
                     }
                     if use_.wheels && !gap {
                         self.monitor_wheels(f, &ev.measurement, interval);

@@ -1,0 +1,324 @@
+//! The GNSS delay on the car family (issue 28): the estimate against the
+//! receiver's true latency at wheel rates of 25, 50 and 100 Hz, with true
+//! delays of 0 (even members) and 0.05–0.2 s (odd members).
+//!
+//! Each member drives its own 600 s route (`CarFamily::drive`), its wheels
+//! resampled at each rate with the same tone-ring noise in m/s (the edge
+//! jitter scaled by the rate: its speed error is jitter / period). The
+//! estimate is `timing::gnss_delay` with each wheel row used over the
+//! interval it describes (`ekf::WheelRows::Interval`, not the default: see
+//! docs/calibration.md); its error is counted in its own standard errors
+//! (`z`). `DELAY_ROWS=instant` runs the same with the paper's step (the
+//! default), whose positions trail by a wheel period.
+//!
+//! Nothing was tuned for this: `WheelRows::Interval` has no constant. The
+//! members 201–220 were run once with each scheme:
+//!
+//! | wheel rows | 25 Hz within 3σ, mean error | 50 Hz | 100 Hz |
+//! |---|---|---|---|
+//! | interval | 20/20, −6.5 ms (RMS z 1.22) | 20/20, −5.7 ms (1.10) | 20/20, −5.9 ms (1.03) |
+//! | instant (default) | 15/20, −26.0 ms (2.49) | 18/20, −15.1 ms (1.77) | 19/20, −10.6 ms (1.48) |
+//!
+//! ```text
+//! cargo test --profile ci -p deadreckon-sim --test gnss_delay_family -- --include-ignored --nocapture
+//! ```
+
+use deadreckon_core::calibrate::CalibrationOptions;
+use deadreckon_core::ekf::{FilterOptions, WheelRows};
+use deadreckon_core::timing::{self, DelayOptions};
+use deadreckon_sim::family::CarFamily;
+use deadreckon_sim::simulate;
+use rand::{RngExt, SeedableRng};
+use rand_pcg::Pcg64;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// The calibration's options: each wheel row used over the interval it
+/// describes ([`WheelRows::Interval`]; `DELAY_ROWS=instant` for the paper's
+/// step, to measure the bias it gives).
+fn copts() -> CalibrationOptions {
+    let wheel_rows = match std::env::var("DELAY_ROWS").as_deref() {
+        Ok("instant") => WheelRows::Instant,
+        _ => WheelRows::Interval,
+    };
+    CalibrationOptions {
+        filter: FilterOptions {
+            wheel_rows,
+            ..Default::default()
+        },
+        ..Default::default()
+    }
+}
+
+/// The wheel rates every member is resampled at, Hz.
+const RATES_HZ: [f64; 3] = [25.0, 50.0, 100.0];
+
+/// Length of each member's drive, s.
+const DURATION_S: f64 = 600.0;
+
+/// One member at one wheel rate.
+#[derive(Debug, Clone)]
+struct Row {
+    seed: u64,
+    rate_hz: f64,
+    /// The receiver's latency, s.
+    latency_s: f64,
+    /// The estimate and its standard error, s (NaN: the calibration refused
+    /// the drive, see `note`).
+    delay_s: f64,
+    std_s: f64,
+    /// Why not estimated, or the calibration's error.
+    note: String,
+}
+
+impl Row {
+    fn z(&self) -> f64 {
+        (self.delay_s - self.latency_s) / self.std_s
+    }
+}
+
+/// The true latency of member `seed`: 0 for even members, 0.05–0.2 s for odd.
+fn latency_of(seed: u64) -> f64 {
+    if seed.is_multiple_of(2) {
+        0.0
+    } else {
+        Pcg64::seed_from_u64(0x6e55_0000 + seed).random_range(0.05..0.2)
+    }
+}
+
+/// Member `seed`'s drive with its wheels at `rate_hz` and the delay estimated.
+fn estimate(seed: u64, rate_hz: f64) -> Row {
+    let latency_s = latency_of(seed);
+    let mut car = CarFamily::draw(seed);
+    car.edge_jitter_m *= car.wheel_rate_hz / rate_hz;
+    car.wheel_rate_hz = rate_hz;
+    car.gnss_latency_s = latency_s;
+    let sim = simulate(&car.drive(100 + seed, DURATION_S), 100 + seed).unwrap();
+    let mut row = Row {
+        seed,
+        rate_hz,
+        latency_s,
+        delay_s: f64::NAN,
+        std_s: f64::NAN,
+        note: String::new(),
+    };
+    match timing::gnss_delay(&sim.drive, &copts(), &DelayOptions::default()) {
+        Ok((g, _)) => {
+            row.delay_s = g.delay_s;
+            row.std_s = g.std_s;
+            row.note = g.status.reason().unwrap_or("").into();
+        }
+        Err(e) => row.note = e.to_string(),
+    }
+    row
+}
+
+/// Every member at every rate, on two threads, sorted by member and rate.
+fn estimate_all(seeds: &[u64]) -> Vec<Row> {
+    let jobs: Vec<(u64, f64)> = seeds
+        .iter()
+        .flat_map(|&s| RATES_HZ.map(|r| (s, r)))
+        .collect();
+    let next = AtomicUsize::new(0);
+    let mut rows: Vec<Row> = std::thread::scope(|scope| {
+        let workers: Vec<_> = (0..2)
+            .map(|_| {
+                scope.spawn(|| {
+                    let mut out = Vec::new();
+                    while let Some(&(s, r)) = jobs.get(next.fetch_add(1, Ordering::Relaxed)) {
+                        out.push(estimate(s, r));
+                    }
+                    out
+                })
+            })
+            .collect();
+        workers
+            .into_iter()
+            .flat_map(|w| w.join().unwrap())
+            .collect()
+    });
+    rows.sort_by_key(|r| (r.seed, r.rate_hz as u64));
+    rows
+}
+
+/// What one rate's rows show.
+#[derive(Debug, Clone, Copy)]
+struct Summary {
+    /// Rows with a standard error (the calibration did not refuse the drive).
+    with_std: usize,
+    /// Of those, within 3 standard errors of the latency.
+    within_3_sigma: usize,
+    /// Mean error, s, and mean standard error, s.
+    mean_error_s: f64,
+    mean_std_s: f64,
+    /// Root mean square of the errors in standard errors.
+    rms_z: f64,
+}
+
+fn summary(rows: &[&Row]) -> Summary {
+    let ok: Vec<&&Row> = rows.iter().filter(|r| r.std_s.is_finite()).collect();
+    let n = ok.len() as f64;
+    Summary {
+        with_std: ok.len(),
+        within_3_sigma: ok.iter().filter(|r| r.z().abs() <= 3.0).count(),
+        mean_error_s: ok.iter().map(|r| r.delay_s - r.latency_s).sum::<f64>() / n,
+        mean_std_s: ok.iter().map(|r| r.std_s).sum::<f64>() / n,
+        rms_z: (ok.iter().map(|r| r.z().powi(2)).sum::<f64>() / n).sqrt(),
+    }
+}
+
+/// Prints the rows and each rate's summary (all members, and those with a
+/// true delay of 0 and above 0); returns the summaries per rate.
+fn table(rows: &[Row]) -> Vec<(f64, Summary)> {
+    eprintln!("member  wheels   latency    estimate   std err       z  note");
+    for r in rows {
+        eprintln!(
+            "{:6} {:4} Hz  {:.4} s  {:+.4} s  {:.4} s  {:+6.2}  {}",
+            r.seed,
+            r.rate_hz,
+            r.latency_s,
+            r.delay_s,
+            r.std_s,
+            r.z(),
+            r.note.chars().take(70).collect::<String>()
+        );
+    }
+    let mut out = Vec::new();
+    for rate in RATES_HZ {
+        for (which, keep) in [
+            ("all", &(|_: &Row| true) as &dyn Fn(&Row) -> bool),
+            ("delay 0", &|r: &Row| r.latency_s == 0.0),
+            ("delay > 0", &|r: &Row| r.latency_s > 0.0),
+        ] {
+            let sel: Vec<&Row> = rows
+                .iter()
+                .filter(|r| r.rate_hz == rate && keep(r))
+                .collect();
+            let s = summary(&sel);
+            eprintln!(
+                "{rate:3} Hz {which:<9}: {} of {} with a standard error, {} within 3σ; mean error {:+.4} s, mean std {:.4} s, rms z {:.2}",
+                s.with_std,
+                sel.len(),
+                s.within_3_sigma,
+                s.mean_error_s,
+                s.mean_std_s,
+                s.rms_z
+            );
+            if which == "all" {
+                out.push((rate, s));
+            }
+        }
+    }
+    out
+}
+
+/// Held-out members 201–220 at 25, 50 and 100 Hz: within 3σ on at least
+/// 90 % of them at each rate, the mean error a small part of the standard
+/// error, the errors in standard errors near 1 in RMS. 100 s on two cores:
+/// not in CI (`the_gnss_delay_was_biased_by_one_wheel_period` is).
+#[test]
+#[ignore]
+fn the_gnss_delay_is_unbiased_with_honest_errors_on_held_out_family_members() {
+    let seeds: Vec<u64> = (201..=220).collect();
+    let rows = estimate_all(&seeds);
+    for (rate, s) in table(&rows) {
+        // A drive the calibration refuses is not a delay estimate; none of
+        // these members' is.
+        assert_eq!(s.with_std, seeds.len(), "{rate} Hz: {s:?}");
+        assert!(
+            s.within_3_sigma as f64 >= 0.9 * s.with_std as f64,
+            "{rate} Hz: {s:?}"
+        );
+        // Measured: mean errors −6.5, −5.7 and −5.9 ms at 25, 50 and 100 Hz
+        // (0.45, 0.39 and 0.38 of the mean standard errors, 14.4–15.4 ms;
+        // the mean of 20 members scatters by about 3.4 ms).
+        assert!(
+            s.mean_error_s.abs() <= 0.5 * s.mean_std_s,
+            "{rate} Hz: {s:?}"
+        );
+        // Measured RMS of z: 1.22, 1.10 and 1.03; all 20 within 3σ at each
+        // rate.
+        assert!(s.rms_z > 0.8 && s.rms_z < 1.3, "{rate} Hz: {s:?}");
+    }
+}
+
+/// The larger held-out run, members 201–260: the table and the same
+/// checks (not run at this change).
+#[test]
+#[ignore]
+fn the_gnss_delay_on_sixty_held_out_family_members() {
+    let seeds: Vec<u64> = (201..=260).collect();
+    let rows = estimate_all(&seeds);
+    for (rate, s) in table(&rows) {
+        assert!(
+            s.within_3_sigma as f64 >= 0.9 * s.with_std as f64,
+            "{rate} Hz: {s:?}"
+        );
+        assert!(
+            s.mean_error_s.abs() <= 0.5 * s.mean_std_s,
+            "{rate} Hz: {s:?}"
+        );
+    }
+}
+
+/// Members 1–40, for comparison with the held-out ones.
+#[test]
+#[ignore]
+fn the_gnss_delay_on_the_development_members() {
+    let seeds: Vec<u64> = (1..=40).collect();
+    table(&estimate_all(&seeds));
+}
+
+/// Regression: the GNSS delay's dead-reckoned reference (the filter's own
+/// step) moved each wheel step with the previous row's speed (eq. 3 with the
+/// row's mean speed over the period that ended), so its positions trailed by
+/// one wheel period while the speed changed, and the delay read −0.7 to
+/// −0.9 wheel periods with a true delay of 0 (issue 28). Car 1, its 300 s
+/// drive with nearly noise-free fixes (0.03 m, white) at 25, 50 and 100 Hz:
+/// with the paper's step (the default) −29.4 ± 6.5, −15.5 ± 3.1 and
+/// −8.6 ± 1.2 ms; with each row used over its own interval (pinned here)
+/// within 3 ms at every rate.
+#[test]
+fn the_gnss_delay_was_biased_by_one_wheel_period() {
+    let run = |rows: WheelRows| {
+        let copts = CalibrationOptions {
+            filter: FilterOptions {
+                wheel_rows: rows,
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        let mut estimates = Vec::new();
+        for rate_hz in [25.0, 50.0, 100.0] {
+            let mut car = CarFamily::draw(1);
+            car.gnss_markov.0 = 0.0;
+            car.gnss_std_m = 0.03;
+            car.edge_jitter_m *= car.wheel_rate_hz / rate_hz;
+            car.wheel_rate_hz = rate_hz;
+            car.gnss_latency_s = 0.0;
+            let sim = simulate(&car.drive(101, 300.0), 101).unwrap();
+            let (g, _) = timing::gnss_delay(&sim.drive, &copts, &DelayOptions::default()).unwrap();
+            eprintln!(
+                "{rows:?} {rate_hz} Hz: {:+.4} ± {:.4} s",
+                g.delay_s, g.std_s
+            );
+            assert!(g.status.is_estimated(), "{g:?}");
+            estimates.push((rate_hz, g));
+        }
+        estimates
+    };
+    // The paper's step: most of a wheel period early at every rate.
+    for (rate_hz, g) in run(WheelRows::Instant) {
+        let periods = g.delay_s * rate_hz;
+        assert!((-0.95..=-0.6).contains(&periods), "{rate_hz} Hz: {g:?}");
+    }
+    let estimates = run(WheelRows::Interval);
+    for (rate_hz, g) in &estimates {
+        assert!(g.delay_s.abs() < 0.003, "{rate_hz} Hz: {g:?}");
+        assert!(g.delay_s.abs() <= 3.0 * g.std_s, "{rate_hz} Hz: {g:?}");
+    }
+    // With the paper's step: 20.8 ms from 25 to 100 Hz.
+    let d: Vec<f64> = estimates.iter().map(|(_, g)| g.delay_s).collect();
+    let spread = d.iter().fold(f64::NEG_INFINITY, |a, &b| a.max(b))
+        - d.iter().fold(f64::INFINITY, |a, &b| a.min(b));
+    assert!(spread < 0.001, "{d:?}");
+}

@@ -1,0 +1,97 @@
+//! When a wheel row is used (`ekf::WheelRows`, issue 28): the paper's step
+//! (`Instant`, the default) against each row used over the interval it
+//! describes (`Interval`), on family cars 1–8: calibrated on one 300 s drive
+//! and evaluated on another (30 s outages every 10 s), with the same scheme
+//! for both. Mean final error, in brackets the mean error at the windows'
+//! start, m (run once; nothing was chosen on it):
+//!
+//! | family | instant | interval |
+//! |---|---|---|
+//! | kinematic (white fixes, no latency) | 0.499 (0.174) | 0.482 (0.144), better on 8 of 8 |
+//! | dynamic, every effect off | 0.428 (0.138) | 0.427 (0.124) |
+//! | dynamic, every effect on | 3.100 | 3.106 |
+//!
+//! Tick-count drives change little (a count is already the interval's). On
+//! the comma2k19 segment `Interval` loses (`evaluate --outage 20 --step 5`:
+//! 0.886 / 0.856 m mean / median against 0.592 / 0.613 m), which is why it
+//! is not the default (docs/calibration.md, "When a wheel row is used").
+//!
+//! ```text
+//! cargo test --profile ci -p deadreckon-sim --test wheel_rows -- --ignored --nocapture
+//! ```
+use deadreckon_core::calibrate::{calibrate, CalibrationOptions};
+use deadreckon_core::ekf::{FilterOptions, WheelRows};
+use deadreckon_core::outage::evaluate;
+use deadreckon_sim::family::{CarFamily, DynamicCar, Effects};
+use deadreckon_sim::simulate;
+use rayon::prelude::*;
+
+fn run(cal: &deadreckon_core::Drive, ev: &deadreckon_core::Drive, rows: WheelRows) -> (f64, f64) {
+    let fo = FilterOptions {
+        wheel_rows: rows,
+        ..Default::default()
+    };
+    let co = CalibrationOptions {
+        filter: fo.clone(),
+        ..Default::default()
+    };
+    let c = calibrate(cal, &co).unwrap();
+    let out = evaluate(ev, &c.estimate.params, 30.0, 10.0, 5.0, &fo).unwrap();
+    (out.final_error().mean, out.start_error().mean)
+}
+
+#[test]
+#[ignore]
+fn interval_wheel_rows_against_the_papers_step_on_family_cars() {
+    let seeds: Vec<u64> = (1..=8).collect();
+    let rows: Vec<(String, [f64; 2])> = seeds
+        .par_iter()
+        .map(|&seed| {
+            let mut out = String::new();
+            // kinematic family, white fixes, no latency
+            let car = CarFamily::draw(seed);
+            let sc = |s: u64| {
+                let mut sc = car.drive(s, 300.0);
+                let g = sc.sensors.gnss.as_mut().unwrap();
+                g.markov_std_m = 0.0;
+                g.latency_s = 0.0;
+                sc
+            };
+            let cal = simulate(&sc(1000 + seed), 1000 + seed).unwrap().drive;
+            let ev = simulate(&sc(2000 + seed), 2000 + seed).unwrap().drive;
+            let a = run(&cal, &ev, WheelRows::Instant);
+            let b = run(&cal, &ev, WheelRows::Interval);
+            let kinematic = [a.0, b.0];
+            out += &format!(
+                "kin {seed} {} Hz: instant {:.3} ({:.3}) interval {:.3} ({:.3})\n",
+                car.wheel_rate_hz, a.0, a.1, b.0, b.1
+            );
+            let dc = DynamicCar::draw(seed);
+            for (name, e) in [("none", Effects::none()), ("all", Effects::all())] {
+                let cal = simulate(&dc.drive(1000 + seed, 300.0, &e), 1000 + seed)
+                    .unwrap()
+                    .drive;
+                let ev = simulate(&dc.drive(2000 + seed, 300.0, &e), 2000 + seed)
+                    .unwrap()
+                    .drive;
+                let a = run(&cal, &ev, WheelRows::Instant);
+                let b = run(&cal, &ev, WheelRows::Interval);
+                out += &format!(
+                    "dyn-{name} {seed} {:?} {} Hz: instant {:.3} ({:.3}) interval {:.3} ({:.3})\n",
+                    dc.wheel_kind, dc.wheel_rate_hz, a.0, a.1, b.0, b.1
+                );
+            }
+            (out, kinematic)
+        })
+        .collect();
+    for (r, _) in &rows {
+        print!("{r}");
+    }
+    // The kinematic family's mean: measured 0.499 m instant, 0.482 m interval.
+    let n = rows.len() as f64;
+    let mean = |i: usize| rows.iter().map(|(_, k)| k[i]).sum::<f64>() / n;
+    let (instant, interval) = (mean(0), mean(1));
+    println!("kinematic family: instant {instant:.3} m, interval {interval:.3} m");
+    assert!(interval < instant, "{interval} {instant}");
+    assert!((instant - 0.499).abs() < 0.01 && (interval - 0.482).abs() < 0.01);
+}
