@@ -222,8 +222,9 @@ pub fn write_car(
     write(out, format, &t, &bounds, mcap)?;
     // (A drive without GNSS has no aided run: the health is then not checked.)
     let health = match opts.wheel_monitor {
-        Some(_) => deadreckon_core::wheel_health::check_drive(drive, params, opts)
-            .map_err(|e| e.to_string()),
+        Some(_) => {
+            deadreckon_core::ekf::check_wheels(drive, params, opts).map_err(|e| e.to_string())
+        }
         None => Err("--no-wheel-monitor".into()),
     };
     Ok(Written {

@@ -399,7 +399,7 @@ fn calibrate_with(
         }
         c.manoeuvres = Some(crate::observability::manoeuvres(drive, opts.min_speed_mps));
         if opts.filter.wheel_monitor.is_some() {
-            c.wheel_health = crate::wheel_health::check_drive(
+            c.wheel_health = crate::ekf::check_wheels(
                 drive,
                 &c.estimate.params,
                 &FilterOptions {

@@ -48,223 +48,32 @@ use crate::observation::Sensors;
 use crate::vehicle::{Noise, Params, Vehicle};
 use crate::Error;
 
-/// Index of the gyro bias in the augmented state.
-pub const AUG_BIAS: usize = 5;
-/// Index of the speed scale in the augmented state.
-pub const AUG_SCALE: usize = 6;
-/// Index of the first inverse circumference (FL, then FR, RL, RR) in the augmented state.
-pub const AUG_INV_CIRC: usize = 7;
-/// Dimension of the augmented state.
-pub const N_AUG: usize = 11;
+mod gates;
+mod layout;
+#[cfg(test)]
+mod tests;
 
-/// Where the six parameters live in a state of dimension `N`.
-pub trait Layout<const N: usize>: Copy + std::fmt::Debug + Default + PartialEq {
-    /// A short name (`car`, `augmented`).
-    const NAME: &'static str;
-    /// Index in the state of parameter `j` (0 gyro bias, 1 speed scale, 2..6 the
-    /// inverse circumferences FL..RR), or `None` when the parameters are fixed.
-    fn param_index(j: usize) -> Option<usize>;
-    /// Index in the state of the receiver's wander east (north follows), or
-    /// `None` when the fixes are taken as white ([`crate::gnss_error`]).
-    fn wander_index() -> Option<usize> {
-        None
-    }
-    /// Whether the gyro bias (parameter 0, which must then be a state) walks
-    /// by `noise.gyro_bias_walk_rps_per_sqrt_s` ([`crate::gyro_drift`]);
-    /// the calibration's parameters are constants.
-    fn bias_walks() -> bool {
-        false
-    }
-}
+pub use gates::{gate_chi2, GateCounts, SensorKind, Update, N_SENSORS};
+pub use layout::{AugmentedLayout, CarLayout, Layout, AUG_BIAS, AUG_INV_CIRC, AUG_SCALE, N_AUG};
 
-/// The five car states; the parameters are fixed.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct CarLayout;
-
-impl Layout<5> for CarLayout {
-    const NAME: &'static str = "car";
-    fn param_index(_j: usize) -> Option<usize> {
-        None
-    }
-}
-
-/// The car states then the six parameters, estimated as constant states.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct AugmentedLayout;
-
-impl Layout<N_AUG> for AugmentedLayout {
-    const NAME: &'static str = "augmented";
-    fn param_index(j: usize) -> Option<usize> {
-        (j < 6).then_some(5 + j)
-    }
-}
+/// The yaw standard deviation added at a GNSS recovery, rad (about 6°): a
+/// filter that lost the fixes for long has lost its heading too, and the
+/// fix that ends it must be free to turn it. Not tuned.
+pub const RECOVERY_YAW_STD_RAD: f64 = 0.1;
+/// Below this speed a GNSS course says nothing about the yaw, m/s.
+pub const COURSE_MIN_SPEED_MPS: f64 = 3.0;
+/// The receiver's velocity noise a course is taken to carry, m/s: the
+/// course's standard deviation is this over the speed (u-blox-class
+/// receivers quote 0.05–0.5 m/s; the upper end, as the course is an
+/// option off by default and not tuned).
+pub const COURSE_VELOCITY_STD_MPS: f64 = 0.5;
+/// The largest standard deviation of a course used, rad (about 17°).
+pub const COURSE_MAX_STD_RAD: f64 = 0.3;
 
 /// The filter with fixed parameters.
-pub type CarFilter = Filter<CarLayout, 5>;
+pub type CarFilter = Filter<CarLayout, { model::N }>;
 /// The filter with the parameters as states.
 pub type AugmentedFilter = Filter<AugmentedLayout, N_AUG>;
-
-/// Which sensor a measurement comes from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
-pub enum SensorKind {
-    /// Wheel `0..4` (FL, FR, RL, RR).
-    Wheel(u8),
-    /// Gyro.
-    Gyro,
-    /// CAN speed.
-    Speed,
-    /// Steering.
-    Steering,
-    /// GNSS position (2-D; the NIS has 2 degrees of freedom).
-    Gnss,
-    /// GNSS course.
-    Course,
-}
-
-impl SensorKind {
-    /// Every kind, in a fixed order (for tables).
-    pub const ALL: [SensorKind; 9] = [
-        SensorKind::Wheel(0),
-        SensorKind::Wheel(1),
-        SensorKind::Wheel(2),
-        SensorKind::Wheel(3),
-        SensorKind::Gyro,
-        SensorKind::Speed,
-        SensorKind::Steering,
-        SensorKind::Gnss,
-        SensorKind::Course,
-    ];
-
-    /// A short stable name.
-    pub fn name(&self) -> &'static str {
-        match self {
-            SensorKind::Wheel(0) => "wheel_fl",
-            SensorKind::Wheel(1) => "wheel_fr",
-            SensorKind::Wheel(2) => "wheel_rl",
-            SensorKind::Wheel(_) => "wheel_rr",
-            SensorKind::Gyro => "gyro",
-            SensorKind::Speed => "speed",
-            SensorKind::Steering => "steering",
-            SensorKind::Gnss => "gnss",
-            SensorKind::Course => "course",
-        }
-    }
-
-    /// Degrees of freedom of the measurement.
-    pub fn dof(&self) -> usize {
-        if *self == SensorKind::Gnss {
-            2
-        } else {
-            1
-        }
-    }
-
-    fn slot(&self) -> usize {
-        match self {
-            SensorKind::Wheel(i) => (*i as usize).min(3),
-            SensorKind::Gyro => 4,
-            SensorKind::Speed => 5,
-            SensorKind::Steering => 6,
-            SensorKind::Gnss => 7,
-            SensorKind::Course => 8,
-        }
-    }
-}
-
-/// The χ² gate of a sensor, from the vehicle's noise settings.
-pub fn gate_chi2(noise: &Noise, sensor: SensorKind) -> f64 {
-    match sensor {
-        SensorKind::Wheel(_) => noise.wheel_gate_chi2,
-        SensorKind::Gyro => noise.gyro_gate_chi2,
-        SensorKind::Speed => noise.speed_gate_chi2,
-        SensorKind::Steering => noise.steering_gate_chi2,
-        SensorKind::Course => noise.course_gate_chi2,
-        SensorKind::Gnss => noise.gnss_gate_chi2,
-    }
-}
-
-/// The outcome of one measurement update.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Update {
-    /// The sensor.
-    pub sensor: SensorKind,
-    /// Innovation `z − h(x̂⁻)` (first component for GNSS).
-    pub y: f64,
-    /// Innovation variance (first diagonal element for GNSS).
-    pub s: f64,
-    /// Normalised innovation squared `ỹᵀ S⁻¹ ỹ`.
-    pub nis: f64,
-    /// `ln det S` of the innovation covariance the gate decided with (`ln s`
-    /// for a scalar): with `nis`, the measurement's Gaussian log-likelihood
-    /// (what [`crate::wander_fit`] compares receiver models by).
-    pub ln_det_s: f64,
-    /// False when the χ² gate rejected the measurement (the state is unchanged).
-    pub accepted: bool,
-}
-
-/// Per-sensor gate counters: measurements used and rejected, and recoveries
-/// (a measurement accepted after too many consecutive rejections).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-pub struct GateCounts {
-    /// Accepted measurements, per sensor in [`SensorKind::ALL`] order.
-    pub accepted: [u64; 9],
-    /// Rejected measurements, same order.
-    pub rejected: [u64; 9],
-    /// Recoveries, same order.
-    pub recovered: [u64; 9],
-}
-
-impl GateCounts {
-    /// Accepted measurements of one sensor.
-    pub fn accepted(&self, k: SensorKind) -> u64 {
-        self.accepted[k.slot()]
-    }
-    /// Rejected measurements of one sensor.
-    pub fn rejected(&self, k: SensorKind) -> u64 {
-        self.rejected[k.slot()]
-    }
-    /// Recoveries of one sensor.
-    pub fn recovered(&self, k: SensorKind) -> u64 {
-        self.recovered[k.slot()]
-    }
-    /// Adds the counts of another run (e.g. of every outage window).
-    pub fn add(&mut self, other: &GateCounts) {
-        for i in 0..self.accepted.len() {
-            self.accepted[i] += other.accepted[i];
-            self.rejected[i] += other.rejected[i];
-            self.recovered[i] += other.recovered[i];
-        }
-    }
-    /// The counts added since `earlier` (the same counters at an earlier
-    /// time: a filter cloned from it counts on from there).
-    pub fn since(&self, earlier: &GateCounts) -> GateCounts {
-        let d = |a: &[u64; 9], b: &[u64; 9]| std::array::from_fn(|k| a[k].saturating_sub(b[k]));
-        GateCounts {
-            accepted: d(&self.accepted, &earlier.accepted),
-            rejected: d(&self.rejected, &earlier.rejected),
-            recovered: d(&self.recovered, &earlier.recovered),
-        }
-    }
-    /// Rejected measurements of every sensor.
-    pub fn total_rejected(&self) -> u64 {
-        self.rejected.iter().sum()
-    }
-    /// `(name, accepted, rejected, recovered)` for every sensor with any measurement.
-    pub fn rows(&self) -> Vec<(&'static str, u64, u64, u64)> {
-        SensorKind::ALL
-            .iter()
-            .filter(|k| self.accepted(**k) + self.rejected(**k) > 0)
-            .map(|k| {
-                (
-                    k.name(),
-                    self.accepted(*k),
-                    self.rejected(*k),
-                    self.recovered(*k),
-                )
-            })
-            .collect()
-    }
-}
 
 /// The prediction of one step, as the smoother needs it.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -293,7 +102,7 @@ pub struct Filter<L: Layout<N>, const N: usize> {
     #[serde(default)]
     wheels_excluded: [bool; 4],
     /// Consecutive rejections per sensor (same order as [`GateCounts`]).
-    consecutive: [u32; 9],
+    consecutive: [u32; N_SENSORS],
     /// When the current run of rejected GNSS fixes began, s.
     #[serde(default)]
     gnss_rejecting_since_s: Option<f64>,
@@ -318,8 +127,9 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
         params.validate()?;
         let mut x = SVector::<f64, N>::zeros();
         let mut p = SMatrix::<f64, N, N>::zeros();
-        x.fixed_rows_mut::<5>(0).copy_from(&x0);
-        p.fixed_view_mut::<5, 5>(0, 0).copy_from(&p0);
+        x.fixed_rows_mut::<{ model::N }>(0).copy_from(&x0);
+        p.fixed_view_mut::<{ model::N }, { model::N }>(0, 0)
+            .copy_from(&p0);
         if L::param_index(0).is_some() {
             let sd = prior_std.ok_or_else(|| {
                 Error::InvalidParams("the augmented filter needs prior standard deviations".into())
@@ -366,7 +176,7 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
             t_s: t0_s,
             wheels_present: vehicle.wheels_present,
             wheels_excluded: [false; 4],
-            consecutive: [0; 9],
+            consecutive: [0; N_SENSORS],
             gnss_rejecting_since_s: None,
             gates: GateCounts::default(),
             layout: PhantomData,
@@ -393,7 +203,7 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
     }
     /// The car block `[x, y, ψ, v, ψ̇]` of the state.
     pub fn car_state(&self) -> State {
-        self.x.fixed_rows::<5>(0).into_owned()
+        self.x.fixed_rows::<{ model::N }>(0).into_owned()
     }
     /// Replaces state and covariance (e.g. a reset to a reference pose).
     pub fn set_state(&mut self, x: SVector<f64, N>, p: SMatrix<f64, N, N>) {
@@ -530,20 +340,25 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
         let f5 = model::jacobian_slipping(&car, dt, g);
         let q5 = model::process_noise(&self.noise, dt);
         self.x
-            .fixed_rows_mut::<5>(0)
+            .fixed_rows_mut::<{ model::N }>(0)
             .copy_from(&model::evolve_slipping(&car, dt, g));
         // P11 ← F P11 Fᵀ + Q (symmetrised), P12 ← F P12.
-        let p11 = self.p.fixed_view::<5, 5>(0, 0).into_owned();
+        let p11 = self
+            .p
+            .fixed_view::<{ model::N }, { model::N }>(0, 0)
+            .into_owned();
         let n11 = model::propagate_covariance(&p11, &f5, &q5);
-        self.p.fixed_view_mut::<5, 5>(0, 0).copy_from(&n11);
+        self.p
+            .fixed_view_mut::<{ model::N }, { model::N }>(0, 0)
+            .copy_from(&n11);
         // Column j ≥ 5 (its car rows) and its mirror, row j of the car columns.
-        let (car_cols, param_cols) = self.p.data.0.split_at_mut(5);
+        let (car_cols, param_cols) = self.p.data.0.split_at_mut(model::N);
         for (j, col) in param_cols.iter_mut().enumerate() {
-            let head: [f64; 5] = std::array::from_fn(|i| col[i]);
+            let head: [f64; model::N] = std::array::from_fn(|i| col[i]);
             let nc = model::jacobian_times(&f5, &head);
             for (i, (&v, car_col)) in nc.iter().zip(car_cols.iter_mut()).enumerate() {
                 col[i] = v;
-                car_col[5 + j] = v;
+                car_col[model::N + j] = v;
             }
         }
         // The receiver's wander: F = diag(F_car, I, φ·I₂) (crate::gnss_error).
@@ -628,7 +443,7 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
     ) -> Result<Update, Error> {
         let (h, row5) = pred;
         // H by its non-zero entries: the car states, then the parameter.
-        let mut row = [(0usize, 0.0f64); 6];
+        let mut row = [(0usize, 0.0f64); model::N + 1];
         let mut n = 0;
         for (j, &d) in row5.iter().enumerate() {
             if d != 0.0 {
@@ -755,7 +570,7 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
     pub fn update_gnss(&mut self, fix: &GnssFix) -> Result<Update, Error> {
         let (mut h, jac5) = self.sensors.gnss(&self.car_state());
         let mut jac = SMatrix::<f64, 2, N>::zeros();
-        jac.fixed_view_mut::<2, 5>(0, 0).copy_from(&jac5);
+        jac.fixed_view_mut::<2, { model::N }>(0, 0).copy_from(&jac5);
         if let Some(w) = L::wander_index() {
             add_wander(w, &self.x, &mut h, &mut jac);
         }
@@ -769,7 +584,7 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
             for i in [model::X, model::Y] {
                 self.p[(i, i)] += d2;
             }
-            self.p[(model::YAW, model::YAW)] += 0.1f64.powi(2);
+            self.p[(model::YAW, model::YAW)] += RECOVERY_YAW_STD_RAD.powi(2);
             (s, _, nis) = kalman::innovation_stats(&self.p, &y, &jac, &r, self.t_s)?;
         }
         if accepted {
@@ -817,10 +632,10 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
         course_yaw_rad: f64,
         speed_mps: Option<f64>,
     ) -> Result<Option<Update>, Error> {
-        let Some(speed) = speed_mps.filter(|s| *s > 3.0) else {
+        let Some(speed) = speed_mps.filter(|s| *s > COURSE_MIN_SPEED_MPS) else {
             return Ok(None);
         };
-        let sigma = (0.5 / speed).min(0.3);
+        let sigma = (COURSE_VELOCITY_STD_MPS / speed).min(COURSE_MAX_STD_RAD);
         let pred = self.sensors.yaw(&self.car_state());
         self.scalar(
             SensorKind::Course,
@@ -830,125 +645,5 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
             None,
         )
         .map(Some)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn filter() -> CarFilter {
-        let v = Vehicle::paper_car();
-        let x0 = State::from([0.0, 0.0, 0.0, 10.0, 0.0]);
-        let p0 = Mat::from_diagonal(&State::from([1.0, 1.0, 0.01, 1.0, 0.01]));
-        CarFilter::new(&v, &Params::nominal(&v), None, 0.0, x0, p0).unwrap()
-    }
-
-    #[test]
-    fn a_wheel_reading_far_outside_the_gate_is_rejected_and_counted() {
-        let mut f = filter();
-        f.predict_to(0.02);
-        let before = *f.state();
-        let u = f.update_wheel_ticks(0, 500.0, 0.02).unwrap().unwrap();
-        assert!(!u.accepted && u.nis > 1e3);
-        assert_eq!(*f.state(), before);
-        assert_eq!(f.gates().rejected(SensorKind::Wheel(0)), 1);
-        assert_eq!(f.gates().accepted(SensorKind::Wheel(0)), 0);
-    }
-
-    #[test]
-    fn consecutive_rejections_end_in_a_recovery() {
-        let mut f = filter();
-        let max = Vehicle::paper_car().noise.max_rejections as u64;
-        let mut t = 0.0;
-        for _ in 0..=max {
-            t += 0.02;
-            f.predict_to(t);
-            f.update_wheel_ticks(2, 5000.0, 0.02).unwrap();
-        }
-        let rl = SensorKind::Wheel(2);
-        assert_eq!(f.gates().rejected(rl), max);
-        assert_eq!(f.gates().recovered(rl), 1);
-        assert_eq!(f.gates().accepted(rl), 1);
-    }
-
-    #[test]
-    fn absent_wheels_are_never_used() {
-        let mut v = Vehicle::paper_car();
-        v.wheels_present = [true, false, true, false];
-        let x0 = State::from([0.0, 0.0, 0.0, 10.0, 0.0]);
-        let mut f =
-            CarFilter::new(&v, &Params::nominal(&v), None, 0.0, x0, Mat::identity()).unwrap();
-        f.predict_to(0.02);
-        assert!(f.update_wheel_speed(1, 10.0).unwrap().is_none());
-        assert!(f.update_wheel_ticks(3, 5.0, 0.02).unwrap().is_none());
-        assert!(f.update_wheel_speed(0, 10.0).unwrap().is_some());
-    }
-
-    fn augmented() -> AugmentedFilter {
-        let v = Vehicle::paper_car();
-        let sd = Params {
-            gyro_bias_rps: 0.01,
-            speed_scale: 0.05,
-            circumference_fl_m: 0.01,
-            circumference_fr_m: 0.01,
-            circumference_rl_m: 0.01,
-            circumference_rr_m: 0.01,
-        };
-        let x0 = State::from([0.0, 0.0, 0.3, 10.0, 0.05]);
-        let p0 = Mat::from_diagonal(&State::from([1.0, 1.0, 0.01, 1.0, 0.01]));
-        AugmentedFilter::new(&v, &Params::nominal(&v), Some(&sd), 0.0, x0, p0).unwrap()
-    }
-
-    fn epoch(f: &mut AugmentedFilter, k: usize) {
-        for (i, z) in [5.0, 6.0, 5.0, 4.0].into_iter().enumerate() {
-            f.update_wheel_ticks(i, z + (k % 3) as f64, 0.02).unwrap();
-        }
-        f.update_gyro(0.05 + 1e-3 * k as f64).unwrap();
-        f.update_speed(10.1).unwrap();
-        f.update_steering(0.2).unwrap();
-        if k.is_multiple_of(10) {
-            let fix = GnssFix {
-                t_s: f.time_s(),
-                east_m: 0.2 * k as f64,
-                north_m: 0.05,
-                std_m: 0.5,
-                course_deg: None,
-                speed_mps: None,
-            };
-            f.update_gnss(&fix).unwrap();
-        }
-    }
-
-    #[test]
-    fn scalar_updates_keep_the_covariance_exactly_symmetric() {
-        let mut a = augmented();
-        for k in 1..200 {
-            a.predict_to(0.02 * k as f64);
-            epoch(&mut a, k);
-            let p = a.covariance();
-            assert_eq!(*p, p.transpose(), "epoch {k}");
-        }
-    }
-
-    #[test]
-    fn the_augmented_layout_holds_the_parameters() {
-        let v = Vehicle::paper_car();
-        let p = Params::nominal(&v);
-        let sd = Params {
-            gyro_bias_rps: 0.01,
-            speed_scale: 0.05,
-            circumference_fl_m: 0.01,
-            circumference_fr_m: 0.01,
-            circumference_rl_m: 0.01,
-            circumference_rr_m: 0.01,
-        };
-        let x0 = State::from([0.0, 0.0, 0.0, 10.0, 0.0]);
-        let f = AugmentedFilter::new(&v, &p, Some(&sd), 0.0, x0, Mat::identity()).unwrap();
-        let got = f.params_std().unwrap();
-        assert!((got.circumference_fl_m - 0.01).abs() < 1e-12);
-        assert!((f.params().circumference_rr_m - p.circumference_rr_m).abs() < 1e-12);
-        assert!(AugmentedFilter::new(&v, &p, None, 0.0, x0, Mat::identity()).is_err());
-        assert!(filter().params_std().is_none());
     }
 }

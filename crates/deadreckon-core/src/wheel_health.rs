@@ -43,29 +43,8 @@ use std::collections::VecDeque;
 
 use serde::{Deserialize, Serialize};
 
-use crate::drive::Drive;
-use crate::ekf::{self, FilterOptions};
 use crate::filter::{Filter, Layout};
 use crate::model::V;
-use crate::vehicle::Params;
-use crate::Error;
-
-/// The monitor's report of one run of the 5-state filter over `drive` with
-/// `params` and `opts` (the monitor's settings from `opts.wheel_monitor`, the
-/// defaults when it has none).
-pub fn check_drive(
-    drive: &Drive,
-    params: &Params,
-    opts: &FilterOptions,
-) -> Result<WheelHealth, Error> {
-    let opts = FilterOptions {
-        wheel_monitor: Some(opts.wheel_monitor.unwrap_or_default()),
-        record_epochs: false,
-        ..opts.clone()
-    };
-    let out = ekf::run(drive, params, &opts, &mut ())?;
-    Ok(out.wheel_health.unwrap_or_default())
-}
 
 /// Settings of the wheel-health monitor (the defaults are what the tests and
 /// the built-in drives were checked with; see each field).

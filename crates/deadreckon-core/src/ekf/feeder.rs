@@ -1,0 +1,646 @@
+//! The [`Feeder`]: time-ordered events into a step [`Filter`] in one of
+//! the two timing schemes, causally (see the module documentation of
+//! [`crate::ekf`]).
+
+use nalgebra::{SMatrix, SVector};
+use serde::{Deserialize, Serialize};
+
+use super::{FilterOptions, FilterStats, SensorSet, Timing, WheelRows};
+use crate::drive::GnssFix;
+use crate::event::{Event, Measurement};
+use crate::filter::{Filter, Layout, Prediction, SensorKind, Update};
+use crate::gyro_hold::GyroHold;
+use crate::model::Mat;
+use crate::tick_interval::CountingInterval;
+use crate::wheel_health::{WheelHealth, WheelMonitor, WheelReading};
+use crate::Error;
+
+/// Wheel intervals longer than this many times the median interval are gaps:
+/// the row is skipped (a tick count over a gap cannot be predicted from the
+/// speed at its end).
+const GAP_FACTOR: f64 = 5.0;
+/// The median wheel interval is taken over the first this many intervals (then
+/// kept), so the gap rule is causal.
+const GAP_MEDIAN_OF: usize = 64;
+/// No gap is declared before this many intervals have been seen.
+const GAP_MIN_INTERVALS: usize = 3;
+
+/// Feeds time-ordered events to a [`Filter`] in one of the two timing schemes,
+/// causally: an epoch is run once every event with its timestamp has arrived
+/// (a later event, or [`Feeder::finish`]). Serialisable with the filter, so a
+/// stream can stop and resume.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Feeder {
+    timing: Timing,
+    sensors: SensorSet,
+    outages: Vec<(f64, f64)>,
+    start_s: f64,
+    end_s: Option<f64>,
+    /// Time of the last wheel row (the start of the next wheel interval).
+    last_wheel_s: Option<f64>,
+    /// The first wheel intervals, for the gap rule.
+    intervals: Vec<f64>,
+    max_interval_s: Option<f64>,
+    /// The interval a wheel row's tick count covers ([`crate::tick_interval`]).
+    #[serde(default)]
+    counting: CountingInterval,
+    /// Events sharing the newest timestamp, not yet processed.
+    batch: Vec<Event>,
+    /// The paper's scheme: newest unused reading of each other sensor.
+    pending_gyro: Option<f64>,
+    pending_speed: Option<f64>,
+    pending_steering: Option<f64>,
+    pending_gnss: Option<GnssFix>,
+    /// The gyro's latest reading, live for a while ([`crate::gyro_hold`]).
+    #[serde(default)]
+    gyro: GyroHold,
+    stats: FilterStats,
+    #[serde(skip)]
+    updates: Vec<Update>,
+    /// The time of the GNSS fix the gate rejected at this event, if any.
+    #[serde(skip)]
+    gated_fix_t_s: Option<f64>,
+    /// Whether epochs carry their prediction (a copy of the predicted state and
+    /// covariance, which a run that records no epochs does without).
+    #[serde(default = "yes")]
+    predictions: bool,
+    /// The wheel-health monitor, when asked for.
+    #[serde(default)]
+    monitor: Option<WheelMonitor>,
+    /// When a wheel row is used (a feeder saved before this was chosen
+    /// goes on as it began: [`WheelRows::Instant`]).
+    #[serde(default = "instant")]
+    wheel_rows: WheelRows,
+    /// [`WheelRows::Interval`]: the epoch run but not yet handed out, waiting
+    /// for the next wheel row's update at its time.
+    #[serde(default)]
+    held: Option<HeldEpoch>,
+}
+
+/// An epoch waiting for the next wheel row ([`WheelRows::Interval`]): its
+/// prediction (when the feeder keeps predictions), flattened so the feeder
+/// stays independent of the state's size.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+struct HeldEpoch {
+    /// x̂_{k|k-1}, then P_{k|k-1} column by column, then the car block of F
+    /// column by column; empty without a prediction.
+    prediction: Vec<f64>,
+}
+
+impl HeldEpoch {
+    fn new<const N: usize>(prediction: Option<&Prediction<N>>) -> Self {
+        let mut v = Vec::new();
+        if let Some(p) = prediction {
+            v.reserve(N + N * N + 25);
+            v.extend_from_slice(p.x.as_slice());
+            v.extend_from_slice(p.p.as_slice());
+            v.extend_from_slice(p.f.as_slice());
+        }
+        HeldEpoch { prediction: v }
+    }
+
+    fn prediction<const N: usize>(&self) -> Option<Prediction<N>> {
+        let v = &self.prediction;
+        if v.len() != N + N * N + 25 {
+            return None;
+        }
+        Some(Prediction {
+            x: SVector::from_column_slice(&v[..N]),
+            p: SMatrix::from_column_slice(&v[N..N + N * N]),
+            f: Mat::from_column_slice(&v[N + N * N..]),
+        })
+    }
+}
+
+fn instant() -> WheelRows {
+    WheelRows::Instant
+}
+
+fn yes() -> bool {
+    true
+}
+
+/// What one epoch did: the prediction and the updates.
+pub struct EpochOut<'a, const N: usize> {
+    /// The prediction to the epoch's time (`None` unless the feeder keeps
+    /// predictions: [`Feeder::keep_predictions`]).
+    pub prediction: Option<&'a Prediction<N>>,
+    /// The updates applied (or rejected) at the epoch.
+    pub updates: &'a [Update],
+    /// The time of the GNSS fix the χ² gate rejected at this epoch (its own
+    /// time, which identifies it in the drive; the epoch may be later).
+    pub gated_fix_t_s: Option<f64>,
+}
+
+impl Feeder {
+    /// A feeder for a filter started at `start_s`: readings before it (and other
+    /// sensors' readings at it) are ignored; the first wheel row at or after it
+    /// opens the first wheel interval.
+    pub fn new(opts: &FilterOptions, start_s: f64) -> Self {
+        Feeder {
+            timing: opts.timing,
+            sensors: opts.sensors,
+            outages: opts.gnss_outages.clone(),
+            start_s,
+            end_s: opts.end_s,
+            last_wheel_s: None,
+            intervals: Vec::new(),
+            max_interval_s: None,
+            counting: CountingInterval::default(),
+            batch: Vec::new(),
+            pending_gyro: None,
+            pending_speed: None,
+            pending_steering: None,
+            pending_gnss: None,
+            gyro: GyroHold::default(),
+            stats: FilterStats::default(),
+            updates: Vec::new(),
+            gated_fix_t_s: None,
+            predictions: opts.record_epochs,
+            monitor: opts.wheel_monitor.map(WheelMonitor::new),
+            wheel_rows: opts.wheel_rows,
+            held: None,
+        }
+    }
+
+    /// Whether an epoch is run but not yet handed out ([`WheelRows::Interval`]),
+    /// and whether it carries its prediction.
+    pub fn holds_epoch(&self) -> Option<bool> {
+        self.held.as_ref().map(|h| !h.prediction.is_empty())
+    }
+
+    /// Hands out the held epoch, if any.
+    fn release<L: Layout<N>, const N: usize>(
+        &mut self,
+        f: &mut Filter<L, N>,
+        epoch: &mut dyn FnMut(&mut Filter<L, N>, EpochOut<'_, N>),
+    ) {
+        let Some(held) = self.held.take() else {
+            return;
+        };
+        let prediction = held.prediction::<N>();
+        self.stats.epochs += 1;
+        epoch(
+            f,
+            EpochOut {
+                prediction: prediction.as_ref(),
+                updates: &self.updates,
+                gated_fix_t_s: self.gated_fix_t_s,
+            },
+        );
+        self.updates.clear();
+        self.gated_fix_t_s = None;
+    }
+
+    /// Whether the epochs passed to the callback carry their prediction (by
+    /// default when `record_epochs` is set). Does not change the filtering.
+    pub fn keep_predictions(&mut self, keep: bool) {
+        self.predictions = keep;
+    }
+
+    fn predict<L: Layout<N>, const N: usize>(
+        &self,
+        f: &mut Filter<L, N>,
+        t: f64,
+    ) -> Option<Prediction<N>> {
+        if self.predictions {
+            Some(f.predict_to(t))
+        } else {
+            f.advance_to(t);
+            None
+        }
+    }
+
+    /// What the wheel-health monitor has seen (`None` without one).
+    pub fn wheel_health(&self) -> Option<WheelHealth> {
+        self.monitor.as_ref().map(WheelMonitor::report)
+    }
+
+    /// Hands the epoch's wheel readings to the monitor (after the epoch's
+    /// updates: it compares them with the updated state).
+    fn monitor_wheels<L: Layout<N>, const N: usize>(
+        &mut self,
+        f: &mut Filter<L, N>,
+        m: &Measurement,
+        interval_s: f64,
+    ) {
+        let Some(mon) = self.monitor.as_mut() else {
+            return;
+        };
+        let readings = match *m {
+            Measurement::WheelTicks { fl, fr, rl, rr } => [fl, fr, rl, rr].map(|z| {
+                Some(WheelReading::Ticks {
+                    ticks: z as f64,
+                    interval_s,
+                })
+            }),
+            Measurement::WheelSpeeds {
+                fl_mps,
+                fr_mps,
+                rl_mps,
+                rr_mps,
+            } => [fl_mps, fr_mps, rl_mps, rr_mps].map(|z| {
+                Some(WheelReading::Speed {
+                    speed_mps: z,
+                    interval_s,
+                })
+            }),
+            _ => return,
+        };
+        mon.check(f, readings);
+    }
+
+    /// From now on, feeds no GNSS (fixes nor courses; a fix waiting for the
+    /// next wheel epoch is dropped): how a clone of a GNSS-aided run
+    /// dead-reckons through an outage, keeping everything else it had learnt
+    /// (the wheel monitor's windows and verdicts, the wheel-interval rule,
+    /// the readings waiting for the next epoch).
+    pub fn dead_reckon(&mut self) {
+        self.sensors.gnss = false;
+        self.sensors.gnss_course = false;
+        self.pending_gnss = None;
+    }
+
+    /// Counters so far (the gate counters are the filter's: see [`Feeder::stats_with`]).
+    pub fn stats(&self) -> &FilterStats {
+        &self.stats
+    }
+
+    /// Counters so far, with the filter's gate counters folded in.
+    pub fn stats_with<L: Layout<N>, const N: usize>(&self, f: &Filter<L, N>) -> FilterStats {
+        let g = f.gates();
+        let mut st = self.stats;
+        st.gates = *g;
+        st.gyro_updates = g.accepted(SensorKind::Gyro) as usize;
+        st.speed_updates = g.accepted(SensorKind::Speed) as usize;
+        st.steering_updates = g.accepted(SensorKind::Steering) as usize;
+        st.gnss_updates = g.accepted(SensorKind::Gnss) as usize;
+        st.gnss_rejected = g.rejected(SensorKind::Gnss) as usize;
+        st.gnss_recoveries = g.recovered(SensorKind::Gnss) as usize;
+        st.course_updates = g.accepted(SensorKind::Course) as usize;
+        st
+    }
+
+    /// Takes one event (timestamps must not decrease); runs the epochs it
+    /// completes, calling `epoch` after each with the filter (which the caller
+    /// may change, e.g. reset) and what the epoch did.
+    #[inline(always)]
+    pub fn push<L: Layout<N>, const N: usize>(
+        &mut self,
+        f: &mut Filter<L, N>,
+        ev: Event,
+        epoch: &mut dyn FnMut(&mut Filter<L, N>, EpochOut<'_, N>),
+    ) -> Result<(), Error> {
+        if !ev.t_s.is_finite() {
+            return Err(Error::InvalidDrive(format!(
+                "event time {} is not finite",
+                ev.t_s
+            )));
+        }
+        if let Some(last) = self.batch.last() {
+            if ev.t_s < last.t_s {
+                return Err(Error::OutOfOrder {
+                    t_s: ev.t_s,
+                    previous_t_s: last.t_s,
+                });
+            }
+            if ev.t_s > last.t_s {
+                self.process_batch(f, epoch)?;
+            }
+        }
+        // Readings at or before the start are not used; the first wheel row at
+        // or after it opens the first interval.
+        let keep = if ev.is_wheel() {
+            ev.t_s >= self.start_s
+        } else {
+            ev.t_s > self.start_s
+        };
+        if keep {
+            self.batch.push(ev);
+        }
+        Ok(())
+    }
+
+    /// Runs what is still waiting (at the end of a stream).
+    pub fn finish<L: Layout<N>, const N: usize>(
+        &mut self,
+        f: &mut Filter<L, N>,
+        epoch: &mut dyn FnMut(&mut Filter<L, N>, EpochOut<'_, N>),
+    ) -> Result<(), Error> {
+        self.process_batch(f, epoch)?;
+        self.release(f, epoch);
+        // The epochs' scratch (not serialised): a feeder that has finished
+        // equals its saved and loaded copy.
+        self.updates.clear();
+        self.gated_fix_t_s = None;
+        Ok(())
+    }
+
+    fn hidden(&self, t: f64) -> bool {
+        crate::drive::in_windows(t, &self.outages)
+    }
+
+    fn process_batch<L: Layout<N>, const N: usize>(
+        &mut self,
+        f: &mut Filter<L, N>,
+        epoch: &mut dyn FnMut(&mut Filter<L, N>, EpochOut<'_, N>),
+    ) -> Result<(), Error> {
+        let mut batch = std::mem::take(&mut self.batch);
+        // Equal timestamps: the paper's scheme takes the other readings into the
+        // wheel epoch of the same time, so they go first; the per-measurement
+        // scheme runs wheels first.
+        if batch.len() > 1 {
+            match self.timing {
+                Timing::WheelEpochs => batch.sort_by_key(|e| (e.is_wheel(), e.rank())),
+                Timing::EachMeasurement => batch.sort_by_key(|e| e.rank()),
+            }
+        }
+        let result = batch.iter().try_for_each(|ev| self.event(f, *ev, epoch));
+        batch.clear();
+        self.batch = batch;
+        result
+    }
+
+    /// The wheel interval ending at `t`, and whether it is a gap: for tick
+    /// counts (`ticks`) the interval they cover ([`crate::tick_interval`]),
+    /// which for a regular counter with jittered stamps is its cycle; for
+    /// wheel speeds the stamps' (a speed is not a count over an interval).
+    fn wheel_interval(&mut self, t: f64, ticks: bool) -> Option<(f64, bool)> {
+        let prev = self.last_wheel_s.replace(t)?;
+        let interval = t - prev;
+        if self.max_interval_s.is_none() || self.intervals.len() < GAP_MEDIAN_OF {
+            self.intervals.push(interval);
+            if self.intervals.len() >= GAP_MIN_INTERVALS {
+                let mut d = self.intervals.clone();
+                let mid = d.len() / 2;
+                let med = *d.select_nth_unstable_by(mid, |a, b| a.total_cmp(b)).1;
+                self.max_interval_s = Some(GAP_FACTOR * med);
+            }
+        }
+        let gap = self.max_interval_s.is_some_and(|m| interval > m);
+        if gap || !ticks {
+            return Some((interval, gap));
+        }
+        Some((self.counting.push(interval), false))
+    }
+
+    fn wheel_updates<L: Layout<N>, const N: usize>(
+        &mut self,
+        f: &mut Filter<L, N>,
+        m: &Measurement,
+        interval: f64,
+    ) -> Result<(), Error> {
+        self.stats.wheel_updates += 1;
+        match *m {
+            Measurement::WheelTicks { fl, fr, rl, rr } => {
+                for (i, z) in [fl, fr, rl, rr].into_iter().enumerate() {
+                    if let Some(u) = f.update_wheel_ticks(i, z as f64, interval)? {
+                        self.updates.push(u);
+                    }
+                }
+            }
+            Measurement::WheelSpeeds {
+                fl_mps,
+                fr_mps,
+                rl_mps,
+                rr_mps,
+            } => {
+                for (i, z) in [fl_mps, fr_mps, rl_mps, rr_mps].into_iter().enumerate() {
+                    if let Some(u) = f.update_wheel_speed(i, z)? {
+                        self.updates.push(u);
+                    }
+                }
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+
+    fn gnss_update<L: Layout<N>, const N: usize>(
+        &mut self,
+        f: &mut Filter<L, N>,
+        fix: &GnssFix,
+    ) -> Result<(), Error> {
+        let u = f.update_gnss(fix)?;
+        self.updates.push(u);
+        if !u.accepted {
+            self.gated_fix_t_s = Some(fix.t_s);
+        }
+        if u.accepted && self.sensors.gnss_course {
+            if let Some(course) = fix.course_yaw_rad() {
+                if let Some(u) = f.update_course(course, fix.speed_mps)? {
+                    self.updates.push(u);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn event<L: Layout<N>, const N: usize>(
+        &mut self,
+        f: &mut Filter<L, N>,
+        ev: Event,
+        epoch: &mut dyn FnMut(&mut Filter<L, N>, EpochOut<'_, N>),
+    ) -> Result<(), Error> {
+        let t = ev.t_s;
+        if self.end_s.is_some_and(|e| t > e) {
+            return Ok(());
+        }
+        let use_ = self.sensors;
+        // A held epoch keeps its updates until it is handed out.
+        if self.held.is_none() {
+            self.updates.clear();
+            self.gated_fix_t_s = None;
+        }
+        let supersede = |slot: &mut Option<f64>, v: f64, n: &mut usize| {
+            if slot.replace(v).is_some() {
+                *n += 1;
+            }
+        };
+        match self.timing {
+            Timing::WheelEpochs => match ev.measurement {
+                Measurement::YawRate { yaw_rate_rps } if use_.gyro => {
+                    supersede(
+                        &mut self.pending_gyro,
+                        yaw_rate_rps,
+                        &mut self.stats.readings_superseded,
+                    );
+                    self.gyro.push(t, yaw_rate_rps);
+                }
+                Measurement::Speed { speed_mps } if use_.speed => supersede(
+                    &mut self.pending_speed,
+                    speed_mps,
+                    &mut self.stats.readings_superseded,
+                ),
+                Measurement::Steering { steering_wheel_rad } if use_.steering => supersede(
+                    &mut self.pending_steering,
+                    steering_wheel_rad,
+                    &mut self.stats.readings_superseded,
+                ),
+                Measurement::Gnss { .. } if use_.gnss => {
+                    if self.hidden(t) {
+                        self.stats.gnss_hidden += 1;
+                    } else {
+                        self.pending_gnss = ev.gnss_fix();
+                    }
+                }
+                Measurement::WheelTicks { .. } | Measurement::WheelSpeeds { .. } => {
+                    let ticks = matches!(ev.measurement, Measurement::WheelTicks { .. });
+                    let Some((interval, gap)) = self.wheel_interval(t, ticks) else {
+                        return Ok(());
+                    };
+                    let at_start = self.wheel_rows == WheelRows::Interval;
+                    if at_start {
+                        // The row describes the interval that ends now: it
+                        // updates the state at the interval's start, which
+                        // the step below carries over the interval; the
+                        // epoch there is then complete.
+                        if use_.wheels {
+                            if gap {
+                                self.stats.wheel_gaps += 1;
+                            } else {
+                                self.wheel_updates(f, &ev.measurement, interval)?;
+                                self.monitor_wheels(f, &ev.measurement, interval);
+                            }
+                        }
+                        self.release(f, epoch);
+                    }
+                    let prediction = self.predict(f, t);
+                    if use_.wheels && !at_start {
+                        if gap {
+                            self.stats.wheel_gaps += 1;
+                        } else {
+                            self.wheel_updates(f, &ev.measurement, interval)?;
+                        }
+                    }
+                    let fresh_gyro = self.pending_gyro.is_some();
+                    if let Some(v) = self.pending_gyro.take() {
+                        self.updates.push(f.update_gyro(v)?);
+                    }
+                    if let Some(v) = self.pending_speed.take() {
+                        self.updates.push(f.update_speed(v)?);
+                    }
+                    // While the gyro is live, the steering waits for an
+                    // epoch with a gyro reading of its own (crate::gyro_hold).
+                    if fresh_gyro || !(use_.gyro && self.gyro.is_live(t)) {
+                        if let Some(v) = self.pending_steering.take() {
+                            self.updates.push(f.update_steering(v)?);
+                        }
+                    } else if self.pending_steering.is_some() {
+                        self.stats.steering_deferred += 1;
+                    }
+                    if let Some(fix) = self.pending_gnss.take() {
+                        self.gnss_update(f, &fix)?;
+                    }
+                    if at_start {
+                        self.held = Some(HeldEpoch::new(prediction.as_ref()));
+                        return Ok(());
+                    }
+                    if use_.wheels && !gap {
+                        self.monitor_wheels(f, &ev.measurement, interval);
+                    }
+                    self.stats.epochs += 1;
+                    epoch(
+                        f,
+                        EpochOut {
+                            prediction: prediction.as_ref(),
+                            updates: &self.updates,
+                            gated_fix_t_s: self.gated_fix_t_s,
+                        },
+                    );
+                }
+                _ => {}
+            },
+            Timing::EachMeasurement => {
+                let wheel = if ev.is_wheel() {
+                    // The first row after the start only opens an interval.
+                    let ticks = matches!(ev.measurement, Measurement::WheelTicks { .. });
+                    let Some(iv) = self.wheel_interval(t, ticks) else {
+                        return Ok(());
+                    };
+                    Some(iv)
+                } else {
+                    None
+                };
+                let used = match ev.measurement {
+                    Measurement::WheelTicks { .. } | Measurement::WheelSpeeds { .. } => use_.wheels,
+                    Measurement::YawRate { .. } => use_.gyro,
+                    Measurement::Speed { .. } => use_.speed,
+                    Measurement::Steering { .. } => use_.steering,
+                    // Online's input only (crate::live_corrections).
+                    Measurement::Gyro { .. } | Measurement::Accel { .. } => false,
+                    Measurement::Gnss { .. } => {
+                        if use_.gnss && self.hidden(t) {
+                            self.stats.gnss_hidden += 1;
+                            false
+                        } else {
+                            use_.gnss
+                        }
+                    }
+                };
+                if !used {
+                    return Ok(());
+                }
+                if let Measurement::Steering { steering_wheel_rad } = ev.measurement {
+                    if use_.gyro && self.gyro.is_live(t) {
+                        // Waits for the next gyro reading (a newer steering
+                        // reading supersedes it).
+                        if self.pending_steering.replace(steering_wheel_rad).is_some() {
+                            self.stats.readings_superseded += 1;
+                        }
+                        self.stats.steering_deferred += 1;
+                        return Ok(());
+                    }
+                    // The gyro has stopped: the steering stands in, and a
+                    // reading still waiting is superseded by this one.
+                    if self.pending_steering.take().is_some() {
+                        self.stats.readings_superseded += 1;
+                    }
+                }
+                let prediction = self.predict(f, t);
+                match ev.measurement {
+                    Measurement::WheelTicks { .. } | Measurement::WheelSpeeds { .. } => {
+                        if let Some((interval, gap)) = wheel {
+                            if gap {
+                                self.stats.wheel_gaps += 1;
+                            } else {
+                                self.wheel_updates(f, &ev.measurement, interval)?;
+                                self.monitor_wheels(f, &ev.measurement, interval);
+                            }
+                        }
+                    }
+                    Measurement::YawRate { yaw_rate_rps } => {
+                        self.gyro.push(t, yaw_rate_rps);
+                        self.updates.push(f.update_gyro(yaw_rate_rps)?);
+                        if let Some(v) = self.pending_steering.take() {
+                            self.updates.push(f.update_steering(v)?);
+                        }
+                    }
+                    Measurement::Speed { speed_mps } => {
+                        self.updates.push(f.update_speed(speed_mps)?)
+                    }
+                    Measurement::Steering { steering_wheel_rad } => {
+                        self.updates.push(f.update_steering(steering_wheel_rad)?)
+                    }
+                    Measurement::Gnss { .. } => {
+                        if let Some(fix) = ev.gnss_fix() {
+                            self.gnss_update(f, &fix)?;
+                        }
+                    }
+                    // Not `used` (above).
+                    Measurement::Gyro { .. } | Measurement::Accel { .. } => {}
+                }
+                self.stats.epochs += 1;
+                epoch(
+                    f,
+                    EpochOut {
+                        prediction: prediction.as_ref(),
+                        updates: &self.updates,
+                        gated_fix_t_s: self.gated_fix_t_s,
+                    },
+                );
+            }
+        }
+        Ok(())
+    }
+}
