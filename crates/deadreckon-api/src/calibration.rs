@@ -143,17 +143,22 @@ pub fn calibrate_corrected(
 ) -> Result<(CarCalibration, Option<Drive>), Error> {
     let options = &request.options;
     // Without corrections the drive is calibrated as it is, not a copy.
-    let (corrected, corrections) = if request.corrections == Which::None {
-        (None, Corrections::none())
+    let (corrected, corrections, calibrated) = if request.corrections == Which::None {
+        (None, Corrections::none(), None)
     } else {
-        let (d, c) = crate::corrections::estimate_and_apply(drive, options, request.corrections)?;
-        (Some(d), c)
+        let (d, c, cal) =
+            crate::corrections::estimate_and_apply_calibrated(drive, options, request.corrections)?;
+        (Some(d), c, cal)
     };
     let drive = corrected.as_ref().unwrap_or(drive);
-    let calibration = calibrate::calibrate(drive, options).map_err(|source| Error::Step {
-        step: format!("calibrating {name}"),
-        source,
-    })?;
+    // The choice of corrections may have calibrated this drive already.
+    let calibration = match calibrated {
+        Some(c) => c,
+        None => calibrate::calibrate(drive, options).map_err(|source| Error::Step {
+            step: format!("calibrating {name}"),
+            source,
+        })?,
+    };
     let steering = crate::json::car_steering(drive, options.method, options.min_speed_mps)
         .map_err(|source| Error::Step {
             step: "calibrating the steering".into(),

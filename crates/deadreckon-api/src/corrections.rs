@@ -360,9 +360,32 @@ pub fn estimate_and_apply(
     copts: &deadreckon_core::calibrate::CalibrationOptions,
     which: timing::Which,
 ) -> Result<(Drive, Corrections), crate::Error> {
-    deadreckon_core::held_back::prepare(drive, copts, &timing::DelayOptions::default(), which)
-        .map_err(|source| crate::Error::Calibration {
-            what: "estimating the streams' delays and the IMU tilt",
-            source,
-        })
+    estimate_and_apply_calibrated(drive, copts, which).map(|(d, c, _)| (d, c))
+}
+
+/// [`estimate_and_apply`], also returning the corrected drive's calibration
+/// with `copts` when choosing the corrections ran it already
+/// ([`deadreckon_core::held_back::prepare_calibrated`]).
+pub fn estimate_and_apply_calibrated(
+    drive: &Drive,
+    copts: &deadreckon_core::calibrate::CalibrationOptions,
+    which: timing::Which,
+) -> Result<
+    (
+        Drive,
+        Corrections,
+        Option<deadreckon_core::calibrate::Calibration>,
+    ),
+    crate::Error,
+> {
+    deadreckon_core::held_back::prepare_calibrated(
+        drive,
+        copts,
+        &timing::DelayOptions::default(),
+        which,
+    )
+    .map_err(|source| crate::Error::Calibration {
+        what: "estimating the streams' delays and the IMU tilt",
+        source,
+    })
 }

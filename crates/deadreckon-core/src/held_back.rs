@@ -236,8 +236,21 @@ pub fn prepare(
     o: &DelayOptions,
     which: Which,
 ) -> Result<(Drive, Corrections), Error> {
+    prepare_calibrated(drive, copts, o, which).map(|(d, c, _)| (d, c))
+}
+
+/// [`prepare`], also returning `calibrate::calibrate(&drive, copts)` of the
+/// drive it returns when the choice ran it already (with `auto`, the
+/// baseline's calibration when nothing but the GNSS delay was chosen): the
+/// caller need not calibrate the same drive twice. `None` when it did not.
+pub fn prepare_calibrated(
+    drive: &Drive,
+    copts: &CalibrationOptions,
+    o: &DelayOptions,
+    which: Which,
+) -> Result<(Drive, Corrections, Option<crate::calibrate::Calibration>), Error> {
     if which != Which::Auto {
-        return timing::prepare_with(drive, copts, o, which);
+        return timing::prepare_with(drive, copts, o, which).map(|(d, c)| (d, c, None));
     }
     let (_, mut corrections) = timing::prepare_with(drive, copts, o, Which::All)?;
     let windows = windows(drive);
@@ -390,7 +403,10 @@ pub fn prepare(
     let out = applied.apply(drive);
     corrections.model = applied.model;
     corrections.held_back = Some(held);
-    Ok((out, corrections))
+    // Nothing chosen beyond the baseline: `out` is the baseline's drive
+    // (the same known corrections), whose calibration is at hand.
+    let calibration = base_calibration.filter(|_| chosen == base);
+    Ok((out, corrections, calibration))
 }
 
 /// The estimated corrections at least `min_z` standard errors from none,
