@@ -60,19 +60,6 @@ impl Tedris {
             .sum()
     }
 
-    /// The model holds blocks that start before the history's first sample
-    /// (it was trained on another drive, or the history has rolled on):
-    /// blocks a rebuild from the history would lose.
-    pub(super) fn holds_older_blocks(&self) -> bool {
-        let (Some(m), Some((start, _))) = (self.model.as_ref(), self.history.span()) else {
-            return false;
-        };
-        m.repositories
-            .all_sorted()
-            .first()
-            .is_some_and(|t| t.seq < start)
-    }
-
     /// `max_lag_s` in wheel samples.
     pub(super) fn max_lag(&self) -> usize {
         (self.config.max_lag_s / self.sample_period()).round() as usize
@@ -235,12 +222,8 @@ impl Tedris {
     /// regressions are refitted on the repositories as they are.
     pub(super) fn refit(&mut self, t: f64) {
         self.last_refit_t = t;
-        if self.convention.is_none() && self.decide_convention() && !self.holds_older_blocks() {
-            // The history's headings changed: rebuild the blocks on them
-            // (not when the model holds blocks older than the history, as
-            // one trained on another drive does: a rebuild would throw them
-            // away for the few this history has; issue 35, tick car 4 went
-            // from 591 blocks to 35 and its outage to 49 m).
+        if self.convention.is_none() && self.decide_convention() {
+            // The history's headings changed: rebuild the blocks on them.
             let final_upto = self.pending_from.saturating_sub(1);
             let ccf = masked_ccf(&self.history, self.max_lag());
             if self.rebuild(t, final_upto, ccf) {
