@@ -1,7 +1,7 @@
 //! Physical acceptance of a fitted model (issue 35): a model whose turn does
 //! not look like a car's is refused instead of dead-reckoned with.
 //!
-//! Three checks, each against what the data or the physics say:
+//! Four checks, each against what the data or the physics say:
 //!
 //! - **Turn gain**: the heading the model gives per metre of right − left
 //!   wheel distance, times the rear track: `α1·track` for the paper,
@@ -27,6 +27,12 @@
 //!   (another vehicle's course, a wrong sign, a frozen gyro) only the
 //!   measured one. This refuses every kind.
 //!
+//! - **The speed kind's ω·d² term** not significantly different from 0
+//!   (t test at [`SPEED_TERM_TEST_LEVEL`]): without loaded tyres to model it
+//!   is the distance kind plus a term fitted to noise, which the held-back
+//!   choice then picked by chance (the smooth-speed family's cars 101–112:
+//!   1.37 m without the speed kind, 1.44 m with it).
+//!
 //! A chosen kind that is refused gives way to the baseline kind if that
 //! passes, else to another kind that passes; when every kind is refused the
 //! model is refused as a whole, with the failed checks and what the user
@@ -37,7 +43,9 @@ use serde::{Deserialize, Serialize};
 use crate::config::ModelKind;
 use crate::history::History;
 use crate::model::{KindFit, TedrisModel};
-use crate::tuning::{MAX_TURN_GAIN, MIN_CCF_SHARE, R_SQUARED_TEST_LEVEL, TURN_SIGNAL_WINDOW_S};
+use crate::tuning::{
+    MAX_TURN_GAIN, MIN_CCF_SHARE, R_SQUARED_TEST_LEVEL, SPEED_TERM_TEST_LEVEL, TURN_SIGNAL_WINDOW_S,
+};
 
 /// A kind the acceptance refused, and why.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -235,6 +243,16 @@ pub fn check(model: &TedrisModel, track_m: f64, expected_ccf_peak: Option<f64>) 
                     "R² {r2:.3} of {} blocks is not significantly above 0 (needs {min_r2:.3})",
                     f.global.n
                 ));
+            }
+            if f.kind == ModelKind::Speed {
+                if let Some(c) = f.global.coefficients.iter().find(|c| c.name == "omega_speed") {
+                    if c.p_value.is_nan() || c.p_value >= SPEED_TERM_TEST_LEVEL {
+                        why.push(format!(
+                            "its speed term ω·d² is not significantly different from 0 (t = {:.2}, p = {:.3} ≥ {SPEED_TERM_TEST_LEVEL}): the distance kind without a term fitted to noise",
+                            c.t_value, c.p_value
+                        ));
+                    }
+                }
             }
             if let Some(c) = &ccf_failed {
                 why.push(c.clone());

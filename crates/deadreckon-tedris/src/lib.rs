@@ -136,10 +136,13 @@
 //!   chosen so that the quantisation leaves at most 1 % attenuation; the
 //!   choice and why are in the model ([`TedrisModel::blocks`]) and printed
 //!   by `tedris train`. The speed kind ([`config::ModelKind::Speed`])
-//!   follows the loaded outer tyres' smaller radius in turns.
+//!   follows the loaded outer tyres' smaller radius in turns; its
+//!   errors-in-variables fit takes off the noise covariance of its ω·d²
+//!   column with ω's ([`stats::ols_eiv_sum`]).
 //! - **Physical acceptance** ([`acceptance`]): a kind whose turn gain
 //!   (α1·track, or its equivalent) is outside [0.75, 1.33], whose block R²
-//!   is not significantly above 0, or a cross-correlation peak far below what the data's
+//!   is not significantly above 0, the speed kind whose ω·d² term is not
+//!   significant, or a cross-correlation peak far below what the data's
 //!   turning should give, is refused with the failed check and what to do;
 //!   the baseline kind stands in if it passes. docs/tedris.md, "Wheel-tick
 //!   counters and physical acceptance", has the measurements.

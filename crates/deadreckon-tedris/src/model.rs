@@ -18,7 +18,7 @@ use crate::repository::{Repositories, StraightLine, Tuple};
 use crate::residuals::{
     box_pierce, ljung_box, select_correction, Correction, CorrectionFit, Portmanteau,
 };
-use crate::stats::{mean, ols, ols_eiv, OlsFit};
+use crate::stats::{mean, ols, ols_eiv_sum, OlsFit};
 use crate::Error;
 
 /// The design row of a tuple for a kind (`None` when ARX lacks the previous block).
@@ -33,6 +33,51 @@ pub fn design_row(kind: ModelKind, t: &Tuple) -> Option<Vec<f64>> {
         ModelKind::Baseline => vec![t.omega_m, t.dist_m],
         ModelKind::Speed => vec![1.0, t.omega_m, t.dist_m, t.omega_m * t.dist_m * t.dist_m],
     })
+}
+
+/// How a design row moves with the noise of the block's ω (∂row/∂ω) and,
+/// independently, of the previous block's ω (ARX), `None` for the latter
+/// when the kind has no such column.
+fn omega_jacobians(kind: ModelKind, t: &Tuple) -> (Vec<f64>, Option<Vec<f64>>) {
+    match kind {
+        ModelKind::Paper => (vec![0.0, 1.0], None),
+        ModelKind::Distance => (vec![0.0, 1.0, 0.0], None),
+        ModelKind::Arx => (
+            vec![0.0, 1.0, 0.0, 0.0, 0.0],
+            Some(vec![0.0, 0.0, 0.0, 1.0, 0.0]),
+        ),
+        ModelKind::Baseline => (vec![1.0, 0.0], None),
+        // ω·d²: ω's noise times d² (d is far less noisy than ω), correlated
+        // with the ω column's.
+        ModelKind::Speed => (vec![0.0, 1.0, 0.0, t.dist_m * t.dist_m], None),
+    }
+}
+
+/// The sum over the rows of `kind`'s design of the covariance of their
+/// errors from ω's noise of variance `omega_noise_var` (m²): what the
+/// errors-in-variables fit ([`ols_eiv_sum`]) takes off `XᵀX`. Only rows
+/// [`design_row`] gives (ARX needs the previous block).
+pub fn omega_noise_sum(kind: ModelKind, tuples: &[Tuple], omega_noise_var: f64) -> Vec<Vec<f64>> {
+    let p = kind.regressors().len();
+    let mut sum = vec![vec![0.0; p]; p];
+    if !(omega_noise_var.is_finite() && omega_noise_var > 0.0) {
+        return sum;
+    }
+    for t in tuples.iter().filter(|t| design_row(kind, t).is_some()) {
+        let (g, g_prev) = omega_jacobians(kind, t);
+        for g in std::iter::once(&g).chain(g_prev.as_ref()) {
+            for (i, gi) in g.iter().enumerate() {
+                for (j, gj) in g.iter().enumerate() {
+                    sum[i][j] += gi * gj;
+                }
+            }
+        }
+    }
+    // Times the variance last: n·σ² exactly for a column that is ω itself.
+    for v in sum.iter_mut().flatten() {
+        *v *= omega_noise_var;
+    }
+    sum
 }
 
 /// The fit of one model kind: global regression, residual tests, correction and
@@ -108,21 +153,8 @@ pub fn fit_kind(
         .collect();
     let (x, y): (Vec<Vec<f64>>, Vec<f64>) = rows.into_iter().unzip();
     let names = kind.regressors();
-    // ω·d²'s noise is ω's times d⁴ (d is far less noisy than ω).
-    let d4 = if x.is_empty() {
-        0.0
-    } else {
-        tuples.iter().map(|t| t.dist_m.powi(4)).sum::<f64>() / tuples.len() as f64
-    };
-    let noise: Vec<f64> = names
-        .iter()
-        .map(|n| match *n {
-            "alpha1" | "omega_prev" => omega_noise_var,
-            "omega_speed" => omega_noise_var * d4,
-            _ => 0.0,
-        })
-        .collect();
-    let global = ols_eiv(&x, &y, names, &noise)?;
+    let noise = omega_noise_sum(kind, tuples, omega_noise_var);
+    let global = ols_eiv_sum(&x, &y, names, &noise)?;
     let e = global.residuals(&x, &y);
     let lags = cfg.portmanteau_lags.min(e.len() / 4).max(1);
     let bp = box_pierce(&e, lags, 0);
@@ -164,7 +196,9 @@ pub fn fit_kind(
                     continue;
                 }
                 let (rx, ry): (Vec<Vec<f64>>, Vec<f64>) = rows.into_iter().unzip();
-                match ols_eiv(&rx, &ry, names, &noise) {
+                let q: Vec<Tuple> = tq.iter().map(|t| **t).collect();
+                let noise = omega_noise_sum(kind, &q, omega_noise_var);
+                match ols_eiv_sum(&rx, &ry, names, &noise) {
                     Ok(f) => f.beta(),
                     Err(_) => continue,
                 }

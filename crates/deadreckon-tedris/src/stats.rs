@@ -87,6 +87,35 @@ pub fn ols_eiv(
     noise_var: &[f64],
 ) -> Result<OlsFit, Error> {
     let p = names.len();
+    let n = y.len() as f64;
+    let noise_sum: Vec<Vec<f64>> = (0..p)
+        .map(|i| {
+            (0..p)
+                .map(|j| match noise_var.get(i) {
+                    Some(v) if i == j && v.is_finite() && *v > 0.0 => n * v,
+                    _ => 0.0,
+                })
+                .collect()
+        })
+        .collect();
+    ols_eiv_sum(x, y, names, &noise_sum)
+}
+
+/// Least squares with errors in variables whose measurement noise differs
+/// by row and is correlated between columns: `noise_sum` is the sum over the
+/// rows of each row's noise covariance (p × p), and `XᵀX` is replaced by
+/// `XᵀX − noise_sum`. A column that is a product of a noisy regressor and an
+/// exact one (the speed kind's ω·d²) carries that regressor's noise times
+/// the exact factor, correlated with the regressor's own column: leaving the
+/// covariance out, as a diagonal [`ols_eiv`] must, over-corrects (issue 35,
+/// the speed kind on tick-counter car 9). With a zero matrix this is [`ols`].
+pub fn ols_eiv_sum(
+    x: &[Vec<f64>],
+    y: &[f64],
+    names: &[&str],
+    noise_sum: &[Vec<f64>],
+) -> Result<OlsFit, Error> {
+    let p = names.len();
     let n = y.len();
     if x.len() != n || x.iter().any(|r| r.len() != p) {
         return Err(Error::Regression(
@@ -113,9 +142,11 @@ pub fn ols_eiv(
             }
         }
     }
-    for (j, v) in noise_var.iter().enumerate().take(p) {
-        if v.is_finite() && *v > 0.0 {
-            xtx[j][j] -= n as f64 * v;
+    for (i, row) in noise_sum.iter().enumerate().take(p) {
+        for (j, v) in row.iter().enumerate().take(p) {
+            if v.is_finite() {
+                xtx[i][j] -= v;
+            }
         }
     }
     let inv = invert(&xtx)
@@ -504,6 +535,41 @@ mod tests {
             "{}",
             f.coefficients[1].estimate
         );
+    }
+
+    /// γ = 2·ω − 0.5·ω·d² with ω observed with noise ±0.5 (variance 0.25),
+    /// over the full factorial of ω = ±1, noise ±0.5, d² ∈ {1, 3}: the
+    /// product column's noise is ω's times d², correlated with ω's column.
+    /// The covariance taken off `XᵀX` whole gives the truth exactly; the
+    /// diagonal alone (what the speed kind had, issue 35) does not.
+    #[test]
+    fn a_product_column_needs_the_noise_covariance() {
+        let (mut x, mut y, mut sum) = (Vec::new(), Vec::new(), vec![vec![0.0; 2]; 2]);
+        let mut d4 = 0.0;
+        for &xt in &[1.0, -1.0] {
+            for &u in &[0.5, -0.5] {
+                for &d2 in &[1.0, 3.0] {
+                    let w: f64 = xt + u;
+                    x.push(vec![w, w * d2]);
+                    y.push(2.0 * xt - 0.5 * xt * d2);
+                    let g = [1.0, d2];
+                    for i in 0..2 {
+                        for j in 0..2 {
+                            sum[i][j] += 0.25 * g[i] * g[j];
+                        }
+                    }
+                    d4 += d2 * d2 / 8.0;
+                }
+            }
+        }
+        let names = ["alpha1", "omega_speed"];
+        let full = ols_eiv_sum(&x, &y, &names, &sum).unwrap().beta();
+        assert!(
+            (full[0] - 2.0).abs() < 1e-9 && (full[1] + 0.5).abs() < 1e-9,
+            "{full:?}"
+        );
+        let diag = ols_eiv(&x, &y, &names, &[0.25, 0.25 * d4]).unwrap().beta();
+        assert!((diag[1] + 0.5).abs() > 0.1, "{diag:?}");
     }
 
     #[test]

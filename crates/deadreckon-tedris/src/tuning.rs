@@ -186,6 +186,15 @@ pub const MAX_TURN_GAIN: f64 = 1.33;
 /// a model that beat the baseline; the Husky's fix-track reference 0.038
 /// with one turning the wrong way, which the turn gain refuses).
 pub const R_SQUARED_TEST_LEVEL: f64 = 0.01;
+/// Level of the t test that refuses the speed kind when its ω·d² term is
+/// not significantly different from 0 (`acceptance`, two-sided): the kind
+/// is then the distance kind plus a term fitted to noise, and the held-back
+/// choice picked it by chance. On the smooth-speed family's dev cars 1–12
+/// (no loaded radii) |t| was 0.05–0.19; on the tick family's dev cars 1–9
+/// (every dynamic effect) 3.5–10.4 on eight cars and 1.58 on one. With the
+/// speed kind a candidate everywhere the family's cars 101–112 went from
+/// 1.37 to 1.44 m (1.37 m with no speed kind).
+pub const SPEED_TERM_TEST_LEVEL: f64 = 0.01;
 /// Smallest share of the expected cross-correlation peak the measured one
 /// must reach (`acceptance::expected_ccf_peak`). On the tick family's dev
 /// cars 1–3 and 7–9 the measured peak was 0.71–1.7 times the expected one

@@ -16,10 +16,18 @@
 //! block length (`tuning::MAX_QUANTISATION_ATTENUATION`), the speed kind
 //! (found on car 3's [280, 360) outage drifting on a straight), the
 //! acceptance thresholds (`tuning::{MIN_TURN_GAIN, MAX_TURN_GAIN,
-//! R_SQUARED_TEST_LEVEL, MIN_CCF_SHARE}`). The held-out members, cars 101–108, were
-//! run once, at the end, with nothing changed after
-//! (`tick_family_held_out_members_80s_outages`, `#[ignore]`d: about a
-//! minute on two cores).
+//! R_SQUARED_TEST_LEVEL, MIN_CCF_SHARE}`). Dev cars 4–9
+//! (`TEDRIS_TICK_CARS`) saw the second stop's: the speed kind's
+//! errors-in-variables covariance (car 9), the run drive's course
+//! convention rebuilding a trained model (car 4: tried and withdrawn, see
+//! docs/tedris.md) and
+//! `tuning::SPEED_TERM_TEST_LEVEL` (with the smooth-speed family's dev cars
+//! 1–12). The held-out members, cars 101–108, were run once at the end of
+//! the first stop and once at the end of the second; cars 109–116 were
+//! drawn for the second stop and run once at its end, with nothing changed
+//! after (`tick_family_held_out_members_80s_outages`,
+//! `tick_family_new_held_out_members_80s_outages`, `#[ignore]`d: about a
+//! minute each on two cores).
 //!
 //! `cargo test --profile ci -p deadreckon-tedris --test tick_family -- --nocapture`
 
@@ -151,22 +159,24 @@ fn tick_family_dev_members_80s_outages() {
             .collect()
     });
     assert!(
-        cars.iter().all(|c| !(101..=108).contains(c)),
+        cars.iter().all(|c| !(101..=116).contains(c)),
         "held-out cars"
     );
     let (t, b, worst) = run_family(&cars);
-    // Measured on cars 1–3 (12 outages): TedriS 5.81 m mean (worst 19.0 m),
-    // block baseline 6.81 m (worst 24.2 m). Before issue 35: TedriS 74.0 m
-    // mean (α1·track 0.33–0.49: medians of quantised ticks). NOT the
-    // issue's target on more cars: over dev cars 1–9 (36 outages) TedriS
-    // 11.41 m (worst 150.5 m: car 9, [200, 280), where the baseline has
-    // 50.6 m) against the block baseline's 7.49 m; without the speed kind
-    // 10.41 m. The bounds below guard the fix (the turn gain, the blocks),
-    // not a win over the baseline.
+    // Measured on cars 1–3 (12 outages): TedriS 3.81 m mean (worst 7.66 m),
+    // block baseline 6.81 m (worst 24.2 m); 5.81 m (worst 19.0 m) before
+    // the speed kind's errors-in-variables fit took the noise covariance of
+    // its ω·d² column. Before issue 35: TedriS 74.0 m mean (α1·track
+    // 0.33–0.49: medians of quantised ticks). Over dev cars 1–9 (36
+    // outages): TedriS 7.28 m (worst 49.1 m: car 4, [120, 200), where the
+    // baseline has 30.1 m; car 9's [200, 280) 44.3 m against 50.6 m)
+    // against the block baseline's 7.49 m; before this stop 11.41 m
+    // (worst 150.5 m). TedriS is above the baseline on cars 1, 2, 4, 6, 7
+    // and below on 3, 5, 8, 9.
     eprintln!("cars {cars:?}: tedris {t:.2} m, block baseline {b:.2} m, worst {worst:.2} m");
     if cars == [1, 2, 3] {
-        assert!(t < 6.5, "TedriS mean {t} m");
-        assert!(worst < 25.0, "TedriS worst {worst} m");
+        assert!(t < 4.3, "TedriS mean {t} m");
+        assert!(worst < 9.0, "TedriS worst {worst} m");
         assert!(b > 6.0, "block baseline {b} m (measured 6.81 m)");
     }
 }
@@ -176,12 +186,24 @@ fn tick_family_dev_members_80s_outages() {
 fn tick_family_held_out_members_80s_outages() {
     let (t, b, worst) = run_family(&(101..=108).collect::<Vec<_>>());
     eprintln!("held out: tedris {t:.2} m, block baseline {b:.2} m, worst {worst:.2} m");
-    // Run once, at the end, nothing changed after (32 outages): TedriS
-    // 6.33 m mean (worst 43.0 m) against the block baseline's 7.56 m (worst
-    // 41.1 m); per car TedriS lower on 101, 102, 103, 108 (1.73–8.53 m
-    // against 2.66–14.50 m), higher on 104, 105, 106, 107 (5.31–13.63 m
-    // against 4.38–12.25 m). Every model accepted had a physical turn gain
-    // (0.889–0.967, checked per car in `run_car`).
+    // Run at the end of the second stop (32 outages): TedriS 4.14 m mean
+    // (worst 28.7 m) against the block baseline's 7.56 m (worst 41.1 m);
+    // lower on 7 of 8 cars (higher on 107: 4.91 m against 4.38 m). At the
+    // end of the first stop: 6.33 m (worst 43.0 m), lower on 4 of 8. Every
+    // model accepted had a physical turn gain (trained 0.890–0.970,
+    // checked per car in `run_car`, after the run too).
+    assert!(t <= b, "TedriS {t} m against the block baseline's {b} m");
+}
+
+#[test]
+#[ignore = "held-out members drawn for the second stop, about a minute on two cores; run once at the end"]
+fn tick_family_new_held_out_members_80s_outages() {
+    let (t, b, worst) = run_family(&(109..=116).collect::<Vec<_>>());
+    eprintln!("new held out: tedris {t:.2} m, block baseline {b:.2} m, worst {worst:.2} m");
+    // Run once, at the end of the second stop, nothing changed after (32
+    // outages): TedriS 6.26 m mean (worst 34.0 m) against the block
+    // baseline's 7.42 m (worst 33.3 m); lower on 6 of 8 cars (higher on
+    // 113: 5.35 m against 4.64 m, and 116: 9.99 m against 7.96 m).
     assert!(t <= b, "TedriS {t} m against the block baseline's {b} m");
 }
 
@@ -292,4 +314,68 @@ fn a_model_turning_a_tenth_of_the_wheels_turn_is_refused() {
         .refused
         .as_deref()
         .is_some_and(|r| r.contains("cross-correlation peak"))));
+}
+
+/// The speed kind's turn gain, `(α1 + α3·d²)·track`, at a distance per
+/// sample `d_m`.
+fn speed_kind_gain(model: &TedrisModel, track_m: f64, d_m: f64) -> f64 {
+    let f = model
+        .fits
+        .iter()
+        .find(|f| f.kind == ModelKind::Speed)
+        .expect("a speed kind fit");
+    let c = |n: &str| {
+        f.global
+            .coefficients
+            .iter()
+            .find(|c| c.name == n)
+            .expect("a coefficient")
+            .estimate
+    };
+    (c("alpha1") + c("omega_speed") * d_m * d_m) * track_m
+}
+
+/// Tick car 9 (40 teeth at 50 Hz) lost 150 m in its [200, 280) outage, at
+/// 9–11 m/s in long turns: the speed kind, chosen by the held-back
+/// calibration on the test drive, turned at 0.55 of the wheels' turn there.
+/// Its errors-in-variables fit took ω's noise off the ω·d² column's
+/// variance but not off its covariance with the ω column (the same noise
+/// times d²), and over-corrected the speed term: α1·track 1.085 at rest,
+/// 0.553 at 11 m/s. The wheels' turn over the true yaw rate on that drive
+/// is 1.00–1.05 at 1–6 m/s and 1.11–1.26 near 10 m/s (a gain of 0.79–0.90).
+#[test]
+fn the_speed_kind_over_corrected_the_turn_at_speed_tick_car_9() {
+    let car = DynamicCar::draw_tick_counter(9);
+    let track = car.base.vehicle.track_rear_m;
+    let drive = simulate(&car.drive(1009, 900.0, &Effects::all()), 1009)
+        .expect("train drive")
+        .drive;
+    let (model, _) = train(&drive, TedrisConfig::default(), None).expect("trained");
+    let per_sample = |v_mps: f64| v_mps / car.wheel_rate_hz;
+    let slow = speed_kind_gain(&model, track, per_sample(1.0));
+    let fast = speed_kind_gain(&model, track, per_sample(11.11));
+    eprintln!("speed kind's gain: {slow:.3} at 1 m/s, {fast:.3} at 11.1 m/s");
+    // Measured: 0.973 at 1 m/s, 0.878 at 11.1 m/s (before: 1.085, 0.553).
+    assert!((0.93..=1.01).contains(&slow), "{slow}");
+    assert!((0.84..=0.92).contains(&fast), "{fast}");
+}
+
+/// The speed kind on a car without loaded tyres (the smooth-speed family's
+/// car 1): its ω·d² term is noise (t = 0.08), and the held-back choice
+/// picked such kinds by chance (the family's cars 101–112: 1.44 m with the
+/// speed kind a candidate, 1.37 m without it). Refused, with why.
+#[test]
+fn the_speed_kind_without_loaded_tyres_is_refused() {
+    let car = deadreckon_sim::family::CarFamily::draw(1);
+    let drive = simulate(&car.drive(1001, 900.0), 1001)
+        .expect("train drive")
+        .drive;
+    let (model, _) = train(&drive, TedrisConfig::default(), None).expect("trained");
+    let r = model
+        .refused_kinds
+        .iter()
+        .find(|r| r.kind == ModelKind::Speed)
+        .expect("the speed kind refused");
+    assert!(r.reason.contains("speed term"), "{}", r.reason);
+    assert_ne!(model.chosen, ModelKind::Speed);
 }
