@@ -304,6 +304,13 @@ impl BoundFit {
         self.k * radius(cov)
     }
 
+    /// The 95 % bound of a position whose filter covariance is `cov`, over
+    /// a receiver's offset of covariance `floor` that the factor does not
+    /// inflate: `r(k² P + F)`, m.
+    pub fn floored_bound_m(&self, cov: &Cov2, floor: &Cov2) -> f64 {
+        radius(&cov.scaled_plus(self.k * self.k, floor))
+    }
+
     /// The 95 % bound of what is compared with a reference of covariance
     /// `reference` (a fix's own noise; zero for the truth), m.
     pub fn compared_bound_m(&self, cov: &Cov2, reference: &Cov2) -> f64 {
@@ -529,49 +536,69 @@ pub fn reach(ev: &crate::outage::OutageEvaluation, fit: &BoundFit, alert_m: f64)
     })
 }
 
-/// Each window's end of `ev` (the settled ones) as a [`Sample`].
+/// Each window's end of `ev` (the settled ones) as a [`Sample`]
+/// ([`crate::compared::OutageResult::final_sample`]).
 pub fn samples(ev: &crate::outage::OutageEvaluation) -> Vec<Sample> {
-    ev.windows
-        .iter()
-        .filter_map(|w| {
-            Some(Sample {
-                error_m: w.final_m(),
-                cov: *w.covariances_m2.last()?,
-                reference: *w.reference_m2.last()?,
-            })
-        })
-        .collect()
+    ev.windows.iter().filter_map(|w| w.final_sample()).collect()
 }
 
 impl crate::compared::OutageResult {
+    /// The receiver's floor at error `i` (zero when not recorded).
+    fn floor_at(&self, i: usize) -> Cov2 {
+        self.floor_m2.get(i).copied().unwrap_or(Cov2::circular(0.0))
+    }
+
     /// The 95 % bound at each error, m (empty when the estimator gave no
-    /// covariance).
+    /// covariance): [`BoundFit::floored_bound_m`] of the estimator's
+    /// covariance and the receiver's floor.
     pub fn bounds_95_m(&self, fit: &BoundFit) -> Vec<f64> {
-        self.covariances_m2.iter().map(|c| fit.bound_m(c)).collect()
+        self.covariances_m2
+            .iter()
+            .enumerate()
+            .map(|(i, c)| fit.floored_bound_m(c, &self.floor_at(i)))
+            .collect()
     }
 
     /// The 95 % bound at the window's end (the last error), m.
     pub fn bound_95_m(&self, fit: &BoundFit) -> Option<f64> {
-        self.covariances_m2.last().map(|c| fit.bound_m(c))
+        let i = self.covariances_m2.len().checked_sub(1)?;
+        Some(fit.floored_bound_m(&self.covariances_m2[i], &self.floor_at(i)))
     }
 
-    /// Whether the final error is within the bound of what was compared:
-    /// the position's bound, widened by the reference's own noise when the
-    /// reference is a fix ([`BoundFit::compared_bound_m`]).
+    /// The sample the final error makes for [`fit`] and the coverage: the
+    /// inflated part is the estimator's covariance `P`; the rest is what
+    /// the receiver adds. Against the truth that is the floor `F` (the
+    /// offset of the position handed over). Against a hidden fix it is
+    /// `2F + R`: the offset handed over and the hidden fix's own offset,
+    /// taken as independent, plus the fix's white noise `R` (the
+    /// reference's covariance). `None` without covariances.
+    pub fn final_sample(&self) -> Option<Sample> {
+        let i = self.covariances_m2.len().checked_sub(1)?;
+        let floor = self.floor_at(i);
+        let reference = match self.against {
+            crate::compared::Against::Gnss => floor.scaled_plus(2.0, self.reference_m2.get(i)?),
+            _ => floor,
+        };
+        Some(Sample {
+            error_m: self.final_m(),
+            cov: self.covariances_m2[i],
+            reference,
+        })
+    }
+
+    /// Whether the final error is within the bound of what was compared
+    /// (`r(k² P + R)`, `R` the reference part of [`Self::final_sample`]):
+    /// against the truth, the bound itself ([`Self::bound_95_m`]).
     pub fn within_bound(&self, fit: &BoundFit) -> Option<bool> {
-        let c = self.covariances_m2.last()?;
-        let r = self.reference_m2.last()?;
-        Some(self.final_m() <= fit.compared_bound_m(c, r))
+        let s = self.final_sample()?;
+        Some(s.error_m <= fit.compared_bound_m(&s.cov, &s.reference))
     }
 
     /// When the bound first reaches `alert_m`: time from the outage start,
     /// s, and distance travelled, m (`None` for the distance when not
     /// known); `None` when it never does in the window.
     pub fn bound_reaches(&self, fit: &BoundFit, alert_m: f64) -> Option<(f64, Option<f64>)> {
-        let i = self
-            .covariances_m2
-            .iter()
-            .position(|c| fit.bound_m(c) >= alert_m)?;
+        let i = self.bounds_95_m(fit).iter().position(|b| *b >= alert_m)?;
         Some((self.errors[i].0, self.travelled_m.get(i).copied()))
     }
 }
