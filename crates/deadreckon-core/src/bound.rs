@@ -19,28 +19,33 @@
 //! [`radius`] interpolates `g` from a table of 257 exact values (within
 //! 1e-6 relative). `2.45 √trace` would be 41 % too wide on a circle.
 //!
-//! **The covariance.** `P` is the filter's position covariance plus the
-//! declared variance of the last fix before the outage
-//! ([`receiver_std_m`]² per axis). The filter takes the fixes as white and
-//! averages their noise away, but a receiver's error is correlated over
-//! tens of seconds: the position it hands over is off by about its
-//! declared accuracy, which no held-back fix shows (the fixes carry the
-//! same offset). On the development cars 301–306 the bound without it
-//! covered 85 % of held-out windows (the misses: stops, where the filter's
-//! covariance stays small and the error is the receiver's offset).
+//! **The bound.** `r(k² P + F)`: `P` the filter's covariance of the
+//! position, inflated by the fitted factor `k`, and `F = σ² I` the
+//! receiver's floor, `σ` the declared accuracy of the last fix before
+//! the outage ([`receiver_std_m`]). The filter takes the fixes as white
+//! and averages their noise away, but a receiver's error is correlated
+//! over tens of seconds: the position it hands over is off by about its
+//! declared accuracy. `k` is not applied to `F`: no held-back fix can
+//! tell the offset (the fixes carry it), so nothing fitted on them may
+//! shrink it (a `k` of 0.15 on comma2k19 once did, and 5 of 7 windows
+//! fell outside).
 //!
 //! **The factor.** A filter's covariance is not its error (the family's
-//! pose NEES reads ×1.5–×250 over-confident, issue 36), so the bound is
-//! `k · r(P)`, the radius of the inflated covariance `k² P`. `k` is fitted
-//! by split conformal prediction on outage windows of the calibration
-//! drive against its own hidden fixes ([`fit`]): per window, the score is
-//! the least `k_i ≥ 0` with `|e_i| ≤ r(k_i² P_i + R_i)`, `R_i` the fix's
-//! own covariance (so the fix's noise is not charged to the dead
-//! reckoning); `k` is the `⌈0.95 (n + 1)⌉`-th smallest score, which covers
-//! a new exchangeable window with probability at least 95 % (the largest
-//! score when `n < 19`). Windows overlap and are not exchangeable with
-//! another drive's: the held-out coverage is measured, not assumed
-//! (`docs/bound.md`).
+//! pose NEES reads ×1.5–×250 over-confident, issue 36). `k` is fitted by
+//! split conformal prediction on outage windows of the calibration drive
+//! against its own hidden fixes ([`fit`]). Against a hidden fix the
+//! error is the dead reckoning's, plus the offset handed over, minus the
+//! hidden fix's own offset and white noise; the offsets are taken as
+//! independent (a window is about as long as a receiver's correlation
+//! time), so a window's score is the least `k_i ≥ 0` with
+//! `|e_i| ≤ r(k_i² P_i + 2F + R)`, `R` the fixes' white noise
+//! ([`fix_scatter_std_m`]) ([`crate::compared::OutageResult::final_sample`]).
+//! `k` is the `⌈0.95 (n + 1)⌉`-th smallest score, which covers a new
+//! exchangeable window with probability at least 95 % (the largest score
+//! when `n < 19`). `k = 0` says the receiver's declaration explains every
+//! window's error: the bound is then the floor. Windows overlap and are
+//! not exchangeable with another drive's: the held-out coverage is
+//! measured, not assumed (`docs/bound.md`).
 
 use std::sync::OnceLock;
 
@@ -274,12 +279,13 @@ impl std::fmt::Display for Method {
     }
 }
 
-/// The bound's inflation: `bound = k · r(P)`.
+/// The bound's inflation: `bound = r(k² P + F)` ([`BoundFit::floored_bound_m`]).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BoundFit {
     /// How `k` was found.
     pub method: Method,
-    /// The factor on the filter's 95 % radius.
+    /// The factor on the filter's covariance (`k² P`; with no floor, the
+    /// factor on its 95 % radius).
     pub k: f64,
     /// Windows it was fitted on (0 for [`Method::Filter`]).
     pub windows: usize,
@@ -299,7 +305,8 @@ impl BoundFit {
         step_s: 0.0,
     };
 
-    /// The 95 % bound of a position whose filter covariance is `cov`, m.
+    /// The 95 % bound of a position whose filter covariance is `cov` and
+    /// has no receiver's floor (the differential drive's), m: `k · r(P)`.
     pub fn bound_m(&self, cov: &Cov2) -> f64 {
         self.k * radius(cov)
     }
