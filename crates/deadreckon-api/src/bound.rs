@@ -188,14 +188,20 @@ pub fn outage_bound_lines(
 /// The bound in words: the method and its factor.
 pub fn fit_text(fit: &BoundFit) -> String {
     match fit.method {
-        Method::Conformal => format!(
-            "the filter's covariance inflated by k = {} (k² P) over the last fix's declared \
+        Method::Conformal => {
+            format!(
+                "the filter's covariance inflated by k = {} (k² P) over the last fix's declared \
              accuracy, fitted on {} windows of {:.1} s of the calibration drive against its hidden \
              fixes",
-            fmt_k(fit.k),
-            fit.windows,
-            fit.outage_s
-        ),
+                fmt_k(fit.k),
+                fit.windows,
+                fit.outage_s
+            ) + if fit.k == 0.0 {
+                " (the declared accuracy explains every window's error: the bound is that floor)"
+            } else {
+                ""
+            }
+        }
         Method::Filter => fit.method.to_string(),
     }
 }
