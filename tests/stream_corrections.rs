@@ -166,7 +166,7 @@ fn stream_disagreed_with_run_on_stored_delays() {
         let extra: toml::Table = toml::from_str(&stored).unwrap();
         let c = deadreckon_api::corrections::stored_corrections(&extra).unwrap();
         // The bound's factor the stream and run both apply: fitted, so the
-        // comparison below is of k · r(P + σ²I), not of k = 1.
+        // comparison below is of r(k²P + σ²I), not of k = 1.
         let fit = deadreckon_api::bound::bound_from_extra(&extra).unwrap();
         assert_eq!(
             fit.method,

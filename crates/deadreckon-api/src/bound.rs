@@ -5,7 +5,7 @@
 //! ```toml
 //! [bound]
 //! method = "conformal"   # or "filter": the filter's covariance alone
-//! k = 1.83               # the factor on the filter's 95 % radius
+//! k = 1.83               # the factor on the filter's covariance: bound = r(k² P + σ² I)
 //! windows = 57           # outage windows of the calibration drive it was fitted on
 //! outage_s = 30.0        # their length, s
 //! step_s = 10.0          # the step between them, s
@@ -188,13 +188,20 @@ pub fn outage_bound_lines(
 /// The bound in words: the method and its factor.
 pub fn fit_text(fit: &BoundFit) -> String {
     match fit.method {
-        Method::Conformal => format!(
-            "{} × the filter's 95 % radius, fitted on {} windows of {:.1} s of the calibration drive \
-             against its hidden fixes",
-            fmt_k(fit.k),
-            fit.windows,
-            fit.outage_s
-        ),
+        Method::Conformal => {
+            format!(
+                "the filter's covariance inflated by k = {} (k² P) over the last fix's declared \
+             accuracy, fitted on {} windows of {:.1} s of the calibration drive against its hidden \
+             fixes",
+                fmt_k(fit.k),
+                fit.windows,
+                fit.outage_s
+            ) + if fit.k == 0.0 {
+                " (the declared accuracy explains every window's error: the bound is that floor)"
+            } else {
+                ""
+            }
+        }
         Method::Filter => fit.method.to_string(),
     }
 }

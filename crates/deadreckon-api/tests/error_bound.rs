@@ -7,13 +7,27 @@
 //! window, is the final error within `bound_95_m`; per set, the coverage and
 //! the sharpness (median bound over median final error).
 //!
-//! Cars: development 301–306 (the method's choices were made on them, in
-//! CI); held-out 401–424 (not used for any choice, `#[ignore]`d):
+//! Cars: development 301–306 (in CI) and 501–540 (`#[ignore]`d): the
+//! method's choices were made on them (docs/bound.md); held-out 401–424
+//! (not used for any choice, `#[ignore]`d, run once per construction):
 //!
 //! ```text
 //! cargo test --profile ci -p deadreckon-api --test error_bound -- --nocapture
 //! cargo test --profile ci -p deadreckon-api --test error_bound -- --ignored --nocapture
 //! ```
+//!
+//! Measured with the bound `r(k² P + F)` and the fit's score
+//! `r(k² P + 2F + R)` (docs/bound.md), the issue's targets coverage
+//! 0.90–0.99 and sharpness at most 3:
+//!
+//! | cars | windows | within | coverage | sharpness |
+//! |---|---|---|---|---|
+//! | development 301–306 | 177 | 167 | 0.944 | 2.82 |
+//! | development 501–540 | 1383 | 1314 | 0.950 | 2.64 |
+//! | held-out 401–424 (run once) | 782 | 752 | 0.962 | 2.71 |
+//!
+//! The first construction, `k · r(P + F)`: 0.938 / 2.64, 0.967 / 3.06 and
+//! 0.976 / 3.37.
 
 use rayon::prelude::*;
 
@@ -113,24 +127,39 @@ fn measure(cars: &[u64], drive_s: f64) -> (f64, f64, usize) {
 #[test]
 fn the_bound_covers_95_percent_of_outages_on_development_cars() {
     let (coverage, sharpness, n) = measure(&(301..=306).collect::<Vec<_>>(), 300.0);
-    // Measured: 166 of 177 windows within (0.938), median bound / median
-    // final error 2.64 (k 0.52–1.79 per car, fitted on 29–53 windows). The
-    // filter's covariance alone, without the receiver's declared accuracy:
-    // 150 of 177 (0.847), 2.77.
+    // Measured: 167 of 177 windows within (0.944), median bound / median
+    // final error 2.82 (k 0–2.25 per car, fitted on 29–53 windows; k = 0
+    // on cars 303, 305, 306: the receiver's floor explains their fit
+    // windows). The filter's covariance alone, without the receiver's
+    // floor: 150 of 177 (0.847), 2.77.
     assert_eq!(n, 177);
-    assert!((0.92..=0.96).contains(&coverage), "{coverage}");
-    assert!((2.4..=2.9).contains(&sharpness), "{sharpness}");
+    assert!((0.92..=0.97).contains(&coverage), "{coverage}");
+    assert!((2.65..=3.0).contains(&sharpness), "{sharpness}");
+}
+
+#[test]
+#[ignore]
+fn the_bound_covers_95_percent_of_outages_on_development_cars_501_to_540() {
+    let (coverage, sharpness, n) = measure(&(501..=540).collect::<Vec<_>>(), 300.0);
+    // Measured: 1314 of 1383 windows within (0.950), sharpness 2.64: the
+    // second development set, on which the fit's score (2F + R, the
+    // offsets a window apart independent) was chosen over F + R (0.980,
+    // 2.88) and the first construction (0.967, 3.06).
+    assert_eq!(n, 1383);
+    assert!((0.93..=0.97).contains(&coverage), "{coverage}");
+    assert!((2.5..=2.8).contains(&sharpness), "{sharpness}");
 }
 
 #[test]
 #[ignore]
 fn the_bound_covers_95_percent_of_outages_on_held_out_cars_401_to_424() {
     let (coverage, sharpness, n) = measure(&(401..=424).collect::<Vec<_>>(), 300.0);
-    // Measured (run once, after every choice was made on cars 301–306):
-    // 763 of 782 windows within (0.976), median bound / median final error
-    // 3.37 (k 0.43–4.29 per car). The issue's coverage (90–99 %) is met;
-    // its sharpness (at most 3) is not: pinned here as measured.
+    // Measured (run once, after every choice was made on cars 301–306 and
+    // 501–540): 752 of 782 windows within (0.962), median bound / median
+    // final error 2.71 (k 0–23.4 per car; k = 0 on 6 of 24). The issue's
+    // coverage (90–99 %) and sharpness (at most 3) are both met. The
+    // first construction, k · r(P + F): 763 of 782 (0.976), 3.37.
     assert_eq!(n, 782);
-    assert!((0.95..=0.99).contains(&coverage), "{coverage}");
-    assert!((3.1..=3.6).contains(&sharpness), "{sharpness}");
+    assert!((0.94..=0.98).contains(&coverage), "{coverage}");
+    assert!((2.55..=2.85).contains(&sharpness), "{sharpness}");
 }

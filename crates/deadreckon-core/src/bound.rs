@@ -19,28 +19,33 @@
 //! [`radius`] interpolates `g` from a table of 257 exact values (within
 //! 1e-6 relative). `2.45 √trace` would be 41 % too wide on a circle.
 //!
-//! **The covariance.** `P` is the filter's position covariance plus the
-//! declared variance of the last fix before the outage
-//! ([`receiver_std_m`]² per axis). The filter takes the fixes as white and
-//! averages their noise away, but a receiver's error is correlated over
-//! tens of seconds: the position it hands over is off by about its
-//! declared accuracy, which no held-back fix shows (the fixes carry the
-//! same offset). On the development cars 301–306 the bound without it
-//! covered 85 % of held-out windows (the misses: stops, where the filter's
-//! covariance stays small and the error is the receiver's offset).
+//! **The bound.** `r(k² P + F)`: `P` the filter's covariance of the
+//! position, inflated by the fitted factor `k`, and `F = σ² I` the
+//! receiver's floor, `σ` the declared accuracy of the last fix before
+//! the outage ([`receiver_std_m`]). The filter takes the fixes as white
+//! and averages their noise away, but a receiver's error is correlated
+//! over tens of seconds: the position it hands over is off by about its
+//! declared accuracy. `k` is not applied to `F`: no held-back fix can
+//! tell the offset (the fixes carry it), so nothing fitted on them may
+//! shrink it (a `k` of 0.15 on comma2k19 once did, and 5 of 7 windows
+//! fell outside).
 //!
 //! **The factor.** A filter's covariance is not its error (the family's
-//! pose NEES reads ×1.5–×250 over-confident, issue 36), so the bound is
-//! `k · r(P)`, the radius of the inflated covariance `k² P`. `k` is fitted
-//! by split conformal prediction on outage windows of the calibration
-//! drive against its own hidden fixes ([`fit`]): per window, the score is
-//! the least `k_i ≥ 0` with `|e_i| ≤ r(k_i² P_i + R_i)`, `R_i` the fix's
-//! own covariance (so the fix's noise is not charged to the dead
-//! reckoning); `k` is the `⌈0.95 (n + 1)⌉`-th smallest score, which covers
-//! a new exchangeable window with probability at least 95 % (the largest
-//! score when `n < 19`). Windows overlap and are not exchangeable with
-//! another drive's: the held-out coverage is measured, not assumed
-//! (`docs/bound.md`).
+//! pose NEES reads ×1.5–×250 over-confident, issue 36). `k` is fitted by
+//! split conformal prediction on outage windows of the calibration drive
+//! against its own hidden fixes ([`fit`]). Against a hidden fix the
+//! error is the dead reckoning's, plus the offset handed over, minus the
+//! hidden fix's own offset and white noise; the offsets are taken as
+//! independent (a window is about as long as a receiver's correlation
+//! time), so a window's score is the least `k_i ≥ 0` with
+//! `|e_i| ≤ r(k_i² P_i + 2F + R)`, `R` the fixes' white noise
+//! ([`fix_scatter_std_m`]) ([`crate::compared::OutageResult::final_sample`]).
+//! `k` is the `⌈0.95 (n + 1)⌉`-th smallest score, which covers a new
+//! exchangeable window with probability at least 95 % (the largest score
+//! when `n < 19`). `k = 0` says the receiver's declaration explains every
+//! window's error: the bound is then the floor. Windows overlap and are
+//! not exchangeable with another drive's: the held-out coverage is
+//! measured, not assumed (`docs/bound.md`).
 
 use std::sync::OnceLock;
 
@@ -274,12 +279,13 @@ impl std::fmt::Display for Method {
     }
 }
 
-/// The bound's inflation: `bound = k · r(P)`.
+/// The bound's inflation: `bound = r(k² P + F)` ([`BoundFit::floored_bound_m`]).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BoundFit {
     /// How `k` was found.
     pub method: Method,
-    /// The factor on the filter's 95 % radius.
+    /// The factor on the filter's covariance (`k² P`; with no floor, the
+    /// factor on its 95 % radius).
     pub k: f64,
     /// Windows it was fitted on (0 for [`Method::Filter`]).
     pub windows: usize,
@@ -299,9 +305,17 @@ impl BoundFit {
         step_s: 0.0,
     };
 
-    /// The 95 % bound of a position whose filter covariance is `cov`, m.
+    /// The 95 % bound of a position whose filter covariance is `cov` and
+    /// has no receiver's floor (the differential drive's), m: `k · r(P)`.
     pub fn bound_m(&self, cov: &Cov2) -> f64 {
         self.k * radius(cov)
+    }
+
+    /// The 95 % bound of a position whose filter covariance is `cov`, over
+    /// a receiver's offset of covariance `floor` that the factor does not
+    /// inflate: `r(k² P + F)`, m.
+    pub fn floored_bound_m(&self, cov: &Cov2, floor: &Cov2) -> f64 {
+        radius(&cov.scaled_plus(self.k * self.k, floor))
     }
 
     /// The 95 % bound of what is compared with a reference of covariance
@@ -529,49 +543,69 @@ pub fn reach(ev: &crate::outage::OutageEvaluation, fit: &BoundFit, alert_m: f64)
     })
 }
 
-/// Each window's end of `ev` (the settled ones) as a [`Sample`].
+/// Each window's end of `ev` (the settled ones) as a [`Sample`]
+/// ([`crate::compared::OutageResult::final_sample`]).
 pub fn samples(ev: &crate::outage::OutageEvaluation) -> Vec<Sample> {
-    ev.windows
-        .iter()
-        .filter_map(|w| {
-            Some(Sample {
-                error_m: w.final_m(),
-                cov: *w.covariances_m2.last()?,
-                reference: *w.reference_m2.last()?,
-            })
-        })
-        .collect()
+    ev.windows.iter().filter_map(|w| w.final_sample()).collect()
 }
 
 impl crate::compared::OutageResult {
+    /// The receiver's floor at error `i` (zero when not recorded).
+    fn floor_at(&self, i: usize) -> Cov2 {
+        self.floor_m2.get(i).copied().unwrap_or(Cov2::circular(0.0))
+    }
+
     /// The 95 % bound at each error, m (empty when the estimator gave no
-    /// covariance).
+    /// covariance): [`BoundFit::floored_bound_m`] of the estimator's
+    /// covariance and the receiver's floor.
     pub fn bounds_95_m(&self, fit: &BoundFit) -> Vec<f64> {
-        self.covariances_m2.iter().map(|c| fit.bound_m(c)).collect()
+        self.covariances_m2
+            .iter()
+            .enumerate()
+            .map(|(i, c)| fit.floored_bound_m(c, &self.floor_at(i)))
+            .collect()
     }
 
     /// The 95 % bound at the window's end (the last error), m.
     pub fn bound_95_m(&self, fit: &BoundFit) -> Option<f64> {
-        self.covariances_m2.last().map(|c| fit.bound_m(c))
+        let i = self.covariances_m2.len().checked_sub(1)?;
+        Some(fit.floored_bound_m(&self.covariances_m2[i], &self.floor_at(i)))
     }
 
-    /// Whether the final error is within the bound of what was compared:
-    /// the position's bound, widened by the reference's own noise when the
-    /// reference is a fix ([`BoundFit::compared_bound_m`]).
+    /// The sample the final error makes for [`fit`] and the coverage: the
+    /// inflated part is the estimator's covariance `P`; the rest is what
+    /// the receiver adds. Against the truth that is the floor `F` (the
+    /// offset of the position handed over). Against a hidden fix it is
+    /// `2F + R`: the offset handed over and the hidden fix's own offset,
+    /// taken as independent, plus the fix's white noise `R` (the
+    /// reference's covariance). `None` without covariances.
+    pub fn final_sample(&self) -> Option<Sample> {
+        let i = self.covariances_m2.len().checked_sub(1)?;
+        let floor = self.floor_at(i);
+        let reference = match self.against {
+            crate::compared::Against::Gnss => floor.scaled_plus(2.0, self.reference_m2.get(i)?),
+            _ => floor,
+        };
+        Some(Sample {
+            error_m: self.final_m(),
+            cov: self.covariances_m2[i],
+            reference,
+        })
+    }
+
+    /// Whether the final error is within the bound of what was compared
+    /// (`r(k² P + R)`, `R` the reference part of [`Self::final_sample`]):
+    /// against the truth, the bound itself ([`Self::bound_95_m`]).
     pub fn within_bound(&self, fit: &BoundFit) -> Option<bool> {
-        let c = self.covariances_m2.last()?;
-        let r = self.reference_m2.last()?;
-        Some(self.final_m() <= fit.compared_bound_m(c, r))
+        let s = self.final_sample()?;
+        Some(s.error_m <= fit.compared_bound_m(&s.cov, &s.reference))
     }
 
     /// When the bound first reaches `alert_m`: time from the outage start,
     /// s, and distance travelled, m (`None` for the distance when not
     /// known); `None` when it never does in the window.
     pub fn bound_reaches(&self, fit: &BoundFit, alert_m: f64) -> Option<(f64, Option<f64>)> {
-        let i = self
-            .covariances_m2
-            .iter()
-            .position(|c| fit.bound_m(c) >= alert_m)?;
+        let i = self.bounds_95_m(fit).iter().position(|b| *b >= alert_m)?;
         Some((self.errors[i].0, self.travelled_m.get(i).copied()))
     }
 }

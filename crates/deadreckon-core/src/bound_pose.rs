@@ -3,11 +3,12 @@
 //! equals `run` on the same epochs.
 //!
 //! **The rule.** A pose of the four-wheel filter (rear axle, covariance
-//! `P` of east/north) gets `k · r(P + σ² I)`, `k` the fitted factor
+//! `P` of east/north) gets `r(k² P + σ² I)`, `k` the fitted factor
 //! ([`BoundFit`]) and `σ` the declared accuracy of the last GNSS fix at
 //! or before the pose's time that the filter was given (hidden fixes of
 //! `gnss_outages` do not count): the receiver's offset that the filter
-//! cannot see ([`crate::bound`]'s floor). In an outage that fix is the
+//! cannot see ([`crate::bound`]'s floor, which the factor does not
+//! inflate). In an outage that fix is the
 //! last one handed over, as `evaluate --outage` computes it; where GNSS
 //! is present it is the latest fix, and the bound is the bound of the
 //! filtered position. A pose before any fix gets the filter's covariance
@@ -38,7 +39,7 @@ pub fn point_bound_m(fit: &BoundFit, p: &TrackPoint, receiver_std_m: f64) -> f64
         en_m2: 0.5 * (p.cov_pose[1] + p.cov_pose[3]),
         nn_m2: p.cov_pose[4],
     };
-    fit.bound_m(&cov.scaled_plus(1.0, &Cov2::circular(receiver_std_m)))
+    fit.floored_bound_m(&cov, &Cov2::circular(receiver_std_m))
 }
 
 /// The most fixes [`FixFloor`] keeps ahead of the poses (a stream's fixes
@@ -162,15 +163,16 @@ mod tests {
     }
 
     #[test]
-    fn a_circle_of_the_filter_and_the_receiver_gives_the_rayleigh_radius_times_k() {
-        // Var 3 m² from the filter plus 1 m std from the receiver: a circle
-        // of 4 m², whose 95 % radius is 2 √(−2 ln 0.05) = 4.8955 m.
+    fn the_factor_inflates_the_filter_and_not_the_receivers_floor() {
+        // Var 3 m² from the filter inflated by k² = 1.5² to 6.75 m², plus
+        // 1 m std from the receiver: a circle of 7.75 m², whose 95 % radius
+        // is √7.75 · √(−2 ln 0.05) = 6.8143 m.
         let fit = BoundFit {
             k: 1.5,
             ..BoundFit::FILTER
         };
         let b = point_bound_m(&fit, &point(0.0, 3.0), 1.0);
-        let want = 1.5 * 2.0 * (-2.0 * 0.05f64.ln()).sqrt();
+        let want = 7.75f64.sqrt() * (-2.0 * 0.05f64.ln()).sqrt();
         assert!((b - want).abs() < 1e-5 * want, "{b} vs {want}");
     }
 

@@ -160,11 +160,15 @@ pub struct OutageResult {
     /// The filter's yaw standard deviation where the dead reckoning started,
     /// rad (`None` when the estimator has none).
     pub start_yaw_std_rad: Option<f64>,
-    /// The horizontal covariance the error bound is made of at each error,
-    /// m² (empty when the estimator has none): the estimator's covariance
-    /// of the compared point plus the declared accuracy of the last fix
-    /// before the outage ([`crate::bound`]).
+    /// The estimator's covariance of the compared point at each error, m²
+    /// (empty when the estimator has none): the part of the error bound
+    /// the factor inflates ([`crate::bound`]).
     pub covariances_m2: Vec<crate::bound::Cov2>,
+    /// The receiver's offset at each error, m² (the declared accuracy of
+    /// the last fix before the outage, [`crate::bound`]'s floor, not
+    /// inflated; zero where the estimator carries it in its state; empty
+    /// with `covariances_m2`).
+    pub floor_m2: Vec<crate::bound::Cov2>,
     /// The reference's own covariance at each error, m² (a hidden fix's
     /// noise; zero for the truth; empty with `covariances_m2`).
     pub reference_m2: Vec<crate::bound::Cov2>,
@@ -192,6 +196,7 @@ impl OutageResult {
             distance_m,
             start_yaw_std_rad: None,
             covariances_m2: Vec::new(),
+            floor_m2: Vec::new(),
             reference_m2: Vec::new(),
         }
     }

@@ -475,6 +475,7 @@ fn window_errors(
         .map(|(_, c)| *c)
         .collect();
     let mut cov_at = Vec::new();
+    let mut floor_at = Vec::new();
     let mut reference_at = Vec::new();
     // The antenna the fixes see: the car's plus the wander expected.
     let seen: Vec<(f64, State)> = states
@@ -502,7 +503,8 @@ fn window_errors(
                     );
                     errors.push((*ts - t0, est.distance_to(&truth)));
                     if let Some(c) = covs.get(k) {
-                        cov_at.push(Cov2::rear_axle(c).scaled_plus(1.0, &receiver));
+                        cov_at.push(Cov2::rear_axle(c));
+                        floor_at.push(receiver);
                         reference_at.push(Cov2::circular(0.0));
                     }
                 }
@@ -522,7 +524,8 @@ fn window_errors(
                     // The covariance of the last epoch at or before the fix.
                     let k = states.partition_point(|s| s.0 <= g.t_s).saturating_sub(1);
                     if let Some(c) = covs.get(k) {
-                        cov_at.push(Cov2::ahead(c, x[YAW], lever).scaled_plus(1.0, &receiver));
+                        cov_at.push(Cov2::ahead(c, x[YAW], lever));
+                        floor_at.push(receiver);
                         reference_at.push(Cov2::circular(fix_std_m));
                     }
                 }
@@ -552,6 +555,7 @@ fn window_errors(
     };
     if cov_at.len() == out.errors.len() {
         out.covariances_m2 = cov_at;
+        out.floor_m2 = floor_at;
         out.reference_m2 = reference_at;
     }
     Some(out)

@@ -496,8 +496,9 @@ fn outage_bound(
         .collect();
     let factor = match fit.method {
         deadreckon_core::bound::Method::Conformal => format!(
-            "{:.2} × the filter's 95 % radius (with the last fix's declared accuracy), fitted on \
-             {} windows of {:.1} s of this drive against its own hidden fixes (in-sample)",
+            "the filter's covariance inflated by k = {:.2} (k² P) over the last fix's declared \
+             accuracy, fitted on {} windows of {:.1} s of this drive against its own hidden fixes \
+             (in-sample)",
             fit.k, fit.windows, fit.outage_s
         ),
         deadreckon_core::bound::Method::Filter => fit.method.to_string(),

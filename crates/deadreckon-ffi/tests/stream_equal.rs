@@ -293,14 +293,25 @@ fn the_c_api_gives_each_pose_the_bound_of_stream() {
             w.point.t_s
         );
     }
-    // The factor is in it: 1.7 times the filter's own bound (with the floor).
+    // The factor is in it: r(1.7² P + σ² I), the filter's covariance
+    // inflated and the last fix's declared accuracy not (docs/bound.md),
+    // wider than the filter's own bound and narrower than 1.7 times it.
     let plain = deadreckon_core::bound::BoundFit::FILTER;
     let last = want.last().unwrap();
     let fix_std = d.gnss.last().unwrap().std_m;
     let unit = deadreckon_core::bound_pose::point_bound_m(&plain, &last.point, fix_std);
+    let p = &last.point.cov_pose;
+    let inflated = deadreckon_core::bound::Cov2 {
+        ee_m2: 1.7 * 1.7 * p[0] + fix_std * fix_std,
+        en_m2: 1.7 * 1.7 * 0.5 * (p[1] + p[3]),
+        nn_m2: 1.7 * 1.7 * p[4] + fix_std * fix_std,
+    };
+    let want_last = deadreckon_core::bound::radius(&inflated);
     assert!(
-        (last.bound_95_m / unit - 1.7).abs() < 1e-12,
-        "{} {unit}",
+        (last.bound_95_m / want_last - 1.0).abs() < 1e-12
+            && last.bound_95_m > unit
+            && last.bound_95_m < 1.7 * unit,
+        "{} {want_last} {unit}",
         last.bound_95_m
     );
     let mut latest = f64::NAN;
