@@ -182,6 +182,9 @@ pub(crate) struct Frame {
     pub y_categories: Option<Vec<String>>,
     /// The x values are counts (iterations): labelled at integers only, without decimals.
     pub x_integer: bool,
+    /// The y values are decimal logarithms: labelled at whole decades as the
+    /// value they stand for (`0.1`, `1`, `10`).
+    pub y_log10: bool,
 }
 
 impl Frame {
@@ -202,7 +205,15 @@ impl Frame {
             legend: Legend::Right,
             y_categories: None,
             x_integer: false,
+            y_log10: false,
         }
+    }
+
+    /// Labels y as a logarithmic axis: the y values are log10 of the
+    /// quantity, labelled at whole decades with the quantity.
+    pub fn y_log10(mut self) -> Self {
+        self.y_log10 = true;
+        self
     }
 
     /// Labels x at whole numbers only, without decimals (an iteration axis).
@@ -298,11 +309,21 @@ pub(crate) fn render_chart(
                     String::new()
                 }
             }
+            None if frame.y_log10 => {
+                let r = v.round();
+                if (v - r).abs() < 1e-6 {
+                    fmt_trim(10f64.powf(r), 3)
+                } else {
+                    String::new()
+                }
+            }
             None => y_num(v),
         };
         let n_x = if frame.width < 500 { 5 } else { 10 };
         let n_y = match &frame.y_categories {
             Some(names) => names.len() + 1,
+            // One label per decade.
+            None if frame.y_log10 => (frame.y.end - frame.y.start).round() as usize + 1,
             None if frame.height < 300 => 5,
             None => 8,
         };

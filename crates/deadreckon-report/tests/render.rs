@@ -278,6 +278,7 @@ fn a_section_with_only_some_data_shows_only_that() {
             gnss: Some(EnPath {
                 east_m: vec![0.0, 1.0, 2.0],
                 north_m: vec![0.0, 1.0, f64::NAN],
+                ..Default::default()
             }),
             ..Default::default()
         }),
@@ -437,6 +438,7 @@ fn series_without_finite_values_give_no_empty_frames() {
             truth: Some(EnPath {
                 east_m: vec![nan; 3],
                 north_m: vec![1.0; 3],
+                ..Default::default()
             }),
             ..Default::default()
         }),
@@ -511,6 +513,7 @@ fn a_dead_reckoned_spiral_set_the_trajectory_frame() {
                 .map(|(k, e)| e + 5.0 * k as f64)
                 .collect(),
             north_m: t.north_m.clone(),
+            t_s: t.t_s.clone(),
         }
     };
     input.trajectories.as_mut().unwrap().dead_reckoned[0].path = far;
@@ -587,6 +590,7 @@ fn a_runaway_filtered_track_set_the_trajectory_axes() {
             .map(|(k, e)| e + 3.0 * k as f64)
             .collect(),
         north_m: p.north_m.clone(),
+        t_s: p.t_s.clone(),
     };
     t.filtered = t.filtered.as_ref().map(runaway);
     let html = render_html(&input).unwrap();
