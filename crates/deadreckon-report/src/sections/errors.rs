@@ -209,7 +209,7 @@ pub(crate) fn section(
     } else {
         let total: f64 = gaps.iter().map(|g| g.1 - g.0).sum();
         format!(
-            "Shaded: the drive's GNSS outages, where no fix came for more than {} s ({} of them, {} s in all); \
+            "Shaded: the GNSS outages of the drive, where no fix came for more than {} s ({} of them, {} s in all); \
              the filtered and smoothed tracks dead-reckon through them.",
             GAP_MIN_S,
             gaps.len(),
@@ -288,7 +288,7 @@ pub(crate) fn section(
             blocks.push(Block::Figure(FigureView {
                 name: "error-distance".into(),
                 caption: format!(
-                    "The same errors against the distance travelled along the reference (m): \
+                    "The same errors (m, logarithmic axis) against the distance travelled along the reference (m): \
                      the drift of each dead reckoning per metre driven, standstills left out. {gap_note}"
                 ),
                 svg: chart(
