@@ -620,7 +620,15 @@ pub(crate) const GATED: RGBColor = RGBColor(213, 94, 0);
 pub(crate) const REFERENCE: RGBColor = RGBColor(200, 30, 30);
 
 fn canonical(method: &str) -> String {
-    let m = method.trim().to_lowercase();
+    // A label that says where the values came from (`RTS, calibrated on
+    // this drive; streams corrected as params.toml stores`) keeps its
+    // method's colour.
+    let m = method
+        .split([',', ';'])
+        .next()
+        .unwrap_or(method)
+        .trim()
+        .to_lowercase();
     match m.as_str() {
         "gt" | "ground truth" | "reference" => "truth".to_string(),
         "ours" | "our method" | "rts calibration" | "rts-calibrated" => "rts".to_string(),
