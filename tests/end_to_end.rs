@@ -4,7 +4,7 @@
 mod common;
 
 use std::path::Path;
-use std::process::Output;
+use std::process::{Command, Output};
 
 use common::{bin, json, run_ok, COMMA2K19 as COMMA, HUSKY_BAG as HUSKY};
 

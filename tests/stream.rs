@@ -5,7 +5,7 @@
 mod common;
 
 use std::io::Write;
-use std::process::{Command, Stdio};
+use std::process::Stdio;
 
 use deadreckon_core::drive::Wheels;
 use deadreckon_core::ekf::{self, DriveEvents, FilterOptions, Timing};
