@@ -341,7 +341,11 @@ fn husky_report_drew_no_dead_reckoned_track_and_no_tedris_outage() {
         String::from_utf8_lossy(&st.stderr)
     );
     let html = std::fs::read_to_string(&html).unwrap();
-    assert!(html.contains("DR (RTS)"), "no dead-reckoned track");
+    // Named by where its values and corrections come from (issue 34).
+    assert!(
+        html.contains("DR (RTS, this drive"),
+        "no dead-reckoned track"
+    );
     assert!(
         html.contains("final error TedriS"),
         "no TedriS outage curve"
