@@ -849,10 +849,11 @@ fn the_comma2k19_trajectory_collapsed_to_one_line() {
     // Paths without times (reports written before them) draw no such figure.
     let mut old = input.clone();
     let t = old.trajectories.as_mut().unwrap();
-    for p in [&mut t.truth, &mut t.gnss, &mut t.filtered, &mut t.smoothed] {
-        if let Some(p) = p {
-            p.t_s.clear();
-        }
+    for p in [&mut t.truth, &mut t.gnss, &mut t.filtered, &mut t.smoothed]
+        .into_iter()
+        .flatten()
+    {
+        p.t_s.clear();
     }
     let html = render_html(&old).unwrap();
     assert!(!html.contains("error-time"));
