@@ -2,12 +2,12 @@
 //! rows, the history table, outage evaluation columns, refused outputs,
 //! closed pipes.
 
-use std::path::Path;
-use std::process::{Command, Stdio};
+mod common;
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_deadreckon"))
-}
+use std::path::Path;
+use std::process::Stdio;
+
+use common::bin;
 
 fn run(args: &[&str]) -> std::process::Output {
     bin().args(args).output().expect("binary runs")

@@ -2,6 +2,8 @@
 //! (issue: "what done looks like"). Run with an optimised profile
 //! (`cargo test --profile ci`): each case simulates and smooths kilometres of driving.
 
+mod common;
+
 use deadreckon_core::calibrate::{self, CalibrationOptions, Iteration, Method, PassState};
 use deadreckon_core::ekf::{self, FilterOptions, Timing};
 use deadreckon_core::metrics::{self, Summary};
@@ -15,8 +17,8 @@ fn rel(a: f64, b: f64) -> f64 {
 /// Calibrates on a simulated calibration drive and evaluates on an evaluation
 /// drive; checks the accuracy targets of the issue.
 fn check_seed(seed: u64) {
-    let cal = simulate(&Scenario::builtin("calibration").unwrap(), seed).unwrap();
-    let eval = simulate(&Scenario::builtin("evaluation").unwrap(), seed + 1000).unwrap();
+    let cal = common::sim("calibration", seed);
+    let eval = common::sim("evaluation", seed + 1000);
     let truth = cal.truth_params.to_array();
 
     let rts = calibrate::calibrate(&cal.drive, &CalibrationOptions::default()).unwrap();
@@ -222,7 +224,7 @@ fn covariances_stay_symmetric_positive_definite_over_two_hours() {
 /// reckoning still works with the calibrated parameters.
 #[test]
 fn filter_runs_with_any_sensor_absent() {
-    let cal = simulate(&Scenario::builtin("evaluation").unwrap(), 31).unwrap();
+    let cal = common::sim("evaluation", 31);
     let p = cal.truth_params;
     let full = Summary::of(
         &metrics::drift(&cal.drive, &p, 100.0, Timing::WheelEpochs)

@@ -137,7 +137,7 @@ fn the_report_ignored_the_corrections_of_its_params_and_estimated_none() {
     let (with_stored, rows) =
         corrected(&drive, &options(&dir, Some(ps), Which::Gnss), &()).unwrap();
     let rows = rows.expect("stored corrections shown");
-    assert_eq!(rows.source, format!("stored in {ps}"));
+    assert_eq!(rows.source, format!("read from {ps}"));
     let stored = deadreckon_api::corrections::stored_in_file(&p).unwrap();
     assert_eq!(with_stored.yaw_rate, stored.apply(&drive).yaw_rate);
     assert_ne!(

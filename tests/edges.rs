@@ -2,11 +2,11 @@
 //! cause once, the file the user named, not a temporary file), values refused
 //! with the reason, outputs written whole.
 
+mod common;
+
 use std::process::Command;
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_deadreckon"))
-}
+use common::bin;
 
 fn vehicle_dir() -> tempfile::TempDir {
     let tmp = tempfile::tempdir().unwrap();
@@ -313,10 +313,7 @@ fn simulate_interrupted_by_sigint_left_its_temporary_directory() {
 /// though the captions named them.
 #[test]
 fn husky_report_drew_no_dead_reckoned_track_and_no_tedris_outage() {
-    let husky = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../shared/data/husky-gps-bag/husky_gps.bag"
-    );
+    let husky = common::HUSKY_BAG;
     let tmp = tempfile::tempdir().unwrap();
     let model = tmp.path().join("model.json");
     let st = bin()
@@ -344,7 +341,11 @@ fn husky_report_drew_no_dead_reckoned_track_and_no_tedris_outage() {
         String::from_utf8_lossy(&st.stderr)
     );
     let html = std::fs::read_to_string(&html).unwrap();
-    assert!(html.contains("DR (RTS)"), "no dead-reckoned track");
+    // Named by where its values and corrections come from (issue 34).
+    assert!(
+        html.contains("DR (RTS, this drive"),
+        "no dead-reckoned track"
+    );
     assert!(
         html.contains("final error TedriS"),
         "no TedriS outage curve"

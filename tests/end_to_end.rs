@@ -1,22 +1,12 @@
 //! End-to-end tests of the `deadreckon` binary in temporary directories: the
 //! slow cases (whole simulated drives through every command) live here.
 
+mod common;
+
 use std::path::Path;
 use std::process::{Command, Output};
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_deadreckon"))
-}
-
-fn run_ok(args: &[&str]) -> String {
-    let out = bin().args(args).output().expect("binary runs");
-    assert!(
-        out.status.success(),
-        "deadreckon {args:?} failed:\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout).expect("utf-8 output")
-}
+use common::{bin, json, run_ok, COMMA2K19 as COMMA, HUSKY_BAG as HUSKY};
 
 fn run_err(args: &[&str]) -> Output {
     let out = bin().args(args).output().expect("binary runs");
@@ -27,20 +17,8 @@ fn run_err(args: &[&str]) -> Output {
     out
 }
 
-fn json(s: &str) -> serde_json::Value {
-    serde_json::from_str(s).unwrap_or_else(|e| panic!("not JSON ({e}):\n{s}"))
-}
-
 fn simulate(dir: &Path, scenario: &str, seed: u64) {
-    run_ok(&[
-        "simulate",
-        "--scenario",
-        scenario,
-        "--seed",
-        &seed.to_string(),
-        "--out",
-        dir.to_str().unwrap(),
-    ]);
+    common::simulate_into(dir, scenario, &seed.to_string());
 }
 
 #[test]
@@ -370,8 +348,6 @@ fn check_in_chromium(html: &Path, min_figures: usize) {
     );
 }
 
-const COMMA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/comma2k19-rav4");
-
 /// comma2k19 held out (issue 33): calibrated on one half of the segment
 /// (split at 46438.6 s), evaluated on the other with 20 s outages every
 /// 2 s, both ways, as the README's commands do. The in-sample figures above
@@ -587,11 +563,6 @@ fn comma2k19_whole_drive_bound_covers_80_percent_of_outages() {
     assert_eq!(o["outages"].as_array().unwrap().len(), 7, "{o}");
     assert!((sharp - 3.99).abs() < 0.3, "sharpness {sharp}");
 }
-
-const HUSKY: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../shared/data/husky-gps-bag/husky_gps.bag"
-);
 
 /// The Husky bag is read directly by every command (no conversion step), and
 /// dead-reckons through 30 s outages against the hidden GNSS fixes, here

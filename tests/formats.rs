@@ -3,42 +3,14 @@
 //! calibrate --format autoware|eagleye against calibrate --json. (evo itself
 //! is run in tests/evo.rs.)
 
+mod common;
+
 use std::path::Path;
-use std::process::Command;
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_deadreckon"))
-}
-
-fn run_ok(args: &[&str]) -> String {
-    let out = bin().args(args).output().expect("binary runs");
-    assert!(
-        out.status.success(),
-        "deadreckon {args:?} failed:\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout).expect("utf-8 output")
-}
-
-fn run_err(args: &[&str]) -> String {
-    let out = bin().args(args).output().expect("binary runs");
-    assert!(
-        !out.status.success(),
-        "deadreckon {args:?} should have failed"
-    );
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
+use common::{run_err, run_ok};
 
 fn simulate(dir: &Path, scenario: &str, seed: &str) {
-    run_ok(&[
-        "simulate",
-        "--scenario",
-        scenario,
-        "--seed",
-        seed,
-        "--out",
-        dir.to_str().unwrap(),
-    ]);
+    common::simulate_into(dir, scenario, seed);
 }
 
 fn data_lines(path: &Path) -> Vec<String> {

@@ -33,8 +33,10 @@
 //! Every path here is sequential (no parallel reductions), so the numbers are
 //! the same from run to run (`golden_outputs_are_deterministic`, bit for bit).
 
+mod common;
+
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use deadreckon_core::calibrate::{self, CalibrationOptions};
 use deadreckon_core::ekf::{self, FilterOptions};
@@ -53,7 +55,7 @@ const SEED: u64 = 11;
 const DURATION_S: f64 = 60.0;
 
 fn golden_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/golden")
+    common::repo_path("tests/golden")
 }
 
 fn drive() -> Drive {

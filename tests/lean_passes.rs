@@ -1,16 +1,14 @@
 //! The calibration's passes that keep less than every epoch (issue 30)
 //! give what the recorded runs gave, bit for bit.
 
+mod common;
+
 use deadreckon_core::ekf::{self, FilterOptions, Init, SensorSet};
 use deadreckon_core::reference::Reference;
 use deadreckon_core::{Drive, Params};
-use deadreckon_sim::{simulate, Scenario};
 
 fn drive(seed: u64, duration_s: f64) -> Drive {
-    let sc = Scenario::builtin("calibration")
-        .unwrap()
-        .with_duration_s(duration_s);
-    simulate(&sc, seed).unwrap().drive
+    common::sim_drive("calibration", seed, Some(duration_s))
 }
 
 /// `timing::gnss_delay` smoothed the whole recorded run (every epoch and

@@ -49,7 +49,7 @@ run_chromium --dump-dom "file://$html" >"$work/dom.html" 2>"$work/dom.log" || {
     tail -n 20 "$work/dom.log" >&2
     exit 1
 }
-run_chromium --screenshot="$png" --window-size="1200,$height" "file://$html" >"$work/shot.out" 2>"$work/shot.log" || {
+run_chromium --screenshot="$png" --window-size="1280,$height" "file://$html" >"$work/shot.out" 2>"$work/shot.log" || {
     echo "chromium --screenshot failed:" >&2
     tail -n 20 "$work/shot.log" >&2
     exit 1
@@ -92,7 +92,7 @@ for id in $(grep -o '<section id="[a-z0-9-]*"' "$html" | sed 's/.*id="\([^"]*\)"
     one="$work/section-$id.html"
     sed "s#</head>#<style>section:not(\#$id){display:none !important}</style></head>#" "$html" >"$one"
     shot="${png%.png}-$id.png"
-    if run_chromium --screenshot="$shot" --window-size="1200,$height" "file://$one" >/dev/null 2>&1 && [[ -s $shot ]]; then
+    if run_chromium --screenshot="$shot" --window-size="1280,$height" "file://$one" >/dev/null 2>&1 && [[ -s $shot ]]; then
         echo "section screenshot: $shot"
     else
         echo "FAIL: no screenshot of section $id" >&2

@@ -2,8 +2,10 @@
 //! round trips, and `deadreckon events | deadreckon stream` against
 //! `deadreckon run` (issue: "the four-wheel estimator online").
 
+mod common;
+
 use std::io::Write;
-use std::process::{Command, Stdio};
+use std::process::Stdio;
 
 use deadreckon_core::drive::Wheels;
 use deadreckon_core::ekf::{self, DriveEvents, FilterOptions, Timing};
@@ -12,10 +14,7 @@ use deadreckon_core::{Drive, Params, TrackPoint};
 use deadreckon_sim::{simulate, Scenario};
 
 fn drive(seed: u64, duration_s: f64) -> Drive {
-    let sc = Scenario::builtin("evaluation")
-        .unwrap()
-        .with_duration_s(duration_s);
-    simulate(&sc, seed).unwrap().drive
+    common::sim_drive("evaluation", seed, Some(duration_s))
 }
 
 fn online_track(d: &Drive, params: &Params, timing: Timing) -> Vec<TrackPoint> {
@@ -173,9 +172,7 @@ fn rows_t(d: &deadreckon_core::Drive, k: usize) -> f64 {
     d.wheels.t_s(k)
 }
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_deadreckon"))
-}
+use common::bin;
 
 fn csv_filtered(path: &std::path::Path) -> Vec<(f64, f64, f64, f64)> {
     let mut r = csv::Reader::from_path(path).unwrap();

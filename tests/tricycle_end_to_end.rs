@@ -9,37 +9,11 @@
 //! error 0.271 m (84 windows; nominal parameters 9.10 m); first half →
 //! second 0.200 m, second → first 0.586 m.
 
+mod common;
+
 use std::path::Path;
-use std::process::Command;
 
-const LOG: &str = "../shared/data/tricycle-tracker/dataset.txt";
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_deadreckon"))
-}
-
-fn run_ok(args: &[&str]) -> String {
-    let out = bin().args(args).output().expect("binary runs");
-    assert!(
-        out.status.success(),
-        "deadreckon {args:?} failed:\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout).expect("utf-8 output")
-}
-
-fn run_err(args: &[&str]) -> String {
-    let out = bin().args(args).output().expect("binary runs");
-    assert!(
-        !out.status.success(),
-        "deadreckon {args:?} should have failed"
-    );
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
-
-fn json(s: &str) -> serde_json::Value {
-    serde_json::from_str(s).unwrap_or_else(|e| panic!("not JSON ({e}):\n{s}"))
-}
+use common::{json, run_err, run_ok, TRICYCLE_LOG as LOG};
 
 fn calibrate(out: &Path, range: &[&str]) -> serde_json::Value {
     let mut args = vec![

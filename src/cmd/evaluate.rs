@@ -46,7 +46,10 @@ pub fn run(a: EvaluateArgs, load: &common::Loader) -> Result<()> {
     if a.params.is_none() && !a.json {
         outln!("parameters: {} ({})", chosen.label, evaluate::RULE);
     } else if !a.json {
-        outln!("parameters: {}", chosen.source);
+        outln!(
+            "parameters: {}",
+            deadreckon_api::report_labels::given_line(&chosen.source)
+        );
     }
     let mut ev = evaluate::measure(&drive, chosen, a.timing.into(), a.metric())?;
     ev.alert_m = a.alert_m;

@@ -79,3 +79,68 @@ pub fn simulated(dir: &std::path::Path, name: &str, duration_s: &str) -> String 
     ]);
     out
 }
+
+/// The `deadreckon` binary as a command, for tests that set it up further
+/// (standard input, environment, signals).
+pub fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_deadreckon"))
+}
+
+/// Parses a command's JSON output; panics showing the text otherwise.
+pub fn json(s: &str) -> serde_json::Value {
+    serde_json::from_str(s).unwrap_or_else(|e| panic!("not JSON ({e}):\n{s}"))
+}
+
+/// A real log under `../shared/data` (read only; never copied into the
+/// repository), e.g. `data("comma2k19-rav4")`.
+pub fn data(rel: &str) -> String {
+    format!("{}/../shared/data/{rel}", env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Simulates the built-in `scenario` with `seed` into `dir` through the
+/// binary.
+pub fn simulate_into(dir: &std::path::Path, scenario: &str, seed: &str) {
+    run_ok(&[
+        "simulate",
+        "--scenario",
+        scenario,
+        "--seed",
+        seed,
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+}
+
+/// The built-in `scenario` simulated in-process with `seed` (the drive and
+/// its true parameters).
+pub fn sim(scenario: &str, seed: u64) -> deadreckon_sim::SimOutput {
+    deadreckon_sim::simulate(&deadreckon_sim::Scenario::builtin(scenario).unwrap(), seed).unwrap()
+}
+
+/// The built-in `scenario` simulated in-process with `seed`, cut to
+/// `duration_s` when given.
+pub fn sim_drive(scenario: &str, seed: u64, duration_s: Option<f64>) -> deadreckon_core::Drive {
+    let mut sc = deadreckon_sim::Scenario::builtin(scenario).unwrap();
+    if let Some(d) = duration_s {
+        sc = sc.with_duration_s(d);
+    }
+    deadreckon_sim::simulate(&sc, seed).unwrap().drive
+}
+
+/// The comma2k19 segment (`../shared/data/comma2k19-rav4`).
+pub const COMMA2K19: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/comma2k19-rav4");
+/// The Husky's ROS bag with GNSS.
+pub const HUSKY_BAG: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../shared/data/husky-gps-bag/husky_gps.bag"
+);
+/// The tricycle's log with its tracker.
+pub const TRICYCLE_LOG: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../shared/data/tricycle-tracker/dataset.txt"
+);
+
+/// A path inside the repository (`tests/golden`).
+pub fn repo_path(rel: &str) -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
+}

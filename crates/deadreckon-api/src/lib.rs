@@ -74,6 +74,7 @@ pub mod options;
 pub mod params_file;
 pub mod report;
 pub mod report_kinematic;
+pub mod report_labels;
 pub mod shape;
 pub mod source;
 pub mod stream;

@@ -55,8 +55,14 @@ pub fn corrected(
         let stored = crate::corrections::stored_in_file(Path::new(p)).map_err(Error::Invalid)?;
         if !stored.is_empty() {
             let c = rp::Corrections {
-                source: format!("stored in {p}"),
-                rows: crate::corrections::stored_rows(&stored),
+                source: format!("{} {p}", crate::report_labels::READ_FROM),
+                rows: crate::corrections::stored_rows(&stored)
+                    .into_iter()
+                    .map(|r| rp::CorrectionRow {
+                        status: format!("{} {p}, applied", crate::report_labels::READ_FROM),
+                        ..r
+                    })
+                    .collect(),
             };
             return Ok((stored.apply(drive), Some(c)));
         }
@@ -104,6 +110,7 @@ pub fn write(
         });
     }
     let mut input = four_wheel_input(drive, &methods, o.outage_s, o.step_s, steps)?;
+    crate::report_labels::say_what_was_applied(&mut input, o.params, corrections.as_ref());
     input
         .calibration
         .get_or_insert_with(Default::default)

@@ -19,10 +19,15 @@ use crate::report::ReportOptions;
 use crate::shape::Found;
 use crate::Error;
 
-/// An east-north path of the tracks' points.
-fn path(points: impl Iterator<Item = (f64, f64)>) -> rp::EnPath {
-    let (east_m, north_m) = points.unzip();
-    rp::EnPath { east_m, north_m }
+/// An east-north path of timed points `(t_s, east_m, north_m)`.
+fn path(points: impl Iterator<Item = (f64, f64, f64)>) -> rp::EnPath {
+    let mut p = rp::EnPath::default();
+    for (t, e, n) in points {
+        p.t_s.push(t);
+        p.east_m.push(e);
+        p.north_m.push(n);
+    }
+    p
 }
 
 /// Builds the report of a kinematic shape's drive and writes it to `out`.
@@ -40,10 +45,14 @@ pub fn write(
     let mut input = rp::ReportInput::default();
     let mut traj = rp::Trajectories::default();
     if !drive.truth.is_empty() {
-        traj.truth = Some(path(drive.truth.iter().map(|p| (p.east_m, p.north_m))));
+        traj.truth = Some(path(
+            drive.truth.iter().map(|p| (p.t_s, p.east_m, p.north_m)),
+        ));
     }
     if !drive.gnss.is_empty() {
-        traj.gnss = Some(path(drive.gnss.iter().map(|g| (g.east_m, g.north_m))));
+        traj.gnss = Some(path(
+            drive.gnss.iter().map(|g| (g.t_s, g.east_m, g.north_m)),
+        ));
     }
     steps.step("kinematic calibration");
     let (calibrated, evaluated) = match found.shape {
@@ -53,7 +62,7 @@ pub fn write(
             if let Some(t) = tracks.iter().find(|t| t.name == "dead-reckoned") {
                 traj.dead_reckoned.push(rp::MethodPath {
                     method: source,
-                    path: path(t.points.iter().map(|p| (p.east_m, p.north_m))),
+                    path: path(t.points.iter().map(|p| (p.t_s, p.east_m, p.north_m))),
                 });
             }
             steps.step("outages");

@@ -76,6 +76,7 @@ fn path_of(t: &Track) -> rp::EnPath {
     rp::EnPath {
         east_m: t.points.iter().map(|p| p.east_m).collect(),
         north_m: t.points.iter().map(|p| p.north_m).collect(),
+        t_s: t.points.iter().map(|p| p.t_s).collect(),
     }
 }
 
@@ -326,6 +327,7 @@ pub fn four_wheel_input(
         traj.truth = Some(rp::EnPath {
             east_m: r.x.iter().map(|x| x[0]).collect(),
             north_m: r.x.iter().map(|x| x[1]).collect(),
+            t_s: r.t.clone(),
         });
     }
     // Filter health and the aided tracks with the best parameters available.
@@ -346,6 +348,7 @@ pub fn four_wheel_input(
             traj.gnss = Some(rp::EnPath {
                 east_m: drive.gnss.iter().map(|g| g.east_m).collect(),
                 north_m: drive.gnss.iter().map(|g| g.north_m).collect(),
+                t_s: drive.gnss.iter().map(|g| g.t_s).collect(),
             });
             if st.gnss_rejected > 0 {
                 // The fixes the filter says it gated (they were matched by
@@ -354,6 +357,7 @@ pub fn four_wheel_input(
                 traj.gnss_gated = Some(rp::EnPath {
                     east_m: gg.iter().map(|g| g.east_m).collect(),
                     north_m: gg.iter().map(|g| g.north_m).collect(),
+                    t_s: gg.iter().map(|g| g.t_s).collect(),
                 });
             }
             traj.filtered = tracks.first().map(path_of);

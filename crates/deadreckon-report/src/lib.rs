@@ -29,7 +29,7 @@
 //! let mut input = ReportInput::default();
 //! input.header.drive_name = "loop".into();
 //! input.trajectories = Some(Trajectories {
-//!     truth: Some(EnPath { east_m: vec![0.0, 10.0, 20.0], north_m: vec![0.0, 5.0, 0.0] }),
+//!     truth: Some(EnPath { east_m: vec![0.0, 10.0, 20.0], north_m: vec![0.0, 5.0, 0.0], ..Default::default() }),
 //!     ..Default::default()
 //! });
 //! let html = render_html(&input).unwrap();

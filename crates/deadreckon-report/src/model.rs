@@ -110,6 +110,11 @@ pub struct EnPath {
     pub east_m: Vec<f64>,
     /// North of the origin, m.
     pub north_m: Vec<f64>,
+    /// The time of each point, s, increasing: empty (not known: the path
+    /// is drawn in the east-north plane only), or as long as `east_m`.
+    /// With times, the report draws each track's error against the
+    /// reference through time and distance.
+    pub t_s: Vec<f64>,
 }
 
 /// A path produced by one method (e.g. dead reckoning with one calibration).

@@ -106,10 +106,14 @@ fn draw_keys(
     }
     // plotters' own estimate of the text width for the SVG backend.
     let font = (FONT, KEY_FONT).into_font();
-    let text_w = keys
-        .0
+    // Long labels (a method that says where its values and corrections
+    // come from, issue 34) wrap onto more lines instead of running out of
+    // the chart.
+    let wrapped: Vec<Vec<String>> = keys.0.iter().map(|(l, _)| wrap(l, KEY_CHARS)).collect();
+    let text_w = wrapped
         .iter()
-        .map(|(l, _)| {
+        .flatten()
+        .map(|l| {
             font.box_size(l)
                 .map(|b| b.0 as i32)
                 .unwrap_or(8 * l.chars().count() as i32)
@@ -117,7 +121,8 @@ fn draw_keys(
         .max()
         .unwrap_or(0);
     let w = 40 + text_w + 8;
-    let h = KEY_ROW * keys.0.len() as i32 + 8;
+    let lines: i32 = wrapped.iter().map(|l| l.len() as i32).sum();
+    let h = KEY_ROW * lines + 8;
     let x = if align_right { x - w } else { x };
     root.draw(&Rectangle::new(
         [(x, y), (x + w, y + h)],
@@ -129,8 +134,10 @@ fn draw_keys(
         RGBColor(170, 170, 170),
     ))
     .or_plot()?;
-    for (i, (label, swatch)) in keys.0.iter().enumerate() {
-        let cy = y + 4 + KEY_ROW * i as i32 + KEY_ROW / 2;
+    let mut row = 0;
+    for ((_, swatch), label) in keys.0.iter().zip(&wrapped) {
+        let cy = y + 4 + KEY_ROW * row + KEY_ROW / 2;
+        row += label.len() as i32;
         let (sx, ex) = (x + 8, x + 32);
         match *swatch {
             Swatch::Line(c, w) => root.draw(&PathElement::new(
@@ -156,16 +163,41 @@ fn draw_keys(
             )),
         }
         .or_plot()?;
-        root.draw(&Text::new(
-            label.clone(),
-            (ex + 8, cy),
-            font.clone()
-                .color(&BLACK)
-                .pos(Pos::new(HPos::Left, VPos::Center)),
-        ))
-        .or_plot()?;
+        for (k, line) in label.iter().enumerate() {
+            root.draw(&Text::new(
+                line.clone(),
+                (ex + 8, cy + KEY_ROW * k as i32),
+                font.clone()
+                    .color(&BLACK)
+                    .pos(Pos::new(HPos::Left, VPos::Center)),
+            ))
+            .or_plot()?;
+        }
     }
     Ok(())
+}
+
+/// The most characters on one line of a legend entry (the legend column
+/// holds about 24 at its font).
+const KEY_CHARS: usize = 24;
+
+/// `text` in lines of at most `max` characters, broken at spaces (a longer
+/// word keeps its own line).
+fn wrap(text: &str, max: usize) -> Vec<String> {
+    let mut lines: Vec<String> = Vec::new();
+    for word in text.split(' ') {
+        match lines.last_mut() {
+            Some(l) if l.chars().count() + 1 + word.chars().count() <= max => {
+                l.push(' ');
+                l.push_str(word);
+            }
+            _ => lines.push(word.to_string()),
+        }
+    }
+    if lines.is_empty() {
+        lines.push(String::new());
+    }
+    lines
 }
 
 /// The frame of one chart.
@@ -182,6 +214,9 @@ pub(crate) struct Frame {
     pub y_categories: Option<Vec<String>>,
     /// The x values are counts (iterations): labelled at integers only, without decimals.
     pub x_integer: bool,
+    /// The y values are decimal logarithms: labelled at whole decades as the
+    /// value they stand for (`0.1`, `1`, `10`).
+    pub y_log10: bool,
 }
 
 impl Frame {
@@ -202,7 +237,15 @@ impl Frame {
             legend: Legend::Right,
             y_categories: None,
             x_integer: false,
+            y_log10: false,
         }
+    }
+
+    /// Labels y as a logarithmic axis: the y values are log10 of the
+    /// quantity, labelled at whole decades with the quantity.
+    pub fn y_log10(mut self) -> Self {
+        self.y_log10 = true;
+        self
     }
 
     /// Labels x at whole numbers only, without decimals (an iteration axis).
@@ -298,11 +341,21 @@ pub(crate) fn render_chart(
                     String::new()
                 }
             }
+            None if frame.y_log10 => {
+                let r = v.round();
+                if (v - r).abs() < 1e-6 {
+                    fmt_trim(10f64.powf(r), 3)
+                } else {
+                    String::new()
+                }
+            }
             None => y_num(v),
         };
         let n_x = if frame.width < 500 { 5 } else { 10 };
         let n_y = match &frame.y_categories {
             Some(names) => names.len() + 1,
+            // One label per decade.
+            None if frame.y_log10 => (frame.y.end - frame.y.start).round() as usize + 1,
             None if frame.height < 300 => 5,
             None => 8,
         };
@@ -599,7 +652,15 @@ pub(crate) const GATED: RGBColor = RGBColor(213, 94, 0);
 pub(crate) const REFERENCE: RGBColor = RGBColor(200, 30, 30);
 
 fn canonical(method: &str) -> String {
-    let m = method.trim().to_lowercase();
+    // A label that says where the values came from (`RTS, calibrated on
+    // this drive; streams corrected as params.toml stores`) keeps its
+    // method's colour.
+    let m = method
+        .split([',', ';', '+'])
+        .next()
+        .unwrap_or(method)
+        .trim()
+        .to_lowercase();
     match m.as_str() {
         "gt" | "ground truth" | "reference" => "truth".to_string(),
         "ours" | "our method" | "rts calibration" | "rts-calibrated" => "rts".to_string(),

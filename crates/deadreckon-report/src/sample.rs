@@ -57,6 +57,7 @@ pub fn sample_input(duration_s: f64) -> ReportInput {
         EnPath {
             east_m: e,
             north_m: nn,
+            t_s: t.clone(),
         }
     };
     // Dead reckoning drifts by a slowly growing rotation and scale about the start.
@@ -77,7 +78,9 @@ pub fn sample_input(duration_s: f64) -> ReportInput {
     };
     let filtered = jitter(0.4);
     let smoothed = jitter(0.1);
-    let gnss_idx: Vec<usize> = (0..n).step_by(5).collect();
+    // A GNSS outage of 5 % of the drive at 40 % of it (a tunnel).
+    let gap = (0.40 * n as f64) as usize..(0.45 * n as f64) as usize;
+    let gnss_idx: Vec<usize> = (0..n).step_by(5).filter(|i| !gap.contains(i)).collect();
     let mut gnss = EnPath::default();
     let mut gated = EnPath::default();
     for (k, &i) in gnss_idx.iter().enumerate() {
@@ -85,9 +88,11 @@ pub fn sample_input(duration_s: f64) -> ReportInput {
         if k % 997 == 500 {
             gated.east_m.push(e + 25.0 + 5.0 * rng.gauss());
             gated.north_m.push(nn - 18.0 + 5.0 * rng.gauss());
+            gated.t_s.push(t[i]);
         } else {
             gnss.east_m.push(e + 1.5 * rng.gauss());
             gnss.north_m.push(nn + 1.5 * rng.gauss());
+            gnss.t_s.push(t[i]);
         }
     }
     let distance: f64 = truth

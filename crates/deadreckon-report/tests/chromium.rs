@@ -27,8 +27,9 @@ fn the_sample_report_draws_every_figure_in_headless_chromium() {
         out.status.success(),
         "{script:?} failed:\n{stdout}\n{stderr}"
     );
-    // 22 since the outage bound figure (issue 31).
-    assert!(stdout.contains("selfcheck: ok=true figures=22"), "{stdout}");
+    // 22 since the outage bound figure (issue 31), 24 since the error
+    // against time and distance (issue 34).
+    assert!(stdout.contains("selfcheck: ok=true figures=24"), "{stdout}");
     assert!(
         png.metadata().unwrap().len() > 10_000,
         "screenshot too small"

@@ -82,6 +82,7 @@ fn every_section_and_figure_of_a_full_report_draws_data() {
         [
             "not-computed",
             "trajectories",
+            "errors",
             "calibration",
             "drift",
             "health",
@@ -92,10 +93,11 @@ fn every_section_and_figure_of_a_full_report_draws_data() {
     let figs = figures(&html);
     // 1 trajectory + 6 iteration plots + 2 drift + 3 innovations + 2 NIS
     // + cross-correlation, heading, repositories, 3 outages + 1 outage evaluation
-    // + its 95 % bound (issue 31).
+    // + its 95 % bound (issue 31) + the error against time and distance
+    // (issue 34).
     assert_eq!(
         figs.len(),
-        22,
+        24,
         "{:?}",
         figs.iter().map(|f| &f.0).collect::<Vec<_>>()
     );
@@ -263,7 +265,13 @@ fn each_section_renders_alone() {
     ];
     for (id, input) in cases {
         let html = render_html(&input).unwrap();
-        assert_eq!(section_ids(&html), [id]);
+        // The trajectories bring the error against the reference (issue 34).
+        let want: &[&str] = if id == "trajectories" {
+            &["trajectories", "errors"]
+        } else {
+            &[id]
+        };
+        assert_eq!(section_ids(&html), want);
         assert!(
             figures(&html).iter().all(|(_, b)| drawn_elements(b) > 0),
             "{id}"
@@ -278,6 +286,7 @@ fn a_section_with_only_some_data_shows_only_that() {
             gnss: Some(EnPath {
                 east_m: vec![0.0, 1.0, 2.0],
                 north_m: vec![0.0, 1.0, f64::NAN],
+                ..Default::default()
             }),
             ..Default::default()
         }),
@@ -437,6 +446,7 @@ fn series_without_finite_values_give_no_empty_frames() {
             truth: Some(EnPath {
                 east_m: vec![nan; 3],
                 north_m: vec![1.0; 3],
+                ..Default::default()
             }),
             ..Default::default()
         }),
@@ -511,6 +521,7 @@ fn a_dead_reckoned_spiral_set_the_trajectory_frame() {
                 .map(|(k, e)| e + 5.0 * k as f64)
                 .collect(),
             north_m: t.north_m.clone(),
+            t_s: t.t_s.clone(),
         }
     };
     input.trajectories.as_mut().unwrap().dead_reckoned[0].path = far;
@@ -587,6 +598,7 @@ fn a_runaway_filtered_track_set_the_trajectory_axes() {
             .map(|(k, e)| e + 3.0 * k as f64)
             .collect(),
         north_m: p.north_m.clone(),
+        t_s: p.t_s.clone(),
     };
     t.filtered = t.filtered.as_ref().map(runaway);
     let html = render_html(&input).unwrap();
@@ -813,4 +825,36 @@ fn the_outage_section_draws_the_error_against_its_bound_with_the_coverage() {
     // The sample's windows: 30 s each, so the time axis ends near 30 s.
     let top = largest_label(fig);
     assert!(top >= 30.0, "largest axis label {top}");
+}
+
+/// Issue 34: on comma2k19 the trajectory figure collapsed to one line on a
+/// 1 km straight and the methods could not be told apart; each track's error
+/// against the reference is drawn through time and distance, the GNSS
+/// outage shaded and named in the caption.
+#[test]
+fn the_comma2k19_trajectory_collapsed_to_one_line() {
+    let input = sample_input(600.0);
+    let html = render_html(&input).unwrap();
+    for name in ["error-time", "error-distance"] {
+        let cap = figure(&html, name);
+        assert!(cap.contains("logarithmic"), "{name}: {cap}");
+        // The sample's one outage: 239.9 to 270.0 s (5 % of 600 s at 40 %).
+        assert!(cap.contains("(1 of them, 30.1 s in all)"), "{name}: {cap}");
+    }
+    let svg = &html[html.find("data-figure=\"error-time\"").unwrap()..];
+    let svg = &svg[..svg.find("</figure>").unwrap()];
+    for key in ["filtered", "DR (nominal)", "DR (RTS)", "GNSS outage"] {
+        assert!(svg.contains(key), "no legend entry {key}");
+    }
+    // Paths without times (reports written before them) draw no such figure.
+    let mut old = input.clone();
+    let t = old.trajectories.as_mut().unwrap();
+    for p in [&mut t.truth, &mut t.gnss, &mut t.filtered, &mut t.smoothed]
+        .into_iter()
+        .flatten()
+    {
+        p.t_s.clear();
+    }
+    let html = render_html(&old).unwrap();
+    assert!(!html.contains("error-time"));
 }

@@ -66,7 +66,10 @@ pub(crate) fn section(
             tables: vec![TableView {
                 caption: "Calibrated parameters (table III); ± one standard error; \
                           n.e.: not estimated, held at its starting value (the drive \
-                          cannot determine it)."
+                          cannot determine it). Each method says where its values \
+                          come from (nominal, calibrated on this drive, a params.toml) \
+                          and, after +, where the corrections every section applied \
+                          to the streams come from."
                     .into(),
                 headers,
                 rows,

@@ -5,6 +5,7 @@ mod calibration;
 #[cfg(test)]
 mod caption_colours;
 mod drift;
+mod errors;
 mod health;
 mod kinematic;
 mod outages;
@@ -44,6 +45,7 @@ pub(crate) fn render_all(input: &ReportInput) -> Result<Vec<SectionView>, Report
     };
     if let Some(t) = &input.trajectories {
         push(trajectories::section(t, &mut palette)?);
+        push(errors::section(t, input.header.start_t_s, &mut palette)?);
     }
     if let Some(k) = &input.kinematic {
         push(Some(kinematic::section(k)));
