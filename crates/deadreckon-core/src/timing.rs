@@ -35,46 +35,16 @@
 //! no speed changes for the CAN speed).
 
 use crate::drive::Drive;
+pub(crate) use crate::series::lag1;
+pub use crate::status::{Status, MEASURED};
 
 /// Speed above which the steering is compared with the curvature, m/s.
 pub const MIN_CURVATURE_SPEED_MPS: f64 = 2.0;
-
-/// How the reason of every correction measured but not applied starts
-/// (`--corrections gnss`'s other delays, `auto`'s rejected corrections).
-pub const MEASURED: &str = "measured, not applied";
 
 /// The reason of a delay that was measured but not applied because only the
 /// GNSS delay was asked for (`Which::Gnss`); such a [`Delay`] keeps its
 /// measured `delay_s` and `std_s`.
 pub const MEASURED_NOT_APPLIED: &str = "measured, not applied: only the GNSS delay was asked for";
-
-/// Estimated, or not with the reason.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Status {
-    /// Estimated and applied.
-    Estimated,
-    /// Not estimated (and not applied): why.
-    NotEstimated(String),
-}
-
-impl Status {
-    /// True when estimated.
-    pub fn is_estimated(&self) -> bool {
-        matches!(self, Status::Estimated)
-    }
-    /// True when it was measured and deliberately not applied (the reason
-    /// starts with [`MEASURED`]): its value and standard error are kept.
-    pub fn is_measured_not_applied(&self) -> bool {
-        matches!(self, Status::NotEstimated(r) if r.starts_with(MEASURED))
-    }
-    /// The reason it was not estimated, if not.
-    pub fn reason(&self) -> Option<&str> {
-        match self {
-            Status::Estimated => None,
-            Status::NotEstimated(r) => Some(r),
-        }
-    }
-}
 
 /// The streams with a delay.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -252,21 +222,6 @@ impl Default for DelayOptions {
             gnss_iterations: 8,
             gnss_window_s: 20.0,
         }
-    }
-}
-
-/// Lag-one autocorrelation of `r`.
-pub(crate) fn lag1(r: &[f64]) -> f64 {
-    if r.len() < 3 {
-        return 0.0;
-    }
-    let m = r.iter().sum::<f64>() / r.len() as f64;
-    let c0: f64 = r.iter().map(|x| (x - m).powi(2)).sum();
-    let c1: f64 = r.windows(2).map(|p| (p[0] - m) * (p[1] - m)).sum();
-    if c0 > 0.0 {
-        (c1 / c0).clamp(-0.99, 0.99)
-    } else {
-        0.0
     }
 }
 

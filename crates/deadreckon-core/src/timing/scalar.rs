@@ -5,7 +5,8 @@ use super::{
     jackknife_std, lag1, Delay, DelayOptions, Status, JACKKNIFE_BLOCKS, MIN_CURVATURE_SPEED_MPS,
 };
 use crate::drive::{Drive, Scalar};
-use crate::imu::{interp, wheel_speed};
+use crate::imu::wheel_speed;
+use crate::series::interp;
 
 /// The sums of a straight-line fit y = a + b x.
 #[derive(Debug, Clone, Copy, Default)]
