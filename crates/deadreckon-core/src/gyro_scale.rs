@@ -16,8 +16,8 @@
 
 use crate::angle;
 use crate::drive::Drive;
-use crate::imu::interp;
-use crate::timing::Status;
+use crate::series::interp;
+use crate::status::Status;
 
 /// Largest mean yaw rate over ±1 s of a straight moment, rad/s.
 pub const STRAIGHT_RPS: f64 = 0.01;

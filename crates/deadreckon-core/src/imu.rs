@@ -40,7 +40,8 @@
 //! rejected, never clamped.
 
 use crate::drive::{Axes, Drive, Scalar};
-use crate::timing::Status;
+use crate::series::interp;
+use crate::status::Status;
 
 /// Standard gravity, m/s².
 pub const GRAVITY_MPS2: f64 = 9.80665;
@@ -124,26 +125,6 @@ impl Tilt {
     pub fn is_estimated(&self) -> bool {
         self.status.is_estimated()
     }
-}
-
-/// Linear interpolation of `(t, v)` samples sorted by time; `None` outside.
-pub(crate) fn interp(s: &[(f64, f64)], t: f64) -> Option<f64> {
-    let n = s.len();
-    if n == 0 || !(t >= s[0].0 && t <= s[n - 1].0) {
-        return None;
-    }
-    let i = s.partition_point(|p| p.0 <= t);
-    if i >= n {
-        return Some(s[n - 1].1);
-    }
-    let i = i.max(1);
-    let (a, b) = (s[i - 1], s[i]);
-    let w = if b.0 > a.0 {
-        (t - a.0) / (b.0 - a.0)
-    } else {
-        0.0
-    };
-    Some(a.1 * (1.0 - w) + b.1 * w)
 }
 
 /// The mean speed of the present wheels, `(t, m/s)`.

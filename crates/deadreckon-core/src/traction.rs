@@ -39,7 +39,7 @@
 //! (rejected, never clamped).
 
 use crate::drive::{Drive, Wheels};
-use crate::timing::Status;
+use crate::status::Status;
 
 /// Slowest speed of a block used, m/s (wheel speeds are coarse below).
 pub const MIN_SPEED_MPS: f64 = 3.0;
@@ -206,7 +206,7 @@ pub fn estimate(drive: &Drive) -> Option<TractionSlip> {
     let k = sxy / sxx;
     let res: Vec<f64> = b.iter().map(|r| r.2 - my - k * (r.1 - mx)).collect();
     let s2 = res.iter().map(|e| e * e).sum::<f64>() / (n - 2) as f64;
-    let rho = crate::timing::lag1(&res).clamp(0.0, 0.9);
+    let rho = crate::series::lag1(&res).clamp(0.0, 0.9);
     let std = (s2 / sxx * (1.0 + rho) / (1.0 - rho)).sqrt();
     let status = if !(std.is_finite() && std <= MAX_STD_PER_MPS2) {
         Status::NotEstimated(format!(

@@ -1,0 +1,305 @@
+//! Every stream's delay and the corrections of a drive: [`estimate`],
+//! [`prepare`] and the corrections known in advance ([`KnownCorrections`]).
+
+use super::gnss::gnss_delay_of;
+use super::scalar::{gyro_delay, speed_delay, steering_delay};
+use super::{shift, Delay, DelayOptions, Delays, Status, Stream, MEASURED_NOT_APPLIED};
+use crate::calibrate::{self, CalibrationOptions};
+use crate::drive::Drive;
+use crate::{Error, Params};
+
+/// Every stream's delay: the scalar streams on `drive` as given, then the
+/// GNSS on the drive with the scalar delays applied.
+pub fn estimate(
+    drive: &Drive,
+    copts: &CalibrationOptions,
+    o: &DelayOptions,
+) -> Result<Delays, Error> {
+    estimate_with_params(drive, copts, o).map(|(d, _)| d)
+}
+
+/// [`estimate`], also returning the calibration at the final GNSS delay
+/// (with the scalar delays applied), when the GNSS delay was estimated.
+pub fn estimate_with_params(
+    drive: &Drive,
+    copts: &CalibrationOptions,
+    o: &DelayOptions,
+) -> Result<(Delays, Option<Params>), Error> {
+    let mut delays = Delays {
+        gyro: gyro_delay(drive, o),
+        speed: speed_delay(drive, o),
+        steering: steering_delay(drive, o),
+        gnss: Delay::not_estimated("not estimated"),
+    };
+    let partly = delays.apply(drive);
+    let (g, params) = gnss_delay_of(partly, copts, o)?;
+    delays.gnss = g;
+    Ok((delays, params))
+}
+
+/// Which corrections [`crate::held_back::prepare`] estimates and applies.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Which {
+    /// Every correction estimated; each applied only when it lowers the
+    /// dead-reckoning error through GNSS the calibration did not see
+    /// ([`crate::held_back`]): the commands' default.
+    #[default]
+    Auto,
+    /// The driven axle's slip, the IMU tilt, every stream's delay and the
+    /// gyro scale.
+    All,
+    /// The driven axle's slip, the IMU tilt, the GNSS delay and the gyro
+    /// scale (the other streams' delays estimated and reported, not
+    /// applied).
+    Gnss,
+    /// Nothing estimated or applied.
+    None,
+}
+
+impl Which {
+    /// The word the command line takes: `auto`, `all`, `gnss`, `none`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Which::Auto => "auto",
+            Which::All => "all",
+            Which::Gnss => "gnss",
+            Which::None => "none",
+        }
+    }
+}
+
+/// What [`prepare`] found and applied.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Corrections {
+    /// The driven axle's slip (`None`: no accelerometer in the drive, or
+    /// not attempted).
+    pub traction: Option<crate::traction::TractionSlip>,
+    /// The IMU's tilt (`None`: no three-axis IMU in the drive).
+    pub tilt: Option<crate::imu::Tilt>,
+    /// The streams' delays.
+    pub delays: Delays,
+    /// The gyro's scale error (`None` when not attempted: no GNSS delay, so
+    /// no calibration to take the bias from).
+    pub gyro_scale: Option<crate::gyro_scale::GyroScale>,
+    /// With [`Which::Auto`]: what the held-back GNSS said of each
+    /// correction ([`crate::held_back`]).
+    pub held_back: Option<crate::held_back::HeldBack>,
+    /// With [`Which::Auto`]: the additions to the paper's model the
+    /// held-back GNSS chose ([`crate::model_options`]; empty otherwise).
+    pub model: crate::model_options::ModelOptions,
+}
+
+impl Corrections {
+    /// Nothing estimated or applied: what [`prepare_with`] returns with
+    /// [`Which::None`] (the drive then unchanged).
+    pub fn none() -> Corrections {
+        Corrections {
+            traction: None,
+            tilt: None,
+            delays: Delays::none(),
+            gyro_scale: None,
+            held_back: None,
+            model: Default::default(),
+        }
+    }
+}
+
+/// Estimates the driven axle's slip ([`crate::traction`], correcting its
+/// wheel speeds when estimated), the IMU tilt (projecting the gyro on the
+/// vertical when estimated), every stream's delay and the gyro scale error
+/// ([`crate::gyro_scale`], with the bias of a calibration at the final
+/// delays), and returns the drive with them applied.
+pub fn prepare(
+    drive: &Drive,
+    copts: &CalibrationOptions,
+    o: &DelayOptions,
+) -> Result<(Drive, Corrections), Error> {
+    prepare_with(drive, copts, o, Which::All)
+}
+
+/// [`prepare`] with a choice of what is applied (see [`Which`]); an
+/// unapplied delay is marked not estimated with the reason.
+/// [`Which::Auto`] is decided by [`crate::held_back::prepare`], which calls
+/// this with [`Which::All`]; asked here, it is refused.
+pub fn prepare_with(
+    drive: &Drive,
+    copts: &CalibrationOptions,
+    o: &DelayOptions,
+    which: Which,
+) -> Result<(Drive, Corrections), Error> {
+    if which == Which::None {
+        return Ok((drive.clone(), Corrections::none()));
+    }
+    if which == Which::Auto {
+        return Err(Error::InvalidParams(
+            "the automatic choice of corrections is made by held_back::prepare".into(),
+        ));
+    }
+    // The driven axle's slip first: the wheels are the clock and the scale
+    // every other correction is measured against.
+    let traction = crate::traction::estimate(drive);
+    let slipped;
+    let drive = match &traction {
+        Some(t) if t.is_estimated() => {
+            slipped = crate::traction::apply(drive, t.slip_per_mps2);
+            &slipped
+        }
+        _ => drive,
+    };
+    let (levelled, tilt) = crate::imu::level(drive);
+    let (mut delays, params) = estimate_with_params(&levelled, copts, o)?;
+    if which == Which::Gnss {
+        for d in [&mut delays.gyro, &mut delays.speed, &mut delays.steering] {
+            if d.status.is_estimated() {
+                // The measured delay and its std stay in `d` for the reports.
+                d.status = Status::NotEstimated(MEASURED_NOT_APPLIED.to_string());
+            }
+        }
+    }
+    // The levelled drive becomes the output (moved, not copied).
+    let mut out = levelled;
+    delays.apply_in_place(&mut out);
+    // The bias of the calibration at the final GNSS delay (a time shift of
+    // the gyro does not change its bias), else of a calibration here.
+    let params = match params {
+        Some(p) => Some(p),
+        None => calibrate::calibrate_parameters(&out, copts)
+            .ok()
+            .map(|c| c.estimate.params),
+    };
+    let gyro_scale = params.map(|p| crate::gyro_scale::estimate(&out, p.gyro_bias_rps));
+    if let Some(g) = gyro_scale.as_ref().filter(|g| g.is_estimated()) {
+        crate::gyro_scale::apply_in_place(&mut out, g.scale_error);
+    }
+    Ok((
+        out,
+        Corrections {
+            traction,
+            tilt,
+            delays,
+            gyro_scale,
+            held_back: None,
+            model: Default::default(),
+        },
+    ))
+}
+
+/// Applies known corrections (e.g. from a params.toml): the yaw rate
+/// projected on `up` (sensor axes) when given and the drive has a three-axis
+/// gyro, then the delays, s, in [`Stream::ALL`] order, then the gyro scale
+/// error.
+pub fn apply_known(
+    drive: &Drive,
+    delays_s: [f64; 4],
+    up: Option<[f64; 3]>,
+    gyro_scale_error: f64,
+) -> Drive {
+    let d = match up {
+        Some(u) => crate::imu::level_with(drive, u),
+        None => drive.clone(),
+    };
+    let d = shift(&d, delays_s);
+    if gyro_scale_error != 0.0 {
+        crate::gyro_scale::apply(&d, gyro_scale_error)
+    } else {
+        d
+    }
+}
+
+/// Corrections known beforehand and applied as they are: those a
+/// params.toml stores (`[delays]`, `[traction]`, `[imu]`, `[gyro_scale]`), or those a
+/// TedriS model was trained with.
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+pub struct KnownCorrections {
+    /// Delays, s, in [`Stream::ALL`] order (0: none).
+    pub delays_s: [f64; 4],
+    /// The IMU's vertical in its own axes (`None`: the gyro as it is).
+    pub up: Option<[f64; 3]>,
+    /// The gyro's relative scale error (0: none).
+    pub gyro_scale_error: f64,
+    /// The driven axle's slip per m/s² of forward specific force
+    /// ([`crate::traction`]; 0: none; the sign names the axle). Absent from
+    /// models and files written before it: 0.
+    #[serde(default)]
+    pub traction_slip_per_mps2: f64,
+    /// The mean forward specific force, m/s², of the drive the slip was
+    /// estimated on ([`crate::traction::TractionSlip::mean_force_mps2`]),
+    /// the level the wheel speeds are corrected to. `None` (files written
+    /// before it): each drive's own mean, which a live stream cannot know
+    /// ([`crate::live_corrections`] then leaves the slip out).
+    #[serde(default)]
+    pub traction_mean_force_mps2: Option<f64>,
+    /// Additions to the paper's model set on the vehicle
+    /// ([`crate::model_options`]; empty: the vehicle's own). Absent from
+    /// models and files written before them: none.
+    #[serde(default)]
+    pub model: crate::model_options::ModelOptions,
+}
+
+impl KnownCorrections {
+    /// Applies them to `drive`: the slip first ([`crate::traction::apply`]),
+    /// then [`apply_known`], in [`prepare_with`]'s order.
+    pub fn apply(&self, drive: &Drive) -> Drive {
+        let slipped;
+        let drive = if self.traction_slip_per_mps2 != 0.0 {
+            slipped = crate::traction::apply_at(
+                drive,
+                self.traction_slip_per_mps2,
+                self.traction_mean_force_mps2,
+            );
+            &slipped
+        } else {
+            drive
+        };
+        let mut out = apply_known(drive, self.delays_s, self.up, self.gyro_scale_error);
+        self.model.apply_to(&mut out.vehicle);
+        out
+    }
+
+    /// Whether there is nothing to apply.
+    pub fn is_empty(&self) -> bool {
+        *self == KnownCorrections::default()
+    }
+
+    /// Checks the values are plausible: delays finite and under 10 s, `up`
+    /// a unit vector, the scale error within
+    /// [`crate::gyro_scale::MAX_SCALE_ERROR`]. The error names the key.
+    pub fn validate(&self) -> Result<(), String> {
+        for (s, v) in Stream::ALL.iter().zip(self.delays_s) {
+            if !(v.is_finite() && v.abs() < 10.0) {
+                return Err(format!(
+                    "`delays.{}.delay_s` = {v} is not a plausible delay (|d| < 10 s)",
+                    s.name()
+                ));
+            }
+        }
+        if let Some(u) = self.up {
+            let n = u.iter().map(|x| x * x).sum::<f64>().sqrt();
+            if (n - 1.0).abs().is_nan() || (n - 1.0).abs() >= 1e-3 {
+                return Err("`imu.up` must be a unit vector of 3 numbers".into());
+            }
+        }
+        let g = self.gyro_scale_error;
+        if !(g.is_finite() && g.abs() <= crate::gyro_scale::MAX_SCALE_ERROR) {
+            return Err(format!(
+                "`gyro_scale.scale_error` = {g} is not a plausible gyro scale error"
+            ));
+        }
+        let k = self.traction_slip_per_mps2;
+        if !(k.is_finite() && k.abs() <= crate::traction::MAX_SLIP_PER_MPS2) {
+            return Err(format!(
+                "`traction.slip_per_mps2` = {k} is not a plausible tyre slip (|κ| ≤ {} per m/s²)",
+                crate::traction::MAX_SLIP_PER_MPS2
+            ));
+        }
+        self.model.validate()?;
+        if let Some(m) = self.traction_mean_force_mps2 {
+            if !(m.is_finite() && m.abs() < 100.0) {
+                return Err(format!(
+                    "`traction.mean_force_mps2` = {m} is not a plausible mean forward specific force (|f| < 100 m/s²)"
+                ));
+            }
+        }
+        Ok(())
+    }
+}
