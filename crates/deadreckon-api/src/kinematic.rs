@@ -22,6 +22,12 @@ use crate::error::{invalid, While};
 use crate::load::check_range;
 use crate::Error;
 
+/// Fewest odometry samples in a range a kinematic drive is read from.
+pub const MIN_ODOMETRY_SAMPLES: usize = 2;
+/// Fewest GNSS fixes in a range a differential drive is calibrated or
+/// evaluated on (two give a heading, one more says anything of it).
+pub const MIN_DIFF_DRIVE_FIXES: usize = 3;
+
 /// Whether `path` is a recording read through a kinematic shape (a
 /// tricycle `dataset.txt`), as the format detection says.
 pub fn is_tricycle_log(path: &Path) -> bool {
@@ -46,7 +52,7 @@ pub fn diff_drive(
 ) -> Result<DiffDriveDrive, Error> {
     check_range(from, until)?;
     let d = DiffDriveDrive::from_drive(drive, yaw, from, until)?;
-    if d.samples.len() < 2 || d.fixes.len() < 3 {
+    if d.samples.len() < MIN_ODOMETRY_SAMPLES || d.fixes.len() < MIN_DIFF_DRIVE_FIXES {
         invalid!(
             "{} odometry samples and {} GNSS fixes in the range: a differential drive needs odometry and GNSS",
             d.samples.len(),
@@ -92,7 +98,7 @@ pub fn load_tricycle_from(
         }
     };
     let cut = d.time_range(from, until);
-    if cut.samples.len() < 2 {
+    if cut.samples.len() < MIN_ODOMETRY_SAMPLES {
         invalid!(
             "{}: {} samples in the range --from {} --until {} (the log runs from {:.3} to {:.3} s)",
             path.display(),

@@ -26,8 +26,7 @@ use deadreckon_core::Track;
 
 use crate::error::RosError;
 
-/// The frame of the poses: the local east-north-up frame of the drive.
-pub const FRAME_ID: &str = "enu";
+pub use crate::ros2_out::FRAME_ID;
 
 fn time_schema(description: &str) -> Value {
     json!({

@@ -5,7 +5,7 @@
 //! Per track `<name>`: `/deadreckon/<name>/odom`, with
 //!
 //! - `header.stamp` the pose's time (`builtin_interfaces/Time`: seconds as
-//!   int32, so 0 ≤ t < 2³¹ s), `header.frame_id` [`crate::foxglove::FRAME_ID`]
+//!   int32, so 0 ≤ t < 2³¹ s), `header.frame_id` [`FRAME_ID`]
 //!   (the drive's local east-north-up frame), `child_frame_id` [`CHILD_FRAME_ID`];
 //! - the pose: position (east, north, 0), orientation the yaw about z;
 //!   covariance (x, y, z, roll, pitch, yaw, row-major) with the track's
@@ -23,6 +23,10 @@ use crate::ros2::{
 
 /// The schema name of the messages.
 pub const ODOMETRY_SCHEMA_NAME: &str = "nav_msgs/msg/Odometry";
+
+/// The frame of the poses: the local east-north-up frame of the drive
+/// (the Foxglove poses' too, [`crate::foxglove`]).
+pub const FRAME_ID: &str = "enu";
 
 /// The frame the twist is in: the vehicle (rear-axle centre, REP 105's `base_link`).
 pub const CHILD_FRAME_ID: &str = "base_link";
@@ -93,7 +97,7 @@ pub fn stamp(t_s: f64) -> Option<Time> {
 /// The Odometry message of one track pose (see the module doc), or `None`
 /// when its time has no ROS 2 stamp.
 pub fn odometry(p: &TrackPoint) -> Option<Odometry> {
-    odometry_in(p, crate::foxglove::FRAME_ID)
+    odometry_in(p, FRAME_ID)
 }
 
 /// [`odometry`] with the pose in frame `frame_id` (the live node's `odom`).

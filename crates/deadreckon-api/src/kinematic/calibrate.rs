@@ -150,7 +150,7 @@ pub fn calibrate_tricycle(
     let method = method_for(shape, o.method)?;
     let drive = load_tricycle_from(path, drive, o.from_s, o.until_s)?;
     let opts = KinematicOptions {
-        window_s: o.window_s.unwrap_or(2.0),
+        window_s: o.window_s.unwrap_or(KinematicOptions::default().window_s),
         min_speed_mps: o.min_speed_mps.unwrap_or(shape.default_min_speed_mps()),
         ..Default::default()
     };
