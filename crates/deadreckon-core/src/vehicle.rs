@@ -47,7 +47,7 @@ pub struct Noise {
     pub process_xy_m: f64,
     /// α_ψ: yaw process noise per reference step, rad (default
     /// [`PROCESS_YAW_RAD`], 5e-5; table I: 1e-5). The RTS calibration's
-    /// passes use it too unless told otherwise
+    /// passes run at table I's value instead unless told otherwise
     /// ([`crate::calibrate::SMOOTHING_PROCESS_YAW_RAD`]).
     pub process_yaw_rad: f64,
     /// α_v: speed process noise per reference step, m/s (table I: 10).
@@ -178,11 +178,10 @@ fn is_default_scale_hold(v: &f64) -> bool {
 /// 1e-5). On the comma2k19 segment it changes the 20 s outage error by at
 /// most 0.02 m (held-out second half → first: 0.714 → 0.697 m median).
 ///
-/// In the RTS calibration's smoother (which uses it by default) the larger
-/// value lets the yaw take what the gyro bias should explain, and a good
-/// gyro's bias reads low (issue 36): table I's value for the passes is an
-/// option, [`crate::calibrate::SMOOTHING_PROCESS_YAW_RAD`], with its
-/// measurements and why it is not the default.
+/// In the RTS calibration's smoother the larger value lets the yaw take
+/// what the gyro bias should explain, and a good gyro's bias reads low
+/// (issue 36): the passes run at table I's value by default,
+/// [`crate::calibrate::SMOOTHING_PROCESS_YAW_RAD`], with its measurements.
 pub const PROCESS_YAW_RAD: f64 = 5e-5;
 
 /// How the process noise of the yaw rate reaches the yaw over one step.
