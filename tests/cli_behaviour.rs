@@ -204,10 +204,14 @@ fn report_had_no_step_so_an_evaluate_figure_could_not_be_reproduced_in_a_report(
         run_ok(&args);
         std::fs::read_to_string(&out).unwrap()
     };
-    // The outage histogram's legend counts the windows of each method.
-    let rts = |n: u64| format!("RTS (n = {n})");
-    assert!(html(&["--step", "10"]).contains(&rts(every_10)));
-    assert!(html(&[]).contains(&rts(every_15)));
+    // The outage histogram's legend counts the windows of each method,
+    // named by where its parameters came from (issue 34: "RTS, this drive",
+    // with "+ corrections estimated here" when any were applied).
+    let rts = |html: &str, n: u64| {
+        html.contains("RTS, this drive") && html.contains(&format!("(n = {n})"))
+    };
+    assert!(rts(&html(&["--step", "10"]), every_10));
+    assert!(rts(&html(&[]), every_15));
     let e = run_err(&["report", &d, "--step", "10", "--out", &p("x.html")]);
     assert!(e.contains("--outage"), "{e}");
 }

@@ -127,14 +127,16 @@ fn measure(cars: &[u64], drive_s: f64) -> (f64, f64, usize) {
 #[test]
 fn the_bound_covers_95_percent_of_outages_on_development_cars() {
     let (coverage, sharpness, n) = measure(&(301..=306).collect::<Vec<_>>(), 300.0);
-    // Measured: 167 of 177 windows within (0.944), median bound / median
-    // final error 2.82 (k 0–2.25 per car, fitted on 29–53 windows; k = 0
-    // on cars 303, 305, 306: the receiver's floor explains their fit
-    // windows). The filter's covariance alone, without the receiver's
+    // Measured: 162 of 177 windows within (0.915), median bound / median
+    // final error 2.98, since the calibration's passes run at table I's
+    // yaw noise with batch-means standard errors (issue 36). Before that:
+    // 167 of 177 (0.944), 2.82 (k 0–2.25 per car, fitted on 29–53 windows;
+    // k = 0 on cars 303, 305, 306: the receiver's floor explains their fit
+    // windows); the filter's covariance alone, without the receiver's
     // floor: 150 of 177 (0.847), 2.77.
     assert_eq!(n, 177);
-    assert!((0.92..=0.97).contains(&coverage), "{coverage}");
-    assert!((2.65..=3.0).contains(&sharpness), "{sharpness}");
+    assert!((0.90..=0.94).contains(&coverage), "{coverage}");
+    assert!((2.85..=3.1).contains(&sharpness), "{sharpness}");
 }
 
 #[test]
@@ -158,7 +160,9 @@ fn the_bound_covers_95_percent_of_outages_on_held_out_cars_401_to_424() {
     // 501–540): 752 of 782 windows within (0.962), median bound / median
     // final error 2.71 (k 0–23.4 per car; k = 0 on 6 of 24). The issue's
     // coverage (90–99 %) and sharpness (at most 3) are both met. The
-    // first construction, k · r(P + F): 763 of 782 (0.976), 3.37.
+    // first construction, k · r(P + F): 763 of 782 (0.976), 3.37. Again
+    // after the calibration's passes moved to table I's yaw noise with
+    // batch-means standard errors (issue 36): 753 of 782 (0.963), 2.72.
     assert_eq!(n, 782);
     assert!((0.94..=0.98).contains(&coverage), "{coverage}");
     assert!((2.55..=2.85).contains(&sharpness), "{sharpness}");
