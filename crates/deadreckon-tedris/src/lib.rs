@@ -276,6 +276,7 @@ pub mod baseline;
 pub mod blocks;
 pub mod ccf;
 pub mod config;
+pub mod convention;
 pub mod history;
 pub mod input;
 pub mod machine;

@@ -337,7 +337,7 @@ pub struct TedrisModel {
     /// reference, no lever arm, or too few turns at low speed to tell; the
     /// course is then taken as the antenna's).
     #[serde(default)]
-    pub course_convention: Option<crate::machine::ConventionFit>,
+    pub course_convention: Option<crate::convention::ConventionFit>,
     /// Every required repository reached its minimum fill.
     pub complete: bool,
     /// g: gain on the turning part of γ̂ (1 = the regression as fitted),

@@ -5,6 +5,7 @@
 //! the heading anchor.
 
 use super::*;
+pub use crate::convention::{ConventionFit, CourseConvention};
 use crate::tuning::*;
 
 impl Tedris {
@@ -331,43 +332,6 @@ impl Tedris {
 /// The heading offset from (t, reference − DR) pairs: their mean.
 pub(super) fn anchor(pairs: &VecDeque<(f64, f64)>) -> f64 {
     pairs.iter().map(|p| p.1).sum::<f64>() / pairs.len() as f64
-}
-
-/// What a GNSS course is the direction of.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum CourseConvention {
-    /// The antenna's velocity: the rear-axle heading plus atan(l·ψ̇/v).
-    AntennaVelocity,
-    /// The body's yaw (receivers fusing an IMU or two antennas).
-    BodyYaw,
-}
-
-impl std::fmt::Display for CourseConvention {
-    /// Words for people: what the receiver's course is the direction of.
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
-            CourseConvention::AntennaVelocity => "the antenna's velocity",
-            CourseConvention::BodyYaw => "the body's yaw",
-        })
-    }
-}
-
-impl CourseConvention {
-    /// True for [`CourseConvention::AntennaVelocity`].
-    pub fn is_antenna(self) -> bool {
-        self == CourseConvention::AntennaVelocity
-    }
-}
-
-/// The convention found on a drive, with its evidence.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct ConventionFit {
-    /// The convention chosen.
-    pub convention: CourseConvention,
-    /// Residual sum of squares of the heading fit taking the course as the
-    /// body's yaw over that taking it as the antenna's (each at its best lag).
-    pub rss_ratio: f64,
 }
 
 /// Which convention the synchronised headings of `h` support: the heading
