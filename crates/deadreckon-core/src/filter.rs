@@ -331,6 +331,27 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
         }
     }
 
+    /// [`Filter::predict_to`] with the yaw rate's process noise per step
+    /// `process_yaw_rate_rps` instead of the vehicle's (a wheel epoch
+    /// without a gyro reading: `Noise::gyro_gap_process_yaw_rate_rps`).
+    pub fn predict_to_with_yaw_rate_noise(
+        &mut self,
+        t_s: f64,
+        process_yaw_rate_rps: f64,
+        copy_out: bool,
+    ) -> Option<Prediction<N>> {
+        let own = self.noise.process_yaw_rate_rps;
+        self.noise.process_yaw_rate_rps = process_yaw_rate_rps;
+        let out = if copy_out {
+            Some(self.predict_to(t_s))
+        } else {
+            self.advance_to(t_s);
+            None
+        };
+        self.noise.process_yaw_rate_rps = own;
+        out
+    }
+
     /// [`Filter::predict_to`] without copying the predicted state and
     /// covariance out: returns the car block of F only.
     pub fn advance_to(&mut self, t_s: f64) -> Mat {

@@ -107,6 +107,18 @@ pub struct Noise {
     /// bias the fixes last showed instead of the calibration drive's mean.
     #[serde(skip_serializing_if = "is_zero")]
     pub gyro_bias_walk_rps_per_sqrt_s: f64,
+    /// The yaw rate's process noise per `process_step_s` at a wheel epoch
+    /// without a gyro reading of its own while the gyro is live, rad/s
+    /// (default 0: `process_yaw_rate_rps`, table I's, at every epoch).
+    /// Table I's 1 rad/s per 20 ms leaves the yaw rate to whichever sensor
+    /// reads it; at an epoch whose gyro reading came a few milliseconds late
+    /// (the ECUs' clocks and stamp jitter) that is the wheels' speed
+    /// difference over one wheel period, whose error the next epochs' gyro
+    /// does not take back: above 0, the yaw rate keeps what the last
+    /// reading gave, changing by about this much per step
+    /// ([`crate::gyro_hold`]).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub gyro_gap_process_yaw_rate_rps: f64,
     /// χ² gate (1 degree of freedom) of each wheel reading, ticks or speed
     /// (default [`GROSS_FAULT_CHI2`]: only gross faults such as a spinning
     /// wheel or a counter glitch are rejected; `inf` switches the gate off).
@@ -241,6 +253,7 @@ impl Default for Noise {
             gnss_wander_std_m: 0.0,
             gnss_wander_tau_s: DEFAULT_GNSS_WANDER_TAU_S,
             gyro_bias_walk_rps_per_sqrt_s: 0.0,
+            gyro_gap_process_yaw_rate_rps: 0.0,
             wheel_gate_chi2: GROSS_FAULT_CHI2,
             gyro_gate_chi2: GROSS_FAULT_CHI2,
             speed_gate_chi2: GROSS_FAULT_CHI2,
@@ -484,6 +497,13 @@ impl Vehicle {
             return Err(Error::InvalidVehicle(format!(
                 "noise.gyro_bias_walk_rps_per_sqrt_s must be a non-negative number (0: a constant bias), got {}",
                 n.gyro_bias_walk_rps_per_sqrt_s
+            )));
+        }
+        if !(n.gyro_gap_process_yaw_rate_rps.is_finite() && n.gyro_gap_process_yaw_rate_rps >= 0.0)
+        {
+            return Err(Error::InvalidVehicle(format!(
+                "noise.gyro_gap_process_yaw_rate_rps must be a non-negative number (0: table I's at every epoch), got {}",
+                n.gyro_gap_process_yaw_rate_rps
             )));
         }
         if !(n.gnss_wander_tau_s.is_finite() && n.gnss_wander_tau_s > 0.0) {

@@ -505,7 +505,21 @@ impl Feeder {
                         }
                         self.release(f, epoch);
                     }
-                    let prediction = self.predict(f, t);
+                    // A gyro reading late by a few milliseconds leaves this
+                    // epoch without one: the yaw rate keeps the last
+                    // reading's instead of taking the wheels' (gyro_hold).
+                    let gap_q = f.noise().gyro_gap_process_yaw_rate_rps;
+                    let prediction = if gap_q > 0.0
+                        && use_.gyro
+                        && self.pending_gyro.is_none()
+                        && self.gyro.is_live(t)
+                    {
+                        self.stats.gyro_gap_epochs += 1;
+                        let q = gap_q.min(f.noise().process_yaw_rate_rps);
+                        f.predict_to_with_yaw_rate_noise(t, q, self.predictions)
+                    } else {
+                        self.predict(f, t)
+                    };
                     if use_.wheels && !at_start {
                         if gap {
                             self.stats.wheel_gaps += 1;

@@ -85,6 +85,11 @@ pub struct FilterStats {
     /// ([`crate::gyro_hold`]).
     #[serde(default)]
     pub steering_deferred: usize,
+    /// Wheel epochs without a gyro reading of their own while the gyro was
+    /// live, predicted with `Noise::gyro_gap_process_yaw_rate_rps` (0 when
+    /// that is off).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub gyro_gap_epochs: usize,
     /// GNSS fixes used.
     pub gnss_updates: usize,
     /// GNSS fixes rejected by the Mahalanobis gate.
@@ -143,4 +148,9 @@ impl<const N: usize> EpochHook<N> for () {
     fn is_noop(&self) -> bool {
         true
     }
+}
+
+/// Whether a count is zero (not written to JSON).
+fn is_zero(n: &usize) -> bool {
+    *n == 0
 }
