@@ -326,7 +326,7 @@ fn calibrated_parameters_within_their_error_bars_with_better_gyros() {
 
 /// The check on cars no choice was made on.
 #[test]
-#[ignore = "slow: 24 cars, two calibrations and three filter runs each"]
+#[ignore = "slow: 24 cars, two calibrations, a wander fit and four filter runs each"]
 fn calibrated_parameters_within_their_error_bars_on_cars_no_choice_saw() {
     let t = table(CHECK_CARS);
     // Measured (cars 89–112): every parameter within 3σ on 24/24, the gyro
