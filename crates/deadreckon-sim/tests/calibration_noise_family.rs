@@ -25,6 +25,21 @@
 //! average at every point of the windows (`consistency::Verdict`), as
 //! `consistency.rs` judges it.
 //!
+//! Why the pose NEES is over-confident (issue 36's second stop, measured by
+//! `pose_nees_decomposed_on_the_choice_cars`): not the calibrated
+//! parameters (the true ones give the same NEES within ±25 %; the six
+//! parameters carried as states with their calibrated variance change the
+//! end-of-window NEES by −55 %…+55 %, the yaw σ by 0.1–0.3 mrad), but the pose
+//! the GNSS-aided filter hands over at the window's start, 0.7–2.1 m off
+//! where the filter says 0.1–0.2 m: the receiver's wander (Gauss–Markov,
+//! 0–1.5 m) and its latency (0–0.15 s), which a filter taking the fixes as
+//! white and prompt averages away. The NEES is largest at the start and
+//! falls through the window as the dead reckoning's own growth dominates;
+//! with white prompt fixes and the true parameters it is 1–4 per degree of
+//! freedom. The filter carrying the receiver's wander
+//! (`deadreckon_core::gnss_error`) with (σ, τ) fitted on the calibration
+//! drive's own fixes (`deadreckon_core::wander_fit`) is printed beside it.
+//!
 //! Cars 65–88 chose the default (yaw noise and batch count); cars 89–112
 //! check it (no choice was made on them; slow, `#[ignore]`d):
 //!
@@ -109,6 +124,11 @@ struct Member {
     k: f64,
     /// The pose NEES with the covariance inflated by `k²`.
     pose_bound: Verdict,
+    /// The receiver's wander fitted on the calibration drive
+    /// (`deadreckon_core::wander_fit`), `None` for white fixes.
+    wander: Option<deadreckon_core::gnss_error::Wander>,
+    /// The pose NEES with the filter carrying that wander.
+    pose_wander: Verdict,
 }
 
 /// The verdict on the NEES `values` (per point of the windows, `dof`
@@ -146,6 +166,16 @@ fn member(seed: u64) -> Result<Member, String> {
     let w = windows(&ev.drive, 30.0, 60.0, 60.0);
     let n = nees_through_windows(&ev.drive, params, &w, &FilterOptions::default())
         .map_err(|e| e.to_string())?;
+    let wander = deadreckon_core::wander_fit::fit(&cal.drive, params, &FilterOptions::default())
+        .map_err(|e| e.to_string())?
+        .best;
+    let mut carried = ev.drive.clone();
+    if let Some(wd) = wander {
+        carried.vehicle.noise.gnss_wander_std_m = wd.std_m;
+        carried.vehicle.noise.gnss_wander_tau_s = wd.tau_s;
+    }
+    let nw = nees_through_windows(&carried, params, &w, &FilterOptions::default())
+        .map_err(|e| e.to_string())?;
     Ok(Member {
         seed,
         gyro_rps,
@@ -154,6 +184,8 @@ fn member(seed: u64) -> Result<Member, String> {
         pose: n.pose.verdict(),
         k: fit.k,
         pose_bound: scaled_verdict(&n.pose.values, n.pose.dof, fit.k * fit.k),
+        wander,
+        pose_wander: nw.pose.verdict(),
     })
 }
 
@@ -172,6 +204,19 @@ struct Table {
     bias_rms_z: (f64, f64),
     /// Pose NEES consistent: the filter's covariance, inflated by `k²`.
     consistent: (usize, usize),
+    /// Pose NEES consistent with the filter carrying the receiver's wander
+    /// fitted on the calibration drive.
+    consistent_wander: usize,
+    /// The largest factor of those verdicts (over- or under-confident).
+    worst_wander: f64,
+}
+
+/// A verdict's factor (1 when consistent).
+fn factor(v: &Verdict) -> f64 {
+    match v {
+        Verdict::Consistent => 1.0,
+        Verdict::OverConfident(k) | Verdict::UnderConfident(k) => *k,
+    }
 }
 
 fn table(cars: std::ops::RangeInclusive<u64>) -> Table {
@@ -192,14 +237,19 @@ fn table(cars: std::ops::RangeInclusive<u64>) -> Table {
     };
     for m in &ms {
         println!(
-            "{:3} | {:.5} | {} | {} | {} | k {:.2}: {}",
+            "{:3} | {:.5} | {} | {} | {} | k {:.2}: {} | wander {}: {}",
             m.seed,
             m.gyro_rps,
             f(&m.z),
             f(&m.z_vehicle),
             m.pose,
             m.k,
-            m.pose_bound
+            m.pose_bound,
+            m.wander.map_or("white".to_string(), |w| format!(
+                "{:.2} m {:.0} s",
+                w.std_m, w.tau_s
+            )),
+            m.pose_wander
         );
     }
     let n = ms.len();
@@ -219,11 +269,17 @@ fn table(cars: std::ops::RangeInclusive<u64>) -> Table {
             count(&|m| m.pose == Verdict::Consistent),
             count(&|m| m.pose_bound == Verdict::Consistent),
         ),
+        consistent_wander: count(&|m| m.pose_wander == Verdict::Consistent),
+        worst_wander: ms
+            .iter()
+            .map(|m| factor(&m.pose_wander))
+            .fold(1.0, f64::max),
     };
     println!(
         "default: every parameter within 3σ {}/{n}, the gyro bias {}/{n} (RMS z {:.2}); \
          passes at the vehicle's yaw noise: {}/{n}, {}/{n} (RMS z {:.2}); \
-         pose NEES consistent {}/{n} ({}/{n} with the bound's k²)",
+         pose NEES consistent {}/{n} ({}/{n} with the bound's k²); with the receiver's \
+         wander fitted on the calibration drive {}/{n} (worst ×{:.1})",
         t.within.0,
         t.bias_within.0,
         t.bias_rms_z.0,
@@ -232,6 +288,8 @@ fn table(cars: std::ops::RangeInclusive<u64>) -> Table {
         t.bias_rms_z.1,
         t.consistent.0,
         t.consistent.1,
+        t.consistent_wander,
+        t.worst_wander,
     );
     t
 }
@@ -245,6 +303,17 @@ fn calibrated_parameters_within_their_error_bars_with_better_gyros() {
     // wide); at the vehicle's yaw noise 23/24 (car 74, −3.22σ), RMS z 0.97.
     // With the lag-1 standard errors alone (before): 22/24 and 20/24, RMS
     // z 1.65 and 1.97. The pose NEES: see the check below.
+    // The pose NEES (issue 36's second stop, `pose_nees_decomposed_on_the_
+    // choice_cars`): over-confident on 24/24 (×1.9–×276) with the
+    // five-state filter, whose fixes are white; the excess is the pose
+    // handed over at the window's start (the receiver's wander and
+    // latency, not the parameters: the true ones read the same). With the
+    // filter carrying the receiver's wander fitted on the calibration
+    // drive (`wander_fit`): 12/24 consistent, the rest ×1.6–×3.4 (over
+    // on 6, under on 6).
+    assert_eq!(t.consistent.0, 0);
+    assert_eq!(t.consistent_wander, 12, "the wander carried");
+    assert!(t.worst_wander < 3.6, "worst ×{}", t.worst_wander);
     assert_eq!(t.n, 24);
     assert_eq!(t.within.0, 24, "every parameter within 3σ");
     assert!(t.within.1 <= 23);
@@ -257,7 +326,7 @@ fn calibrated_parameters_within_their_error_bars_with_better_gyros() {
 
 /// The check on cars no choice was made on.
 #[test]
-#[ignore = "slow: 24 cars, two calibrations and three filter runs each"]
+#[ignore = "slow: 24 cars, two calibrations, a wander fit and four filter runs each"]
 fn calibrated_parameters_within_their_error_bars_on_cars_no_choice_saw() {
     let t = table(CHECK_CARS);
     // Measured (cars 89–112): every parameter within 3σ on 24/24, the gyro
@@ -283,6 +352,13 @@ fn calibrated_parameters_within_their_error_bars_on_cars_no_choice_saw() {
     );
     assert!(t.within.1 <= 21 && t.bias_rms_z.1 > 1.5);
     assert_eq!(t.consistent, (0, 0));
+    // With the filter carrying the receiver's wander fitted on the
+    // calibration drive (chosen on cars 65–88: 12/24), measured once here:
+    // 7/24 consistent, the rest ×1.8–×5.9 over or under, and car 107
+    // under-confident by ×12.9 (its wander fitted at 1.0 m; its white
+    // five-state verdict ×101 over). The issue's NEES bar is not met.
+    assert_eq!(t.consistent_wander, 7, "the wander carried");
+    assert!(t.worst_wander < 14.0, "worst ×{}", t.worst_wander);
 }
 
 /// Issue 36's case, a new user's drive: the built-in calibration scenario
@@ -350,4 +426,210 @@ fn car_30s_late_heading_calibrates_in_the_core_with_either_yaw_noise() {
             "{z:?}"
         );
     }
+}
+
+/// Collects `(t, x, P)` of the car block at every epoch of any layout.
+struct Epochs(
+    Vec<(
+        f64,
+        deadreckon_core::model::State,
+        deadreckon_core::model::Mat,
+    )>,
+);
+
+impl<const N: usize> deadreckon_core::ekf::EpochHook<N> for Epochs {
+    fn after_epoch(
+        &mut self,
+        t: f64,
+        x: &mut nalgebra::SVector<f64, N>,
+        p: &mut nalgebra::SMatrix<f64, N, N>,
+    ) {
+        self.0.push((
+            t,
+            x.fixed_rows::<5>(0).into_owned(),
+            p.fixed_view::<5, 5>(0, 0).into_owned(),
+        ));
+    }
+}
+
+/// The window points of the decomposition: the start (the last epoch before
+/// the window) and the consistency's four.
+const DECOMPOSED_POINTS: [f64; 5] = [0.0, 0.25, 0.5, 0.75, 1.0];
+
+/// Mean NEES per degree of freedom over the windows at each point of
+/// [`DECOMPOSED_POINTS`]: `[position (2), heading (1), pose (3)]`, and the
+/// RMS errors (position m, heading rad) with the filter's RMS σ. With
+/// `prior_std` the filter carries the six parameters as states starting at
+/// `params` with those standard deviations (the augmented filter: their
+/// uncertainty enters the pose's covariance).
+fn decomposed(
+    drive: &deadreckon_core::Drive,
+    params: &Params,
+    prior_std: Option<&Params>,
+    w: &[(f64, f64)],
+) -> Vec<([f64; 3], [f64; 4])> {
+    use deadreckon_core::model::{X, Y, YAW};
+    let truth = deadreckon_core::reference::Reference::from_truth(&drive.truth).unwrap();
+    let opts = FilterOptions {
+        gnss_outages: w.to_vec(),
+        record_epochs: false,
+        ..FilterOptions::default()
+    };
+    let mut hook = Epochs(Vec::new());
+    if let Some(sd) = prior_std {
+        let f = deadreckon_core::ekf::augmented_filter(drive, params, sd, &opts).unwrap();
+        deadreckon_core::ekf::run_filter(drive, f, &opts, &mut hook).unwrap();
+    } else if drive.vehicle.noise.gnss_wander_std_m > 0.0 {
+        use deadreckon_core::gnss_error::{CarWanderLayout, N_WANDER};
+        let f =
+            deadreckon_core::ekf::fixed_filter::<CarWanderLayout, N_WANDER>(drive, params, &opts)
+                .unwrap();
+        deadreckon_core::ekf::run_filter(drive, f, &opts, &mut hook).unwrap();
+    } else {
+        deadreckon_core::ekf::run(drive, params, &opts, &mut hook).unwrap();
+    }
+    let s = hook.0;
+    DECOMPOSED_POINTS
+        .iter()
+        .map(|f| {
+            let (mut acc, mut err, mut m) = ([0.0; 3], [0.0; 4], 0.0);
+            for &(a, b) in w {
+                let t = a + f * (b - a);
+                let k = if *f == 0.0 {
+                    s.partition_point(|e| e.0 < a)
+                } else {
+                    s.partition_point(|e| e.0 <= t)
+                };
+                let Some((ts, x, p)) = k.checked_sub(1).map(|k| &s[k]) else {
+                    continue;
+                };
+                let Some(r) = truth.state_at(*ts) else {
+                    continue;
+                };
+                let e = nalgebra::Vector3::new(
+                    x[X] - r[X],
+                    x[Y] - r[Y],
+                    deadreckon_core::angle::diff(x[YAW], r[YAW]),
+                );
+                let p3: nalgebra::Matrix3<f64> = p.fixed_view::<3, 3>(0, 0).into_owned();
+                let p2: nalgebra::Matrix2<f64> = p.fixed_view::<2, 2>(0, 0).into_owned();
+                let e2 = nalgebra::Vector2::new(e[0], e[1]);
+                acc[0] += (e2.transpose() * p2.try_inverse().unwrap() * e2)[0] / 2.0;
+                acc[1] += e[2] * e[2] / p3[(2, 2)];
+                acc[2] += (e.transpose() * p3.try_inverse().unwrap() * e)[0] / 3.0;
+                err[0] += e2.norm_squared();
+                err[1] += p2.trace();
+                err[2] += e[2] * e[2];
+                err[3] += p3[(2, 2)];
+                m += 1.0;
+            }
+            (acc.map(|v| v / m), err.map(|v| (v / m).sqrt()))
+        })
+        .collect()
+}
+
+/// Issue 36's diagnosis: the pose NEES decomposed (window start against
+/// end, position against heading) with the calibrated parameters, the true
+/// ones, and the true ones on the same car with white fixes (no receiver
+/// wander).
+#[test]
+#[ignore = "diagnostic: prints the decomposition"]
+fn pose_nees_decomposed_on_the_choice_cars() {
+    let rows: Vec<String> = CHOICE_CARS
+        .into_par_iter()
+        .map(|seed| {
+            let (s, _) = scenario(seed, 100 + seed);
+            let cal = simulate(&s, 100 + seed).unwrap();
+            let c = calibrate(&cal.drive, &CalibrationOptions::default()).unwrap();
+            let (s, _) = scenario(seed, 200 + seed);
+            let ev = simulate(&s, 200 + seed).unwrap();
+            let w = windows(&ev.drive, 30.0, 60.0, 60.0);
+            let mut white = s.clone();
+            if let Some(g) = white.sensors.gnss.as_mut() {
+                g.markov_std_m = 0.0;
+            }
+            let evw = simulate(&white, 200 + seed).unwrap();
+            let mut prompt = white.clone();
+            if let Some(g) = prompt.sensors.gnss.as_mut() {
+                g.latency_s = 0.0;
+            }
+            let evp = simulate(&prompt, 200 + seed).unwrap();
+            let mut wandering = ev.drive.clone();
+            let g = s.sensors.gnss.as_ref().unwrap();
+            wandering.vehicle.noise.gnss_wander_std_m = g.markov_std_m.max(0.05);
+            wandering.vehicle.noise.gnss_wander_tau_s = g.markov_tau_s;
+            let mut out = format!(
+                "car {seed}: latency {:.3} s, markov {:.2} m, fix std {:.2} m, bias err {:+.2e} ± {:.1e}\n",
+                s.sensors.gnss.as_ref().unwrap().latency_s,
+                s.sensors.gnss.as_ref().unwrap().markov_std_m,
+                s.sensors.gnss.as_ref().unwrap().std_m,
+                c.estimate.params.gyro_bias_rps - cal.truth_params.gyro_bias_rps,
+                c.estimate.std.gyro_bias_rps
+            );
+            let sd = Some(&c.estimate.std);
+            for (name, d, p, prior) in [
+                ("calibrated", &ev.drive, &c.estimate.params, None),
+                ("calibrated, as states", &ev.drive, &c.estimate.params, sd),
+                ("truth", &ev.drive, &cal.truth_params, None),
+                ("truth, white fixes", &evw.drive, &cal.truth_params, None),
+                ("truth, white, prompt", &evp.drive, &cal.truth_params, None),
+                ("calibrated, wander", &wandering, &c.estimate.params, None),
+            ] {
+                let r = decomposed(d, p, prior, &w);
+                out += &format!("  {name:21}");
+                for (f, (n, e)) in DECOMPOSED_POINTS.iter().zip(&r) {
+                    out += &format!(
+                        " | {f:.2}: pos {:7.1} yaw {:7.1} pose {:7.1} (e {:.2}/{:.2} m, {:.4}/{:.4} rad)",
+                        n[0], n[1], n[2], e[0], e[1], e[2], e[3]
+                    );
+                }
+                out += "\n";
+            }
+            out
+        })
+        .collect();
+    for r in rows {
+        print!("{r}");
+    }
+}
+
+/// Issue 36's second stop: `nees_through_windows` ran the five-state filter
+/// whatever the vehicle declared, so a vehicle with the receiver's wander
+/// (`noise.gnss_wander_std_m`) was judged on a filter it does not run. Now
+/// the pose NEES is the wander filter's: the same as its car block through
+/// the same windows, averaged by hand.
+#[test]
+fn the_nees_ran_the_five_state_filter_whatever_the_vehicle_declared() {
+    let (s, _) = scenario(68, 268);
+    let sim = simulate(&s, 268).unwrap();
+    let (mut drive, truth_params) = (sim.drive, sim.truth_params);
+    let w = windows(&drive, 30.0, 60.0, 60.0);
+    let white = nees_through_windows(&drive, &truth_params, &w, &FilterOptions::default())
+        .unwrap()
+        .pose;
+    drive.vehicle.noise.gnss_wander_std_m = 1.0;
+    drive.vehicle.noise.gnss_wander_tau_s = 120.0;
+    let wander = nees_through_windows(&drive, &truth_params, &w, &FilterOptions::default())
+        .unwrap()
+        .pose;
+    let by_hand = decomposed(&drive, &truth_params, None, &w);
+    for (j, p) in wander.points.iter().enumerate() {
+        // DECOMPOSED_POINTS[j + 1] is WINDOW_POINTS[j]; its pose column is
+        // the NEES per degree of freedom.
+        let hand = 3.0 * by_hand[j + 1].0[2];
+        assert!(
+            (p.nees - hand).abs() < 1e-9 * hand.max(1.0),
+            "{} against {hand}",
+            p.nees
+        );
+    }
+    // Car 68 (wander 1.16 m): the white filter's end NEES is ×100 the
+    // wander filter's (measured: 290 and 2.7).
+    let end = |b: &deadreckon_core::consistency::BlockNees| b.points.last().unwrap().nees;
+    println!(
+        "end NEES: white {:.1}, wander {:.1}",
+        end(&white),
+        end(&wander)
+    );
+    assert!(end(&white) > 30.0 * end(&wander));
 }
