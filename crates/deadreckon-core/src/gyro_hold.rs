@@ -30,6 +30,13 @@
 //! under-rates its wheel-speed noise (tone-ring jitter differenced at
 //! 100 Hz), which a reused reading covered.
 //!
+//! What the wheels give at such an epoch is held down instead by
+//! [`crate::vehicle::Noise::gyro_gap_process_yaw_rate_rps`] (off by
+//! default, a model option `--corrections auto` judges on held-back GNSS,
+//! [`crate::model_options`]): the epoch's prediction gives the yaw rate a
+//! physical process noise, so it keeps the last reading's value unless the
+//! wheels clearly say otherwise; the reading itself is still used once.
+//!
 //! A reading keeps the gyro live for [`HOLD_INTERVALS`] times the gyro's
 //! typical interval (an exponential average of the intervals between its
 //! readings, weight [`INTERVAL_WEIGHT`]), and never longer than

@@ -48,9 +48,9 @@ pub const GNSS_RECOVERY_AFTER_S: f64 = 10.0;
 /// chosen on the dynamic family's cars 1–30 with the `clocks` effect alone
 /// among 0.03 and 0.1 (mean final error of 30 s outages 0.476 and 0.523 m
 /// against 0.584 m without it and 0.432 m without the clocks; 100 Hz
-/// wheel speeds 0.399 and 0.514 m against 0.549 m; the scratch experiment
-/// is described in docs/dynamics.md, "A gyro reading a few milliseconds
-/// late"). The held-out cars 101–110 are in
+/// wheel speeds 0.399 and 0.514 m against 0.549 m;
+/// `deadreckon-api/tests/clock_parts.rs`, docs/dynamics.md). Checked on
+/// held-out cars 101–110 through `--corrections auto` in
 /// `deadreckon-api/tests/dynamic_family_defaults.rs`.
 pub const GYRO_GAP_PROCESS_YAW_RATE_RPS: f64 = 0.03;
 
