@@ -1,7 +1,9 @@
 //! The commands' own cost, beside the kernel's (`estimation.rs`): each
 //! command's library path end to end, reading the drive directory included
 //! ([`deadreckon_bench::command`]), on a simulated 10-minute and 1-hour
-//! drive (the calibration scenario, seed 1, written once).
+//! drive (the calibration scenario, seed 1, written once). `calibrate` is
+//! measured with each choice of corrections: the default (`auto`, chosen on
+//! held-back GNSS), `gnss` (the GNSS delay's steps alone) and `none`.
 //!
 //! Targets (issue 30, on the 2-core machines): `calibrate` with the default
 //! corrections under 0.12 s on the 10-minute drive, and at most 1.5 times

@@ -13,8 +13,12 @@ use deadreckon_core::timing::Which;
 /// A command as the command line runs it with its defaults.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Command {
-    /// `deadreckon calibrate DIR` (RTS, the default corrections).
+    /// `deadreckon calibrate DIR` (RTS, the default corrections: `auto`,
+    /// each chosen on held-back GNSS).
     Calibrate,
+    /// `deadreckon calibrate DIR --corrections gnss` (the GNSS delay's
+    /// steps without the held-back choice).
+    CalibrateGnss,
     /// `deadreckon calibrate DIR --corrections none`.
     CalibrateNone,
     /// `deadreckon evaluate DIR --outage 30 --step 10` (self-calibrating
@@ -27,18 +31,20 @@ pub enum Command {
 
 impl Command {
     /// Every command, in the order of the tables.
-    pub const ALL: [Command; 4] = [
+    pub const ALL: [Command; 5] = [
         Command::Calibrate,
+        Command::CalibrateGnss,
         Command::CalibrateNone,
         Command::EvaluateOutage,
         Command::Run,
     ];
 
     /// The name on the example's command line (`calibrate`,
-    /// `calibrate-none`, `evaluate-outage`, `run`).
+    /// `calibrate-gnss`, `calibrate-none`, `evaluate-outage`, `run`).
     pub fn name(self) -> &'static str {
         match self {
             Command::Calibrate => "calibrate",
+            Command::CalibrateGnss => "calibrate-gnss",
             Command::CalibrateNone => "calibrate-none",
             Command::EvaluateOutage => "evaluate-outage",
             Command::Run => "run",
@@ -49,6 +55,7 @@ impl Command {
     pub fn command_line(self) -> &'static str {
         match self {
             Command::Calibrate => "deadreckon calibrate DIR",
+            Command::CalibrateGnss => "deadreckon calibrate DIR --corrections gnss",
             Command::CalibrateNone => "deadreckon calibrate DIR --corrections none",
             Command::EvaluateOutage => "deadreckon evaluate DIR --outage 30 --step 10",
             Command::Run => "deadreckon run DIR --params nominal --out tracks.csv",
@@ -66,13 +73,13 @@ impl Command {
     pub fn run(self, dir: &Path, out: &Path) -> Result<usize, deadreckon_api::Error> {
         let load = Loader::default();
         match self {
-            Command::Calibrate | Command::CalibrateNone => {
+            Command::Calibrate | Command::CalibrateGnss | Command::CalibrateNone => {
                 let read = deadreckon_io::ReadOptions::default().without_truth();
                 let drive = load.drive_with(dir, &read)?;
-                let which = if self == Command::Calibrate {
-                    Which::default()
-                } else {
-                    Which::None
+                let which = match self {
+                    Command::CalibrateGnss => Which::Gnss,
+                    Command::CalibrateNone => Which::None,
+                    _ => Which::default(),
                 };
                 let cc = deadreckon_api::calibration::calibrate(
                     &drive,

@@ -36,7 +36,7 @@ use crate::chords::{chord_scale, ChordScale};
 use crate::drive::{Drive, Wheels};
 use crate::ekf::{self, FilterOptions, Init, Timing};
 use crate::kinematics::steering::{calibrate_steering_understeer, SteeringCalibration};
-use crate::model::{State, V, YAW_RATE};
+use crate::model::{V, YAW_RATE};
 use crate::observation::Sensors;
 use crate::reference::Reference;
 use crate::side_slip::SideSlip;
@@ -478,18 +478,17 @@ fn fitting_pass(
     let yaw_q = opts
         .smoothing_process_yaw_rad
         .unwrap_or(drive.vehicle.noise.process_yaw_rad);
-    let (sm, stats) = match opts.state {
+    let (t, x, stats) = match opts.state {
         PassState::Paper => {
             let f = ekf::car_filter(drive, p, &fopts)?.with_process_yaw_rad(yaw_q);
-            crate::checkpoint::smooth_car_states(drive, f, &fopts)?
+            crate::checkpoint::smooth_car_columns(drive, f, &fopts)?
         }
         PassState::Augmented => {
             let f = ekf::augmented_filter(drive, p, &opts.prior_std, &fopts)?
                 .with_process_yaw_rad(yaw_q);
-            crate::checkpoint::smooth_car_states(drive, f, &fopts)?
+            crate::checkpoint::smooth_car_columns(drive, f, &fopts)?
         }
     };
-    let (t, x): (Vec<f64>, Vec<State>) = sm.into_iter().unzip();
     let reference = Reference::from_states(t, x);
     let (mut est, samples) = least_squares(drive, &reference, opts.min_speed_mps, false)?;
     let chords = chord_scale(drive, &reference);

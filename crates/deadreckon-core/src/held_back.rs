@@ -71,6 +71,7 @@ use crate::outage;
 use crate::timing::{self, Corrections, DelayOptions, KnownCorrections, Status, Stream, Which};
 use crate::vehicle::Params;
 use crate::Error;
+use rayon::prelude::*;
 
 /// Longest held-back window, s: 20 s, the length of the outages `evaluate`
 /// reports on comma2k19 (long enough for a delay or a scale error to show
@@ -583,40 +584,81 @@ fn held_back_errors(
     folds: &[Vec<(f64, f64)>; 2],
     calibrated: Option<&[Option<Params>; 2]>,
 ) -> Result<HeldBackRun, Error> {
+    // The two folds are independent: run in parallel, merged in fold order
+    // (the same numbers as one after the other).
+    let per_fold: Vec<Result<Option<FoldRun>, Error>> = folds
+        .par_iter()
+        .enumerate()
+        .map(|(k, fold)| fold_run(drive, copts, initial, k, fold, calibrated))
+        .collect();
     let mut out = HeldBackRun {
         errors: Vec::new(),
         params: [None, None],
         recoveries: 0,
     };
-    for (k, fold) in folds.iter().enumerate().filter(|f| !f.1.is_empty()) {
-        let params = match calibrated {
-            Some(c) => match c[k] {
-                Some(p) => p,
-                None => continue,
-            },
-            None => {
-                let mut o = copts.clone();
-                o.filter.gnss_outages.extend_from_slice(fold);
-                if initial.is_some() {
-                    o.initial = initial;
-                }
-                match calibrate::calibrate_parameters(drive, &o) {
-                    Ok(c) => c.estimate.params,
-                    // A fold the calibration cannot take: judge with the start.
-                    Err(_) => match initial {
-                        Some(p) => p,
-                        None => continue,
-                    },
-                }
-            }
+    for (k, run) in per_fold.into_iter().enumerate() {
+        let Some(run) = run? else {
+            continue;
         };
-        out.params[k] = Some(params);
-        let ev = outage::through_windows_against_fixes(drive, &params, fold, &copts.filter)?;
-        out.recoveries += ev.gates.recovered(crate::filter::SensorKind::Gnss);
-        out.errors
-            .extend(ev.windows.iter().map(|w| (w.start_s, w.final_m())));
+        out.params[k] = Some(run.params);
+        out.recoveries += run.recoveries;
+        out.errors.extend(run.errors);
     }
     Ok(out)
+}
+
+/// One fold of [`held_back_errors`]: the parameters dead-reckoned with, the
+/// error at each window's end and the GNSS recoveries.
+struct FoldRun {
+    params: Params,
+    errors: WindowErrors,
+    recoveries: u64,
+}
+
+/// Fold `k` of [`held_back_errors`] (`None`: skipped, being empty or
+/// without parameters to judge with).
+fn fold_run(
+    drive: &Drive,
+    copts: &CalibrationOptions,
+    initial: Option<Params>,
+    k: usize,
+    fold: &[(f64, f64)],
+    calibrated: Option<&[Option<Params>; 2]>,
+) -> Result<Option<FoldRun>, Error> {
+    if fold.is_empty() {
+        return Ok(None);
+    }
+    let params = match calibrated {
+        Some(c) => match c[k] {
+            Some(p) => p,
+            None => return Ok(None),
+        },
+        None => {
+            let mut o = copts.clone();
+            o.filter.gnss_outages.extend_from_slice(fold);
+            if initial.is_some() {
+                o.initial = initial;
+            }
+            match calibrate::calibrate_parameters(drive, &o) {
+                Ok(c) => c.estimate.params,
+                // A fold the calibration cannot take: judge with the start.
+                Err(_) => match initial {
+                    Some(p) => p,
+                    None => return Ok(None),
+                },
+            }
+        }
+    };
+    let ev = outage::through_windows_against_fixes(drive, &params, fold, &copts.filter)?;
+    Ok(Some(FoldRun {
+        params,
+        recoveries: ev.gates.recovered(crate::filter::SensorKind::Gnss),
+        errors: ev
+            .windows
+            .iter()
+            .map(|w| (w.start_s, w.final_m()))
+            .collect(),
+    }))
 }
 
 /// The mean of `errors`, m (NaN when empty).
