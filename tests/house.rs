@@ -528,3 +528,25 @@ fn no_import_circle_among_the_modules_issue_34_separated() {
     }
     assert!(bad.is_empty(), "import circles back:\n{}", bad.join("\n"));
 }
+
+/// Regression (issue 34): the README was a research log (219 lines, the
+/// comma2k19 paragraph alone 40 lines of measurements); it is a guide, the
+/// measurements live in docs/. 199 lines when this was written.
+#[test]
+fn readme_is_a_guide_under_200_lines() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
+    let lines = readme.lines().count();
+    assert!(
+        lines < 200,
+        "README.md has {lines} lines: move detail to docs/"
+    );
+    // The two commands and the tour's start stay.
+    for must in [
+        "cargo run --release -- demo",
+        "cargo test --workspace --profile ci",
+        "deadreckon import comma2k19",
+    ] {
+        assert!(readme.contains(must), "README.md lost `{must}`");
+    }
+}
