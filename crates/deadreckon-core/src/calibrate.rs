@@ -36,8 +36,7 @@ use crate::chords::{chord_scale, ChordScale};
 use crate::drive::{Drive, Wheels};
 use crate::ekf::{self, FilterOptions, Init, Timing};
 use crate::kinematics::steering::{calibrate_steering_understeer, SteeringCalibration};
-use crate::model::{State, V, YAW_RATE};
-use crate::observation::Sensors;
+use crate::model::State;
 use crate::reference::Reference;
 use crate::side_slip::SideSlip;
 
