@@ -122,7 +122,39 @@ fn message(e: &anyhow::Error) -> String {
             msg.push_str(&c);
         }
     }
+    if let Some(hint) = e
+        .chain()
+        .find_map(|c| c.downcast_ref::<deadreckon_core::Error>())
+        .and_then(flag_hint)
+    {
+        msg.push_str(" (");
+        msg.push_str(hint);
+        msg.push(')');
+    }
     msg
+}
+
+/// The command line's words for a library error that a flag answers: the
+/// library's messages name no flag (its C, Python and ROS 2 users have
+/// none), so the CLI adds them here (issue 34).
+fn flag_hint(e: &deadreckon_core::Error) -> Option<&'static str> {
+    use deadreckon_core::{Error, Input, Need, Task};
+    match e {
+        Error::Insufficient {
+            need: Need::InitialPose,
+        } => Some("give one with --init-pose EAST_M,NORTH_M,YAW_RAD"),
+        Error::Insufficient {
+            need:
+                Need::Input {
+                    task: Task::GyroYaw,
+                    input: Input::Gyro,
+                },
+        } => Some("--yaw gyro needs one; --yaw odometry takes the yaw from the wheels"),
+        Error::NoiseTooHighForPerReadingTiming { .. } => Some(
+            "per-reading timing is --timing each; --timing wheel times them at the wheel epochs",
+        ),
+        _ => None,
+    }
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {

@@ -91,7 +91,8 @@ fn geojson_of_a_simulated_drive_failed_for_want_of_an_origin() {
     // An origin off the globe is refused and nothing is written.
     let st = sim("95,11.6", &d);
     assert!(!st.status.success());
-    assert!(String::from_utf8_lossy(&st.stderr).contains("latitude"));
+    // The key as vehicle.toml spells it (issue 34: core's errors carry the key).
+    assert!(String::from_utf8_lossy(&st.stderr).contains("origin.lat_deg"));
     assert!(!d.exists());
     let st = sim("48.1,11.6", &d);
     assert!(
@@ -782,7 +783,9 @@ fn an_origin_at_95_degrees_wrote_geojson_at_85_north() {
     let err = String::from_utf8_lossy(&st.stderr);
     assert!(!st.status.success());
     assert!(
-        err.contains("vehicle.toml") && err.contains("origin latitude must be within ±90°, got 95"),
+        // Issue 34: the key as the file spells it (was "origin latitude").
+        err.contains("vehicle.toml")
+            && err.contains("origin.lat_deg must be a number within ±90, got 95"),
         "{err}"
     );
     assert!(!out.exists());
@@ -801,7 +804,8 @@ fn an_origin_at_95_degrees_wrote_geojson_at_85_north() {
         .unwrap();
     let err = String::from_utf8_lossy(&st.stderr);
     assert!(
-        !st.status.success() && err.contains("origin height"),
+        !st.status.success()
+            && err.contains("origin.height_m must be metres above the WGS84 ellipsoid"),
         "{err}"
     );
 }

@@ -7,16 +7,11 @@
 
 use std::path::Path;
 
-use deadreckon_core::kinematics::diff_drive::{
-    self, calibrate_diff_drive, calibrate_held_back, evaluate_diff_drive, DiffDriveDrive,
-    DiffDriveOptions, DiffDriveOutages, FilterNoise, OutageStart, YawSource,
-};
+use deadreckon_core::kinematics::diff_drive::{DiffDriveDrive, YawSource};
 use deadreckon_core::kinematics::tricycle::{TricycleDrive, TricycleGeometry, TricycleParams};
-use deadreckon_core::kinematics::{
-    self, KinematicCalibration, KinematicModel, KinematicOptions, KinematicOutages, Shape,
-};
-use deadreckon_core::{Drive, Track};
-use deadreckon_io::kinematic_toml::{is_kinematic_params, KinematicParamsFile};
+use deadreckon_core::kinematics::{KinematicModel, Shape};
+use deadreckon_core::Drive;
+use deadreckon_io::kinematic_toml::is_kinematic_params;
 
 use crate::error::{invalid, While};
 use crate::load::check_range;

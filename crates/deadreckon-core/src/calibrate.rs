@@ -36,13 +36,11 @@ use crate::chords::{chord_scale, ChordScale};
 use crate::drive::{Drive, Wheels};
 use crate::ekf::{self, FilterOptions, Init, Timing};
 use crate::kinematics::steering::{calibrate_steering_understeer, SteeringCalibration};
-use crate::model::{V, YAW_RATE};
-use crate::observation::Sensors;
 use crate::reference::Reference;
 use crate::side_slip::SideSlip;
 
 use crate::vehicle::{Noise, Params, ParamsWithStd};
-use crate::Error;
+use crate::{Error, Input, Limit, Need, Rule, ScaleRejection, Task, Value};
 
 /// The largest speed process noise (m/s per `process_step_s`) with which
 /// the parameters are learnt under [`Timing::EachMeasurement`].
@@ -79,33 +77,26 @@ pub fn check_learning_noise(noise: &Noise, timing: Timing) -> Result<(), Error> 
     if timing != Timing::EachMeasurement {
         return Ok(());
     }
-    let over: Vec<String> = [
+    let over: Vec<Limit> = [
         (
-            "process_speed_mps",
+            "noise.process_speed_mps",
             noise.process_speed_mps,
             EACH_MAX_PROCESS_SPEED_MPS,
         ),
         (
-            "process_yaw_rate_rps",
+            "noise.process_yaw_rate_rps",
             noise.process_yaw_rate_rps,
             EACH_MAX_PROCESS_YAW_RATE_RPS,
         ),
     ]
     .iter()
     .filter(|(_, v, max)| *v > *max)
-    .map(|(k, v, max)| format!("noise.{k} = {v} (at most {max})"))
+    .map(|&(key, value, max)| Limit { key, value, max })
     .collect();
     if over.is_empty() {
         return Ok(());
     }
-    Err(Error::InvalidVehicle(format!(
-        "the parameters cannot be learnt with per-reading timing (--timing each) and {}: \
-         the readings between wheel rows would set the speed and yaw rate, and the \
-         calibration would read the GNSS fixes as speed (circumferences millimetres to \
-         metres off on simulated cars). Calibrate with --timing wheel, or lower these \
-         values in vehicle.toml's [noise]",
-        over.join(" and ")
-    )))
+    Err(Error::NoiseTooHighForPerReadingTiming { over })
 }
 
 /// Table I's yaw process noise for the RTS calibration's smoothing passes,
@@ -155,9 +146,11 @@ impl std::str::FromStr for Method {
             "rts" => Ok(Method::Rts),
             "zupt" => Ok(Method::Zupt),
             "truth" => Ok(Method::Truth),
-            _ => Err(Error::InvalidParams(format!(
-                "unknown calibration method `{s}` (rts, zupt, truth)"
-            ))),
+            _ => Err(Error::param(
+                "calibration method",
+                Value::Text(s.to_string()),
+                Rule::OneOf(&["rts", "zupt", "truth"]),
+            )),
         }
     }
 }
@@ -356,10 +349,11 @@ fn calibrate_with(
     drive.validate()?;
     if !(opts.min_speed_mps.is_finite() && opts.min_speed_mps >= 0.0) {
         // `--min-speed nan` calibrated on no epoch at all.
-        return Err(Error::InvalidParams(format!(
-            "the minimum speed must be a number of m/s, 0 or more, not {}",
-            opts.min_speed_mps
-        )));
+        return Err(Error::param(
+            "min_speed_mps",
+            opts.min_speed_mps,
+            Rule::NonNegative { zero_means: None },
+        ));
     }
     if opts.method == Method::Rts {
         check_learning_noise(&drive.vehicle.noise, opts.filter.timing)?;
@@ -371,9 +365,7 @@ fn calibrate_with(
         Method::Zupt => zupt(drive, &nominal),
         Method::Truth => {
             let reference = Reference::from_truth(&drive.truth).ok_or_else(|| {
-                Error::Insufficient(
-                    "truth calibration needs truth.csv with at least 3 poses".into(),
-                )
+                Error::needs(Task::TruthCalibration, Input::Truth { min_poses: 3 })
             })?;
             let (est, samples) = least_squares(drive, &reference, opts.min_speed_mps, true)?;
             Ok(Calibration {
@@ -513,9 +505,7 @@ fn rts_calibration(
     report: bool,
 ) -> Result<Calibration, Error> {
     if drive.gnss.len() < 2 {
-        return Err(Error::Insufficient(
-            "RTS calibration needs GNSS fixes (gnss.csv)".into(),
-        ));
+        return Err(Error::needs(Task::RtsCalibration, Input::Gnss));
     }
     let u = units(drive.vehicle.wheel_circumference_m);
     let scale = |p: &Params| -> DVector<f64> {
@@ -574,8 +564,9 @@ fn rts_calibration(
             g.params
         };
     }
-    let (last, (side_slip, steering)) =
-        last.ok_or_else(|| Error::Insufficient("no calibration pass ran".into()))?;
+    let (last, (side_slip, steering)) = last.ok_or(Error::Insufficient {
+        need: Need::CalibrationPass,
+    })?;
     if let Some(c) = last.chords.filter(|c| c.disagrees()) {
         let st = &last.stats;
         let circ = last.estimate.params.circumferences();
@@ -584,24 +575,19 @@ fn rts_calibration(
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
                 (a.min(x), b.max(x))
             });
-        return Err(Error::Rejected(format!(
-            "the calibrated distance scale disagrees with the GNSS chords by {:+.2}% ± {:.2}% \
-             ({:+.1} standard errors over {} blocks of {} s, p = {:.1e}): the smoothing \
-             filter did not follow the fixes ({} of {} rejected by its gate, {} recoveries; \
-             circumferences {:.4}–{:.4} m after {} passes)",
-            100.0 * c.mean,
-            100.0 * c.std,
-            c.sigmas(),
-            c.blocks,
-            crate::chords::BLOCK_S,
-            c.p_value(),
-            st.gnss_rejected,
-            st.gnss_updates + st.gnss_rejected,
-            st.gnss_recoveries,
-            lo,
-            hi,
-            history.len(),
-        )));
+        return Err(Error::Rejected(Box::new(ScaleRejection {
+            scale_error: c.mean,
+            scale_error_std: c.std,
+            standard_errors: c.sigmas(),
+            blocks: c.blocks,
+            block_s: crate::chords::BLOCK_S,
+            p_value: c.p_value(),
+            gnss_rejected: st.gnss_rejected,
+            gnss_fixes: st.gnss_updates + st.gnss_rejected,
+            gnss_recoveries: st.gnss_recoveries,
+            circumference_m: (lo, hi),
+            passes: history.len(),
+        })));
     }
     Ok(Calibration {
         estimate: last.estimate,
@@ -687,8 +673,9 @@ pub fn zupt(drive: &Drive, nominal: &Params) -> Result<Calibration, Error> {
         .map(|s| s.value)
         .collect();
     if vals.len() < 3 {
-        return Err(Error::Insufficient(
-            "ZUPT found no standstill of at least 1 s with gyro readings".into(),
+        return Err(Error::needs(
+            Task::ZuptCalibration,
+            Input::Standstill { min_s: 1.0 },
         ));
     }
     let n = vals.len() as f64;

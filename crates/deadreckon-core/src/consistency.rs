@@ -33,7 +33,7 @@ use crate::gyro_drift::{CarBiasLayout, CarWanderBiasLayout, N_BIAS, N_WANDER_BIA
 use crate::model::{self, Mat, State, V, X, Y, YAW, YAW_RATE};
 use crate::reference::Reference;
 use crate::vehicle::Params;
-use crate::Error;
+use crate::{Error, Input, Need, Task};
 
 /// The points of each window where the NEES is taken, as fractions of it.
 pub const WINDOW_POINTS: [f64; 4] = [0.25, 0.5, 0.75, 1.0];
@@ -171,7 +171,7 @@ impl Consistency {
 /// The 95 % bounds of the average of `m` NEES values of `n` degrees of freedom.
 pub fn averaged_nees_bounds(n: usize, m: usize) -> Result<(f64, f64), Error> {
     let k = (n * m) as f64;
-    let chi = ChiSquared::new(k).map_err(|e| Error::Insufficient(format!("χ²({k}): {e}")))?;
+    let chi = ChiSquared::new(k).map_err(|_| Error::from(Need::DegreesOfFreedom { dof: k }))?;
     let a = 0.5 * (1.0 - BOUND_PROBABILITY);
     Ok((
         chi.inverse_cdf(a) / m as f64,
@@ -248,9 +248,9 @@ pub fn nees_through_windows(
     base: &FilterOptions,
 ) -> Result<Consistency, Error> {
     let truth = Reference::from_truth(&drive.truth)
-        .ok_or_else(|| Error::Insufficient("NEES needs truth.csv".into()))?;
+        .ok_or_else(|| Error::needs(Task::Nees, Input::Truth { min_poses: 0 }))?;
     if windows.is_empty() {
-        return Err(Error::Insufficient("NEES needs at least one window".into()));
+        return Err(Error::needs(Task::Nees, Input::Window));
     }
     let opts = FilterOptions {
         gnss_outages: windows.to_vec(),

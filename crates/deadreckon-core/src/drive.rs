@@ -7,7 +7,7 @@
 //! increasing `t_s` (readers validate this; [`Drive::validate`] re-checks it).
 
 use crate::vehicle::Vehicle;
-use crate::Error;
+use crate::{DriveFault, Error};
 
 /// Ticks counted by each wheel encoder since the previous row.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -251,22 +251,35 @@ impl Drive {
     pub fn validate(&self) -> Result<(), Error> {
         self.vehicle.validate()?;
         if self.wheels.len() < 2 {
-            return Err(Error::InvalidDrive(
-                "the wheel stream needs at least two epochs".into(),
+            return Err(Error::drive(
+                "wheels",
+                DriveFault::TooFewSamples {
+                    min: 2,
+                    have: self.wheels.len(),
+                },
             ));
         }
-        fn check(name: &str, ts: impl Iterator<Item = f64>) -> Result<(), Error> {
+        fn check(name: &'static str, ts: impl Iterator<Item = f64>) -> Result<(), Error> {
             let mut prev = f64::NEG_INFINITY;
             for (i, t) in ts.enumerate() {
                 if !t.is_finite() {
-                    return Err(Error::InvalidDrive(format!(
-                        "{name}: sample {i} has a non-finite time"
-                    )));
+                    return Err(Error::drive(
+                        name,
+                        DriveFault::NonFiniteTime {
+                            index: Some(i),
+                            t_s: t,
+                        },
+                    ));
                 }
                 if t <= prev {
-                    return Err(Error::InvalidDrive(format!(
-                        "{name}: sample {i} at t={t} s is not after the previous one (t={prev} s)"
-                    )));
+                    return Err(Error::drive(
+                        name,
+                        DriveFault::NotIncreasing {
+                            index: i,
+                            t_s: t,
+                            previous_t_s: prev,
+                        },
+                    ));
                 }
                 prev = t;
             }
@@ -282,7 +295,10 @@ impl Drive {
                         && s.rl_mps.is_finite()
                         && s.rr_mps.is_finite())
                 }) {
-                    return Err(Error::InvalidDrive("wheel_speeds: non-finite speed".into()));
+                    return Err(Error::drive(
+                        "wheel_speeds",
+                        DriveFault::NonFinite { what: "speed" },
+                    ));
                 }
             }
         }
@@ -293,15 +309,28 @@ impl Drive {
         ] {
             check(name, s.iter().map(|s| s.t_s))?;
             if s.iter().any(|s| !s.value.is_finite()) {
-                return Err(Error::InvalidDrive(format!("{name}: non-finite value")));
+                return Err(Error::drive(name, DriveFault::NonFinite { what: "value" }));
             }
         }
         check("gnss", self.gnss.iter().map(|s| s.t_s))?;
-        if self.gnss.iter().any(|g| {
-            !(g.east_m.is_finite() && g.north_m.is_finite() && g.std_m.is_finite() && g.std_m > 0.0)
-        }) {
-            return Err(Error::InvalidDrive(
-                "gnss: non-finite position or non-positive std_m".into(),
+        if self
+            .gnss
+            .iter()
+            .any(|g| !(g.east_m.is_finite() && g.north_m.is_finite()))
+        {
+            return Err(Error::drive(
+                "gnss",
+                DriveFault::NonFinite { what: "position" },
+            ));
+        }
+        if self
+            .gnss
+            .iter()
+            .any(|g| !(g.std_m.is_finite() && g.std_m > 0.0))
+        {
+            return Err(Error::drive(
+                "gnss",
+                DriveFault::NotPositive { what: "std_m" },
             ));
         }
         check("truth", self.truth.iter().map(|s| s.t_s))?;
@@ -311,7 +340,7 @@ impl Drive {
         ] {
             check(name, s.iter().map(|s| s.t_s))?;
             if s.iter().any(|s| s.xyz().iter().any(|v| !v.is_finite())) {
-                return Err(Error::InvalidDrive(format!("{name}: non-finite value")));
+                return Err(Error::drive(name, DriveFault::NonFinite { what: "value" }));
             }
         }
         Ok(())

@@ -122,8 +122,9 @@ pub(crate) fn start(drive: &Drive, opts: &FilterOptions) -> Result<(f64, State, 
 fn start_validated(drive: &Drive, opts: &FilterOptions) -> Result<(f64, State, Mat), Error> {
     let (t0, x0, p0) = initial_state(drive, opts)?;
     if first_wheel_at_or_after(&drive.wheels, t0) + 1 >= drive.wheels.len() {
-        return Err(Error::Insufficient(
-            "no wheel epochs after the initial time".into(),
+        return Err(Error::needs(
+            crate::Task::Filter,
+            crate::Input::WheelEpochsAfterStart,
         ));
     }
     Ok((t0, x0, p0))

@@ -28,7 +28,7 @@
 //!
 //! Poses are planar here (z = 0, no roll or pitch), as they are in the files.
 
-use crate::{Error, Track, TrackPoint};
+use crate::{Error, Need, Rule, Track, TrackPoint};
 
 /// The evo release these functions are matched to.
 pub const EVO_VERSION: &str = "1.38.1";
@@ -265,10 +265,12 @@ fn associated<'a>(
     let et: Vec<f64> = estimate.points.iter().map(|p| p.t_s).collect();
     let pairs = associate(&rt, &et, max_diff_s);
     if pairs.is_empty() {
-        return Err(Error::Insufficient(format!(
-            "no poses of `{}` and `{}` are within {max_diff_s} s of each other",
-            reference.name, estimate.name
-        )));
+        return Err(Need::Association {
+            reference: reference.name.clone(),
+            estimate: estimate.name.clone(),
+            max_diff_s,
+        }
+        .into());
     }
     Ok(pairs
         .into_iter()
@@ -284,10 +286,7 @@ pub fn rpe(
     opts: &RpeOptions,
 ) -> Result<TrajectoryError, Error> {
     if !(opts.delta_m > 0.0 && opts.delta_m.is_finite()) {
-        return Err(Error::Insufficient(format!(
-            "the RPE's path delta must be a positive length, not {} m",
-            opts.delta_m
-        )));
+        return Err(Error::param("RPE delta_m", opts.delta_m, Rule::Positive));
     }
     let poses = associated(reference, estimate, opts.max_diff_s)?;
     let chooser: Vec<&TrackPoint> = poses
@@ -303,16 +302,16 @@ pub fn rpe(
         for w in chooser.windows(2) {
             path += (w[1].east_m - w[0].east_m).hypot(w[1].north_m - w[0].north_m);
         }
-        return Err(Error::Insufficient(format!(
-            "the {} path over the {} associated poses is {path:.1} m, \
-             shorter than the RPE's delta of {} m",
-            match opts.pairs_from {
+        return Err(Need::RpePath {
+            whose: match opts.pairs_from {
                 PairsFrom::Estimate => "estimate's",
                 PairsFrom::Reference => "reference's",
             },
-            poses.len(),
-            opts.delta_m
-        )));
+            poses: poses.len(),
+            path_m: path,
+            delta_m: opts.delta_m,
+        }
+        .into());
     }
     let mut errors_m = Vec::with_capacity(pairs.len());
     let mut t_s = Vec::with_capacity(pairs.len());
@@ -347,8 +346,9 @@ fn finish(matched: usize, t_s: Vec<f64>, errors_m: Vec<f64>) -> Result<Trajector
             what: "non-finite pose in a trajectory error".into(),
         });
     }
-    let stats = Stats::of(&errors_m)
-        .ok_or_else(|| Error::Insufficient("no trajectory errors to summarise".into()))?;
+    let stats = Stats::of(&errors_m).ok_or(Error::Insufficient {
+        need: Need::TrajectoryErrors,
+    })?;
     Ok(TrajectoryError {
         matched,
         t_s,

@@ -132,7 +132,13 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
             .copy_from(&p0);
         if L::param_index(0).is_some() {
             let sd = prior_std.ok_or_else(|| {
-                Error::InvalidParams("the augmented filter needs prior standard deviations".into())
+                Error::param(
+                    "prior_std",
+                    crate::Value::Unstated,
+                    crate::Rule::Said(
+                        "the augmented filter needs prior standard deviations".into(),
+                    ),
+                )
             })?;
             let c = params.circumferences();
             let cs = sd.circumferences();
@@ -152,16 +158,22 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
                 .filter_map(L::param_index)
                 .any(|j| p[(j, j)].is_nan() || p[(j, j)] <= 0.0)
             {
-                return Err(Error::InvalidParams(
-                    "prior standard deviations of the parameters must be positive".into(),
+                return Err(Error::param(
+                    "prior_std",
+                    crate::Value::Unstated,
+                    crate::Rule::Positive,
                 ));
             }
         }
         if let Some(w) = L::wander_index() {
             let sd = vehicle.noise.gnss_wander_std_m;
             if !(sd.is_finite() && sd > 0.0) {
-                return Err(Error::InvalidParams(
-                    "a filter with the receiver's wander needs noise.gnss_wander_std_m > 0".into(),
+                return Err(Error::param(
+                    "noise.gnss_wander_std_m",
+                    sd,
+                    crate::Rule::Said(
+                        "must be positive in a filter with the receiver's wander".into(),
+                    ),
                 ));
             }
             p[(w, w)] = sd * sd;

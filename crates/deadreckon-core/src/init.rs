@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 use crate::drive::{Drive, GnssFix};
 use crate::ekf::{FilterOptions, Init};
 use crate::model::{Mat, State};
-use crate::Error;
+use crate::{Error, Input, Task};
 
 /// Interpolated reference pose from the truth at `t`, as a full state (speed and
 /// yaw rate derived by finite differences where not given).
@@ -28,11 +28,8 @@ pub fn initial_state(drive: &Drive, opts: &FilterOptions) -> Result<(f64, State,
                     .map(|t| t.t_s)
                     .unwrap_or(f64::NEG_INFINITY),
             );
-            let x = truth_state(drive, t0).ok_or_else(|| {
-                Error::Insufficient(
-                    "initialisation from the truth needs truth.csv covering the drive".into(),
-                )
-            })?;
+            let x = truth_state(drive, t0)
+                .ok_or_else(|| Error::needs(Task::InitFromTruth, Input::TruthCovering))?;
             let p = Mat::from_diagonal(&State::from([1e-4, 1e-4, 1e-6, 1e-2, 1e-4]));
             Ok((t0, x, p))
         }
@@ -107,10 +104,13 @@ impl GnssInit {
 
     /// Why no start was found.
     pub fn why_not(&self) -> Error {
-        Error::Insufficient(if self.first.is_none() {
-            "initialisation from GNSS needs at least one fix".into()
-        } else {
-            "initialisation from GNSS needs the vehicle to move 10 m".into()
-        })
+        Error::needs(
+            Task::InitFromGnss,
+            if self.first.is_none() {
+                Input::GnssFix
+            } else {
+                Input::Travel { distance_m: 10.0 }
+            },
+        )
     }
 }

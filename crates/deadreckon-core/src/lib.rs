@@ -34,6 +34,7 @@ pub mod consistency;
 mod cursor;
 pub mod drive;
 pub mod ekf;
+mod error;
 pub mod event;
 pub mod evo;
 pub mod filter;
@@ -74,43 +75,6 @@ pub use drive::Drive;
 pub use track::{Track, TrackPoint};
 pub use vehicle::{Params, ParamsWithStd, Vehicle};
 
-/// Errors of the core library.
-#[derive(Debug, thiserror::Error)]
-#[non_exhaustive]
-pub enum Error {
-    /// The drive breaks an invariant (unsorted time, non-finite value, too short).
-    #[error("invalid drive: {0}")]
-    InvalidDrive(String),
-    /// An event earlier than the one before it: a stream's events must be
-    /// in time order (equal times are fine).
-    #[error(
-        "invalid drive: event at t={t_s} s comes after one at t={previous_t_s} s: events must be in time order"
-    )]
-    OutOfOrder {
-        /// The event's time, s.
-        t_s: f64,
-        /// The time of the event before it, s.
-        previous_t_s: f64,
-    },
-    /// The vehicle description is not usable.
-    #[error("invalid vehicle: {0}")]
-    InvalidVehicle(String),
-    /// Calibration parameters are not usable.
-    #[error("invalid parameters: {0}")]
-    InvalidParams(String),
-    /// A covariance lost positive definiteness or a matrix could not be inverted.
-    #[error("numerical failure at t={t_s} s: {what}")]
-    Numerical {
-        /// Timestamp of the failing step.
-        t_s: f64,
-        /// What failed.
-        what: String,
-    },
-    /// The data cannot support the requested computation (e.g. no GNSS for RTS calibration).
-    #[error("insufficient data: {0}")]
-    Insufficient(String),
-    /// An estimate the data contradict, refused rather than kept (a
-    /// calibrated distance scale the GNSS chords disagree with).
-    #[error("estimate rejected: {0}")]
-    Rejected(String),
-}
+pub use error::{
+    DriveFault, Error, Input, Invalid, Limit, Need, Rule, ScaleRejection, Task, Value,
+};

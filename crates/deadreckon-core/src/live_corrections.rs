@@ -98,7 +98,9 @@ impl LiveCorrections {
     /// The corrections `known` on a live stream (checked:
     /// [`KnownCorrections::validate`]).
     pub fn new(known: &KnownCorrections) -> Result<Self, Error> {
-        known.validate().map_err(Error::InvalidParams)?;
+        known.validate().map_err(|m| {
+            Error::param("corrections", crate::Value::Unstated, crate::Rule::Said(m))
+        })?;
         let slip = known.traction_slip_per_mps2 != 0.0 && known.traction_mean_force_mps2.is_some();
         let mut hold_s = known.delays_s.iter().fold(0.0_f64, |m, d| m.max(*d));
         if slip {
@@ -152,7 +154,13 @@ impl LiveCorrections {
     ) -> Result<(), Error> {
         let t = ev.t_s;
         if !t.is_finite() {
-            return Err(Error::InvalidDrive(format!("event time {t} is not finite")));
+            return Err(Error::drive(
+                "events",
+                crate::DriveFault::NonFiniteTime {
+                    index: None,
+                    t_s: t,
+                },
+            ));
         }
         if let Some(last) = self.last_input_s {
             if t < last {

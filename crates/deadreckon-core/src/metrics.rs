@@ -17,7 +17,7 @@ use crate::filter::GateCounts;
 use crate::model::{Mat, State, X, Y, YAW};
 use crate::reference::Reference;
 use crate::vehicle::Params;
-use crate::Error;
+use crate::{Error, Input, Need, Task};
 
 /// Summary statistics of a sample.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -193,13 +193,11 @@ impl EpochHook for ResetHook<'_> {
 
 /// Refuses a length that is not a finite positive number (`--segment-m 0`,
 /// `--threshold-m=-1` and NaN printed inf/NaN tables).
-fn positive(what: &str, v: f64) -> Result<(), Error> {
+fn positive(what: &'static str, v: f64) -> Result<(), Error> {
     if v.is_finite() && v > 0.0 {
         Ok(())
     } else {
-        Err(Error::InvalidParams(format!(
-            "{what} must be a positive number, not {v}"
-        )))
+        Err(Error::param(what, v, crate::Rule::Positive))
     }
 }
 
@@ -209,9 +207,8 @@ fn run_with_resets(
     timing: Timing,
     rule: Rule,
 ) -> Result<(Vec<f64>, Vec<f64>, GateCounts), Error> {
-    let reference = Reference::from_truth(&drive.truth).ok_or_else(|| {
-        Error::Insufficient("evaluation needs truth.csv with at least 3 poses".into())
-    })?;
+    let reference = Reference::from_truth(&drive.truth)
+        .ok_or_else(|| Error::needs(Task::Evaluation, Input::Truth { min_poses: 3 }))?;
     let mut hook = ResetHook {
         distance: reference.distance(),
         reference: &reference,
@@ -243,9 +240,7 @@ pub fn drift(
         run_with_resets(drive, params, timing, Rule::Every(segment_m))?;
     if errors_m.is_empty() {
         // "mean 0.000%" over no segment read as perfect dead reckoning.
-        return Err(Error::Insufficient(format!(
-            "the drive has no complete segment of {segment_m} m to measure drift on"
-        )));
+        return Err(Need::DriftSegment { segment_m }.into());
     }
     Ok(DriftResult {
         segment_m,

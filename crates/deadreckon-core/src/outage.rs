@@ -34,7 +34,7 @@ use crate::metrics::Summary;
 use crate::model::{State, V, X, Y, YAW};
 use crate::reference::Reference;
 use crate::vehicle::Params;
-use crate::Error;
+use crate::{Error, Input, Need, Rule, Task, Value};
 use nalgebra::{SMatrix, SVector};
 
 pub use crate::compared::{Against, OutageResult};
@@ -111,20 +111,26 @@ pub const HEADING_KNOWN_YAW_STD_RAD: f64 = 0.035;
 pub fn check_windows(drive: &Drive, windows: &[(f64, f64)]) -> Result<(), Error> {
     let n = drive.wheels.len();
     if n == 0 {
-        return Err(Error::Insufficient("the drive has no wheel rows".into()));
+        return Err(Error::needs(Task::OutageEvaluation, Input::WheelRows));
     }
     let (t0, t1) = (drive.wheels.t_s(0), drive.wheels.t_s(n - 1));
     for &(a, b) in windows {
         if !(a.is_finite() && b.is_finite() && a < b) {
-            return Err(Error::InvalidParams(format!(
-                "outage window {a}:{b} s is empty or not a number"
-            )));
+            return Err(Error::param(
+                "outage window",
+                Value::Numbers(vec![a, b]),
+                Rule::TimeRange,
+            ));
         }
         if a < t0 || b > t1 {
-            return Err(Error::InvalidParams(format!(
-                "outage window {a}:{b} s is not inside the drive, which runs {t0:.3}–{t1:.3} s \
-                 (drive times, e.g. UNIX time for bags)"
-            )));
+            return Err(Error::param(
+                "outage window",
+                Value::Numbers(vec![a, b]),
+                Rule::InsideDrive {
+                    from_s: t0,
+                    until_s: t1,
+                },
+            ));
         }
     }
     Ok(())
@@ -265,8 +271,10 @@ fn evaluate_in<L: Layout<N>, const N: usize>(
     use_truth: bool,
 ) -> Result<OutageEvaluation, Error> {
     if !(outage_s > 0.0 && step_s > 0.0) {
-        return Err(Error::InvalidParams(
-            "outage length and step must be positive".into(),
+        return Err(Error::param(
+            "outage length and step (s)",
+            Value::Numbers(vec![outage_s, step_s]),
+            Rule::Positive,
         ));
     }
     let truth = if use_truth {
@@ -280,9 +288,7 @@ fn evaluate_in<L: Layout<N>, const N: usize>(
         Against::Gnss
     };
     if reference == Against::Gnss && drive.gnss.len() < 2 {
-        return Err(Error::Insufficient(
-            "outage evaluation needs truth.csv or GNSS fixes".into(),
-        ));
+        return Err(Error::needs(Task::OutageEvaluation, Input::TruthOrGnss));
     }
     // A first GNSS-aided pass finds where windows can start and end.
     let aided_opts = FilterOptions {
@@ -303,7 +309,7 @@ fn evaluate_in<L: Layout<N>, const N: usize>(
         &mut aided,
     )?;
     if aided.first_t.is_nan() {
-        return Err(Error::Insufficient("the filter produced no epochs".into()));
+        return Err(Need::FilterEpochs.into());
     }
     let mut end_limit = aided.last_t;
     if let Some(t) = &truth {
@@ -312,9 +318,10 @@ fn evaluate_in<L: Layout<N>, const N: usize>(
         end_limit = end_limit.min(g.t_s);
     }
     let Some(moving_t) = aided.moving_t else {
-        return Err(Error::Insufficient(format!(
-            "the vehicle never moves faster than {MOVING_MPS} m/s: no outage to evaluate"
-        )));
+        return Err(Need::Motion {
+            min_speed_mps: MOVING_MPS,
+        }
+        .into());
     };
     let first_t = aided.first_t;
     let fix_std_m = crate::bound::fix_scatter_std_m(&drive.gnss);
@@ -402,26 +409,22 @@ fn evaluate_in<L: Layout<N>, const N: usize>(
     feeder.finish(&mut f, &mut noop)?;
     gates.add(f.gates());
     if windows.is_empty() && unsettled.is_empty() {
-        return Err(Error::Insufficient(format!(
-            "the drive ({:.1}–{:.1} s, moving from {:.1} s) is too short for a {outage_s} s \
-             outage after {warmup_s} s of warm-up",
-            first_t, end_limit, moving_t
-        )));
+        return Err(Need::OutageWindow {
+            outage_s,
+            warmup_s,
+            span_s: (first_t, end_limit),
+            moving_from_s: Some(moving_t),
+        }
+        .into());
     }
     if windows.is_empty() {
-        let known = match heading_known_t {
-            Some(k) => format!(
-                "first falls to {:.1}° at {k:.1} s",
-                heading_limit.to_degrees()
-            ),
-            None => format!("never falls to {:.1}°", heading_limit.to_degrees()),
-        };
-        return Err(Error::Insufficient(format!(
-            "no {outage_s} s outage window starts with the heading known: the aided filter's \
-             yaw standard deviation {known}, and every window ({}) starts before that \
-             (too few GNSS fixes while moving, or a drive too short)",
-            unsettled.len(),
-        )));
+        return Err(Need::KnownHeading {
+            outage_s,
+            yaw_std_rad: heading_limit,
+            known_from_s: heading_known_t,
+            windows: unsettled.len(),
+        }
+        .into());
     }
     Ok(OutageEvaluation {
         outage_s,

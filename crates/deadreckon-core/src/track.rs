@@ -7,7 +7,7 @@ use crate::filter::{CarLayout, Layout};
 use crate::gyro_drift::{CarBiasLayout, N_BIAS};
 use crate::model::{Mat, State};
 use crate::vehicle::Origin;
-use crate::{rts, Drive, Error, Params};
+use crate::{rts, Drive, Error, Need, Params};
 
 /// The names of the tracks [`drive_tracks`] builds, in its order.
 pub mod names {
@@ -264,9 +264,7 @@ pub fn dead_reckoning_init(
     } else if let Some((t_s, x, p)) = smoothed_start {
         Init::Given { t_s, x, p }
     } else {
-        return Err(Error::Insufficient(
-            "dead reckoning needs an initial pose: truth.csv, gnss.csv or --init-pose".into(),
-        ));
+        return Err(Need::InitialPose.into());
     })
 }
 
@@ -298,10 +296,9 @@ pub fn dead_reckoned(
 /// The track named `name` among `tracks`, or an error listing the names there are.
 pub fn find<'a>(tracks: &'a [Track], name: &str) -> Result<&'a Track, Error> {
     tracks.iter().find(|t| t.name == name).ok_or_else(|| {
-        let have: Vec<&str> = tracks.iter().map(|t| t.name.as_str()).collect();
-        Error::Insufficient(format!(
-            "no track named `{name}` (this drive has: {})",
-            have.join(", ")
-        ))
+        Error::from(Need::Track {
+            name: name.to_string(),
+            have: tracks.iter().map(|t| t.name.clone()).collect(),
+        })
     })
 }

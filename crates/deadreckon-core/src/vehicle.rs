@@ -3,7 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::Error;
+use crate::{Error, Rule, Value};
 
 /// A geodetic origin for drives recorded in latitude/longitude: the point
 /// whose tangent plane is the drive's east/north frame.
@@ -359,22 +359,29 @@ impl Vehicle {
     pub fn validate(&self) -> Result<(), Error> {
         if let Some(o) = &self.origin {
             if !(o.lat_deg.is_finite() && o.lat_deg.abs() <= 90.0) {
-                return Err(Error::InvalidVehicle(format!(
-                    "origin latitude must be within ±90°, got {}",
-                    o.lat_deg
-                )));
+                return Err(Error::vehicle(
+                    "origin.lat_deg",
+                    o.lat_deg,
+                    Rule::WithinAbs(90.0),
+                ));
             }
             if !(o.lon_deg.is_finite() && o.lon_deg.abs() <= 180.0) {
-                return Err(Error::InvalidVehicle(format!(
-                    "origin longitude must be within ±180°, got {}",
-                    o.lon_deg
-                )));
+                return Err(Error::vehicle(
+                    "origin.lon_deg",
+                    o.lon_deg,
+                    Rule::WithinAbs(180.0),
+                ));
             }
             if !(o.height_m.is_finite() && (-1000.0..=10_000.0).contains(&o.height_m)) {
-                return Err(Error::InvalidVehicle(format!(
-                    "origin height must be metres above the WGS84 ellipsoid, -1000 to 10000, got {}",
-                    o.height_m
-                )));
+                return Err(Error::vehicle(
+                    "origin.height_m",
+                    o.height_m,
+                    Rule::Between {
+                        min: -1000.0,
+                        max: 10_000.0,
+                        unit: "metres above the WGS84 ellipsoid",
+                    },
+                ));
             }
         }
         let pos = [
@@ -386,9 +393,7 @@ impl Vehicle {
         ];
         for (k, v) in pos {
             if !(v.is_finite() && v > 0.0) {
-                return Err(Error::InvalidVehicle(format!(
-                    "{k} must be a positive number, got {v}"
-                )));
+                return Err(Error::vehicle(k, v, Rule::Positive));
             }
         }
         for (k, v, max) in [
@@ -405,34 +410,42 @@ impl Vehicle {
             ),
         ] {
             if !(v.is_finite() && v.abs() <= max) {
-                return Err(Error::InvalidVehicle(format!(
-                    "{k} must be a number within ±{max}, got {v}"
-                )));
+                return Err(Error::vehicle(k, v, Rule::WithinAbs(max)));
             }
         }
         if !self.gnss_lever_arm_m.is_finite() {
-            return Err(Error::InvalidVehicle(
-                "gnss_lever_arm_m must be finite".into(),
+            return Err(Error::vehicle(
+                "gnss_lever_arm_m",
+                self.gnss_lever_arm_m,
+                Rule::Finite,
             ));
         }
         if let Some(id) = &self.vehicle_id {
             if id.trim().is_empty() || id.chars().any(char::is_control) {
-                return Err(Error::InvalidVehicle(format!(
-                    "vehicle_id must be a non-empty name without control characters, got {id:?}"
-                )));
+                return Err(Error::vehicle(
+                    "vehicle_id",
+                    Value::Text(id.clone()),
+                    Rule::Name,
+                ));
             }
         }
         if let Some(t) = &self.recorded_at {
-            recorded_at_key(t).map_err(Error::InvalidVehicle)?;
+            recorded_at_key(t).map_err(|_| {
+                Error::vehicle("recorded_at", Value::Text(t.clone()), Rule::DateTime)
+            })?;
         }
         if !self.wheels_present.iter().any(|p| *p) {
-            return Err(Error::InvalidVehicle(
-                "wheels_present must name at least one wheel".into(),
+            return Err(Error::vehicle(
+                "wheels_present",
+                Value::Unstated,
+                Rule::NonEmpty,
             ));
         }
         if self.ticks_per_rev == 0 {
-            return Err(Error::InvalidVehicle(
-                "ticks_per_rev must be positive".into(),
+            return Err(Error::vehicle(
+                "ticks_per_rev",
+                Value::Count(0),
+                Rule::Positive,
             ));
         }
         let n = &self.noise;
@@ -449,9 +462,7 @@ impl Vehicle {
             ("noise.steering", n.steering),
         ] {
             if !(v.is_finite() && v > 0.0) {
-                return Err(Error::InvalidVehicle(format!(
-                    "{k} must be a positive number, got {v}"
-                )));
+                return Err(Error::vehicle(k, v, Rule::Positive));
             }
         }
         // 0 would take every rejected reading as a recovery: the gate off.
@@ -460,9 +471,14 @@ impl Vehicle {
             ("noise.max_rejections", n.max_rejections),
         ] {
             if v == 0 {
-                return Err(Error::InvalidVehicle(format!(
-                    "{k} must be at least 1 (0 would switch the gate off; set the gate to inf for that)"
-                )));
+                return Err(Error::vehicle(
+                    k,
+                    Value::Count(0),
+                    Rule::AtLeast {
+                        min: 1.0,
+                        why: Some("0 would switch the gate off; set the gate to inf for that"),
+                    },
+                ));
             }
         }
         // A gate may be infinite (switched off), never zero, negative or NaN.
@@ -475,48 +491,67 @@ impl Vehicle {
             ("noise.course_gate_chi2", n.course_gate_chi2),
         ] {
             if v.is_nan() || v <= 0.0 {
-                return Err(Error::InvalidVehicle(format!(
-                    "{k} must be positive (or inf to switch the gate off), got {v}"
-                )));
+                return Err(Error::vehicle(
+                    k,
+                    v,
+                    Rule::PositiveOrInf {
+                        inf_means: "to switch the gate off",
+                    },
+                ));
             }
         }
         if !(n.gnss_recovery_after_s.is_finite() && n.gnss_recovery_after_s >= 0.0) {
-            return Err(Error::InvalidVehicle(format!(
-                "noise.gnss_recovery_after_s must be a non-negative number, got {}",
-                n.gnss_recovery_after_s
-            )));
+            return Err(Error::vehicle(
+                "noise.gnss_recovery_after_s",
+                n.gnss_recovery_after_s,
+                Rule::NonNegative { zero_means: None },
+            ));
         }
         if !(n.gnss_wander_std_m.is_finite() && n.gnss_wander_std_m >= 0.0) {
-            return Err(Error::InvalidVehicle(format!(
-                "noise.gnss_wander_std_m must be a non-negative number (0: white fixes), got {}",
-                n.gnss_wander_std_m
-            )));
+            return Err(Error::vehicle(
+                "noise.gnss_wander_std_m",
+                n.gnss_wander_std_m,
+                Rule::NonNegative {
+                    zero_means: Some("white fixes"),
+                },
+            ));
         }
         if !(n.gyro_bias_walk_rps_per_sqrt_s.is_finite() && n.gyro_bias_walk_rps_per_sqrt_s >= 0.0)
         {
-            return Err(Error::InvalidVehicle(format!(
-                "noise.gyro_bias_walk_rps_per_sqrt_s must be a non-negative number (0: a constant bias), got {}",
-                n.gyro_bias_walk_rps_per_sqrt_s
-            )));
+            return Err(Error::vehicle(
+                "noise.gyro_bias_walk_rps_per_sqrt_s",
+                n.gyro_bias_walk_rps_per_sqrt_s,
+                Rule::NonNegative {
+                    zero_means: Some("a constant bias"),
+                },
+            ));
         }
         if !(n.gyro_gap_process_yaw_rate_rps.is_finite() && n.gyro_gap_process_yaw_rate_rps >= 0.0)
         {
-            return Err(Error::InvalidVehicle(format!(
-                "noise.gyro_gap_process_yaw_rate_rps must be a non-negative number (0: table I's at every epoch), got {}",
-                n.gyro_gap_process_yaw_rate_rps
-            )));
+            return Err(Error::vehicle(
+                "noise.gyro_gap_process_yaw_rate_rps",
+                n.gyro_gap_process_yaw_rate_rps,
+                Rule::NonNegative {
+                    zero_means: Some("table I's at every epoch"),
+                },
+            ));
         }
         if !(n.gnss_wander_tau_s.is_finite() && n.gnss_wander_tau_s > 0.0) {
-            return Err(Error::InvalidVehicle(format!(
-                "noise.gnss_wander_tau_s must be a positive number, got {}",
-                n.gnss_wander_tau_s
-            )));
+            return Err(Error::vehicle(
+                "noise.gnss_wander_tau_s",
+                n.gnss_wander_tau_s,
+                Rule::Positive,
+            ));
         }
         let v = n.scale_hold_yaw_std_rad;
         if v.is_nan() || v <= 0.0 {
-            return Err(Error::InvalidVehicle(format!(
-                "noise.scale_hold_yaw_std_rad must be positive (or inf to learn the scale and circumferences always), got {v}"
-            )));
+            return Err(Error::vehicle(
+                "noise.scale_hold_yaw_std_rad",
+                v,
+                Rule::PositiveOrInf {
+                    inf_means: "to learn the scale and circumferences always",
+                },
+            ));
         }
         Ok(())
     }
@@ -672,10 +707,8 @@ impl Params {
         let a = self.to_array();
         for (i, v) in a.iter().enumerate() {
             if !v.is_finite() || (i > 0 && *v <= 0.0) {
-                return Err(Error::InvalidParams(format!(
-                    "{} = {v} is not valid",
-                    Params::NAMES[i]
-                )));
+                let rule = if i == 0 { Rule::Finite } else { Rule::Positive };
+                return Err(Error::param(Params::NAMES[i], *v, rule));
             }
         }
         Ok(())

@@ -21,7 +21,7 @@ use crate::ekf::{self, EpochOut, FilterOptions};
 use crate::filter::{CarLayout, Filter, Layout, SensorKind};
 use crate::gnss_error::{CarWanderLayout, Wander, N_WANDER};
 use crate::vehicle::{Params, Vehicle};
-use crate::Error;
+use crate::{Error, Input, Task};
 
 /// The wander standard deviations tried, m per axis.
 pub const STD_GRID_M: [f64; 5] = [0.25, 0.5, 1.0, 1.5, 2.0];
@@ -80,9 +80,7 @@ pub fn fit(drive: &Drive, params: &Params, opts: &FilterOptions) -> Result<Wande
         }
     }
     if candidates[0].fixes == 0 {
-        return Err(Error::Insufficient(
-            "the receiver's wander cannot be fitted: no GNSS fix after the filter's start".into(),
-        ));
+        return Err(Error::needs(Task::WanderFit, Input::GnssFixAfterStart));
     }
     let best = candidates
         .iter()

@@ -178,14 +178,18 @@ pub fn read_comma2k19_with(dir: &Path, o: &Comma2k19Options) -> Result<Import, I
         if !v.is_finite() {
             return Err(invalid(
                 dir,
-                deadreckon_core::Error::InvalidParams(format!("{k} must be finite")),
+                deadreckon_core::Error::param(k, v, deadreckon_core::Rule::Finite),
             ));
         }
     }
     if !(o.gnss_std_m.is_finite() && o.gnss_std_m > 0.0) {
         return Err(invalid(
             dir,
-            deadreckon_core::Error::InvalidParams("gnss_std_m must be positive".into()),
+            deadreckon_core::Error::param(
+                "gnss_std_m",
+                o.gnss_std_m,
+                deadreckon_core::Rule::Positive,
+            ),
         ));
     }
     let mut report = ImportReport {

@@ -42,10 +42,13 @@ use deadreckon_core::kinematics::tricycle::{
 };
 use deadreckon_core::kinematics::Pose2;
 use deadreckon_core::vehicle::Noise;
-use deadreckon_core::{Drive, Vehicle};
+use deadreckon_core::{Drive, DriveFault, Rule, Value, Vehicle};
 
 use crate::stream::{Reject, StreamBuilder};
 use crate::{Import, ImportError, ImportReport, TimeOrderPolicy};
+
+/// The one `kinematic_model` of the log's header that is supported.
+const KINEMATIC_MODEL: &[&str] = &["traction_drive_wheel"];
 
 /// The header of a tricycle log.
 #[derive(Debug, Clone, PartialEq)]
@@ -436,14 +439,15 @@ pub fn tricycle_drive(
     o: &TricycleOptions,
 ) -> Result<Import, ImportError> {
     let h = &log.header;
-    let inv = |m: String| ImportError::Invalid {
+    let inv = |source: deadreckon_core::Error| ImportError::Invalid {
         path: path.to_path_buf(),
-        source: deadreckon_core::Error::InvalidVehicle(m),
+        source,
     };
-    if h.kinematic_model != "traction_drive_wheel" {
-        return Err(inv(format!(
-            "kinematic_model `{}` is not supported (traction_drive_wheel)",
-            h.kinematic_model
+    if h.kinematic_model != KINEMATIC_MODEL[0] {
+        return Err(inv(deadreckon_core::Error::vehicle(
+            "kinematic_model",
+            Value::Text(h.kinematic_model.clone()),
+            Rule::OneOf(KINEMATIC_MODEL),
         )));
     }
     let vehicle = o.vehicle.clone().unwrap_or_else(|| vehicle_from_header(h));
@@ -452,7 +456,11 @@ pub fn tricycle_drive(
         source,
     })?;
     if !(o.max_speed_mps.is_finite() && o.max_speed_mps > 0.0) {
-        return Err(inv("max_speed_mps must be positive".into()));
+        return Err(inv(deadreckon_core::Error::param(
+            "max_speed_mps",
+            o.max_speed_mps,
+            Rule::Positive,
+        )));
     }
     let m_per_tick = vehicle.wheel_circumference_m / f64::from(vehicle.ticks_per_rev);
     let steer_max = i64::from(h.steering_encoder_max);
@@ -606,18 +614,29 @@ pub fn tricycle_kinematic(
     o: &TricycleOptions,
 ) -> Result<TricycleDrive, ImportError> {
     let h = &log.header;
-    let inv = |m: String| ImportError::Invalid {
+    let bad = |source: deadreckon_core::Error| ImportError::Invalid {
         path: path.to_path_buf(),
-        source: deadreckon_core::Error::InvalidDrive(m),
+        source,
     };
-    if h.kinematic_model != "traction_drive_wheel" {
-        return Err(inv(format!(
-            "kinematic_model `{}` is not supported (traction_drive_wheel)",
-            h.kinematic_model
+    let inv = |m: String| {
+        bad(deadreckon_core::Error::drive(
+            "tricycle",
+            DriveFault::Said(m),
+        ))
+    };
+    if h.kinematic_model != KINEMATIC_MODEL[0] {
+        return Err(bad(deadreckon_core::Error::vehicle(
+            "kinematic_model",
+            Value::Text(h.kinematic_model.clone()),
+            Rule::OneOf(KINEMATIC_MODEL),
         )));
     }
     if !(o.max_speed_mps.is_finite() && o.max_speed_mps > 0.0) {
-        return Err(inv("max_speed_mps must be positive".into()));
+        return Err(bad(deadreckon_core::Error::param(
+            "max_speed_mps",
+            o.max_speed_mps,
+            Rule::Positive,
+        )));
     }
     let [qx, qy, qz, qw] = h.sensor_rotation_xyzw;
     let sensor_yaw = (2.0 * (qw * qz + qx * qy)).atan2(1.0 - 2.0 * (qy * qy + qz * qz));

@@ -26,6 +26,7 @@
 use std::path::Path;
 
 use deadreckon_core::kinematics::{KinematicCalibration, ParamEstimate, Shape};
+use deadreckon_core::{Rule, Value};
 use serde::{Deserialize, Serialize};
 
 use crate::{atomic_write, IoError};
@@ -101,41 +102,59 @@ impl KinematicParamsFile {
     /// Checks the parameters against a shape's names (same set, same order),
     /// finite values and finite non-negative standard errors.
     pub fn check(&self, path: &Path, shape: Shape, names: &[&str]) -> Result<(), IoError> {
-        let bad = |m: String| IoError::Invalid {
+        let bad = |source: deadreckon_core::Error| IoError::Invalid {
             path: path.to_path_buf(),
-            source: deadreckon_core::Error::InvalidParams(m),
+            source,
+        };
+        let said = |key: &'static str, m: String| {
+            bad(deadreckon_core::Error::param(
+                key,
+                Value::Unstated,
+                Rule::Said(m),
+            ))
         };
         if self.shape != shape {
-            return Err(bad(format!(
-                "parameters of a {} used for a {}",
-                self.shape.name(),
-                shape.name()
-            )));
+            return Err(said(
+                "shape",
+                format!(
+                    "parameters of a {} used for a {}",
+                    self.shape.name(),
+                    shape.name()
+                ),
+            ));
         }
         let have: Vec<&str> = self.param.iter().map(|p| p.name.as_str()).collect();
         if have != names {
-            return Err(bad(format!(
-                "a {} needs the parameters {names:?} in that order, the file has {have:?}",
-                shape.name()
-            )));
+            return Err(said(
+                "param",
+                format!(
+                    "a {} needs the parameters {names:?} in that order, the file has {have:?}",
+                    shape.name()
+                ),
+            ));
         }
         for p in &self.param {
             if !p.value.is_finite() {
-                return Err(bad(format!("{} = {} is not finite", p.name, p.value)));
+                return Err(bad(deadreckon_core::Error::param(
+                    p.name.clone(),
+                    p.value,
+                    Rule::Finite,
+                )));
             }
             if let Some(s) = p.std {
                 if !(s.is_finite() && s >= 0.0) {
-                    return Err(bad(format!(
-                        "std of {} = {s} must be finite and non-negative",
-                        p.name
+                    return Err(bad(deadreckon_core::Error::param(
+                        format!("std of {}", p.name),
+                        s,
+                        Rule::NonNegative { zero_means: None },
                     )));
                 }
             }
             if !p.estimated && p.reason.is_none() {
-                return Err(bad(format!(
-                    "{} is not estimated but the file gives no reason",
-                    p.name
-                )));
+                return Err(said(
+                    "reason",
+                    format!("{} is not estimated but the file gives no reason", p.name),
+                ));
             }
         }
         Ok(())

@@ -125,9 +125,11 @@ fn check_std(path: &Path, std: &Params) -> Result<(), IoError> {
         if !(v.is_finite() && v >= 0.0) {
             return Err(invalid(
                 path,
-                deadreckon_core::Error::InvalidParams(format!(
-                    "std.{name} = {v} must be finite and non-negative"
-                )),
+                deadreckon_core::Error::param(
+                    format!("std.{name}"),
+                    v,
+                    deadreckon_core::Rule::NonNegative { zero_means: None },
+                ),
             ));
         }
     }

@@ -32,13 +32,24 @@ fn per_reading_timing_read_the_gnss_fixes_as_speed() {
         },
         ..CalibrationOptions::default()
     };
-    let err = calibrate::calibrate(&sim.drive, &each)
-        .unwrap_err()
-        .to_string();
+    let err = calibrate::calibrate(&sim.drive, &each).unwrap_err();
+    // Both limits as data, for a front end to word (the CLI names its
+    // `--timing` flags: issue 34).
+    match &err {
+        deadreckon_core::Error::NoiseTooHighForPerReadingTiming { over } => {
+            let keys: Vec<&str> = over.iter().map(|l| l.key).collect();
+            assert_eq!(
+                keys,
+                ["noise.process_speed_mps", "noise.process_yaw_rate_rps"]
+            );
+        }
+        e => panic!("not the per-reading timing refusal: {e}"),
+    }
+    let err = err.to_string();
     for needle in [
         "noise.process_speed_mps = 10 (at most 0.5)",
         "noise.process_yaw_rate_rps = 1 (at most 0.03)",
-        "--timing wheel",
+        "timing at the wheel epochs",
     ] {
         assert!(err.contains(needle), "{needle:?} not in {err}");
     }

@@ -2,7 +2,18 @@
 //! ([`CalibrateOptions`]), [`calibrate_tricycle`], [`calibrate_diff`] and
 //! their result with its table and `--json` object ([`Calibrated`]).
 
-use super::*;
+use std::path::Path;
+
+use deadreckon_core::kinematics::diff_drive::{
+    self, calibrate_diff_drive, calibrate_held_back, DiffDriveOptions, FilterNoise, YawSource,
+};
+use deadreckon_core::kinematics::{self, KinematicCalibration, KinematicOptions, Shape};
+use deadreckon_core::Drive;
+use deadreckon_io::kinematic_toml::KinematicParamsFile;
+
+use super::{load_tricycle_from, yaw_name};
+use crate::error::{invalid, While};
+use crate::Error;
 
 /// A kinematic calibration with what it was made against, as `calibrate`
 /// prints and writes it.
@@ -175,7 +186,7 @@ pub fn calibrate_diff(
 ) -> Result<Calibrated, Error> {
     let shape = Shape::DiffDrive;
     let method = method_for(shape, o.method)?;
-    let dd = diff_drive(drive, yaw, o.from_s, o.until_s)?;
+    let dd = super::diff_drive(drive, yaw, o.from_s, o.until_s)?;
     let opts = DiffDriveOptions {
         window_s: o.window_s.unwrap_or(DiffDriveOptions::default().window_s),
         min_speed_mps: o.min_speed_mps.unwrap_or(shape.default_min_speed_mps()),

@@ -3,7 +3,21 @@
 //! ([`Evaluated`]), the yaw source's choice ([`diff_yaw`]) and the
 //! tricycle's tracks ([`tricycle_tracks`]).
 
-use super::*;
+use std::path::Path;
+
+use deadreckon_core::kinematics::diff_drive::{
+    self, evaluate_diff_drive, DiffDriveDrive, DiffDriveOutages, OutageStart, YawSource,
+};
+use deadreckon_core::kinematics::tricycle::TricycleParams;
+use deadreckon_core::kinematics::{self, KinematicOptions, KinematicOutages, Shape};
+use deadreckon_core::{Drive, Track};
+
+use super::{
+    calibrate_diff, load_params, load_params_file_with_std, load_tricycle_from, yaw_name,
+    CalibrateOptions, LoadedParams,
+};
+use crate::error::While;
+use crate::Error;
 
 /// Sliding-outage evaluation of a kinematic shape, as `evaluate` prints it.
 #[derive(Debug, Clone)]
@@ -219,7 +233,7 @@ pub fn evaluate_diff(
         OutageStart::Filter(noise) => OutageStart::Filter(noise.with_param_std(&std)),
         OutageStart::Align => OutageStart::Align,
     };
-    let dd = diff_drive(drive, yaw, from_s, until_s)?;
+    let dd = super::diff_drive(drive, yaw, from_s, until_s)?;
     let diff = evaluate_diff_drive(&dd, &params, length_s, step_s, align_s, &start)?;
     let bound = diff_bound(&dd, &params, &start, align_s, calibrated_here, spec)?;
     Ok(Evaluated {

@@ -3,7 +3,12 @@
 //! [`TICK_BLOCK_S`], with the standard errors' lag-1 and batch-means
 //! inflation.
 
-use super::*;
+use crate::drive::{Drive, Wheels};
+use crate::model::{V, YAW_RATE};
+use crate::observation::Sensors;
+use crate::reference::Reference;
+use crate::vehicle::{Params, ParamsWithStd};
+use crate::Error;
 
 /// A one-dimensional least-squares fit `z ≈ θ·r` with the residuals' lag-1
 /// autocorrelation folded into its standard error.

@@ -292,10 +292,13 @@ impl Feeder {
         epoch: &mut dyn FnMut(&mut Filter<L, N>, EpochOut<'_, N>),
     ) -> Result<(), Error> {
         if !ev.t_s.is_finite() {
-            return Err(Error::InvalidDrive(format!(
-                "event time {} is not finite",
-                ev.t_s
-            )));
+            return Err(Error::drive(
+                "events",
+                crate::DriveFault::NonFiniteTime {
+                    index: None,
+                    t_s: ev.t_s,
+                },
+            ));
         }
         if let Some(last) = self.batch.last() {
             if ev.t_s < last.t_s {

@@ -34,7 +34,7 @@ use serde::{Deserialize, Serialize};
 
 use super::{KinematicModel, Pose2};
 use crate::angle::wrap;
-use crate::Error;
+use crate::{Error, Rule};
 
 /// Options of [`calibrate`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -271,20 +271,20 @@ pub fn calibrate<M: KinematicModel>(
     o: &KinematicOptions,
 ) -> Result<KinematicCalibration, Error> {
     if !(o.window_s.is_finite() && o.window_s > 0.0) {
-        return Err(Error::InvalidParams(format!(
-            "window length must be positive, got {}",
-            o.window_s
-        )));
+        return Err(Error::param("window_s", o.window_s, Rule::Positive));
     }
     if !(o.min_speed_mps.is_finite() && o.min_speed_mps >= 0.0) {
-        return Err(Error::InvalidParams(format!(
-            "speed threshold must be non-negative, got {}",
-            o.min_speed_mps
-        )));
+        return Err(Error::param(
+            "min_speed_mps",
+            o.min_speed_mps,
+            Rule::NonNegative { zero_means: None },
+        ));
     }
     if !(o.heading_weight_m.is_finite() && o.heading_weight_m > 0.0) {
-        return Err(Error::InvalidParams(
-            "heading weight must be positive".into(),
+        return Err(Error::param(
+            "heading_weight_m",
+            o.heading_weight_m,
+            Rule::Positive,
         ));
     }
     let names = model.names();

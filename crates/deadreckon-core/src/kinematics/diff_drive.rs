@@ -22,7 +22,7 @@
 //! at or before the outage's end.
 
 use crate::drive::Wheels;
-use crate::{Drive, Error};
+use crate::{Drive, DriveFault, Error, Input, Task};
 
 /// Index of the odometry speed scale.
 pub const SPEED_SCALE: usize = 0;
@@ -96,9 +96,7 @@ impl DiffDriveDrive {
         until_s: Option<f64>,
     ) -> Result<DiffDriveDrive, Error> {
         let Wheels::Speeds(w) = &drive.wheels else {
-            return Err(Error::InvalidDrive(
-                "a differential drive needs wheel speeds (odometry), not ticks".into(),
-            ));
+            return Err(Error::drive("wheel_ticks", DriveFault::TicksNotSpeeds));
         };
         let track = drive.vehicle.track_front_m;
         let (lo, hi) = (
@@ -107,7 +105,7 @@ impl DiffDriveDrive {
         );
         let gyro = &drive.yaw_rate;
         if source == YawSource::Gyro && gyro.is_empty() {
-            return Err(Error::Insufficient("no gyro stream for --yaw gyro".into()));
+            return Err(Error::needs(Task::GyroYaw, Input::Gyro));
         }
         let mut samples = Vec::new();
         let mut prev_t = f64::NEG_INFINITY;

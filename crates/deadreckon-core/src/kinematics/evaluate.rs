@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 
 use super::KinematicModel;
 use crate::metrics::Summary;
-use crate::Error;
+use crate::{Error, Need, Rule, Value};
 
 /// One outage window.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -57,22 +57,23 @@ pub fn evaluate<M: KinematicModel>(
     step_s: f64,
 ) -> Result<KinematicOutages, Error> {
     if !(outage_s.is_finite() && outage_s > 0.0 && step_s.is_finite() && step_s > 0.0) {
-        return Err(Error::InvalidParams(format!(
-            "outage length and step must be positive, got {outage_s} and {step_s}"
-        )));
+        return Err(Error::param(
+            "outage length and step (s)",
+            Value::Numbers(vec![outage_s, step_s]),
+            Rule::Positive,
+        ));
     }
     if params.len() != model.names().len() || params.iter().any(|v| !v.is_finite()) {
-        return Err(Error::InvalidParams(format!(
-            "{} finite parameters expected",
-            model.names().len()
-        )));
+        return Err(Error::param(
+            "parameters",
+            Value::Count(params.len()),
+            Rule::FiniteCount(model.names().len()),
+        ));
     }
     let n = model.len();
     let refs: Vec<usize> = (0..n).filter(|&i| model.reference(i).is_some()).collect();
     let (Some(&first), Some(&last)) = (refs.first(), refs.last()) else {
-        return Err(Error::Insufficient(
-            "no reference poses to start and score outages".into(),
-        ));
+        return Err(Need::ReferencePoses.into());
     };
     let (t0, t_last) = (model.time(first), model.time(last));
     let mut windows = Vec::new();
@@ -102,10 +103,13 @@ pub fn evaluate<M: KinematicModel>(
         });
     }
     if windows.is_empty() {
-        return Err(Error::Insufficient(format!(
-            "the drive ({:.1} s with a reference) is shorter than one {outage_s} s outage",
-            t_last - t0
-        )));
+        return Err(Need::OutageWindow {
+            outage_s,
+            warmup_s: 0.0,
+            span_s: (t0, t_last),
+            moving_from_s: None,
+        }
+        .into());
     }
     Ok(KinematicOutages {
         outage_s,

@@ -56,7 +56,7 @@ use nalgebra::{DMatrix, DVector, Dyn, Owned};
 use super::ParamEstimate;
 use crate::model::{V, YAW_RATE};
 use crate::reference::Reference;
-use crate::{Drive, Error};
+use crate::{Drive, Error, Rule};
 
 /// Readings needed for a fit.
 pub const MIN_SAMPLES: usize = 20;
@@ -155,9 +155,11 @@ pub fn calibrate_steering(
     min_speed_mps: f64,
 ) -> Result<SteeringCalibration, Error> {
     if !(min_speed_mps.is_finite() && min_speed_mps >= 0.0) {
-        return Err(Error::InvalidParams(format!(
-            "speed threshold must be non-negative, got {min_speed_mps}"
-        )));
+        return Err(Error::param(
+            "min_speed_mps",
+            min_speed_mps,
+            Rule::NonNegative { zero_means: None },
+        ));
     }
     let l = drive.vehicle.wheelbase_m;
     let nominal = drive.vehicle.steering_ratio;

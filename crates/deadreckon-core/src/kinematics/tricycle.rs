@@ -18,7 +18,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::{KinematicModel, Pose2, PoseJacobian};
-use crate::Error;
+use crate::{DriveFault, Error, Need, Rule, Value};
 
 /// Index of `Ktraction` (metres per traction-encoder revolution).
 pub const KTRACTION: usize = 0;
@@ -118,10 +118,11 @@ impl TricycleParams {
     /// From a vector in [`NAMES`] order.
     pub fn from_slice(p: &[f64]) -> Result<TricycleParams, Error> {
         if p.len() != N_PARAMS {
-            return Err(Error::InvalidParams(format!(
-                "a tricycle has {N_PARAMS} parameters, got {}",
-                p.len()
-            )));
+            return Err(Error::param(
+                "tricycle parameters",
+                Value::Count(p.len()),
+                Rule::FiniteCount(N_PARAMS),
+            ));
         }
         let t = TricycleParams {
             ktraction_m: p[KTRACTION],
@@ -137,15 +138,18 @@ impl TricycleParams {
     /// Checks that the parameters are finite and the axle length positive.
     pub fn validate(&self) -> Result<(), Error> {
         if self.to_vec().iter().any(|v| !v.is_finite()) {
-            return Err(Error::InvalidParams(
-                "a tricycle parameter is not finite".into(),
+            return Err(Error::param(
+                "tricycle parameters",
+                Value::Numbers(self.to_vec()),
+                Rule::Finite,
             ));
         }
         if self.axle_length_m <= 0.0 {
-            return Err(Error::InvalidParams(format!(
-                "axle_length_m must be positive, got {}",
-                self.axle_length_m
-            )));
+            return Err(Error::param(
+                "axle_length_m",
+                self.axle_length_m,
+                Rule::Positive,
+            ));
         }
         Ok(())
     }
@@ -188,18 +192,34 @@ struct Step {
 impl TricycleDrive {
     /// Checks the geometry, the parameters and that time strictly increases.
     pub fn validate(&self) -> Result<(), Error> {
-        if self.geometry.ticks_per_rev == 0 || self.geometry.steer_counts_per_rev < 2 {
-            return Err(Error::InvalidVehicle(
-                "tricycle encoder ranges must be positive".into(),
+        if self.geometry.ticks_per_rev == 0 {
+            return Err(Error::vehicle(
+                "ticks_per_rev",
+                Value::Count(0),
+                Rule::Positive,
+            ));
+        }
+        if self.geometry.steer_counts_per_rev < 2 {
+            return Err(Error::vehicle(
+                "steer_counts_per_rev",
+                Value::Count(self.geometry.steer_counts_per_rev as usize),
+                Rule::AtLeast {
+                    min: 2.0,
+                    why: None,
+                },
             ));
         }
         self.nominal.validate()?;
-        for w in self.samples.windows(2) {
+        for (i, w) in self.samples.windows(2).enumerate() {
             if w[1].t_s.partial_cmp(&w[0].t_s) != Some(std::cmp::Ordering::Greater) {
-                return Err(Error::InvalidDrive(format!(
-                    "tricycle samples not strictly increasing in time at t={} s",
-                    w[1].t_s
-                )));
+                return Err(Error::drive(
+                    "tricycle",
+                    DriveFault::NotIncreasing {
+                        index: i + 1,
+                        t_s: w[1].t_s,
+                        previous_t_s: w[0].t_s,
+                    },
+                ));
             }
         }
         Ok(())
@@ -273,9 +293,7 @@ impl TricycleDrive {
     pub fn tracks(&self, params: &TricycleParams) -> Result<Vec<crate::Track>, Error> {
         params.validate()?;
         let Some(a) = self.samples.iter().position(|s| s.reference.is_some()) else {
-            return Err(Error::Insufficient(
-                "dead reckoning needs a reference pose to start from".into(),
-            ));
+            return Err(Need::ReferencePoses.into());
         };
         let start = self.samples[a]
             .reference

@@ -131,8 +131,12 @@ pub fn prepare_with(
         return Ok((drive.clone(), Corrections::none()));
     }
     if which == Which::Auto {
-        return Err(Error::InvalidParams(
-            "the automatic choice of corrections is made by held_back::prepare".into(),
+        return Err(Error::param(
+            "corrections",
+            crate::Value::Text("auto".into()),
+            crate::Rule::Said(
+                "the automatic choice of corrections is made by held_back::prepare".into(),
+            ),
         ));
     }
     // The driven axle's slip first: the wheels are the clock and the scale

@@ -8,7 +8,9 @@ use rand::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
 use rand_pcg::Pcg64;
 
-use super::*;
+use super::{
+    tilt_rotation, CourseConvention, LowSpeedCourse, SensorsSpec, WheelKind, ACCEL_NOISE_STD_MPS2,
+};
 use crate::faults::WheelFaults;
 use crate::imperfections::{EcuClock, GaussMarkov, Multipath, ToneRings};
 use crate::truth::{Kinematics, State};

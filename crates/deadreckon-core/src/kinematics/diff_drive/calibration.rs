@@ -6,7 +6,7 @@ use nalgebra::{DMatrix, DVector, Dyn, Owned};
 
 use super::{align, at, DiffDriveDrive, Window, NAMES, N_PARAMS, TOLERANCE};
 use crate::kinematics::{KinematicCalibration, ParamEstimate};
-use crate::Error;
+use crate::{Error, Rule, Value};
 
 /// Options of [`calibrate_diff_drive`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -175,9 +175,11 @@ pub fn calibrate_diff_drive(
         .iter()
         .all(|v| v.is_finite());
     if !finite || o.window_s <= 0.0 || o.stride_s <= 0.0 || o.min_speed_mps < 0.0 {
-        return Err(Error::InvalidParams(format!(
-            "bad calibration options {o:?}"
-        )));
+        return Err(Error::param(
+            "window_s, stride_s, min_speed_mps",
+            Value::Numbers(vec![o.window_s, o.stride_s, o.min_speed_mps]),
+            Rule::Said("window_s and stride_s must be positive, min_speed_mps 0 or more".into()),
+        ));
     }
     let nominal = DiffDriveDrive::nominal();
     let (wins, total, fastest) = windows(d, o);

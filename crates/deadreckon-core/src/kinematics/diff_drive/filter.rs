@@ -48,7 +48,7 @@ use nalgebra::{SMatrix, SVector};
 use super::{align, DiffDriveDrive, ANTENNA_X, ANTENNA_Y, N_PARAMS, SPEED_SCALE as P_SPEED};
 use super::{YAW_BIAS as P_BIAS, YAW_SCALE as P_YAW};
 use crate::kalman::{innovation_stats, predict_covariance, update_vector, CovarianceForm};
-use crate::Error;
+use crate::{Error, Rule, Value};
 
 /// Index of the base's east coordinate, m.
 pub const X: usize = 0;
@@ -232,9 +232,11 @@ impl FilterNoise {
             ("init_path_m", self.init_path_m),
         ];
         match v.iter().find(|(_, x)| !(x.is_finite() && *x > 0.0)) {
-            Some((name, x)) => Err(Error::InvalidParams(format!(
-                "filter noise {name} must be finite and positive, got {x}"
-            ))),
+            Some((name, x)) => Err(Error::param(
+                format!("filter noise {name}"),
+                *x,
+                Rule::Positive,
+            )),
             None => Ok(()),
         }
     }
@@ -352,9 +354,11 @@ impl<'a> DiffDriveFilter<'a> {
     ) -> Result<Option<DiffDriveFilter<'a>>, Error> {
         noise.check()?;
         if params.len() != N_PARAMS || params.iter().any(|v| !v.is_finite()) {
-            return Err(Error::InvalidParams(format!(
-                "{N_PARAMS} finite parameters expected"
-            )));
+            return Err(Error::param(
+                "parameters",
+                Value::Numbers(params.to_vec()),
+                Rule::FiniteCount(N_PARAMS),
+            ));
         }
         let antenna = [params[ANTENNA_X], params[ANTENNA_Y]];
         let Some(first) = d.samples.first() else {

@@ -5,7 +5,7 @@
 use super::filter::{DiffDriveFilter, FilterNoise};
 use super::{align, at, DiffDriveDrive, N_PARAMS};
 use crate::kinematics::evaluate::{KinematicOutages, KinematicWindow};
-use crate::Error;
+use crate::{Error, Input, Need, Rule, Task, Value};
 
 /// Where an outage starts from.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -97,26 +97,30 @@ pub fn evaluate_diff_drive(
 ) -> Result<DiffDriveOutages, Error> {
     let finite = [outage_s, step_s, warmup_s].iter().all(|v| v.is_finite());
     if !finite || outage_s <= 0.0 || step_s <= 0.0 || warmup_s <= 0.0 {
-        return Err(Error::InvalidParams(format!(
-            "outage, step and alignment lengths must be positive, got {outage_s}, {step_s}, {warmup_s}"
-        )));
+        return Err(Error::param(
+            "outage, step and alignment lengths (s)",
+            Value::Numbers(vec![outage_s, step_s, warmup_s]),
+            Rule::Positive,
+        ));
     }
     if params.len() != N_PARAMS || params.iter().any(|v| !v.is_finite()) {
-        return Err(Error::InvalidParams(format!(
-            "{N_PARAMS} finite parameters expected"
-        )));
+        return Err(Error::param(
+            "parameters",
+            Value::Numbers(params.to_vec()),
+            Rule::FiniteCount(N_PARAMS),
+        ));
     }
     let (Some(first), Some(last)) = (d.samples.first(), d.samples.last()) else {
-        return Err(Error::Insufficient("no odometry samples".into()));
+        return Err(Error::needs(Task::DeadReckoning, Input::Odometry));
     };
     let mut filter = match start {
         OutageStart::Align => None,
         OutageStart::Filter(noise) => {
             Some(DiffDriveFilter::start(d, params, noise)?.ok_or_else(|| {
-                Error::Insufficient(format!(
-                    "the odometry never travels {} m with three fixes: the filter cannot start",
-                    noise.init_path_m
-                ))
+                Error::from(Need::FilterStart {
+                    path_m: noise.init_path_m,
+                    fixes: 3,
+                })
             })?)
         }
     };
@@ -203,9 +207,13 @@ pub fn evaluate_diff_drive(
         });
     }
     if windows.is_empty() {
-        return Err(Error::Insufficient(format!(
-            "no {outage_s} s outage with {warmup_s} s of fixes before it fits in the drive"
-        )));
+        return Err(Need::OutageWindow {
+            outage_s,
+            warmup_s,
+            span_s: (first.t_s, last.t_s),
+            moving_from_s: None,
+        }
+        .into());
     }
     Ok(DiffDriveOutages {
         outages: KinematicOutages {

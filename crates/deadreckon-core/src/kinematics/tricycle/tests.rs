@@ -168,7 +168,7 @@ fn evaluate_rejects_bad_lengths_and_missing_references() {
     assert!(evaluate(&d, &p, 30.0, f64::NAN).is_err());
     assert!(matches!(
         evaluate(&d, &p, 1.0, 1.0),
-        Err(Error::Insufficient(_))
+        Err(Error::Insufficient { .. })
     ));
     assert!(evaluate(&d, &p[..3], 1.0, 1.0).is_err());
 }
