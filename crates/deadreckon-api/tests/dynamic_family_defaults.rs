@@ -50,6 +50,25 @@
 //! | steering_offset | 0.470 | 0.546 |
 //! | all | 3.246 (1.606) | 2.536 (0.985) |
 //!
+//! With the held yaw rate a candidate too (issue 28,
+//! `model_options::GYRO_GAP_PROCESS_YAW_RATE_RPS`, chosen on cars 1–30 with
+//! the clocks alone, `tests/clock_parts.rs`), after issue 36's calibration
+//! default; `DEFAULTS_SAY=1 DEFAULTS_ONLY_AUTO=1 DEFAULTS_HELD_OUT=1
+//! DEFAULTS_EFFECTS=none,clocks,all`, 5.5 min at a load of 3–6; the
+//! held-out cars run once. Mean final (start) error, m, with the candidate
+//! / without it (the same code, the candidate switched off by hand):
+//!
+//! | effects | dev cars 1–6 | held-out 101–110 (104 apart) |
+//! |---|---|---|
+//! | none | 0.419 (0.158) / the same (no missed readings) | 0.497 (0.189) / the same |
+//! | clocks | 0.457 (0.202) / 0.457 | 0.538 (0.196) / 0.831 (0.205) |
+//! | all | 3.258 (1.617) / 3.258 (1.610) | 1.887 (0.963) / 2.533 (0.965) |
+//!
+//! It was a candidate on 10 of the 30 drives and applied on 8 (held-back
+//! t −1.2 to −4.0); on the dev cars it was not applied, or changed
+//! nothing. Held out, every effect on is now ×3.8 every effect off (×5.1
+//! before).
+//!
 //! Against `auto` before them (the table above): held out, none 0.466 →
 //! 0.500 (the walking bias applied on three of nine effect-free cars, t
 //! −1.4 to −1.6, and a side slip on one), clocks 0.851 → 0.829, all 2.598 →
