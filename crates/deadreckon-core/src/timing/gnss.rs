@@ -10,6 +10,10 @@ use crate::model::{V, X, Y, YAW, YAW_RATE};
 use crate::reference::Reference;
 use crate::{Error, Params};
 
+/// The GNSS delay's steps stop once a step would move it by less than this
+/// fraction of its standard error (issue 30: each step is a calibration).
+pub const GNSS_SETTLED_FRACTION_OF_STD: f64 = 0.1;
+
 /// The GNSS delay against the smoothed track, calibrating with `copts` at
 /// each step (see the module documentation). `params` (the calibration's
 /// result at the final delay) is returned with it.
@@ -120,7 +124,11 @@ pub(super) fn gnss_delay_of(
             None => (d + delta, 1.0),
         };
         last = Some((std * scale, n, params));
-        if delta.abs() < 1e-4 {
+        // Settled: the next step would move the delay by less than a tenth
+        // of its standard error (on the simulated evaluation drive, seed 25,
+        // the steps cycled through −19.55, −19.17, −19.86, −19.51 ms with a
+        // standard error of 6.1 ms until the cap of `gnss_iterations`).
+        if delta.abs() < 1e-4 || (next - d).abs() < GNSS_SETTLED_FRACTION_OF_STD * std * scale {
             break;
         }
         d = next;
