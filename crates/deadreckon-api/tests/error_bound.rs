@@ -127,16 +127,20 @@ fn measure(cars: &[u64], drive_s: f64) -> (f64, f64, usize) {
 #[test]
 fn the_bound_covers_95_percent_of_outages_on_development_cars() {
     let (coverage, sharpness, n) = measure(&(301..=306).collect::<Vec<_>>(), 300.0);
-    // Measured: 162 of 177 windows within (0.915), median bound / median
-    // final error 2.98, since the calibration's passes run at table I's
+    // Measured: 166 of 177 windows within (0.938), median bound / median
+    // final error 2.81, since the GNSS delay's steps stop once settled
+    // (`timing::gnss::GNSS_SETTLED_FRACTION_OF_STD`, issue 30: the delays
+    // of these cars' calibrations moved by fractions of their standard
+    // errors, and with them each car's k). Before that: 162 of 177
+    // (0.915), 2.98, since the calibration's passes run at table I's
     // yaw noise with batch-means standard errors (issue 36). Before that:
     // 167 of 177 (0.944), 2.82 (k 0–2.25 per car, fitted on 29–53 windows;
     // k = 0 on cars 303, 305, 306: the receiver's floor explains their fit
     // windows); the filter's covariance alone, without the receiver's
     // floor: 150 of 177 (0.847), 2.77.
     assert_eq!(n, 177);
-    assert!((0.90..=0.94).contains(&coverage), "{coverage}");
-    assert!((2.85..=3.1).contains(&sharpness), "{sharpness}");
+    assert!((0.92..=0.96).contains(&coverage), "{coverage}");
+    assert!((2.7..=2.95).contains(&sharpness), "{sharpness}");
 }
 
 #[test]
