@@ -169,6 +169,25 @@ impl Feeder {
         self.held.as_ref().map(|h| !h.prediction.is_empty())
     }
 
+    /// Hands one epoch out: counts it and passes its prediction, updates and
+    /// gated fix to the callback.
+    fn hand_out<L: Layout<N>, const N: usize>(
+        &mut self,
+        f: &mut Filter<L, N>,
+        prediction: Option<&Prediction<N>>,
+        epoch: &mut dyn FnMut(&mut Filter<L, N>, EpochOut<'_, N>),
+    ) {
+        self.stats.epochs += 1;
+        epoch(
+            f,
+            EpochOut {
+                prediction,
+                updates: &self.updates,
+                gated_fix_t_s: self.gated_fix_t_s,
+            },
+        );
+    }
+
     /// Hands out the held epoch, if any.
     fn release<L: Layout<N>, const N: usize>(
         &mut self,
@@ -179,15 +198,7 @@ impl Feeder {
             return;
         };
         let prediction = held.prediction::<N>();
-        self.stats.epochs += 1;
-        epoch(
-            f,
-            EpochOut {
-                prediction: prediction.as_ref(),
-                updates: &self.updates,
-                gated_fix_t_s: self.gated_fix_t_s,
-            },
-        );
+        self.hand_out(f, prediction.as_ref(), epoch);
         self.updates.clear();
         self.gated_fix_t_s = None;
     }
@@ -556,15 +567,7 @@ impl Feeder {
                     if use_.wheels && !gap {
                         self.monitor_wheels(f, &ev.measurement, interval);
                     }
-                    self.stats.epochs += 1;
-                    epoch(
-                        f,
-                        EpochOut {
-                            prediction: prediction.as_ref(),
-                            updates: &self.updates,
-                            gated_fix_t_s: self.gated_fix_t_s,
-                        },
-                    );
+                    self.hand_out(f, prediction.as_ref(), epoch);
                 }
                 _ => {}
             },
@@ -647,15 +650,7 @@ impl Feeder {
                     // Not `used` (above).
                     Measurement::Gyro { .. } | Measurement::Accel { .. } => {}
                 }
-                self.stats.epochs += 1;
-                epoch(
-                    f,
-                    EpochOut {
-                        prediction: prediction.as_ref(),
-                        updates: &self.updates,
-                        gated_fix_t_s: self.gated_fix_t_s,
-                    },
-                );
+                self.hand_out(f, prediction.as_ref(), epoch);
             }
         }
         Ok(())
