@@ -73,8 +73,10 @@ fn bin_setting(samples: &[Sample<'_>]) -> Vec<f64> {
         .flatten()
         .copied()
         .fold(f64::INFINITY, f64::min);
+    // No positive best median (none, or 0): every method sets the bins.
+    let ratio_applies = best > 0.0;
     let keep =
-        |m: &Option<f64>| m.is_some_and(|m| !(best > 0.0) || m <= HISTOGRAM_OUTLIER_RATIO * best);
+        |m: &Option<f64>| m.is_some_and(|m| !ratio_applies || m <= HISTOGRAM_OUTLIER_RATIO * best);
     sorted_finite(
         &samples
             .iter()
