@@ -260,7 +260,7 @@ pub fn nees_through_windows(
     let n = &drive.vehicle.noise;
     let states = match (
         n.gnss_wander_std_m > 0.0,
-        n.gyro_bias_walk_rps_per_sqrt_s > 0.0,
+        crate::gyro_drift::carries_bias(n),
     ) {
         (false, false) => epochs::<CarLayout, { model::N }>(drive, params, &opts)?,
         (true, false) => epochs::<CarWanderLayout, N_WANDER>(drive, params, &opts)?,

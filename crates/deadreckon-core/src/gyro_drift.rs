@@ -21,10 +21,25 @@
 //! drive's mean). [`CarWanderBiasLayout`] adds it to the receiver's wander
 //! ([`crate::gnss_error`]). `gyro_bias_walk_rps_per_sqrt_s = 0` (the
 //! default) is the paper's constant bias and the five-state filter.
+//!
+//! `[noise] gyro_bias_drive_std_rps` above 0 carries the bias as the same
+//! state for another reason: a gyro's bias on a new drive is not the
+//! calibration drive's (turn-on repeatability, temperature). The state then
+//! starts with that standard deviation added to the walk's
+//! ([`prior_std`]), and with no walk it stays put once the drive's fixes
+//! have shown it. Measured on the dynamic family (dev cars 1–25, 30 s
+//! outages on a drive other than the calibration's; `deadreckon-sim/tests/walk_evidence.rs`):
+//! it takes most of what the walk takes back where the gyro drifts, and the
+//! calibration drive's own fixes cannot tell whether it will help
+//! ([`walk_evidence`]): the bias that differs is the next drive's.
 
-use crate::filter::Layout;
+use crate::drive::Drive;
+use crate::ekf::FilterOptions;
+use crate::filter::{CarLayout, Layout};
 use crate::gnss_error::WANDER_E;
 use crate::vehicle::{Noise, Params};
+use crate::wander_fit::likelihood;
+use crate::Error;
 
 /// Index of the gyro bias in [`CarBiasLayout`]'s state.
 pub const BIAS: usize = 5;
@@ -72,18 +87,79 @@ impl Layout<N_WANDER_BIAS> for CarWanderBiasLayout {
     }
 }
 
+/// Whether the aided filter carries the gyro bias as a state (a walk, or a
+/// bias that may differ on this drive).
+pub fn carries_bias(noise: &Noise) -> bool {
+    noise.gyro_bias_walk_rps_per_sqrt_s > 0.0 || noise.gyro_bias_drive_std_rps > 0.0
+}
+
 /// The prior standard deviations a walking-bias filter starts with: the
-/// bias's `walk·√START_SPAN_S` (the other parameters are not states; their
-/// entries are unused).
+/// bias's `walk·√START_SPAN_S` and `gyro_bias_drive_std_rps` together (the
+/// other parameters are not states; their entries are unused).
 pub fn prior_std(noise: &Noise) -> Params {
     Params {
-        gyro_bias_rps: noise.gyro_bias_walk_rps_per_sqrt_s * START_SPAN_S.sqrt(),
+        gyro_bias_rps: (noise.gyro_bias_walk_rps_per_sqrt_s * START_SPAN_S.sqrt())
+            .hypot(noise.gyro_bias_drive_std_rps),
         speed_scale: 0.0,
         circumference_fl_m: 0.0,
         circumference_fr_m: 0.0,
         circumference_rl_m: 0.0,
         circumference_rr_m: 0.0,
     }
+}
+
+/// What a drive's own fixes say about a walking bias: the GNSS-aided
+/// filter's mean capped log-likelihood per fix (as
+/// [`crate::wander_fit`] scores a receiver model) with the calibration's
+/// constant bias and with the bias walking.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WalkEvidence {
+    /// With the constant bias (the paper's model).
+    pub constant: f64,
+    /// With the bias a state ([`carries_bias`]).
+    pub walking: f64,
+    /// Fixes each averages.
+    pub fixes: usize,
+}
+
+impl WalkEvidence {
+    /// The log-likelihood ratio of the bias as a state over the constant
+    /// one, summed over the fixes.
+    pub fn log_ratio(&self) -> f64 {
+        (self.walking - self.constant) * self.fixes as f64
+    }
+}
+
+/// Runs the GNSS-aided filter over `drive` with the constant bias of
+/// `params` and with the bias a state as `noise` (its walk and drive
+/// standard deviation) says; each fix's innovation is predicted from the
+/// fixes before it only, so the ratio is out of sample one fix ahead.
+pub fn walk_evidence(
+    drive: &Drive,
+    params: &Params,
+    opts: &FilterOptions,
+    noise: &Noise,
+) -> Result<WalkEvidence, Error> {
+    let opts = FilterOptions {
+        record_epochs: false,
+        record_innovations: false,
+        ..opts.clone()
+    };
+    let mut constant_vehicle = drive.vehicle.clone();
+    constant_vehicle.noise.gyro_bias_walk_rps_per_sqrt_s = 0.0;
+    constant_vehicle.noise.gyro_bias_drive_std_rps = 0.0;
+    let constant = likelihood::<CarLayout, 5>(drive, &constant_vehicle, params, None, &opts, None)?;
+    let mut v = drive.vehicle.clone();
+    v.noise.gyro_bias_walk_rps_per_sqrt_s = noise.gyro_bias_walk_rps_per_sqrt_s;
+    v.noise.gyro_bias_drive_std_rps = noise.gyro_bias_drive_std_rps;
+    let prior = prior_std(&v.noise);
+    let walking =
+        likelihood::<CarBiasLayout, N_BIAS>(drive, &v, params, Some(&prior), &opts, None)?;
+    Ok(WalkEvidence {
+        constant: constant.log_likelihood,
+        walking: walking.log_likelihood,
+        fixes: constant.fixes.min(walking.fixes),
+    })
 }
 
 #[cfg(test)]
@@ -105,6 +181,26 @@ mod tests {
             ..Params::nominal(&v)
         };
         Filter::new(&v, &params, Some(&prior_std(&v.noise)), 0.0, x0, p0).unwrap()
+    }
+
+    #[test]
+    fn a_bias_that_differs_per_drive_starts_with_its_std_and_stays_put() {
+        let mut v = Vehicle::paper_car();
+        assert!(!carries_bias(&v.noise));
+        v.noise.gyro_bias_drive_std_rps = 5e-5;
+        assert!(carries_bias(&v.noise));
+        let x0 = State::from([1.0, -2.0, 0.3, 12.0, 0.08]);
+        let p0 = Mat::from_diagonal(&State::from([1.0, 1.0, 0.01, 1.0, 0.01]));
+        let params = Params::nominal(&v);
+        let mut f: Filter<CarBiasLayout, N_BIAS> =
+            Filter::new(&v, &params, Some(&prior_std(&v.noise)), 0.0, x0, p0).unwrap();
+        assert!((f.covariance()[(BIAS, BIAS)] - 2.5e-9).abs() < 1e-22);
+        f.predict_to(1.0);
+        assert!((f.covariance()[(BIAS, BIAS)] - 2.5e-9).abs() < 1e-22);
+        // With a walk too, the two add in variance.
+        v.noise.gyro_bias_walk_rps_per_sqrt_s = 3e-6;
+        let want = (9e-12 * START_SPAN_S + 2.5e-9).sqrt();
+        assert!((prior_std(&v.noise).gyro_bias_rps - want).abs() < 1e-18);
     }
 
     #[test]

@@ -215,7 +215,7 @@ impl Online {
     fn started(&self, t0: f64, x0: State, p0: Mat) -> Result<Stage, Error> {
         let feeder = Feeder::new(&self.opts, t0);
         let form = self.opts.covariance_form;
-        let walks = self.vehicle.noise.gyro_bias_walk_rps_per_sqrt_s > 0.0;
+        let walks = crate::gyro_drift::carries_bias(&self.vehicle.noise);
         Ok(match &self.prior_std {
             None if walks => Stage::Walking {
                 filter: Box::new(

@@ -243,7 +243,7 @@ fn evaluate_with(
     let n = &drive.vehicle.noise;
     match (
         n.gnss_wander_std_m > 0.0,
-        n.gyro_bias_walk_rps_per_sqrt_s > 0.0,
+        crate::gyro_drift::carries_bias(n),
     ) {
         (false, false) => {
             evaluate_in::<CarLayout, 5>(drive, params, outage_s, step_s, warmup_s, base, use_truth)
@@ -614,7 +614,7 @@ fn through_windows_in(
     let mut hook = Collect(Vec::new());
     // The gyro bias walks where the vehicle says so, as in `run`'s tracks
     // and `stream` (the receiver's wander is carried by `evaluate` only).
-    let stats = if drive.vehicle.noise.gyro_bias_walk_rps_per_sqrt_s > 0.0 {
+    let stats = if crate::gyro_drift::carries_bias(&drive.vehicle.noise) {
         ekf::run_filter(
             drive,
             ekf::fixed_filter::<CarBiasLayout, N_BIAS>(drive, params, &opts)?,

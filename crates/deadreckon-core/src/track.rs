@@ -196,8 +196,7 @@ pub fn drive_tracks(
     let mut out = Vec::new();
     let mut smoothed_start = None;
     if drive.gnss.len() >= 2 {
-        let (filtered, smoothed, start) = if drive.vehicle.noise.gyro_bias_walk_rps_per_sqrt_s > 0.0
-        {
+        let (filtered, smoothed, start) = if crate::gyro_drift::carries_bias(&drive.vehicle.noise) {
             aided_tracks::<CarBiasLayout, N_BIAS>(drive, params, opts)?
         } else {
             aided_tracks::<CarLayout, 5>(drive, params, opts)?

@@ -107,6 +107,16 @@ pub struct Noise {
     /// bias the fixes last showed instead of the calibration drive's mean.
     #[serde(skip_serializing_if = "is_zero")]
     pub gyro_bias_walk_rps_per_sqrt_s: f64,
+    /// How far the gyro bias may be on a drive from the calibrated one,
+    /// rad/s (default 0: the calibrated constant, the paper's model). A
+    /// gyro's bias changes between drives (its turn-on repeatability and
+    /// temperature) by more than it moves within one: above 0 the aided
+    /// filter carries the bias as a state that starts at the calibrated
+    /// value with this standard deviation (and walks by
+    /// `gyro_bias_walk_rps_per_sqrt_s`, if set), so each drive's fixes
+    /// re-learn it ([`crate::gyro_drift`]).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub gyro_bias_drive_std_rps: f64,
     /// The yaw rate's process noise per `process_step_s` at a wheel epoch
     /// without a gyro reading of its own while the gyro is live, rad/s
     /// (default 0: `process_yaw_rate_rps`, table I's, at every epoch).
@@ -254,6 +264,7 @@ impl Default for Noise {
             gnss_wander_tau_s: DEFAULT_GNSS_WANDER_TAU_S,
             gyro_bias_walk_rps_per_sqrt_s: 0.0,
             gyro_gap_process_yaw_rate_rps: 0.0,
+            gyro_bias_drive_std_rps: 0.0,
             wheel_gate_chi2: GROSS_FAULT_CHI2,
             gyro_gate_chi2: GROSS_FAULT_CHI2,
             speed_gate_chi2: GROSS_FAULT_CHI2,
@@ -523,6 +534,15 @@ impl Vehicle {
                 n.gyro_bias_walk_rps_per_sqrt_s,
                 Rule::NonNegative {
                     zero_means: Some("a constant bias"),
+                },
+            ));
+        }
+        if !(n.gyro_bias_drive_std_rps.is_finite() && n.gyro_bias_drive_std_rps >= 0.0) {
+            return Err(Error::vehicle(
+                "noise.gyro_bias_drive_std_rps",
+                n.gyro_bias_drive_std_rps,
+                Rule::NonNegative {
+                    zero_means: Some("the calibrated bias"),
                 },
             ));
         }

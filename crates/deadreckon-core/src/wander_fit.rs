@@ -61,6 +61,7 @@ pub fn fit(drive: &Drive, params: &Params, opts: &FilterOptions) -> Result<Wande
         drive,
         &drive.vehicle,
         params,
+        None,
         &opts,
         None,
     )?];
@@ -74,6 +75,7 @@ pub fn fit(drive: &Drive, params: &Params, opts: &FilterOptions) -> Result<Wande
                 drive,
                 &v,
                 params,
+                None,
                 &opts,
                 Some(w),
             )?);
@@ -89,16 +91,18 @@ pub fn fit(drive: &Drive, params: &Params, opts: &FilterOptions) -> Result<Wande
     Ok(WanderFit { candidates, best })
 }
 
-/// The mean capped log-likelihood per fix of one receiver model.
-fn likelihood<L: Layout<N>, const N: usize>(
+/// The mean capped log-likelihood per fix of one receiver model (the
+/// filter's parameter states, if it has any, start with `prior_std`).
+pub(crate) fn likelihood<L: Layout<N>, const N: usize>(
     drive: &Drive,
     vehicle: &Vehicle,
     params: &Params,
+    prior_std: Option<&Params>,
     opts: &FilterOptions,
     wander: Option<Wander>,
 ) -> Result<Candidate, Error> {
     let (t0, x0, p0) = ekf::start(drive, opts)?;
-    let mut f = Filter::<L, N>::new(vehicle, params, None, t0, x0, p0)?
+    let mut f = Filter::<L, N>::new(vehicle, params, prior_std, t0, x0, p0)?
         .with_covariance_form(opts.covariance_form);
     let gate = vehicle.noise.gnss_gate_chi2;
     let (mut feeder, events) = ekf::feed(drive, opts, f.time_s());

@@ -107,7 +107,8 @@ impl Effects {
         Some(e)
     }
 
-    fn flag(&mut self, name: &str) -> Option<&mut bool> {
+    /// The switch of the effect `name` (one of [`Effects::NAMES`]).
+    pub fn flag(&mut self, name: &str) -> Option<&mut bool> {
         Some(match name {
             "side_slip" => &mut self.side_slip,
             "longitudinal" => &mut self.longitudinal,
