@@ -159,6 +159,23 @@ fn stream_disagreed_with_run_on_stored_delays() {
             .unwrap();
             t.insert("model".into(), model.into());
             std::fs::write(params, toml::to_string(&t).unwrap()).unwrap();
+            // A gyro bias free to differ on this drive (issue 28,
+            // `[noise] gyro_bias_drive_std_rps`, a vehicle setting): it
+            // must change `run`'s track, and `stream` must follow it.
+            let drive = dir.to_str().unwrap();
+            let before = run_filtered(drive, params, "wheel", tmp.path());
+            let text = std::fs::read_to_string(&vehicle).unwrap();
+            assert!(text.contains("[noise]\n"), "{text}");
+            let text = text.replace("[noise]\n", "[noise]\ngyro_bias_drive_std_rps = 5e-5\n");
+            std::fs::write(&vehicle, text).unwrap();
+            let after = run_filtered(drive, params, "wheel", tmp.path());
+            let moved = before
+                .iter()
+                .zip(&after)
+                .map(|(a, b)| (a[1] - b[1]).hypot(a[2] - b[2]))
+                .fold(0.0, f64::max);
+            println!("edited: the per-drive gyro bias moved run's track by up to {moved:.3e} m");
+            assert!(moved > 1e-6, "gyro_bias_drive_std_rps did not reach run");
         } else {
             run_ok(&["calibrate", d, "--corrections", which, "--out", params]);
         }
