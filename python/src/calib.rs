@@ -138,7 +138,7 @@ pub fn params_arg(
     // another vehicle's file is refused.
     let file = deadreckon_api::params_file::ParamsFile::read(&label).map_err(to_py_err)?;
     let params = file.estimate.params;
-    deadreckon_api::binding::check(&label, file.vehicle.as_ref(), &params, vehicle, false)
+    deadreckon_api::binding::check(&label, file.vehicle(), &params, vehicle, false)
         .map_err(to_py_err)?;
     Ok((params, label))
 }
