@@ -23,10 +23,10 @@ use crate::Error;
 /// What to calibrate with: the method and its options, and the timing and
 /// mounting corrections estimated (and applied) before calibrating.
 ///
-/// `Default` is the command's default: RTS, augmented state, Anderson
-/// iteration, 60 passes at most, 2 m/s speed threshold, wheel timing, the
-/// wheel-health monitor on (all [`CalibrationOptions::default`]) and
-/// `--corrections auto` ([`Which::default`]).
+/// `Default` is the command's default: the method, passes, speed threshold,
+/// timing and wheel-health monitor of [`CalibrationOptions::default`] (the
+/// one place their values are written) and `--corrections auto`
+/// ([`Which::default`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct CalibrationRequest {
     /// The method and its options.
