@@ -56,6 +56,36 @@ pub(crate) fn toml_message(within: &str, e: &toml::de::Error) -> String {
     }
 }
 
+/// Another shape's parameter file given for a car: the reader's error with
+/// what to do (`--shape`, or calibrate the car), in the command's words.
+#[derive(Debug, thiserror::Error)]
+#[error("{source}: give it with --shape {}, or calibrate the car (deadreckon calibrate DRIVE --out FILE)", shape.replace('_', "-"))]
+pub struct OtherShape {
+    /// The file's `shape` key.
+    pub shape: String,
+    /// The reader's error.
+    pub source: deadreckon_io::IoError,
+}
+
+/// The reader's error of `name`, with [`OtherShape`]'s hint for another
+/// shape's file.
+fn read_error(e: deadreckon_io::IoError, name: &str) -> Error {
+    let what = format!("reading parameters {name}");
+    match &e {
+        deadreckon_io::IoError::OtherShape { shape, .. } => Error::While {
+            what,
+            source: Box::new(OtherShape {
+                shape: shape.clone(),
+                source: e,
+            }),
+        },
+        _ => Error::While {
+            what,
+            source: Box::new(e),
+        },
+    }
+}
+
 impl ParamsFile {
     /// The file of `estimate` and `tables`, checked as a read file is:
     /// the vehicle's lengths, the stored corrections, the bound.
@@ -84,7 +114,7 @@ impl ParamsFile {
     /// line and column.
     pub fn read(spec: &str) -> Result<ParamsFile, Error> {
         let (estimate, extra) = deadreckon_io::read_params_with_extra(Path::new(spec))
-            .doing(|| format!("reading parameters {spec}"))?;
+            .map_err(|e| read_error(e, spec))?;
         ParamsFile::from_parts(spec, estimate, extra)
     }
 
@@ -92,7 +122,7 @@ impl ParamsFile {
     /// over as text); `name` names it in errors.
     pub fn parse(text: &str, name: &str) -> Result<ParamsFile, Error> {
         let (estimate, extra) = deadreckon_io::parse_params_with_extra(text, Path::new(name))
-            .doing(|| format!("reading parameters {name}"))?;
+            .map_err(|e| read_error(e, name))?;
         ParamsFile::from_parts(name, estimate, extra)
     }
 
