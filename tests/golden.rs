@@ -113,25 +113,26 @@ fn outputs() -> Vec<(&'static str, String)> {
     // Calibration, written as `calibrate --out params.toml` writes it.
     let opts = CalibrationOptions::default();
     let c = calibrate::calibrate(&drive, &opts).unwrap();
-    let mut extra = toml::Table::new();
-    extra.insert("method".into(), "rts".into());
-    extra.insert("iterations".into(), (c.iterations as i64).into());
-    extra.insert("converged".into(), c.converged.into());
-    let not_estimated = deadreckon_api::json::not_estimated(
-        &c,
-        opts.min_speed_mps,
-        deadreckon_api::json::Absent::of(&drive),
-    );
-    if !not_estimated.is_empty() {
-        let t: toml::Table = not_estimated
-            .iter()
-            .map(|(k, why)| (k.to_string(), why.clone().into()))
-            .collect();
-        extra.insert("not_estimated".into(), t.into());
-    }
+    let tables = deadreckon_api::params_file::ParamsTables {
+        method: Some("rts".into()),
+        iterations: Some(c.iterations),
+        converged: Some(c.converged),
+        not_estimated: deadreckon_api::json::not_estimated(
+            &c,
+            opts.min_speed_mps,
+            deadreckon_api::json::Absent::of(&drive),
+        )
+        .into_iter()
+        .map(|(k, why)| (k.to_string(), why))
+        .collect(),
+        ..Default::default()
+    };
     let dir = tempfile::tempdir().unwrap();
     let params_path = dir.path().join("params.toml");
-    deadreckon_io::write_params(&params_path, &c.estimate, Some(&extra)).unwrap();
+    deadreckon_api::params_file::ParamsFile::new(c.estimate, tables, "params.toml")
+        .unwrap()
+        .write(&params_path)
+        .unwrap();
     out.push((
         "params.toml",
         std::fs::read_to_string(&params_path).unwrap(),

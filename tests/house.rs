@@ -217,10 +217,6 @@ const FLAG_ALLOWED: &[(&str, &str)] = &[
     // Names both: "command line: --wheels ticks|speeds; library:
     // ReadOptions::prefer_wheels".
     ("crates/deadreckon-io/src/error.rs", "wheels"),
-    // The params.toml reader's hint for a diff-drive/tricycle file given to
-    // a car (being moved to the typed ParamsFile by issue 30 this round).
-    ("crates/deadreckon-io/src/toml_files.rs", "shape"),
-    ("crates/deadreckon-io/src/toml_files.rs", "out"),
     // TedriS's acceptance advice (`tedris train --reference`, `--model
     // baseline`): a typed advice for the CLI to word is still to do.
     ("crates/deadreckon-tedris/src/acceptance.rs", "reference"),

@@ -176,24 +176,27 @@ def read_drive(path: PathLike, mapping: Optional[PathLike] = None) -> Drive:
 
 def calibrate(
     drive: DriveLike,
-    method: str = "rts",
+    method: Optional[str] = None,
     *,
-    state: str = "augmented",
-    iteration: str = "anderson",
+    state: Optional[str] = None,
+    iteration: Optional[str] = None,
     max_iterations: Optional[int] = None,
-    timing: str = "wheel",
+    timing: Optional[str] = None,
     min_speed: Optional[float] = None,
     mapping: Optional[PathLike] = None,
-    corrections: str = "auto",
+    corrections: Optional[str] = None,
     skip_checks: bool = False,
 ) -> Dict[str, Any]:
     """Calibrates the six parameters; returns ``deadreckon calibrate --json``'s object.
 
     ``method``: ``rts`` (smoothed states, needs GNSS), ``zupt`` (standstill
-    gyro bias) or ``truth``. The options are ``calibrate``'s: ``state``
-    (``augmented`` or ``paper``), ``iteration`` (``anderson`` or ``plain``),
-    ``max_iterations`` (default the command's, 60), ``timing`` (``wheel`` or
-    ``each``), ``min_speed`` (m/s, default the command's, 2), ``corrections`` (``gnss``: estimate the streams' delays, the
+    gyro bias) or ``truth``. The options are ``calibrate``'s, and an option
+    not given (``None``) takes the command's default, held once in the
+    library (``CalibrationRequest::default``): ``state`` (``augmented`` or
+    ``paper``), ``iteration`` (``anderson`` or ``plain``),
+    ``max_iterations``, ``timing`` (``wheel`` or ``each``), ``min_speed``
+    (m/s), ``corrections`` (``auto``: each correction applied only when it
+    lowers the held-back GNSS error; ``gnss``: estimate the streams' delays, the
     driven axle's slip, the IMU tilt and the gyro scale, apply the slip, the
     tilt, the GNSS delay and the scale;
     ``all``: apply every delay too; ``none``). Keys: the six parameters,

@@ -98,14 +98,14 @@ class Online:
 def read_drive(path: str, mapping: Optional[str] = None) -> Drive: ...
 def calibrate(
     source: Union[Drive, str],
-    method: str = "rts",
-    state: str = "augmented",
-    iteration: str = "anderson",
-    max_iterations: int = 60,
-    timing: str = "wheel",
-    min_speed: float = 2.0,
+    method: Optional[str] = None,
+    state: Optional[str] = None,
+    iteration: Optional[str] = None,
+    max_iterations: Optional[int] = None,
+    timing: Optional[str] = None,
+    min_speed: Optional[float] = None,
     mapping: Optional[str] = None,
-    corrections: str = "auto",
+    corrections: Optional[str] = None,
     skip_checks: bool = False,
 ) -> Dict[str, Any]: ...
 def run_tracks(
@@ -122,7 +122,7 @@ def evaluate(
     metric: str = "drift",
     outage: Optional[float] = None,
     step: Optional[float] = None,
-    warmup: float = 5.0,
+    warmup: Optional[float] = None,
     segment_m: float = 100.0,
     threshold_m: float = 1.0,
     track: str = "dead-reckoned",

@@ -3,10 +3,10 @@
 
 use std::path::PathBuf;
 
-use deadreckon_api::calibration::CalibrationRequest;
+use deadreckon_api::calibration::{CalibrationRequest, RequestWords};
 use deadreckon_api::json;
-use deadreckon_api::options::{parse_iteration, parse_pass_state, parse_timing};
-use deadreckon_core::calibrate::{CalibrationOptions, Method};
+use deadreckon_api::options::parse_timing;
+use deadreckon_core::calibrate::Method;
 use deadreckon_core::ekf::FilterOptions;
 use deadreckon_core::metrics;
 use deadreckon_core::{evo, outage, track, Params};
@@ -18,18 +18,10 @@ use crate::drive::{checked, drive_arg};
 use crate::pyjson::to_py;
 use crate::{to_py_err, DeadreckonError};
 
-/// The `--corrections` word of `calibrate` and `evaluate`.
+/// The `--corrections` word of `run_tracks` and `evaluate`
+/// ([`deadreckon_api::options::parse_corrections`]).
 fn corrections_which(s: &str) -> PyResult<deadreckon_core::timing::Which> {
-    use deadreckon_core::timing::Which;
-    match s {
-        "auto" => Ok(Which::Auto),
-        "gnss" => Ok(Which::Gnss),
-        "all" => Ok(Which::All),
-        "none" => Ok(Which::None),
-        other => Err(err(format!(
-            "unknown corrections `{other}` (auto, gnss, all, none)"
-        ))),
-    }
+    deadreckon_api::options::parse_corrections(s).map_err(to_py_err)
 }
 
 /// The drive with the corrections a params.toml `p` stores applied (none for
@@ -49,42 +41,36 @@ fn err(e: impl std::fmt::Display) -> PyErr {
     DeadreckonError::new_err(e.to_string())
 }
 
-/// `calibrate --json` as a dict; the options are the command's, and those
-/// not given (`None`) are [`CalibrationRequest::default`]'s.
+/// `calibrate --json` as a dict; the options are the command's words, and
+/// those not given (`None`) are [`CalibrationRequest::default`]'s
+/// ([`CalibrationRequest::from_words`]: no default is restated here).
 #[pyfunction]
-#[pyo3(signature = (source, method="rts", state="augmented", iteration="anderson", max_iterations=None, timing="wheel", min_speed=None, mapping=None, corrections="auto", skip_checks=false))]
+#[pyo3(signature = (source, method=None, state=None, iteration=None, max_iterations=None, timing=None, min_speed=None, mapping=None, corrections=None, skip_checks=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn calibrate(
     py: Python<'_>,
     source: &Bound<'_, PyAny>,
-    method: &str,
-    state: &str,
-    iteration: &str,
+    method: Option<&str>,
+    state: Option<&str>,
+    iteration: Option<&str>,
     max_iterations: Option<usize>,
-    timing: &str,
+    timing: Option<&str>,
     min_speed: Option<f64>,
     mapping: Option<PathBuf>,
-    corrections: &str,
+    corrections: Option<&str>,
     skip_checks: bool,
 ) -> PyResult<Py<PyAny>> {
-    let d = CalibrationRequest::default().options;
-    let m: Method = method.parse().map_err(to_py_err)?;
-    let request = CalibrationRequest {
-        options: CalibrationOptions {
-            method: m,
-            state: parse_pass_state(state).map_err(to_py_err)?,
-            iteration: parse_iteration(iteration).map_err(to_py_err)?,
-            max_iterations: max_iterations.unwrap_or(d.max_iterations),
-            min_speed_mps: min_speed.unwrap_or(d.min_speed_mps),
-            filter: FilterOptions {
-                timing: parse_timing(timing).map_err(to_py_err)?,
-                ..d.filter
-            },
-            ..d
-        },
-        corrections: corrections_which(corrections)?,
-        ..CalibrationRequest::default()
-    };
+    let request = CalibrationRequest::from_words(&RequestWords {
+        method,
+        state,
+        iteration,
+        max_iterations,
+        timing,
+        min_speed_mps: min_speed,
+        corrections,
+    })
+    .map_err(to_py_err)?;
+    let m = request.options.method;
     // Only the truth calibration reads truth.csv (as `calibrate` does).
     let read = deadreckon_io::ReadOptions::default();
     let read = if m == Method::Truth {
@@ -138,7 +124,7 @@ pub fn params_arg(
     // another vehicle's file is refused.
     let file = deadreckon_api::params_file::ParamsFile::read(&label).map_err(to_py_err)?;
     let params = file.estimate.params;
-    deadreckon_api::binding::check(&label, file.vehicle.as_ref(), &params, vehicle, false)
+    deadreckon_api::binding::check(&label, file.vehicle(), &params, vehicle, false)
         .map_err(to_py_err)?;
     Ok((params, label))
 }

@@ -59,11 +59,15 @@ impl Online {
         let (stored, bound) = match params {
             Some(p) if p.cast::<PyDict>().is_err() => {
                 let spec: std::path::PathBuf = p.extract()?;
-                let stored = deadreckon_api::corrections::stored_in_file(&spec)
-                    .map_err(DeadreckonError::new_err)?;
-                let bound = deadreckon_api::stream::start_bound(&spec.to_string_lossy())
-                    .map_err(to_py_err)?;
-                (stored, bound)
+                // Read once, as `deadreckon stream` reads it.
+                let spec = spec.to_string_lossy();
+                if spec == "nominal" {
+                    (Default::default(), deadreckon_core::bound::BoundFit::FILTER)
+                } else {
+                    let file =
+                        deadreckon_api::params_file::ParamsFile::read(&spec).map_err(to_py_err)?;
+                    (file.corrections, file.bound)
+                }
             }
             _ => (Default::default(), deadreckon_core::bound::BoundFit::FILTER),
         };

@@ -235,5 +235,8 @@ mod tests {
             o.request,
             deadreckon_fleet::batch::BatchOptions::default().request
         );
+        // Its method and options are the library's defaults (only the
+        // corrections and the bound differ, by the fleet's choice).
+        assert_eq!(o.request.options, CalibrationRequest::default().options);
     }
 }

@@ -27,10 +27,13 @@ pub const MAX_CIRCUMFERENCE_DEVIATION: f64 = 0.05;
 /// absorbs decimal printing).
 const SAME_NOMINAL: f64 = 1e-6;
 
-/// The vehicle a params.toml was calibrated for (its `[vehicle]` table).
-#[derive(Debug, Clone, PartialEq)]
+/// The vehicle a params.toml was calibrated for (its `[vehicle]` table,
+/// written and read through this type).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct VehicleRecord {
     /// The drive's `vehicle_id` (none when its vehicle.toml has none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub vehicle_id: Option<String>,
     /// Nominal wheelbase, m.
     pub wheelbase_m: f64,
@@ -54,52 +57,22 @@ impl VehicleRecord {
         }
     }
 
-    /// The `[vehicle]` table params.toml holds.
-    pub fn to_toml(&self) -> toml::Table {
-        let mut t = toml::Table::new();
-        if let Some(id) = &self.vehicle_id {
-            t.insert("vehicle_id".into(), id.clone().into());
+    /// The record checked as read from `spec`: every length finite and
+    /// positive (an error names the key).
+    pub fn check(&self, spec: &str) -> Result<(), Error> {
+        for (k, v) in [
+            ("wheelbase_m", self.wheelbase_m),
+            ("track_front_m", self.track_front_m),
+            ("track_rear_m", self.track_rear_m),
+            ("wheel_circumference_m", self.wheel_circumference_m),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(Error::Invalid(format!(
+                    "{spec}: `vehicle.{k}` = {v} is not a length (finite, positive)"
+                )));
+            }
         }
-        t.insert("wheelbase_m".into(), self.wheelbase_m.into());
-        t.insert("track_front_m".into(), self.track_front_m.into());
-        t.insert("track_rear_m".into(), self.track_rear_m.into());
-        t.insert(
-            "wheel_circumference_m".into(),
-            self.wheel_circumference_m.into(),
-        );
-        t
-    }
-
-    /// The record in a params.toml's other keys (`None`: the file has no
-    /// `[vehicle]` table, written before it existed); an error names the
-    /// key that is missing or not a number.
-    pub fn from_extra(spec: &str, extra: &toml::Table) -> Result<Option<Self>, Error> {
-        let Some(v) = extra.get("vehicle") else {
-            return Ok(None);
-        };
-        let Some(t) = v.as_table() else {
-            return Err(Error::Invalid(format!(
-                "{spec}: `vehicle` must be a table (the vehicle the parameters were calibrated for)"
-            )));
-        };
-        let num = |k: &str| -> Result<f64, Error> {
-            t.get(k)
-                .and_then(|v| v.as_float().or_else(|| v.as_integer().map(|i| i as f64)))
-                .filter(|x| x.is_finite())
-                .ok_or_else(|| {
-                    Error::Invalid(format!("{spec}: `vehicle.{k}` is missing or not a number"))
-                })
-        };
-        Ok(Some(VehicleRecord {
-            vehicle_id: t
-                .get("vehicle_id")
-                .and_then(|v| v.as_str())
-                .map(str::to_string),
-            wheelbase_m: num("wheelbase_m")?,
-            track_front_m: num("track_front_m")?,
-            track_rear_m: num("track_rear_m")?,
-            wheel_circumference_m: num("wheel_circumference_m")?,
-        }))
+        Ok(())
     }
 
     /// In words: `vehicle_id "x", wheelbase 2.58 m, tracks 1.48/1.46 m,
@@ -228,16 +201,13 @@ mod tests {
         b.vehicle_id = Some("B".into());
         assert!(!VehicleRecord::of(&a).is(&b));
         // Round trip through params.toml's table.
-        let mut extra = toml::Table::new();
-        extra.insert("vehicle".into(), VehicleRecord::of(&a).to_toml().into());
-        let back = VehicleRecord::from_extra("p.toml", &extra)
-            .unwrap()
-            .unwrap();
+        let table = toml::Table::try_from(VehicleRecord::of(&a)).unwrap();
+        let back: VehicleRecord = table.try_into().unwrap();
         assert_eq!(back, VehicleRecord::of(&a));
-        assert_eq!(
-            VehicleRecord::from_extra("p.toml", &toml::Table::new()).unwrap(),
-            None
-        );
+        let mut bad = VehicleRecord::of(&a);
+        bad.wheelbase_m = f64::NAN;
+        let e = bad.check("p.toml").unwrap_err().to_string();
+        assert!(e.contains("vehicle.wheelbase_m"), "{e}");
     }
 
     #[test]

@@ -11,69 +11,43 @@
 //! step_s = 10.0          # the step between them, s
 //! ```
 
-use std::path::Path;
-
 use deadreckon_core::bound::{BoundFit, Method};
 use deadreckon_core::outage::OutageEvaluation;
 use serde_json::{json, Value};
 
+use crate::params_tables::BoundTable;
 use crate::Error;
 
-/// The `[bound]` table of params.toml.
+/// The `[bound]` table of params.toml
+/// ([`crate::params_tables::BoundTable`], the one layout; the kinematic
+/// parameter files carry the same table).
 pub fn bound_toml(fit: &BoundFit) -> toml::Table {
-    let mut t = toml::Table::new();
-    t.insert("method".into(), fit.method.name().into());
-    t.insert("k".into(), fit.k.into());
-    t.insert("windows".into(), (fit.windows as i64).into());
-    t.insert("outage_s".into(), fit.outage_s.into());
-    t.insert("step_s".into(), fit.step_s.into());
-    t
+    toml::Table::try_from(BoundTable::of(fit)).unwrap_or_default()
 }
 
-/// The bound stored in the extra keys of a params.toml: its `[bound]`
-/// table, or the filter's covariance alone ([`BoundFit::FILTER`]) in a
-/// file without one (calibrated before the bound existed).
+/// The bound stored in the extra keys of a (kinematic) parameter file: its
+/// `[bound]` table read as [`BoundTable`], or the filter's covariance alone
+/// ([`BoundFit::FILTER`]) in a file without one (calibrated before the
+/// bound existed).
 pub fn bound_from_extra(extra: &toml::Table) -> Result<BoundFit, String> {
     let Some(t) = extra.get("bound") else {
         return Ok(BoundFit::FILTER);
     };
-    let t = t.as_table().ok_or("`bound` must be a table")?;
-    let num = |k: &str| -> Result<f64, String> {
-        t.get(k)
-            .and_then(|v| v.as_float().or(v.as_integer().map(|i| i as f64)))
-            .ok_or_else(|| format!("`bound.{k}` must be a number"))
-    };
-    let method = t
-        .get("method")
-        .and_then(|v| v.as_str())
-        .and_then(Method::from_name)
-        .ok_or("`bound.method` must be \"conformal\" or \"filter\"")?;
-    let k = num("k")?;
-    if !(k.is_finite() && k >= 0.0) {
-        return Err(format!("`bound.k` = {k} must be finite and non-negative"));
-    }
-    let windows = num("windows")?;
-    if !(windows >= 0.0 && windows.fract() == 0.0) {
-        return Err(format!("`bound.windows` = {windows} must be a count"));
-    }
-    Ok(BoundFit {
-        method,
-        k,
-        windows: windows as usize,
-        outage_s: num("outage_s")?,
-        step_s: num("step_s")?,
-    })
+    let t: BoundTable = t
+        .clone()
+        .try_into()
+        .map_err(|e: toml::de::Error| crate::params_file::toml_message("bound", &e))?;
+    t.fit()
 }
 
 /// The bound stored in the params.toml `spec` (`nominal`: the filter's
-/// covariance alone).
+/// covariance alone), read as every `--params` is
+/// ([`crate::params_file::ParamsFile::read`]).
 pub fn stored_bound(spec: &str) -> Result<BoundFit, Error> {
     if spec == "nominal" {
         return Ok(BoundFit::FILTER);
     }
-    let (_, extra) = deadreckon_io::read_params_with_extra(Path::new(spec))
-        .map_err(|e| Error::Invalid(format!("reading the error bound of {spec}: {e}")))?;
-    bound_from_extra(&extra).map_err(|e| Error::Invalid(format!("{spec}: {e}")))
+    Ok(crate::params_file::ParamsFile::read(spec)?.bound)
 }
 
 /// The bound's `--json` object.

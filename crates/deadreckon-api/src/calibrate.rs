@@ -1,6 +1,7 @@
 //! The result of a car calibration ([`CarCalibration`], made by
 //! [`crate::calibration::calibrate`]) and what the commands show of it: the
-//! `--json` object (its `Serialize`), the params.toml keys, the text table,
+//! `--json` object (its `Serialize`), the params.toml tables
+//! ([`crate::params_tables`]), the text table,
 //! the stack parameter files.
 
 use deadreckon_core::calibrate::{Calibration, Method};
@@ -9,6 +10,8 @@ use deadreckon_core::timing::{Corrections, Which};
 use serde_json::Value;
 
 use crate::calibration::{CalibrationRequest, ParamStatus};
+use crate::params_file::ParamsFile;
+use crate::params_tables::{BoundTable, ParamsTables, SideSlipTable, SteeringTable};
 use crate::Error;
 
 /// A car calibration with everything the commands show of it: the one
@@ -92,35 +95,44 @@ impl CarCalibration {
         v
     }
 
-    /// The keys params.toml holds beside the parameters: method, passes,
-    /// convergence, the parameters not estimated, the steering and the
-    /// corrections (when any were asked for).
-    pub fn params_extra(&self) -> toml::Table {
+    /// The tables params.toml holds beside the parameters: method, passes,
+    /// convergence, the parameters not estimated, the steering and side
+    /// slip, the corrections (when any were asked for), the vehicle and the
+    /// error bound.
+    pub fn params_tables(&self) -> ParamsTables {
         let c = &self.calibration;
-        let mut extra = toml::Table::new();
-        extra.insert("method".into(), self.method_name().into());
-        extra.insert("iterations".into(), (c.iterations as i64).into());
-        extra.insert("converged".into(), c.converged.into());
-        let not_estimated = self.not_estimated();
-        if !not_estimated.is_empty() {
-            let t: toml::Table = not_estimated
-                .iter()
-                .map(|(k, why)| (k.to_string(), why.clone().into()))
-                .collect();
-            extra.insert("not_estimated".into(), t.into());
-        }
-        if let Some(st) = &self.steering {
-            extra.insert("steering".into(), steering_toml(st).into());
-        }
-        if let Some(slip) = &self.calibration.side_slip {
-            extra.insert("side_slip".into(), side_slip_toml(slip).into());
-        }
+        let mut t = ParamsTables {
+            method: Some(self.method_name().to_string()),
+            iterations: Some(c.iterations),
+            converged: Some(c.converged),
+            not_estimated: self
+                .not_estimated()
+                .into_iter()
+                .map(|(k, why)| (k.to_string(), why))
+                .collect(),
+            steering: self.steering.as_ref().map(SteeringTable::of),
+            side_slip: c.side_slip.as_ref().map(SideSlipTable::of),
+            vehicle: Some(self.vehicle.clone()),
+            bound: Some(BoundTable::of(&self.bound)),
+            ..Default::default()
+        };
         if self.which() != Which::None {
-            extra.extend(crate::corrections::corrections_toml(&self.corrections));
+            crate::params_tables::corrections_tables(&self.corrections, &mut t);
         }
-        extra.insert("vehicle".into(), self.vehicle.to_toml().into());
-        extra.insert("bound".into(), crate::bound::bound_toml(&self.bound).into());
-        extra
+        t
+    }
+
+    /// The params.toml of this calibration (`name` names it in errors):
+    /// the parameters with their standard errors and
+    /// [`CarCalibration::params_tables`], checked as a file read back is.
+    pub fn params_file(&self, name: &str) -> Result<ParamsFile, Error> {
+        ParamsFile::new(self.calibration.estimate, self.params_tables(), name)
+    }
+
+    /// [`CarCalibration::params_tables`] as the TOML table written beside
+    /// the parameters.
+    pub fn params_extra(&self) -> toml::Table {
+        toml::Table::try_from(self.params_tables()).unwrap_or_default()
     }
 
     /// The provenance line of the stack parameter files.
@@ -220,44 +232,6 @@ impl CarCalibration {
     }
 }
 
-/// The steering calibration as a params.toml table: value, std (when
-/// estimated) and the reason when not.
-pub(crate) fn steering_toml(st: &SteeringCalibration) -> toml::Table {
-    let mut t = toml::Table::new();
-    for p in [&st.ratio, &st.offset]
-        .into_iter()
-        .chain(st.understeer.as_ref())
-    {
-        t.insert(p.name.clone(), estimate_toml(p).into());
-    }
-    t.insert("samples".into(), (st.samples as i64).into());
-    t
-}
-
-/// One estimate as a params.toml table: value, estimated, std (when
-/// estimated) and the reason when not.
-fn estimate_toml(p: &deadreckon_core::kinematics::ParamEstimate) -> toml::Table {
-    let mut e = toml::Table::new();
-    e.insert("value".into(), p.value.into());
-    e.insert("estimated".into(), p.estimated.into());
-    if let Some(s) = p.std {
-        e.insert("std".into(), s.into());
-    }
-    if let Some(r) = &p.reason {
-        e.insert("reason".into(), r.clone().into());
-    }
-    e
-}
-
-/// The side-slip gradient as the params.toml table `[side_slip]`: the
-/// estimate (`rear_slip_gradient_rad_per_mps2`) and the blocks used.
-pub(crate) fn side_slip_toml(s: &deadreckon_core::side_slip::SideSlip) -> toml::Table {
-    let mut t = toml::Table::new();
-    t.insert(s.gradient.name.clone(), estimate_toml(&s.gradient).into());
-    t.insert("blocks".into(), (s.blocks as i64).into());
-    t
-}
-
 /// The file formats a car calibration is written in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Export {
@@ -293,12 +267,7 @@ impl CarCalibration {
         let context = || format!("writing {}", out.display());
         match format {
             Export::Params => {
-                deadreckon_io::write_params(
-                    out,
-                    &self.calibration.estimate,
-                    Some(&self.params_extra()),
-                )
-                .doing(context)?;
+                self.params_file(&out.display().to_string())?.write(out)?;
                 Ok(vec![out.to_path_buf()])
             }
             Export::Autoware => stack_params::write_autoware(out, &export()).doing(context),

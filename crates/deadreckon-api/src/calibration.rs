@@ -23,10 +23,10 @@ use crate::Error;
 /// What to calibrate with: the method and its options, and the timing and
 /// mounting corrections estimated (and applied) before calibrating.
 ///
-/// `Default` is the command's default: RTS, augmented state, Anderson
-/// iteration, 60 passes at most, 2 m/s speed threshold, wheel timing, the
-/// wheel-health monitor on (all [`CalibrationOptions::default`]) and
-/// `--corrections auto` ([`Which::default`]).
+/// `Default` is the command's default: the method, passes, speed threshold,
+/// timing and wheel-health monitor of [`CalibrationOptions::default`] (the
+/// one place their values are written) and `--corrections auto`
+/// ([`Which::default`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct CalibrationRequest {
     /// The method and its options.
@@ -65,6 +65,54 @@ impl CalibrationRequest {
     /// Python's `method` take, what params.toml's `method` records).
     pub fn method_name(&self) -> &'static str {
         method_name(self.options.method)
+    }
+}
+
+/// A calibration request in the option words of the command line, each
+/// `None` when not given: what Python's `calibrate(...)` hands over (its
+/// keyword arguments default to `None`), so that a default is
+/// [`CalibrationRequest::default`]'s and nowhere else.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct RequestWords<'a> {
+    /// `rts`, `zupt` or `truth`.
+    pub method: Option<&'a str>,
+    /// `augmented` or `paper`.
+    pub state: Option<&'a str>,
+    /// `anderson` or `plain`.
+    pub iteration: Option<&'a str>,
+    /// Smoothing passes at most.
+    pub max_iterations: Option<usize>,
+    /// `wheel` or `each`.
+    pub timing: Option<&'a str>,
+    /// The speed threshold, m/s.
+    pub min_speed_mps: Option<f64>,
+    /// `auto`, `gnss`, `all` or `none`.
+    pub corrections: Option<&'a str>,
+}
+
+impl CalibrationRequest {
+    /// The request the words ask for, the default where a word is not given;
+    /// an unknown word is an error naming what is allowed.
+    pub fn from_words(w: &RequestWords<'_>) -> Result<CalibrationRequest, Error> {
+        use crate::options::{parse_corrections, parse_iteration, parse_pass_state, parse_timing};
+        let d = CalibrationRequest::default();
+        let o = &d.options;
+        Ok(CalibrationRequest {
+            options: CalibrationOptions {
+                method: w.method.map_or(Ok(o.method), str::parse)?,
+                state: w.state.map_or(Ok(o.state), parse_pass_state)?,
+                iteration: w.iteration.map_or(Ok(o.iteration), parse_iteration)?,
+                max_iterations: w.max_iterations.unwrap_or(o.max_iterations),
+                min_speed_mps: w.min_speed_mps.unwrap_or(o.min_speed_mps),
+                filter: deadreckon_core::ekf::FilterOptions {
+                    timing: w.timing.map_or(Ok(o.filter.timing), parse_timing)?,
+                    ..o.filter.clone()
+                },
+                ..o.clone()
+            },
+            corrections: w.corrections.map_or(Ok(d.corrections), parse_corrections)?,
+            ..d.clone()
+        })
     }
 }
 
@@ -208,6 +256,42 @@ mod tests {
         for m in [Method::Rts, Method::Zupt, Method::Truth] {
             assert_eq!(method_name(m).parse::<Method>().unwrap(), m);
         }
+    }
+
+    /// Python's `calibrate()` hands its keyword arguments over as
+    /// [`RequestWords`], each `None` unless given: with none given, the
+    /// request is the library's default, and each word the command line
+    /// takes gives the same option.
+    #[test]
+    fn pythons_defaults_are_the_librarys_request() {
+        let none = CalibrationRequest::from_words(&RequestWords::default()).unwrap();
+        assert_eq!(none, CalibrationRequest::default());
+        let d = CalibrationRequest::default();
+        let words = RequestWords {
+            method: Some(d.method_name()),
+            state: Some("augmented"),
+            iteration: Some("anderson"),
+            max_iterations: Some(d.options.max_iterations),
+            timing: Some("wheel"),
+            min_speed_mps: Some(d.options.min_speed_mps),
+            corrections: Some("auto"),
+        };
+        assert_eq!(CalibrationRequest::from_words(&words).unwrap(), d);
+        let other = RequestWords {
+            method: Some("zupt"),
+            max_iterations: Some(7),
+            corrections: Some("none"),
+            ..Default::default()
+        };
+        let r = CalibrationRequest::from_words(&other).unwrap();
+        assert_eq!(r.options.method, Method::Zupt);
+        assert_eq!(r.options.max_iterations, 7);
+        assert_eq!(r.corrections, Which::None);
+        assert!(CalibrationRequest::from_words(&RequestWords {
+            timing: Some("every"),
+            ..Default::default()
+        })
+        .is_err());
     }
 
     #[test]

@@ -10,6 +10,8 @@ use deadreckon_core::timing::{self, Corrections, Delay, Stream};
 use deadreckon_core::Drive;
 use serde_json::{json, Value};
 
+use crate::params_tables::ParamsTables;
+
 fn delay_json(d: &Delay) -> Value {
     let num = |x: f64| if x.is_finite() { json!(x) } else { Value::Null };
     json!({
@@ -109,103 +111,6 @@ pub fn corrections_json(c: &Corrections) -> Value {
     })
 }
 
-/// The `[delays.<stream>]`, `[traction]`, `[imu]` and `[gyro_scale]` tables
-/// of params.toml.
-pub fn corrections_toml(c: &Corrections) -> toml::Table {
-    let mut out = toml::Table::new();
-    let mut delays = toml::Table::new();
-    for s in Stream::ALL {
-        let d = c.delays.get(s);
-        let mut t = toml::Table::new();
-        t.insert("delay_s".into(), d.applied_s().into());
-        if d.status.is_estimated() {
-            t.insert("std_s".into(), d.std_s.into());
-        } else if let Some(r) = d.status.reason() {
-            t.insert("not_estimated".into(), r.into());
-        }
-        delays.insert(s.name().into(), t.into());
-    }
-    out.insert("delays".into(), delays.into());
-    if let Some(tr) = &c.traction {
-        let mut t = toml::Table::new();
-        if tr.is_estimated() {
-            t.insert("slip_per_mps2".into(), tr.slip_per_mps2.into());
-            t.insert("std".into(), tr.std.into());
-            t.insert("axle".into(), tr.axle.name().into());
-            if tr.mean_force_mps2.is_finite() {
-                t.insert("mean_force_mps2".into(), tr.mean_force_mps2.into());
-            }
-        } else if let Some(r) = tr.status.reason() {
-            t.insert("not_estimated".into(), r.into());
-        }
-        out.insert("traction".into(), t.into());
-    }
-    if let Some(tilt) = &c.tilt {
-        let mut t = toml::Table::new();
-        if tilt.is_estimated() {
-            t.insert("tilt_deg".into(), tilt.tilt_rad.to_degrees().into());
-            t.insert("std_deg".into(), tilt.std_rad.to_degrees().into());
-            t.insert(
-                "up".into(),
-                toml::Value::Array(tilt.up.iter().map(|&u| u.into()).collect()),
-            );
-        } else if let Some(r) = tilt.status.reason() {
-            t.insert("not_estimated".into(), r.into());
-        }
-        out.insert("imu".into(), t.into());
-    }
-    if let Some(g) = &c.gyro_scale {
-        let mut t = toml::Table::new();
-        if g.is_estimated() {
-            t.insert("scale_error".into(), g.scale_error.into());
-            t.insert("std".into(), g.std.into());
-            t.insert("turns".into(), (g.turns as i64).into());
-        } else if let Some(r) = g.status.reason() {
-            t.insert("not_estimated".into(), r.into());
-        }
-        out.insert("gyro_scale".into(), t.into());
-    }
-    if let Some(h) = &c.held_back {
-        // The decisions, for whoever reads the file later (not read back:
-        // what is applied is the values above).
-        let mut t = toml::Table::new();
-        t.insert("windows".into(), (h.windows as i64).into());
-        t.insert("window_s".into(), h.window_s.into());
-        if h.without_m.is_finite() {
-            t.insert("without_m".into(), h.without_m.into());
-        }
-        if let Some(why) = &h.not_judged {
-            t.insert("not_judged".into(), why.clone().into());
-        }
-        for j in &h.judged {
-            let mut e = toml::Table::new();
-            for (k, v) in [
-                ("z", j.z),
-                ("with_m", j.with_m),
-                ("against_m", j.against_m),
-                ("t", j.t),
-            ] {
-                if v.is_finite() {
-                    e.insert(k.into(), v.into());
-                }
-            }
-            e.insert("applied".into(), j.applied.into());
-            if j.by_significance {
-                e.insert("by_significance".into(), true.into());
-            }
-            t.insert(j.correction.key(), e.into());
-        }
-        out.insert("held_back".into(), t.into());
-    }
-    if !c.model.is_empty() {
-        // What is applied to the vehicle (read back by `stored_corrections`).
-        if let Ok(t) = toml::Table::try_from(c.model) {
-            out.insert("model".into(), t.into());
-        }
-    }
-    out
-}
-
 /// Corrections read back from params.toml (applied as they are).
 pub type Stored = timing::KnownCorrections;
 
@@ -253,8 +158,8 @@ pub fn stored_rows(stored: &Stored) -> Vec<deadreckon_report::CorrectionRow> {
 }
 
 /// The corrections stored in the params.toml at `spec` (nothing for
-/// `nominal`), as `--params` applies them in the CLI and the Python bindings.
-/// The error names the file.
+/// `nominal`), as `--params` applies them in the CLI and the Python bindings
+/// ([`crate::params_file::ParamsFile::read`]). The error names the file.
 pub fn stored_in_file(spec: &std::path::Path) -> Result<Stored, String> {
     if spec.as_os_str() == "nominal" {
         return Ok(Stored::default());
@@ -264,25 +169,35 @@ pub fn stored_in_file(spec: &std::path::Path) -> Result<Stored, String> {
         .map_err(|e| crate::chain_text(&e))
 }
 
-/// Reads the `[delays]`, `[traction]`, `[imu]`, `[gyro_scale]` and `[model]` tables
-/// from the extra keys of a params.toml (absent: nothing to apply).
+/// Reads the `[delays]`, `[traction]`, `[imu]`, `[gyro_scale]` and `[model]`
+/// tables from the keys of a params.toml (its extra keys, or the whole
+/// file's table: the six parameters and `[std]` are left aside; absent:
+/// nothing to apply), through the typed tables ([`ParamsTables`],
+/// [`stored_of`]).
 pub fn stored_corrections(extra: &toml::Table) -> Result<Stored, String> {
-    let mut s = Stored::default();
-    if let Some(m) = extra.get("model") {
-        s.model = m
-            .clone()
-            .try_into()
-            .map_err(|e| format!("`model`: {}", e.message()))?;
-        s.model.validate()?;
+    let mut extra = extra.clone();
+    for k in deadreckon_core::Params::NAMES.iter().chain(&["std"]) {
+        extra.remove(*k);
     }
-    if let Some(d) = extra.get("delays") {
-        let d = d.as_table().ok_or("`delays` must be a table")?;
+    let tables: ParamsTables = extra
+        .try_into()
+        .map_err(|e: toml::de::Error| crate::params_file::toml_message("", &e))?;
+    stored_of(&tables)
+}
+
+/// The corrections a params.toml's tables store, checked: each delay
+/// plausible (|d| < 10 s), the IMU's vertical a unit vector, the slip and
+/// the gyro scale error within their limits, the model additions valid.
+pub fn stored_of(t: &ParamsTables) -> Result<Stored, String> {
+    let mut s = Stored::default();
+    if let Some(m) = t.model {
+        m.validate()?;
+        s.model = m;
+    }
+    if let Some(d) = &t.delays {
         for (i, st) in Stream::ALL.iter().enumerate() {
-            if let Some(t) = d.get(st.name()) {
-                let v = t
-                    .get("delay_s")
-                    .and_then(|v| v.as_float().or(v.as_integer().map(|i| i as f64)))
-                    .ok_or_else(|| format!("`delays.{}.delay_s` must be a number", st.name()))?;
+            if let Some(dt) = d.get(*st) {
+                let v = dt.delay_s;
                 if !(v.is_finite() && v.abs() < 10.0) {
                     return Err(format!(
                         "`delays.{}.delay_s` = {v} is not a plausible delay (|d| < 10 s)",
@@ -293,26 +208,15 @@ pub fn stored_corrections(extra: &toml::Table) -> Result<Stored, String> {
             }
         }
     }
-    if let Some(imu) = extra.get("imu") {
-        let imu = imu.as_table().ok_or("`imu` must be a table")?;
-        if let Some(up) = imu.get("up") {
-            let a = up
-                .as_array()
-                .ok_or("`imu.up` must be an array of 3 numbers")?;
-            let v: Vec<f64> = a.iter().filter_map(|x| x.as_float()).collect();
-            let n = v.iter().map(|x| x * x).sum::<f64>().sqrt();
-            if v.len() != 3 || !(n - 1.0).abs().lt(&1e-3) {
-                return Err("`imu.up` must be a unit vector of 3 numbers".into());
-            }
-            s.up = Some([v[0], v[1], v[2]]);
+    if let Some(up) = t.imu.as_ref().and_then(|imu| imu.up.as_ref()) {
+        let n = up.iter().map(|x| x * x).sum::<f64>().sqrt();
+        if up.len() != 3 || !(n - 1.0).abs().lt(&1e-3) {
+            return Err("`imu.up` must be a unit vector of 3 numbers".into());
         }
+        s.up = Some([up[0], up[1], up[2]]);
     }
-    if let Some(t) = extra.get("traction") {
-        let t = t.as_table().ok_or("`traction` must be a table")?;
-        if let Some(v) = t.get("slip_per_mps2") {
-            let v = v
-                .as_float()
-                .ok_or("`traction.slip_per_mps2` must be a number")?;
+    if let Some(tr) = &t.traction {
+        if let Some(v) = tr.slip_per_mps2 {
             if !(v.is_finite() && v.abs() <= deadreckon_core::traction::MAX_SLIP_PER_MPS2) {
                 return Err(format!(
                     "`traction.slip_per_mps2` = {v} is not a plausible tyre slip (|κ| ≤ {} per m/s²)",
@@ -321,10 +225,7 @@ pub fn stored_corrections(extra: &toml::Table) -> Result<Stored, String> {
             }
             s.traction_slip_per_mps2 = v;
         }
-        if let Some(v) = t.get("mean_force_mps2") {
-            let v = v
-                .as_float()
-                .ok_or("`traction.mean_force_mps2` must be a number")?;
+        if let Some(v) = tr.mean_force_mps2 {
             if !(v.is_finite() && v.abs() < 100.0) {
                 return Err(format!(
                     "`traction.mean_force_mps2` = {v} is not a plausible mean forward specific force (|f| < 100 m/s²)"
@@ -333,21 +234,50 @@ pub fn stored_corrections(extra: &toml::Table) -> Result<Stored, String> {
             s.traction_mean_force_mps2 = Some(v);
         }
     }
-    if let Some(g) = extra.get("gyro_scale") {
-        let g = g.as_table().ok_or("`gyro_scale` must be a table")?;
-        if let Some(v) = g.get("scale_error") {
-            let v = v
-                .as_float()
-                .ok_or("`gyro_scale.scale_error` must be a number")?;
-            if !(v.is_finite() && v.abs() <= deadreckon_core::gyro_scale::MAX_SCALE_ERROR) {
-                return Err(format!(
-                    "`gyro_scale.scale_error` = {v} is not a plausible gyro scale error"
-                ));
-            }
-            s.gyro_scale_error = v;
+    if let Some(v) = t.gyro_scale.as_ref().and_then(|g| g.scale_error) {
+        if !(v.is_finite() && v.abs() <= deadreckon_core::gyro_scale::MAX_SCALE_ERROR) {
+            return Err(format!(
+                "`gyro_scale.scale_error` = {v} is not a plausible gyro scale error"
+            ));
         }
+        s.gyro_scale_error = v;
     }
     Ok(s)
+}
+
+/// The tables of stored corrections, the zero ones left out: what a file
+/// of parameters learned on corrected events carries on (`stream --learn`),
+/// so that the next stream given it applies them too. [`stored_of`] reads
+/// them back as they were.
+pub fn stored_tables(stored: &Stored) -> ParamsTables {
+    use crate::params_tables::{DelayTable, DelaysTable, GyroScaleTable, ImuTable, TractionTable};
+    let mut delays = DelaysTable::default();
+    for (st, d) in Stream::ALL.iter().zip(stored.delays_s) {
+        if d != 0.0 {
+            *delays.get_mut(*st) = Some(DelayTable {
+                delay_s: d,
+                ..Default::default()
+            });
+        }
+    }
+    ParamsTables {
+        delays: (delays != DelaysTable::default()).then_some(delays),
+        imu: stored.up.map(|up| ImuTable {
+            up: Some(up.to_vec()),
+            ..Default::default()
+        }),
+        gyro_scale: (stored.gyro_scale_error != 0.0).then(|| GyroScaleTable {
+            scale_error: Some(stored.gyro_scale_error),
+            ..Default::default()
+        }),
+        traction: (stored.traction_slip_per_mps2 != 0.0).then(|| TractionTable {
+            slip_per_mps2: Some(stored.traction_slip_per_mps2),
+            mean_force_mps2: stored.traction_mean_force_mps2,
+            ..Default::default()
+        }),
+        model: (!stored.model.is_empty()).then_some(stored.model),
+        ..Default::default()
+    }
 }
 
 /// Estimates the corrections `which` asks for (driven axle's slip, IMU tilt,

@@ -66,9 +66,12 @@ pub fn run(
     for r in &results {
         if let Some(c) = &r.calibration {
             let file = out.join(format!("params_{}.toml", r.source.name().to_lowercase()));
-            let mut extra = toml::Table::new();
-            extra.insert("iterations".into(), (c.iterations as i64).into());
-            deadreckon_io::write_params(&file, &c.estimate, Some(&extra))?;
+            let tables = crate::params_file::ParamsTables {
+                iterations: Some(c.iterations),
+                ..Default::default()
+            };
+            let name = file.display().to_string();
+            crate::params_file::ParamsFile::new(c.estimate, tables, &name)?.write(&file)?;
         }
     }
     // The report of the evaluation drive with the calibrations made on the

@@ -47,7 +47,9 @@
 //! - [`text`]: the commands' text tables and summary lines.
 //! - [`params_file`]: a car's params.toml read once and checked once
 //!   (parameters, `[std]`, `[vehicle]`, stored corrections, `[bound]`),
-//!   for every `--params`.
+//!   for every `--params`, and written by the same type.
+//! - [`params_tables`]: every params.toml table beside the parameters, one
+//!   serde struct each (what is written is what is read).
 //! - [`options`]: the option words of the commands (`--timing wheel|each`,
 //!   `--state`, `--iteration`) parsed into the library's enums.
 //!
@@ -72,6 +74,7 @@ pub mod load;
 pub mod model_keys;
 pub mod options;
 pub mod params_file;
+pub mod params_tables;
 pub mod report;
 pub mod report_kinematic;
 pub mod report_labels;

@@ -136,7 +136,7 @@ fn bind(
     allow_other: bool,
 ) -> Result<(Params, binding::Note), Error> {
     let p = file.estimate.params;
-    let note = binding::check(spec, file.vehicle.as_ref(), &p, &drive.vehicle, allow_other)?;
+    let note = binding::check(spec, file.vehicle(), &p, &drive.vehicle, allow_other)?;
     Ok((p, note))
 }
 

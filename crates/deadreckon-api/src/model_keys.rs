@@ -1,7 +1,7 @@
 //! The calibrated vehicle-model keys of params.toml read back: the
 //! steering's ratio, offset and understeer gradient (`[steering]`) and the
 //! rear-axle side-slip gradient (`[side_slip]`), as `calibrate --out`
-//! writes them ([`crate::calibrate::CarCalibration::params_extra`]). Only
+//! writes them ([`crate::calibrate::CarCalibration::params_tables`]). Only
 //! the values marked `estimated = true` are taken. Applying them to a
 //! vehicle ([`StoredModel::apply`]) is the caller's choice: these tables
 //! report what the drive measured. What the commands apply is the `[model]`
@@ -12,6 +12,8 @@
 use deadreckon_core::kinematics::steering::UNDERSTEER_NAME;
 use deadreckon_core::side_slip::NAME as SLIP_NAME;
 use deadreckon_core::Vehicle;
+
+use crate::params_tables::{EstimateTable, ParamsTables};
 
 /// The estimated model keys found in a params.toml (each `None` when absent
 /// or not estimated).
@@ -27,45 +29,32 @@ pub struct StoredModel {
     pub rear_slip_gradient_rad_per_mps2: Option<f64>,
 }
 
-/// The value of `table.key` when it is marked estimated: `Ok(None)` when
-/// absent or not estimated, an error naming the key when malformed.
-fn estimated(table: &toml::Table, section: &str, key: &str) -> Result<Option<f64>, String> {
-    let Some(e) = table.get(key) else {
-        return Ok(None);
-    };
-    let e = e
-        .as_table()
-        .ok_or_else(|| format!("`{section}.{key}` must be a table"))?;
-    if !e
-        .get("estimated")
-        .and_then(|v| v.as_bool())
-        .unwrap_or(false)
-    {
-        return Ok(None);
-    }
-    let v = e
-        .get("value")
-        .and_then(|v| v.as_float().or(v.as_integer().map(|i| i as f64)))
-        .ok_or_else(|| format!("`{section}.{key}.value` must be a number"))?;
-    if !v.is_finite() {
-        return Err(format!("`{section}.{key}.value` = {v} is not finite"));
-    }
-    Ok(Some(v))
+/// The estimated value of an optional estimate table (`Ok(None)` when
+/// absent or not estimated).
+fn estimated(e: Option<&EstimateTable>, key: &str) -> Result<Option<f64>, String> {
+    e.map_or(Ok(None), |e| e.estimated_value(key))
 }
 
-/// Reads the estimated model keys from the extra keys of a params.toml
-/// (`deadreckon_io::read_params_with_extra`).
-pub fn stored_model(extra: &toml::Table) -> Result<StoredModel, String> {
+/// Reads the estimated model keys from a params.toml's tables
+/// ([`crate::params_file::ParamsFile::tables`]).
+pub fn stored_model(tables: &ParamsTables) -> Result<StoredModel, String> {
     let mut m = StoredModel::default();
-    if let Some(st) = extra.get("steering") {
-        let st = st.as_table().ok_or("`steering` must be a table")?;
-        m.steering_ratio = estimated(st, "steering", "steering_ratio")?;
-        m.steering_offset_rad = estimated(st, "steering", "steering_offset_rad")?;
-        m.understeer_gradient_rad_per_mps2 = estimated(st, "steering", UNDERSTEER_NAME)?;
+    if let Some(st) = &tables.steering {
+        m.steering_ratio = estimated(st.steering_ratio.as_ref(), "steering.steering_ratio")?;
+        m.steering_offset_rad = estimated(
+            st.steering_offset_rad.as_ref(),
+            "steering.steering_offset_rad",
+        )?;
+        m.understeer_gradient_rad_per_mps2 = estimated(
+            st.understeer_gradient_rad_per_mps2.as_ref(),
+            &format!("steering.{UNDERSTEER_NAME}"),
+        )?;
     }
-    if let Some(s) = extra.get("side_slip") {
-        let s = s.as_table().ok_or("`side_slip` must be a table")?;
-        m.rear_slip_gradient_rad_per_mps2 = estimated(s, "side_slip", SLIP_NAME)?;
+    if let Some(s) = &tables.side_slip {
+        m.rear_slip_gradient_rad_per_mps2 = estimated(
+            s.rear_slip_gradient_rad_per_mps2.as_ref(),
+            &format!("side_slip.{SLIP_NAME}"),
+        )?;
     }
     Ok(m)
 }
@@ -106,6 +95,9 @@ mod tests {
     use deadreckon_core::side_slip::SideSlip;
     use deadreckon_core::{Params, ParamsWithStd};
 
+    use crate::params_file::ParamsFile;
+    use crate::params_tables::{SideSlipTable, SteeringTable};
+
     fn est(name: &str, value: f64, estimated: bool) -> ParamEstimate {
         ParamEstimate {
             name: name.into(),
@@ -134,23 +126,21 @@ mod tests {
             blocks: 90,
             rms_lateral_accel_mps2: 0.9,
         };
-        let mut extra = toml::Table::new();
-        extra.insert(
-            "steering".into(),
-            crate::calibrate::steering_toml(&steering).into(),
-        );
-        extra.insert(
-            "side_slip".into(),
-            crate::calibrate::side_slip_toml(&slip).into(),
-        );
+        let mut tables = ParamsTables {
+            steering: Some(SteeringTable::of(&steering)),
+            side_slip: Some(SideSlipTable::of(&slip)),
+            ..Default::default()
+        };
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("params.toml");
         let v = Vehicle::paper_car();
         let p = Params::nominal(&v);
-        deadreckon_io::write_params(&path, &ParamsWithStd { params: p, std: p }, Some(&extra))
-            .unwrap();
-        let (_, back) = deadreckon_io::read_params_with_extra(&path).unwrap();
-        let m = stored_model(&back).unwrap();
+        let file =
+            ParamsFile::new(ParamsWithStd { params: p, std: p }, tables.clone(), "p").unwrap();
+        file.write(&path).unwrap();
+        let back = ParamsFile::read(path.to_str().unwrap()).unwrap();
+        assert_eq!(back, file);
+        let m = stored_model(&back.tables).unwrap();
         assert_eq!(
             m,
             StoredModel {
@@ -169,17 +159,14 @@ mod tests {
             gradient: est(SLIP_NAME, 0.0, false),
             ..slip
         };
-        extra.insert(
-            "side_slip".into(),
-            crate::calibrate::side_slip_toml(&slip_not).into(),
-        );
+        tables.side_slip = Some(SideSlipTable::of(&slip_not));
         assert_eq!(
-            stored_model(&extra)
+            stored_model(&tables)
                 .unwrap()
                 .rear_slip_gradient_rad_per_mps2,
             None
         );
-        assert!(stored_model(&toml::Table::new()).unwrap().is_empty());
+        assert!(stored_model(&ParamsTables::default()).unwrap().is_empty());
         // A value that makes no vehicle is refused, the vehicle unchanged.
         let bad = StoredModel {
             rear_slip_gradient_rad_per_mps2: Some(0.5),

@@ -2,6 +2,7 @@
 
 use deadreckon_core::calibrate::{Iteration, PassState};
 use deadreckon_core::ekf::Timing;
+use deadreckon_core::timing::Which;
 
 use crate::Error;
 
@@ -32,6 +33,17 @@ pub fn parse_pass_state(s: &str) -> Result<PassState, Error> {
     }
 }
 
+/// `--corrections`: `auto`, `gnss`, `all` or `none`.
+pub fn parse_corrections(s: &str) -> Result<Which, Error> {
+    match s {
+        "auto" => Ok(Which::Auto),
+        "gnss" => Ok(Which::Gnss),
+        "all" => Ok(Which::All),
+        "none" => Ok(Which::None),
+        _ => Err(unknown("corrections", s, "auto, gnss, all, none")),
+    }
+}
+
 fn unknown(what: &'static str, value: &str, allowed: &'static str) -> Error {
     Error::UnknownOption {
         what,
@@ -49,6 +61,8 @@ mod tests {
         assert_eq!(parse_timing("each").unwrap(), Timing::EachMeasurement);
         assert_eq!(parse_iteration("plain").unwrap(), Iteration::Plain);
         assert_eq!(parse_pass_state("paper").unwrap(), PassState::Paper);
+        assert_eq!(parse_corrections("gnss").unwrap(), Which::Gnss);
+        assert!(parse_corrections("some").is_err());
         assert_eq!(
             parse_timing("every").unwrap_err().to_string(),
             "unknown timing `every` (wheel, each)"

@@ -24,43 +24,40 @@ pub fn default_prior() -> Params {
     deadreckon_core::calibrate::CalibrationOptions::default().prior_std
 }
 
-/// The starting parameters, the learning prior and the corrections to
-/// apply: `nominal` (the vehicle's, the default prior, none) or a
-/// params.toml (its values; its `[std]` where positive — a std of 0 would
-/// freeze a parameter —, else the default prior; the corrections it stores,
-/// read as `--params` reads them for every other command:
-/// [`crate::corrections::stored_corrections`]).
-pub fn start_params(
-    spec: &str,
-    vehicle: &Vehicle,
-) -> Result<(Params, Params, crate::corrections::Stored), Error> {
+/// What a stream starts from: the parameters, the learning prior, the
+/// corrections to apply and the 95 % bound's factor, all from one read of
+/// the params.toml ([`crate::params_file::ParamsFile::read`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct StartParams {
+    /// The starting parameters.
+    pub params: Params,
+    /// The prior standard deviations of the learned parameters.
+    pub prior: Params,
+    /// The corrections the file stores, applied to the events.
+    pub stored: crate::corrections::Stored,
+    /// The bound's factor the file stores (its `[bound]`, else the
+    /// filter's covariance alone).
+    pub bound: deadreckon_core::bound::BoundFit,
+}
+
+/// The start of `nominal` (the vehicle's parameters, the default prior,
+/// no corrections, the filter's covariance alone) or of a params.toml (its
+/// values; its `[std]` where positive — a std of 0 would freeze a
+/// parameter —, else the default prior; the corrections and the bound it
+/// stores), the file read once as `--params` reads it for every other
+/// command, its circumferences checked against `vehicle`.
+pub fn start_params(spec: &str, vehicle: &Vehicle) -> Result<StartParams, Error> {
     if spec == "nominal" {
-        return Ok((
-            Params::nominal(vehicle),
-            default_prior(),
-            Default::default(),
-        ));
+        return Ok(StartParams {
+            params: Params::nominal(vehicle),
+            prior: default_prior(),
+            stored: Default::default(),
+            bound: deadreckon_core::bound::BoundFit::FILTER,
+        });
     }
-    let p = crate::load::params_file(spec)?;
-    crate::load::check_against_vehicle(spec, &p.params, vehicle)?;
-    let stored = crate::corrections::stored_in_file(Path::new(spec)).map_err(Error::Invalid)?;
-    Ok(started_from(&p, stored))
-}
-
-/// The 95 % bound's factor of the parameters `spec` (`nominal` or a
-/// params.toml): its `[bound]`, else the filter's covariance alone.
-pub fn start_bound(spec: &str) -> Result<deadreckon_core::bound::BoundFit, Error> {
-    crate::bound::stored_bound(spec)
-}
-
-/// [`start_bound`] of the text of a params.toml; `name` names it in errors.
-pub fn start_bound_from_text(
-    text: &str,
-    name: &str,
-) -> Result<deadreckon_core::bound::BoundFit, Error> {
-    let (_, extra) = deadreckon_io::parse_params_with_extra(text, Path::new(name))
-        .doing(|| format!("reading parameters {name}"))?;
-    crate::bound::bound_from_extra(&extra).map_err(|e| Error::Invalid(format!("{name}: {e}")))
+    let file = crate::params_file::ParamsFile::read(spec)?;
+    crate::load::check_against_vehicle(spec, &file.estimate.params, vehicle)?;
+    Ok(started_from(file))
 }
 
 /// One pose line of `stream` (without the newline): the pose's keys
@@ -78,15 +75,10 @@ pub fn pose_line(p: &deadreckon_core::bound_pose::Pose) -> String {
 
 /// [`start_params`] on the text of a params.toml (the C API is handed text);
 /// `name` names it in errors.
-pub fn start_params_from_text(
-    text: &str,
-    name: &str,
-) -> Result<(Params, Params, crate::corrections::Stored), Error> {
-    let (p, extra) = deadreckon_io::parse_params_with_extra(text, Path::new(name))
-        .doing(|| format!("reading parameters {name}"))?;
-    let stored = crate::corrections::stored_corrections(&extra)
-        .map_err(|e| Error::Invalid(format!("parameters {name}: {e}")))?;
-    Ok(started_from(&p, stored))
+pub fn start_params_from_text(text: &str, name: &str) -> Result<StartParams, Error> {
+    Ok(started_from(crate::params_file::ParamsFile::parse(
+        text, name,
+    )?))
 }
 
 /// Stored corrections in words: each stream's delay by its name, the IMU's
@@ -142,16 +134,18 @@ pub fn corrections_warning(name: &str, online: &Online) -> Option<String> {
 }
 
 /// The starting parameters and the prior of a read params.toml.
-fn started_from(
-    p: &ParamsWithStd,
-    stored: crate::corrections::Stored,
-) -> (Params, Params, crate::corrections::Stored) {
+fn started_from(file: crate::params_file::ParamsFile) -> StartParams {
     let d = default_prior().to_array();
-    let s = p.std.to_array();
+    let s = file.estimate.std.to_array();
     let prior = Params::from_array(std::array::from_fn(
         |i| if s[i] > 0.0 { s[i] } else { d[i] },
     ));
-    (p.params, prior, stored)
+    StartParams {
+        params: file.estimate.params,
+        prior,
+        stored: file.corrections,
+        bound: file.bound,
+    }
 }
 
 /// How a stream runs.
@@ -250,7 +244,7 @@ fn with_model(vehicle: &Vehicle, corrections: &crate::corrections::Stored) -> Ve
 /// parameters and corrections `params` names, [`start_params`]) and what to
 /// tell of the corrections ([`corrections_note`], [`corrections_warning`]).
 /// A filter not resumed gives its poses the bound `params` stores
-/// ([`start_bound`]); a resumed one keeps its state's.
+/// ([`StartParams::bound`]); a resumed one keeps its state's.
 pub fn start(
     vehicle: &Path,
     params: &str,
@@ -258,11 +252,11 @@ pub fn start(
 ) -> Result<(Vehicle, Online, Option<String>), Error> {
     let v =
         deadreckon_io::read_vehicle(vehicle).doing(|| format!("reading {}", vehicle.display()))?;
-    let (p, prior, stored) = start_params(params, &v)?;
+    let start = start_params(params, &v)?;
     let resumed = o.state.as_ref().is_some_and(|p| p.exists());
-    let mut online = open(&v, &p, &prior, &stored, o)?;
+    let mut online = open(&v, &start.params, &start.prior, &start.stored, o)?;
     if !resumed {
-        online = online.with_bound(start_bound(params)?);
+        online = online.with_bound(start.bound);
     }
     let warning = corrections_warning(params, &online);
     Ok((v, online, warning))
@@ -375,73 +369,24 @@ pub fn state_from_text(text: &str, name: &str) -> Result<Online, Error> {
     serde_json::from_str::<Online>(text).doing(|| format!("state {name}"))
 }
 
-/// The params.toml tables of stored corrections, as
-/// [`crate::corrections::stored_corrections`] reads them back (the zero
-/// ones left out): what a file of parameters learned on corrected events
-/// carries on, so that the next stream given it applies them too.
-pub fn stored_toml(stored: &crate::corrections::Stored) -> toml::Table {
-    use deadreckon_core::timing::Stream;
-    let mut out = toml::Table::new();
-    let mut delays = toml::Table::new();
-    for (st, d) in Stream::ALL.iter().zip(stored.delays_s) {
-        if d != 0.0 {
-            let mut t = toml::Table::new();
-            t.insert("delay_s".into(), d.into());
-            delays.insert(st.name().into(), t.into());
-        }
-    }
-    if !delays.is_empty() {
-        out.insert("delays".into(), delays.into());
-    }
-    if let Some(up) = stored.up {
-        let mut t = toml::Table::new();
-        t.insert(
-            "up".into(),
-            toml::Value::Array(up.iter().map(|&u| u.into()).collect()),
-        );
-        out.insert("imu".into(), t.into());
-    }
-    if stored.gyro_scale_error != 0.0 {
-        let mut t = toml::Table::new();
-        t.insert("scale_error".into(), stored.gyro_scale_error.into());
-        out.insert("gyro_scale".into(), t.into());
-    }
-    if stored.traction_slip_per_mps2 != 0.0 {
-        let mut t = toml::Table::new();
-        t.insert("slip_per_mps2".into(), stored.traction_slip_per_mps2.into());
-        if let Some(m) = stored.traction_mean_force_mps2 {
-            t.insert("mean_force_mps2".into(), m.into());
-        }
-        out.insert("traction".into(), t.into());
-    }
-    if !stored.model.is_empty() {
-        if let Ok(t) = toml::Table::try_from(stored.model) {
-            out.insert("model".into(), t.into());
-        }
-    }
-    out
-}
-
 /// Writes learned parameters as a params.toml (method `online`, whether
 /// they are valid yet, the percentage calibrated), with the stored
 /// corrections the events were corrected with (the parameters belong to
-/// the corrected streams: [`stored_toml`]).
+/// the corrected streams: [`crate::corrections::stored_tables`]).
 pub fn save_learned(
     path: &Path,
     l: &Learned,
     corrections: &crate::corrections::Stored,
 ) -> Result<(), Error> {
-    let mut extra = stored_toml(corrections);
-    extra.insert("method".into(), "online".into());
-    extra.insert("valid".into(), l.valid.into());
-    extra.insert("calibrated_pct".into(), l.calibrated_pct.into());
-    deadreckon_io::write_params(
-        path,
-        &ParamsWithStd {
-            params: l.params,
-            std: l.std,
-        },
-        Some(&extra),
-    )
-    .doing(|| format!("writing {}", path.display()))
+    let tables = crate::params_file::ParamsTables {
+        method: Some("online".into()),
+        valid: Some(l.valid),
+        calibrated_pct: Some(l.calibrated_pct),
+        ..crate::corrections::stored_tables(corrections)
+    };
+    let estimate = ParamsWithStd {
+        params: l.params,
+        std: l.std,
+    };
+    crate::params_file::ParamsFile::new(estimate, tables, &path.display().to_string())?.write(path)
 }

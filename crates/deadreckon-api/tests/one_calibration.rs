@@ -1,8 +1,8 @@
 //! Issue 30, item 1: one car calibration. What `calibrate --out` writes
 //! (`CarCalibration::write`) reads back through the one reader
 //! (`ParamsFile::read`) as the same parameters, standard errors, vehicle,
-//! stored corrections and bound; and the `--json` object is the type's
-//! `Serialize`.
+//! stored corrections and bound, every table equal to what was written;
+//! and the `--json` object is the type's `Serialize`.
 
 use deadreckon_api::calibrate::Export;
 use deadreckon_api::calibration::{calibrate, CalibrationRequest, ParamStatus};
@@ -26,19 +26,23 @@ fn what_calibrate_writes_reads_back_through_the_one_reader() {
     car.write(&path, Export::Params, &sim.drive.vehicle.noise, "the drive")
         .expect("written");
     let back = ParamsFile::read(&path.to_string_lossy()).expect("read back");
+    // Written and read through the same type: what was written reads back
+    // equal, tables and all.
+    let written = car
+        .params_file(&path.to_string_lossy())
+        .expect("a valid file");
+    assert_eq!(back, written);
     assert_eq!(back.estimate, car.calibration.estimate);
-    assert_eq!(back.vehicle.as_ref(), Some(&car.vehicle));
+    assert_eq!(back.vehicle(), Some(&car.vehicle));
     assert_eq!(back.bound, car.bound);
     // The corrections applied are those stored: applying the stored ones
     // to the raw drive gives the drive the calibration ran on.
     let stored = deadreckon_api::corrections::stored_corrections(&car.params_extra()).unwrap();
     assert_eq!(back.corrections, stored);
     assert!(!back.corrections.is_empty(), "{:?}", car.corrections);
-    assert_eq!(back.rest["method"].as_str(), Some("rts"));
-    assert_eq!(
-        back.rest["iterations"].as_integer(),
-        Some(car.calibration.iterations as i64)
-    );
+    assert_eq!(back.tables.method.as_deref(), Some("rts"));
+    assert_eq!(back.tables.iterations, Some(car.calibration.iterations));
+    assert!(back.tables.delays.is_some());
     // The --json object is the type's serde projection.
     assert_eq!(serde_json::to_value(&car).unwrap(), car.json());
     // Status: the one rule, and the JSON's not_estimated agrees.

@@ -59,17 +59,21 @@ fn the_loader_keeps_the_checks_verdict_and_the_span_of_the_last_drive() {
 fn a_stream_prior_keeps_the_default_where_the_file_fixes_a_parameter() {
     let dir = tempfile::tempdir().unwrap();
     let d = drive(&dir.path().join("d"));
-    let (p, prior, stored) = stream::start_params("nominal", &d.vehicle).unwrap();
+    let start = stream::start_params("nominal", &d.vehicle).unwrap();
+    let p = start.params;
     assert_eq!(p, deadreckon_core::Params::nominal(&d.vehicle));
-    assert_eq!(prior, stream::default_prior());
-    assert!(stored.is_empty());
+    assert_eq!(start.prior, stream::default_prior());
+    assert!(start.stored.is_empty());
+    assert_eq!(start.bound, deadreckon_core::bound::BoundFit::FILTER);
     // A file whose gyro bias std is 0 and speed-scale std is 1e-4.
     let mut std = deadreckon_core::Params::from_array([0.0; 6]);
     std.speed_scale = 1e-4;
     let f = dir.path().join("p.toml");
     deadreckon_io::write_params(&f, &deadreckon_core::ParamsWithStd { params: p, std }, None)
         .unwrap();
-    let (_, prior, _) = stream::start_params(f.to_str().unwrap(), &d.vehicle).unwrap();
+    let prior = stream::start_params(f.to_str().unwrap(), &d.vehicle)
+        .unwrap()
+        .prior;
     assert_eq!(prior.speed_scale, 1e-4);
     assert_eq!(prior.gyro_bias_rps, stream::default_prior().gyro_bias_rps);
 }

@@ -61,17 +61,6 @@ pub struct Calibrations {
     pub skipped: Vec<rp::NotComputed>,
 }
 
-fn param_set(p: &Params) -> rp::ParamSet {
-    rp::ParamSet {
-        gyro_bias_rps: p.gyro_bias_rps,
-        speed_scale: p.speed_scale,
-        circumference_fl_m: p.circumference_fl_m,
-        circumference_fr_m: p.circumference_fr_m,
-        circumference_rl_m: p.circumference_rl_m,
-        circumference_rr_m: p.circumference_rr_m,
-    }
-}
-
 fn path_of(t: &Track) -> rp::EnPath {
     rp::EnPath {
         east_m: t.points.iter().map(|p| p.east_m).collect(),
@@ -395,8 +384,8 @@ pub fn four_wheel_input(
         let has_std = m.params.std.to_array().iter().any(|s| *s > 0.0);
         cal.rows.push(rp::CalibrationRow {
             method: m.source.name().into(),
-            values: param_set(&m.params.params),
-            std: has_std.then(|| param_set(&m.params.std)),
+            values: m.params.params,
+            std: has_std.then_some(m.params.std),
         });
     }
     if let Some(c) = methods
@@ -407,7 +396,6 @@ pub fn four_wheel_input(
         cal.iterated_method = Source::Rts.name().into();
         cal.iterations = std::iter::once(Params::nominal(&drive.vehicle))
             .chain(c.history.iter().copied())
-            .map(|p| param_set(&p))
             .collect();
     }
     input.calibration = Some(cal);

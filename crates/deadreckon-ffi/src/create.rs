@@ -5,7 +5,7 @@ use std::path::Path;
 
 use deadreckon_api::stream::{self, StreamOptions};
 use deadreckon_core::ekf::FilterOptions;
-use deadreckon_core::{Params, Vehicle};
+use deadreckon_core::Vehicle;
 
 use crate::handle::{with_filter, DrFilter};
 use crate::status::{guard, last_error_ptr, DrStatus, Fail};
@@ -50,13 +50,11 @@ fn config_fail(e: &(dyn std::error::Error + 'static)) -> Fail {
 /// The filter `deadreckon stream` opens with these options (no state file).
 fn open(
     vehicle: &Vehicle,
-    start: (Params, Params, deadreckon_api::corrections::Stored),
-    bound: deadreckon_core::bound::BoundFit,
+    start: stream::StartParams,
     options: *const DrOptions,
 ) -> Result<DrFilter, Fail> {
     // SAFETY: null or a valid DrOptions (the callers' contract).
     let options = unsafe { options.as_ref() }.copied().unwrap_or_default();
-    let (params, prior, stored) = start;
     let o = StreamOptions {
         filter: FilterOptions {
             timing: options.timing()?,
@@ -69,9 +67,9 @@ fn open(
         skip_bad_lines: false,
         last_part: false,
     };
-    let online = stream::open(vehicle, &params, &prior, &stored, &o)
+    let online = stream::open(vehicle, &start.params, &start.prior, &start.stored, &o)
         .map_err(|e| config_fail(&e))?
-        .with_bound(bound);
+        .with_bound(start.bound);
     let warning = stream::corrections_warning("params.toml", &online);
     Ok(DrFilter::new(online, warning))
 }
@@ -132,16 +130,14 @@ pub unsafe extern "C" fn dr_filter_new(
             )?;
             let vehicle = deadreckon_io::parse_vehicle(v, Path::new("vehicle.toml"))
                 .map_err(|e| config_fail(&e))?;
-            let (start, bound) = if params_toml.is_null() {
+            let start = if params_toml.is_null() {
                 stream::start_params("nominal", &vehicle)
-                    .and_then(|s| Ok((s, stream::start_bound("nominal")?)))
             } else {
                 let p = text_arg(params_toml, params_len, "params_toml", DrStatus::BadConfig)?;
                 stream::start_params_from_text(p, "params.toml")
-                    .and_then(|s| Ok((s, stream::start_bound_from_text(p, "params.toml")?)))
             }
             .map_err(|e| config_fail(&e))?;
-            open(&vehicle, start, bound, options)
+            open(&vehicle, start, options)
         })
     }
 }
@@ -173,8 +169,7 @@ pub unsafe extern "C" fn dr_filter_new_from_files(
                 path_arg(params_path, "params_path")?
             };
             let start = stream::start_params(spec, &vehicle).map_err(|e| config_fail(&e))?;
-            let bound = stream::start_bound(spec).map_err(|e| config_fail(&e))?;
-            open(&vehicle, start, bound, options)
+            open(&vehicle, start, options)
         })
     }
 }

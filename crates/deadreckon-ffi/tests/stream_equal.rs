@@ -33,8 +33,14 @@ fn stream_options(o: &DrOptions) -> StreamOptions {
 
 /// The filter `stream` opens (nominal parameters, default prior).
 fn rust_online(d: &Drive, o: &DrOptions) -> Result<Online, deadreckon_api::Error> {
-    let (p, prior, stored) = stream::start_params("nominal", &d.vehicle).unwrap();
-    stream::open(&d.vehicle, &p, &prior, &stored, &stream_options(o))
+    let s = stream::start_params("nominal", &d.vehicle).unwrap();
+    stream::open(
+        &d.vehicle,
+        &s.params,
+        &s.prior,
+        &s.stored,
+        &stream_options(o),
+    )
 }
 
 fn rust_poses(online: &mut Online, events: &[Event], finish: bool) -> Vec<DrPose> {
@@ -242,10 +248,17 @@ fn the_c_api_gives_each_pose_the_bound_of_stream() {
     };
     deadreckon_io::write_params(&path, &nominal, Some(&extra)).unwrap();
     let text = std::fs::read_to_string(&path).unwrap();
-    let (p, prior, stored) = stream::start_params_from_text(&text, "p.toml").unwrap();
-    let mut online = stream::open(&d.vehicle, &p, &prior, &stored, &stream_options(&o))
-        .unwrap()
-        .with_bound(stream::start_bound_from_text(&text, "p.toml").unwrap());
+    let s = stream::start_params_from_text(&text, "p.toml").unwrap();
+    assert_eq!(s.bound, fit);
+    let mut online = stream::open(
+        &d.vehicle,
+        &s.params,
+        &s.prior,
+        &s.stored,
+        &stream_options(&o),
+    )
+    .unwrap()
+    .with_bound(s.bound);
     let mut want = Vec::new();
     for ev in &evs {
         online.push_poses(*ev, &mut |p| want.push(p)).unwrap();

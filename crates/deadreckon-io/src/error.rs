@@ -167,6 +167,15 @@ pub enum IoError {
         /// What is missing.
         message: String,
     },
+    /// A params.toml of another vehicle shape (its `shape` key: a tricycle's
+    /// or a differential drive's) given where a four-wheel car's is read.
+    #[error("{}: a {} parameter file (shape = \"{shape}\"), not a four-wheel car's", path.display(), shape.replace('_', "-"))]
+    OtherShape {
+        /// The file.
+        path: PathBuf,
+        /// Its `shape` key, as written (`tricycle`, `diff_drive`).
+        shape: String,
+    },
     /// A TOML file does not parse or does not match its contract (the message
     /// from `toml` carries line and column).
     #[error("{}: {message}", path.display())]

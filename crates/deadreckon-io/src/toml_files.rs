@@ -92,15 +92,10 @@ pub fn parse_params_with_extra(
 ) -> Result<(ParamsWithStd, toml::Table), IoError> {
     let mut table: toml::Table = text.parse().map_err(|e| toml_error(path, e))?;
     if let Some(shape) = table.get("shape").and_then(|v| v.as_str()) {
-        return Err(toml_error(
-            path,
-            format!(
-                "a {} parameter file (shape = \"{shape}\"), not a four-wheel car's: \
-                 give it with --shape {}, or calibrate the car (deadreckon calibrate DRIVE --out FILE)",
-                shape.replace('_', "-"),
-                shape.replace('_', "-"),
-            ),
-        ));
+        return Err(IoError::OtherShape {
+            path: path.to_path_buf(),
+            shape: shape.to_string(),
+        });
     }
     let params = take_params(path, &mut table, None)?;
     params.validate().map_err(|e| invalid(path, e))?;

@@ -9,6 +9,7 @@
 //! well-known names `truth`/`GT`, `nominal`, `ZUPT`, `RTS`/`ours`, `filtered`,
 //! `smoothed`, `GNSS` and `TedriS` get fixed colours (case-insensitive).
 
+pub use deadreckon_core::Params;
 use serde::{Deserialize, Serialize};
 
 /// Everything the report can show. `Default` gives an empty report (header and
@@ -145,58 +146,28 @@ pub struct Trajectories {
     pub dead_reckoned: Vec<MethodPath>,
 }
 
-/// The six calibrated parameters (the `params.toml` keys of deadreckon-core).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
-pub struct ParamSet {
-    /// Gyro bias, rad/s.
-    pub gyro_bias_rps: f64,
-    /// CAN speed scale factor.
-    pub speed_scale: f64,
-    /// Front-left wheel circumference, m.
-    pub circumference_fl_m: f64,
-    /// Front-right wheel circumference, m.
-    pub circumference_fr_m: f64,
-    /// Rear-left wheel circumference, m.
-    pub circumference_rl_m: f64,
-    /// Rear-right wheel circumference, m.
-    pub circumference_rr_m: f64,
-}
-
-impl ParamSet {
-    /// The parameters in the order of [`ParamSet::LABELS`].
-    pub fn to_array(&self) -> [f64; 6] {
-        [
-            self.gyro_bias_rps,
-            self.speed_scale,
-            self.circumference_fl_m,
-            self.circumference_fr_m,
-            self.circumference_rl_m,
-            self.circumference_rr_m,
-        ]
-    }
-
-    /// Display names with units, in [`ParamSet::to_array`] order.
-    pub const LABELS: [&'static str; 6] = [
-        "gyro bias (rad/s)",
-        "speed scale",
-        "circumference FL (m)",
-        "circumference FR (m)",
-        "circumference RL (m)",
-        "circumference RR (m)",
-    ];
-}
-
-/// One row of the calibration table.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+/// One row of the calibration table: the parameters as the calibration
+/// holds them ([`Params`], the params.toml keys).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct CalibrationRow {
     /// The method, e.g. `truth`, `RTS`, `ZUPT`, `nominal`.
     pub method: String,
     /// The estimates.
-    pub values: ParamSet,
+    pub values: Params,
     /// One standard error for each estimate, where the method gives one.
-    pub std: Option<ParamSet>,
+    pub std: Option<Params>,
+}
+
+impl Default for CalibrationRow {
+    /// An empty row (no method, every value 0).
+    fn default() -> Self {
+        CalibrationRow {
+            method: String::new(),
+            values: Params::from_array([0.0; 6]),
+            std: None,
+        }
+    }
 }
 
 /// The calibration table (table III) and the path of the iterated calibration.
@@ -208,9 +179,9 @@ pub struct Calibration {
     /// The method whose iterations are given (its colour in the iteration plots), e.g. `RTS`.
     pub iterated_method: String,
     /// The parameters after each smoothing–calibration iteration; index 0 is the start.
-    pub iterations: Vec<ParamSet>,
+    pub iterations: Vec<Params>,
     /// Standard errors after each iteration: empty, or as long as `iterations`.
-    pub iteration_std: Vec<ParamSet>,
+    pub iteration_std: Vec<Params>,
     /// The timing and mounting corrections every section's streams had
     /// applied (`None`: not given).
     pub corrections: Option<Corrections>,

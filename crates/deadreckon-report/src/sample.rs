@@ -23,15 +23,8 @@ impl Noise {
     }
 }
 
-fn params(b: f64, a: f64, c: [f64; 4]) -> ParamSet {
-    ParamSet {
-        gyro_bias_rps: b,
-        speed_scale: a,
-        circumference_fl_m: c[0],
-        circumference_fr_m: c[1],
-        circumference_rl_m: c[2],
-        circumference_rr_m: c[3],
-    }
+fn params(b: f64, a: f64, c: [f64; 4]) -> Params {
+    Params::from_array([b, a, c[0], c[1], c[2], c[3]])
 }
 
 /// A synthetic report input for a drive of `duration_s` seconds (wheels at 50 Hz,
@@ -170,7 +163,7 @@ pub fn sample_input(duration_s: f64) -> ReportInput {
 
     let gt = params(-0.00298, 0.987, [1.9134, 1.9129, 1.9166, 1.9164]);
     let ours = params(-0.00279, 1.0, [1.9177, 1.9159, 1.9198, 1.9197]);
-    let iterations: Vec<ParamSet> = (0..7)
+    let iterations: Vec<Params> = (0..7)
         .map(|k| {
             let f = (-(k as f64) / 1.5).exp();
             let nominal = [1.92; 4];
@@ -179,7 +172,7 @@ pub fn sample_input(duration_s: f64) -> ReportInput {
             params(o[0] * (1.0 - f), o[1] + f * 0.01, [c(0), c(1), c(2), c(3)])
         })
         .collect();
-    let iteration_std: Vec<ParamSet> = (0..7)
+    let iteration_std: Vec<Params> = (0..7)
         .map(|k| {
             let f = 1.0 + 2.0 * (-(k as f64)).exp();
             params(4e-5 * f, 0.002 * f, [6e-4 * f; 4])

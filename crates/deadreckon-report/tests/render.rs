@@ -293,11 +293,7 @@ fn a_section_with_only_some_data_shows_only_that() {
         calibration: Some(Calibration {
             rows: vec![CalibrationRow {
                 method: "ZUPT".into(),
-                values: ParamSet {
-                    gyro_bias_rps: -0.002,
-                    speed_scale: 1.0,
-                    ..Default::default()
-                },
+                values: Params::from_array([-0.002, 1.0, 0.0, 0.0, 0.0, 0.0]),
                 std: None,
             }],
             ..Default::default()
@@ -452,14 +448,7 @@ fn series_without_finite_values_give_no_empty_frames() {
         }),
         calibration: Some(Calibration {
             iterated_method: "RTS".into(),
-            iterations: vec![
-                ParamSet {
-                    gyro_bias_rps: nan,
-                    speed_scale: nan,
-                    ..Default::default()
-                };
-                3
-            ],
+            iterations: vec![Params::from_array([nan, nan, 0.0, 0.0, 0.0, 0.0]); 3],
             ..Default::default()
         }),
         health: Some(FilterHealth {

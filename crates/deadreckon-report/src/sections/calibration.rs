@@ -3,13 +3,24 @@
 
 use plotters::prelude::*;
 
-use crate::model::{Calibration, ParamSet};
+use crate::model::{Calibration, Params};
 use crate::page::{Block, FigureView, RowView, SectionView, TableView};
 use crate::plot::{
     data_begin, data_end, draw_hline, draw_line, fmt_sig, padded_range, render_chart, Frame,
     Legend, OrPlot, Palette, SMALL_WIDTH,
 };
 use crate::{check_optional_len, ReportError};
+
+/// The figures' names of the six parameters, with units, in
+/// [`Params::to_array`] order ([`Params::NAMES`] are the params.toml keys).
+const PARAM_LABELS: [&str; 6] = [
+    "gyro bias (rad/s)",
+    "speed scale",
+    "circumference FL (m)",
+    "circumference FR (m)",
+    "circumference RL (m)",
+    "circumference RR (m)",
+];
 
 /// Column headings of the table (the paper's symbols).
 const SHORT_LABELS: [&str; 6] = [
@@ -128,11 +139,11 @@ pub(crate) fn section(
                 )
             })
             .collect();
-        let values: Vec<[f64; 6]> = c.iterations.iter().map(ParamSet::to_array).collect();
-        let stds: Vec<[f64; 6]> = c.iteration_std.iter().map(ParamSet::to_array).collect();
+        let values: Vec<[f64; 6]> = c.iterations.iter().map(Params::to_array).collect();
+        let stds: Vec<[f64; 6]> = c.iteration_std.iter().map(Params::to_array).collect();
         let n = values.len();
         let mut figures = Vec::new();
-        for (k, label) in ParamSet::LABELS.iter().enumerate() {
+        for (k, label) in PARAM_LABELS.iter().enumerate() {
             let col: Vec<f64> = values.iter().map(|v| v[k]).collect();
             if !col.iter().any(|v| v.is_finite()) {
                 continue;
