@@ -5,7 +5,7 @@ use super::scalar::status_of;
 use super::{jackknife_std, lag1, Delay, DelayOptions};
 use crate::calibrate::{self, CalibrationOptions};
 use crate::drive::Drive;
-use crate::ekf::{self, FilterOptions, Init, SensorSet};
+use crate::ekf::{self, FilterOptions, Init, SensorSet, WheelRows};
 use crate::model::{V, X, Y, YAW, YAW_RATE};
 use crate::reference::Reference;
 use crate::{Error, Params};
@@ -13,6 +13,17 @@ use crate::{Error, Params};
 /// The GNSS delay's steps stop once a step would move it by less than this
 /// fraction of its standard error (issue 30: each step is a calibration).
 pub const GNSS_SETTLED_FRACTION_OF_STD: f64 = 0.1;
+
+/// How the GNSS delay's dead-reckoned reference uses the wheel rows,
+/// whichever step the calibrating filter takes: each row over the interval
+/// it describes ([`WheelRows::Interval`]). With the paper's step
+/// ([`WheelRows::Instant`], the filter's default) the reference carries the
+/// previous interval's speed, its positions trail by about a wheel period
+/// while the speed changes, and the fixes read that as a negative receiver
+/// delay (issues 28 and 29: −29, −16 and −9 ms at 25, 50 and 100 Hz on
+/// family car 1 with a true delay of 0). The delay estimated is the
+/// receiver's.
+pub const REFERENCE_WHEEL_ROWS: WheelRows = WheelRows::Interval;
 
 /// The GNSS delay against the smoothed track, calibrating with `copts` at
 /// each step (see the module documentation). `params` (the calibration's
@@ -95,6 +106,7 @@ pub(super) fn gnss_delay_of(
                     p: s0.p,
                 },
                 sensors: SensorSet::dead_reckoning(),
+                wheel_rows: REFERENCE_WHEEL_ROWS,
                 ..copts.filter.clone()
             },
         )?;
