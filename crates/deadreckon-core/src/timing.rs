@@ -21,7 +21,11 @@
 //!   the antenna's dead-reckoned position are regressed on its velocity, with
 //!   a bias, a rotation and a stretch per 20 s window for the dead
 //!   reckoning's drift (`r = −δ·V + b + θ·J(p − p_c) + λ(p − p_c)`), until
-//!   `δ` settles. (Against the
+//!   `δ` settles. The dead reckoning takes each wheel row over the
+//!   interval it describes ([`REFERENCE_WHEEL_ROWS`]) whichever step the
+//!   calibrating filter takes, and the scalar streams are moved by their
+//!   delays on true time ([`on_true_time`]): the delay is the receiver's,
+//!   not the paper's wheel step's lag (issue 29). (Against the
 //!   smoothed track, which the fixes pull along, a 0.18 s delay read
 //!   0.11 s.) The smoother absorbs
 //!   part of a wrong delay, so one step under-corrects (`δ ≈ (1 − α)(d* − d)`):
@@ -241,8 +245,8 @@ mod gnss;
 mod scalar;
 
 pub use corrections::{
-    apply_known, estimate, estimate_with_params, prepare, prepare_with, Corrections,
-    KnownCorrections, Which,
+    apply_known, estimate, estimate_with_params, on_true_time, prepare, prepare_with,
+    wheel_half_period_s, Corrections, KnownCorrections, Which,
 };
-pub use gnss::{gnss_delay, regress_gnss, states_at_fixes};
+pub use gnss::{gnss_delay, regress_gnss, states_at_fixes, REFERENCE_WHEEL_ROWS};
 pub use scalar::{gyro_delay, scalar_delay, speed_delay, steering_delay};
