@@ -88,6 +88,14 @@ pub struct Delay {
     pub samples: usize,
     /// Estimated, or why not.
     pub status: Status,
+    /// What the filter's own step adds to the delay it applies, s (the GNSS
+    /// only, else 0): `delay_s` is the receiver's delay against true time,
+    /// while the paper's wheel step ([`crate::ekf::WheelRows::Instant`], the
+    /// default) dead-reckons positions that trail by about a wheel period
+    /// and the scalar streams as they are corrected; the filter applies the
+    /// delay its own dead reckoning matches ([`Delay::applied_s`]). Issue 29;
+    /// see [`gnss_delay`].
+    pub step_offset_s: f64,
 }
 
 impl Delay {
@@ -97,12 +105,14 @@ impl Delay {
             std_s: f64::NAN,
             samples: 0,
             status: Status::NotEstimated(reason.into()),
+            step_offset_s: 0.0,
         }
     }
-    /// The delay to apply: the estimate, or 0 when not estimated.
+    /// The delay to apply: the estimate plus the filter's step offset
+    /// (`delay_s + step_offset_s`), or 0 when not estimated.
     pub fn applied_s(&self) -> f64 {
         if self.status.is_estimated() {
-            self.delay_s
+            self.delay_s + self.step_offset_s
         } else {
             0.0
         }

@@ -32,8 +32,12 @@ pub fn estimate_with_params(
         steering: steering_delay(drive, o),
         gnss: Delay::not_estimated("not estimated"),
     };
-    let partly = on_true_time(&delays, drive).apply(drive);
-    let (g, params) = gnss_delay_of(partly, copts, o)?;
+    let true_time = on_true_time(&delays, drive);
+    let partly = true_time.apply(drive);
+    // The filter's streams are moved by the delays as estimated.
+    let view = [Stream::Gyro, Stream::Speed, Stream::Steering]
+        .map(|s| delays.get(s).applied_s() - true_time.get(s).applied_s());
+    let (g, params) = gnss_delay_of(partly, copts, o, view)?;
     delays.gnss = g;
     Ok((delays, params))
 }
