@@ -159,7 +159,7 @@ pub(super) fn gnss_delay_of(
         return Ok((Delay::not_estimated("no step"), None));
     };
     let mut delay = status_of(d, std, n, o);
-    if delay.status.is_estimated() {
+    if delay.status.is_estimated() && o.gnss_step_offset {
         delay.step_offset_s = step_offset_s(
             &mut shifted,
             &params,
