@@ -24,19 +24,12 @@ pub fn corrections_lines(c: &deadreckon_core::timing::Corrections) -> Vec<String
     for s in Stream::ALL {
         let d = c.delays.get(s);
         out.push(match d.status.reason() {
-            None if d.step_offset_s != 0.0 => format!(
-                "{:<10} {:>+10.4} {:>9.4}  estimated, applied as {:+.4} s (the filter's wheel step and streams add {:+.4} s)",
+            None => format!(
+                "{:<10} {:>+10.4} {:>9.4}  estimated, applied{}",
                 s.name(),
                 d.delay_s,
                 d.std_s,
-                d.applied_s(),
-                d.step_offset_s
-            ),
-            None => format!(
-                "{:<10} {:>+10.4} {:>9.4}  estimated, applied",
-                s.name(),
-                d.delay_s,
-                d.std_s
+                crate::corrections::step_offset_words(d)
             ),
             Some(r) if d.status.is_measured_not_applied() => format!(
                 "{:<10} {:>+10.4} {:>9.4}  {r}",
