@@ -24,6 +24,19 @@ fn delay_json(d: &Delay) -> Value {
     })
 }
 
+/// The words after "applied" when the filter applies another GNSS delay
+/// than the receiver's (`Delay::step_offset_s`, issue 29), else nothing.
+pub fn step_offset_words(d: &Delay) -> String {
+    if d.step_offset_s == 0.0 {
+        return String::new();
+    }
+    format!(
+        " as {:+.4} s (the filter's wheel step and streams add {:+.4} s)",
+        d.applied_s(),
+        d.step_offset_s
+    )
+}
+
 fn tilt_json(t: &Tilt) -> Value {
     let num = |x: f64| if x.is_finite() { json!(x) } else { Value::Null };
     json!({

@@ -25,10 +25,11 @@ pub fn corrections_lines(c: &deadreckon_core::timing::Corrections) -> Vec<String
         let d = c.delays.get(s);
         out.push(match d.status.reason() {
             None => format!(
-                "{:<10} {:>+10.4} {:>9.4}  estimated, applied",
+                "{:<10} {:>+10.4} {:>9.4}  estimated, applied{}",
                 s.name(),
                 d.delay_s,
-                d.std_s
+                d.std_s,
+                crate::corrections::step_offset_words(d)
             ),
             Some(r) if d.status.is_measured_not_applied() => format!(
                 "{:<10} {:>+10.4} {:>9.4}  {r}",

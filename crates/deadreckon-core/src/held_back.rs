@@ -465,7 +465,9 @@ fn known(c: &Corrections, set: &[Correction], model: &ModelOptions) -> KnownCorr
             Correction::Tilt => k.up = c.tilt.as_ref().map(|t| t.up),
             Correction::Delay(s) => {
                 let i = Stream::ALL.iter().position(|&x| x == s).unwrap_or(0);
-                k.delays_s[i] = c.delays.get(s).delay_s;
+                // As `Delays::apply`: the GNSS delay with the filter's step
+                // offset.
+                k.delays_s[i] = c.delays.get(s).applied_s();
             }
             Correction::GyroScale => {
                 if let Some(g) = &c.gyro_scale {

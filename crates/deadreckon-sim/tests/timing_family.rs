@@ -9,10 +9,12 @@
 //! that is: the receiver's slow wander (with white fixes the RTS calibration
 //! is within 5 % of the truth).
 //!
-//! The delays are against the wheel clock: a simulated wheel-speed row is the
-//! mean speed over the preceding wheel period, so the wheels themselves are
-//! half a period late and a stream with latency `L` is `L − T_wheel/2` late
-//! against them.
+//! The scalar delays are against the wheel clock: a simulated wheel-speed
+//! row is the mean speed over the preceding wheel period, so the wheels
+//! themselves are half a period late and a stream with latency `L` is
+//! `L − T_wheel/2` late against them. The GNSS delay is the receiver's
+//! latency `L` (its reference takes each row over its own interval,
+//! `timing::REFERENCE_WHEEL_ROWS`, issue 29).
 
 use deadreckon_core::calibrate::{self, CalibrationOptions};
 use deadreckon_core::ekf::Timing;
@@ -111,7 +113,14 @@ fn family_drift(white_fixes: bool) -> Vec<Drift> {
         eprintln!("car {seed}: {inst:?}, wheels {} Hz", car.wheel_rate_hz);
         for (k, s) in timing::Stream::ALL.iter().enumerate() {
             let d = c.delays.get(*s);
-            let truth = inst.latency_s[k] - half_wheel;
+            // The scalar streams against the wheel rows' stamps; the GNSS
+            // against true time (its reference takes each wheel row over
+            // its own interval, issue 29).
+            let truth = if *s == timing::Stream::Gnss {
+                inst.latency_s[k]
+            } else {
+                inst.latency_s[k] - half_wheel
+            };
             eprintln!(
                 "  {:<9} {:+.4} ± {:.4} s (truth {truth:+.4}) {:?}",
                 s.name(),

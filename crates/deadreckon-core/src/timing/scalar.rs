@@ -327,6 +327,7 @@ pub(super) fn status_of(d: f64, std: f64, n: usize, o: &DelayOptions) -> Delay {
         std_s: std,
         samples: n,
         status,
+        step_offset_s: 0.0,
     }
 }
 
