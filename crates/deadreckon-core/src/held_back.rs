@@ -49,6 +49,16 @@
 //! [`MIN_Z`] standard errors from the vehicle's values, the two settings
 //! without an estimate on the held-back fixes alone (never on a drive too
 //! short to judge; the recovery only where the held-back filter recovered).
+//! The receiver's wander is judged last: fitted
+//! ([`crate::model_options::wander_candidate`]) on the drive with the
+//! options chosen by then and their calibration (which also serves as the
+//! returned drive's calibration: the calibration keeps white fixes, so the
+//! wander does not change it), a candidate when the fit is not white fixes,
+//! applied when the held-back fixes say so; the hidden fixes carry the
+//! wander, so each is compared with the dead-reckoned antenna plus the
+//! wander the filter still expects there
+//! ([`crate::outage::through_windows_against_fixes`]), the prediction a
+//! white-fix filter makes implicitly by keeping the offset it followed.
 //! What is chosen is [`crate::timing::Corrections::model`].
 //!
 //! A drive too short for [`MIN_WINDOWS`] windows cannot judge: there each
