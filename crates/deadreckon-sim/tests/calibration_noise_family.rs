@@ -634,6 +634,15 @@ fn the_nees_ran_the_five_state_filter_whatever_the_vehicle_declared() {
     assert!(end(&white) > 30.0 * end(&wander));
 }
 
+/// One car of [`pose_nees_with_the_wander_auto_chose`]: its seed, auto's
+/// wander, the pose NEES verdict with white fixes and with auto's choice.
+type AutoRow = (
+    u64,
+    Option<deadreckon_core::gnss_error::Wander>,
+    Verdict,
+    Verdict,
+);
+
 /// The pose NEES with the receiver's wander as `--corrections auto` chose
 /// it on the calibration drive (issues 28, 36: fitted after the other
 /// options, applied only when the held-back fixes say so), against the
@@ -660,12 +669,7 @@ fn pose_nees_with_the_wander_auto_chose() {
         ],
     };
     for (title, cars) in sets {
-        let mut rows: Vec<(
-            u64,
-            Option<deadreckon_core::gnss_error::Wander>,
-            Verdict,
-            Verdict,
-        )> = cars
+        let mut rows: Vec<AutoRow> = cars
             .into_par_iter()
             .map(|seed| {
                 let (s, _) = scenario(seed, 100 + seed);
@@ -704,14 +708,7 @@ fn pose_nees_with_the_wander_auto_chose() {
         }
         let n = rows.len();
         let chosen = rows.iter().filter(|r| r.1.is_some()).count();
-        let ok = |f: &dyn Fn(
-            &(
-                u64,
-                Option<deadreckon_core::gnss_error::Wander>,
-                Verdict,
-                Verdict,
-            ),
-        ) -> bool| { rows.iter().filter(|r| f(r)).count() };
+        let ok = |f: &dyn Fn(&AutoRow) -> bool| rows.iter().filter(|r| f(r)).count();
         println!(
             "{title}: the wander chosen on {chosen}/{n}; pose NEES consistent {}/{n} white, \
              {}/{n} with auto's choice (worst ×{:.1})",
