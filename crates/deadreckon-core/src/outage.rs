@@ -28,7 +28,7 @@ use crate::compared::{Antenna, Position, RearAxle};
 use crate::drive::Drive;
 use crate::ekf::{self, EpochHook, EpochOut, FilterOptions};
 use crate::filter::{CarLayout, Filter, GateCounts, Layout};
-use crate::gnss_error::{CarWanderLayout, N_WANDER};
+use crate::gnss_error::{CarWanderLayout, WanderCov, N_WANDER};
 use crate::gyro_drift::{CarBiasLayout, CarWanderBiasLayout, N_BIAS, N_WANDER_BIAS};
 use crate::metrics::Summary;
 use crate::model::{State, V, X, Y, YAW};
@@ -461,42 +461,6 @@ fn evaluate_in<L: Layout<N>, const N: usize>(
         unsettled,
         heading_limit_rad: heading_limit,
     })
-}
-
-/// The receiver's wander's part of a filter covariance: its covariance
-/// with `(X, Y, YAW)` (rows) and its own 2×2 block, m², m·rad.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct WanderCov {
-    cross: [[f64; 2]; 3],
-    block: [[f64; 2]; 2],
-}
-
-impl WanderCov {
-    /// From a covariance whose wander starts at index `w`.
-    fn of<const N: usize>(p: &SMatrix<f64, N, N>, w: usize) -> Self {
-        let i = [X, Y, YAW];
-        WanderCov {
-            cross: std::array::from_fn(|r| std::array::from_fn(|c| p[(i[r], w + c)])),
-            block: std::array::from_fn(|r| std::array::from_fn(|c| p[(w + r, w + c)])),
-        }
-    }
-
-    /// The covariance of the fix predicted at the antenna (`lever_m` ahead
-    /// of the rear axle at `yaw_rad`) plus the wander: `H P Hᵀ` with
-    /// `H = [A | I₂]`, `A = [I₂ | l (−sin ψ, cos ψ)ᵀ]`; `antenna` is
-    /// `A P_pose Aᵀ` ([`Cov2::ahead`]).
-    fn fix_cov(&self, antenna: Cov2, yaw_rad: f64, lever_m: f64) -> Cov2 {
-        let j = [-lever_m * yaw_rad.sin(), lever_m * yaw_rad.cos()];
-        // M = A · cross (2×2).
-        let m = |r: usize, c: usize| self.cross[r][c] + j[r] * self.cross[2][c];
-        Cov2 {
-            ee_m2: antenna.ee_m2 + 2.0 * m(0, 0) + self.block[0][0],
-            en_m2: antenna.en_m2
-                + 0.5 * (m(0, 1) + m(1, 0))
-                + 0.5 * (self.block[0][1] + self.block[1][0]),
-            nn_m2: antenna.nn_m2 + 2.0 * m(1, 1) + self.block[1][1],
-        }
-    }
 }
 
 /// The `(X, Y, YAW)` block of a filter covariance.
