@@ -37,7 +37,7 @@
 //! ci -p deadreckon-api --test error_bound
 //! the_bound_covers_95_percent_of_outages_on_development_cars -- --exact
 //! --nocapture`, which then fails on its `gnss` pins): the wander carried
-//! on 5 of 6 (fitted 0.25–1.0 m against drawn 0.22–0.73 m), k 0–1.90,
+//! on 5 of 6 (fitted 0.25–1.0 m against drawn 0.22–0.73 m), k 0–1.91,
 //! 168 of 177 windows within (0.949), sharpness 3.57 (with `gnss`: 0.938,
 //! 2.81). Coverage holds without the floor; the bound is wider than the
 //! issue's 3 (`auto` without the wander was not measured).
