@@ -27,9 +27,6 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::bound::Cov2;
-use crate::model::{X, Y, YAW};
-
 use crate::filter::Layout;
 
 /// Index of the wander's east component in [`CarWanderLayout`]'s state.
@@ -124,41 +121,6 @@ pub fn add_wander<const N: usize>(
     jac[(1, w + 1)] = 1.0;
 }
 
-/// The receiver's wander's part of a filter covariance: its covariance
-/// with `(X, Y, YAW)` (rows) and its own 2×2 block, m², m·rad.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct WanderCov {
-    cross: [[f64; 2]; 3],
-    block: [[f64; 2]; 2],
-}
-
-impl WanderCov {
-    /// From a covariance whose wander starts at index `w`.
-    pub(crate) fn of<const N: usize>(p: &SMatrix<f64, N, N>, w: usize) -> Self {
-        let i = [X, Y, YAW];
-        WanderCov {
-            cross: std::array::from_fn(|r| std::array::from_fn(|c| p[(i[r], w + c)])),
-            block: std::array::from_fn(|r| std::array::from_fn(|c| p[(w + r, w + c)])),
-        }
-    }
-
-    /// The covariance of the fix predicted at the antenna (`lever_m` ahead
-    /// of the rear axle at `yaw_rad`) plus the wander: `H P Hᵀ` with
-    /// `H = [A | I₂]`, `A = [I₂ | l (−sin ψ, cos ψ)ᵀ]`; `antenna` is
-    /// `A P_pose Aᵀ` ([`Cov2::ahead`]); what the outage evaluation's bound
-    /// compares a hidden fix with ([`crate::outage`]).
-    pub(crate) fn fix_cov(&self, antenna: Cov2, yaw_rad: f64, lever_m: f64) -> Cov2 {
-        let j = [-lever_m * yaw_rad.sin(), lever_m * yaw_rad.cos()];
-        // M = A · cross (2×2).
-        let m = |r: usize, c: usize| self.cross[r][c] + j[r] * self.cross[2][c];
-        Cov2 {
-            ee_m2: antenna.ee_m2 + 2.0 * m(0, 0) + self.block[0][0],
-            en_m2: antenna.en_m2 + m(0, 1) + m(1, 0) + 0.5 * (self.block[0][1] + self.block[1][0]),
-            nn_m2: antenna.nn_m2 + 2.0 * m(1, 1) + self.block[1][1],
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -186,27 +148,5 @@ mod tests {
         assert!((p - want_p).abs().max() < 1e-12);
         assert!((x - want_x).abs().max() < 1e-12);
         assert_eq!(p, p.transpose());
-    }
-
-    #[test]
-    fn the_predicted_fix_covariance_is_h_p_ht_with_the_wander() {
-        let a = SMatrix::<f64, 7, 7>::from_fn(|i, j| ((i * 7 + j) as f64 * 0.43).cos());
-        let p = a * a.transpose() + SMatrix::<f64, 7, 7>::identity();
-        let (yaw, lever) = (0.7_f64, 1.3);
-        let mut h = SMatrix::<f64, 2, 7>::zeros();
-        h[(0, X)] = 1.0;
-        h[(1, Y)] = 1.0;
-        h[(0, YAW)] = -lever * yaw.sin();
-        h[(1, YAW)] = lever * yaw.cos();
-        h[(0, WANDER_E)] = 1.0;
-        h[(1, WANDER_N)] = 1.0;
-        let want = h * p * h.transpose();
-        let idx = [X, Y, YAW];
-        let p3: [[f64; 3]; 3] =
-            std::array::from_fn(|r| std::array::from_fn(|c| p[(idx[r], idx[c])]));
-        let got = WanderCov::of(&p, WANDER_E).fix_cov(Cov2::ahead(&p3, yaw, lever), yaw, lever);
-        assert!((got.ee_m2 - want[(0, 0)]).abs() < 1e-12);
-        assert!((got.en_m2 - want[(0, 1)]).abs() < 1e-12);
-        assert!((got.nn_m2 - want[(1, 1)]).abs() < 1e-12);
     }
 }

@@ -23,12 +23,12 @@
 //! it): leaving out the windows where the filter is unsure would flatter the
 //! figures.
 
-use crate::bound::Cov2;
+use crate::bound::{Cov2, WanderCov};
 use crate::compared::{Antenna, Position, RearAxle};
 use crate::drive::Drive;
 use crate::ekf::{self, EpochHook, EpochOut, FilterOptions};
 use crate::filter::{CarLayout, Filter, GateCounts, Layout};
-use crate::gnss_error::{CarWanderLayout, WanderCov, N_WANDER};
+use crate::gnss_error::{CarWanderLayout, N_WANDER};
 use crate::gyro_drift::{CarBiasLayout, CarWanderBiasLayout, N_BIAS, N_WANDER_BIAS};
 use crate::metrics::Summary;
 use crate::model::{State, V, X, Y, YAW};
