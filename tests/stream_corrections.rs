@@ -154,7 +154,10 @@ fn stream_disagreed_with_run_on_stored_delays() {
                  [steering]\n\
                  steering_ratio = 16.2\n\
                  steering_offset_rad = 0.01\n\
-                 understeer_gradient_rad_per_mps2 = 0.002\n",
+                 understeer_gradient_rad_per_mps2 = 0.002\n\
+                 [gnss_wander]\n\
+                 std_m = 0.7\n\
+                 tau_s = 60.0\n",
             )
             .unwrap();
             t.insert("model".into(), model.into());
@@ -206,6 +209,9 @@ fn stream_disagreed_with_run_on_stored_delays() {
             assert_eq!(c.model.rear_slip_gradient_rad_per_mps2, Some(0.005));
             assert_eq!(c.model.gyro_bias_walk_rps_per_sqrt_s, Some(3e-6));
             assert_eq!(c.model.steering.map(|s| s.steering_ratio), Some(16.2));
+            // The receiver's wander with the walking bias: run and stream
+            // both carry both (issues 28, 36).
+            assert_eq!(c.model.gnss_wander.map(|w| w.std_m), Some(0.7));
         }
         if c.traction_slip_per_mps2 != 0.0 {
             assert!(c.traction_mean_force_mps2.is_some(), "{stored}");

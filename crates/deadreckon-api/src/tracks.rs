@@ -58,6 +58,7 @@ pub fn bounds_95_m(
     init_pose: Option<(f64, f64, f64)>,
 ) -> Vec<Vec<f64>> {
     use deadreckon_core::bound_pose;
+    let wander_carried = bound_pose::carries_wander(&drive.vehicle.noise);
     tracks
         .iter()
         .map(|t| {
@@ -65,11 +66,18 @@ pub fn bounds_95_m(
                 return Vec::new();
             }
             match t.name.as_str() {
-                track::names::FILTERED => {
-                    bound_pose::filtered_bounds_m(t, &drive.gnss, &opts.gnss_outages, fit)
-                }
+                track::names::FILTERED => bound_pose::filtered_bounds_m(
+                    t,
+                    &drive.gnss,
+                    &opts.gnss_outages,
+                    fit,
+                    wander_carried,
+                ),
                 track::names::DEAD_RECKONED => {
-                    let from_gnss = init_pose.is_none() && drive.truth.is_empty();
+                    // A smoothed start separated from the receiver's wander
+                    // carries the offset in its covariance: no floor.
+                    let from_gnss =
+                        init_pose.is_none() && drive.truth.is_empty() && !wander_carried;
                     let start = t.points.first().map_or(f64::NEG_INFINITY, |p| p.t_s);
                     let handed = drive.gnss.partition_point(|g| g.t_s <= start);
                     let std_m = match handed.checked_sub(1) {

@@ -49,6 +49,10 @@
 
 use std::sync::OnceLock;
 
+use nalgebra::SMatrix;
+
+use crate::model::{X, Y, YAW};
+
 /// The coverage the bound is for: 0.95.
 pub const LEVEL: f64 = 0.95;
 
@@ -130,6 +134,41 @@ impl Cov2 {
         let m = 0.5 * (self.ee_m2 + self.nn_m2);
         let d = (0.5 * (self.ee_m2 - self.nn_m2)).hypot(self.en_m2);
         ((m + d).max(0.0), (m - d).max(0.0))
+    }
+}
+
+/// The receiver's wander's part of a filter covariance: its covariance
+/// with `(X, Y, YAW)` (rows) and its own 2×2 block, m², m·rad.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct WanderCov {
+    cross: [[f64; 2]; 3],
+    block: [[f64; 2]; 2],
+}
+
+impl WanderCov {
+    /// From a covariance whose wander starts at index `w`.
+    pub(crate) fn of<const N: usize>(p: &SMatrix<f64, N, N>, w: usize) -> Self {
+        let i = [X, Y, YAW];
+        WanderCov {
+            cross: std::array::from_fn(|r| std::array::from_fn(|c| p[(i[r], w + c)])),
+            block: std::array::from_fn(|r| std::array::from_fn(|c| p[(w + r, w + c)])),
+        }
+    }
+
+    /// The covariance of the fix predicted at the antenna (`lever_m` ahead
+    /// of the rear axle at `yaw_rad`) plus the wander: `H P Hᵀ` with
+    /// `H = [A | I₂]`, `A = [I₂ | l (−sin ψ, cos ψ)ᵀ]`; `antenna` is
+    /// `A P_pose Aᵀ` ([`Cov2::ahead`]); what the outage evaluation's bound
+    /// compares a hidden fix with ([`crate::outage`]).
+    pub(crate) fn fix_cov(&self, antenna: Cov2, yaw_rad: f64, lever_m: f64) -> Cov2 {
+        let j = [-lever_m * yaw_rad.sin(), lever_m * yaw_rad.cos()];
+        // M = A · cross (2×2).
+        let m = |r: usize, c: usize| self.cross[r][c] + j[r] * self.cross[2][c];
+        Cov2 {
+            ee_m2: antenna.ee_m2 + 2.0 * m(0, 0) + self.block[0][0],
+            en_m2: antenna.en_m2 + m(0, 1) + m(1, 0) + 0.5 * (self.block[0][1] + self.block[1][0]),
+            nn_m2: antenna.nn_m2 + 2.0 * m(1, 1) + self.block[1][1],
+        }
     }
 }
 

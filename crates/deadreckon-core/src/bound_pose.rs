@@ -12,7 +12,10 @@
 //! last one handed over, as `evaluate --outage` computes it; where GNSS
 //! is present it is the latest fix, and the bound is the bound of the
 //! filtered position. A pose before any fix gets the filter's covariance
-//! alone (`σ = 0`).
+//! alone (`σ = 0`), and so does every pose of a filter that carries the
+//! receiver's wander ([`crate::gnss_error`]): its covariance holds the
+//! receiver's offset then, which the floor would count a second time
+//! ([`carries_wander`]).
 
 use std::collections::VecDeque;
 
@@ -42,6 +45,13 @@ pub fn point_bound_m(fit: &BoundFit, p: &TrackPoint, receiver_std_m: f64) -> f64
     fit.floored_bound_m(&cov, &Cov2::circular(receiver_std_m))
 }
 
+/// Whether the filter of a vehicle with `noise` carries the receiver's
+/// wander as states: then the bound has no receiver's floor (the module's
+/// rule).
+pub fn carries_wander(noise: &crate::vehicle::Noise) -> bool {
+    noise.gnss_wander_std_m > 0.0
+}
+
 /// The most fixes [`FixFloor`] keeps ahead of the poses (a stream's fixes
 /// run at most a reorder window ahead of its epochs).
 const KEPT_FIXES: usize = 256;
@@ -54,9 +64,22 @@ pub struct FixFloor {
     /// `(t_s, declared std_m)`: the last fix at or before the last pose
     /// asked, then those after it.
     fixes: VecDeque<(f64, f64)>,
+    /// The filter carries the receiver's wander: no floor
+    /// ([`carries_wander`]).
+    #[serde(default)]
+    wander_carried: bool,
 }
 
 impl FixFloor {
+    /// The floor of a filter that carries the receiver's wander or not
+    /// ([`carries_wander`]): with it, every pose's floor is 0.
+    pub fn new(wander_carried: bool) -> Self {
+        FixFloor {
+            fixes: VecDeque::new(),
+            wander_carried,
+        }
+    }
+
     /// Takes a fix given to the filter; one not later than the last taken
     /// (the online filter replays its first events once started) is
     /// ignored.
@@ -78,6 +101,7 @@ impl FixFloor {
             self.fixes.pop_front();
         }
         match self.fixes.front() {
+            _ if self.wander_carried => 0.0,
             Some(&(t, s)) if t <= t_s => s,
             _ => 0.0,
         }
@@ -86,14 +110,16 @@ impl FixFloor {
 
 /// The bounds of a filter's track given the fixes of `gnss` (those in
 /// `hidden` windows left out), pose by pose, m: what the online filter
-/// gives its poses ([`crate::online::Online::push_poses`]).
+/// gives its poses ([`crate::online::Online::push_poses`]). No floor when
+/// the filter carried the receiver's wander (`wander_carried`).
 pub fn filtered_bounds_m(
     track: &Track,
     gnss: &[GnssFix],
     hidden: &[(f64, f64)],
     fit: &BoundFit,
+    wander_carried: bool,
 ) -> Vec<f64> {
-    let mut floor = FixFloor::default();
+    let mut floor = FixFloor::new(wander_carried);
     let mut next = 0;
     track
         .points
@@ -185,11 +211,16 @@ mod tests {
         };
         let gnss = [fix(1.0, 2.0), fix(2.0, 5.0)];
         let fit = BoundFit::FILTER;
-        let b = filtered_bounds_m(&t, &gnss, &[(1.8, 2.2)], &fit);
+        let b = filtered_bounds_m(&t, &gnss, &[(1.8, 2.2)], &fit, false);
         assert_eq!(b[0], point_bound_m(&fit, &t.points[0], 0.0));
         assert_eq!(b[1], point_bound_m(&fit, &t.points[1], 2.0));
         assert_eq!(b[2], point_bound_m(&fit, &t.points[2], 2.0));
-        let open = filtered_bounds_m(&t, &gnss, &[], &fit);
+        let open = filtered_bounds_m(&t, &gnss, &[], &fit, false);
         assert_eq!(open[2], point_bound_m(&fit, &t.points[2], 5.0));
+        // A filter that carries the receiver's wander: no floor.
+        let carried = filtered_bounds_m(&t, &gnss, &[], &fit, true);
+        for (b, p) in carried.iter().zip(&t.points) {
+            assert_eq!(*b, point_bound_m(&fit, p, 0.0));
+        }
     }
 }

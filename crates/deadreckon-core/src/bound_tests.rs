@@ -132,3 +132,29 @@ fn the_factor_is_the_conformal_rank_of_the_scores() {
     // Too few: the filter's covariance alone.
     assert_eq!(fit(&samples[..4], 30.0, 10.0), BoundFit::FILTER);
 }
+
+#[test]
+fn the_predicted_fix_covariance_is_h_p_ht_with_the_wander() {
+    use crate::model::{X, Y, YAW};
+    let a = nalgebra::SMatrix::<f64, 7, 7>::from_fn(|i, j| ((i * 7 + j) as f64 * 0.43).cos());
+    let p = a * a.transpose() + nalgebra::SMatrix::<f64, 7, 7>::identity();
+    let (yaw, lever) = (0.7_f64, 1.3);
+    let mut h = nalgebra::SMatrix::<f64, 2, 7>::zeros();
+    h[(0, X)] = 1.0;
+    h[(1, Y)] = 1.0;
+    h[(0, YAW)] = -lever * yaw.sin();
+    h[(1, YAW)] = lever * yaw.cos();
+    h[(0, crate::gnss_error::WANDER_E)] = 1.0;
+    h[(1, crate::gnss_error::WANDER_N)] = 1.0;
+    let want = h * p * h.transpose();
+    let idx = [X, Y, YAW];
+    let p3: [[f64; 3]; 3] = std::array::from_fn(|r| std::array::from_fn(|c| p[(idx[r], idx[c])]));
+    let got = WanderCov::of(&p, crate::gnss_error::WANDER_E).fix_cov(
+        Cov2::ahead(&p3, yaw, lever),
+        yaw,
+        lever,
+    );
+    assert!((got.ee_m2 - want[(0, 0)]).abs() < 1e-12);
+    assert!((got.en_m2 - want[(0, 1)]).abs() < 1e-12);
+    assert!((got.nn_m2 - want[(1, 1)]).abs() < 1e-12);
+}

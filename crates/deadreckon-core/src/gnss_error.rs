@@ -52,8 +52,10 @@ impl Layout<N_WANDER> for CarWanderLayout {
 }
 
 /// The wander's first-order Gauss–Markov model: standard deviation per axis
-/// and time constant.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// and time constant (params.toml `[model.gnss_wander]`:
+/// [`crate::model_options::ModelOptions::gnss_wander`]).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Wander {
     /// Standard deviation per axis, m.
     pub std_m: f64,

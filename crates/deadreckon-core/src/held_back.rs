@@ -49,6 +49,16 @@
 //! [`MIN_Z`] standard errors from the vehicle's values, the two settings
 //! without an estimate on the held-back fixes alone (never on a drive too
 //! short to judge; the recovery only where the held-back filter recovered).
+//! The receiver's wander is judged last: fitted
+//! ([`crate::model_options::wander_candidate`]) on the drive with the
+//! options chosen by then and their calibration (which also serves as the
+//! returned drive's calibration: the calibration keeps white fixes, so the
+//! wander does not change it), a candidate when the fit is not white fixes,
+//! applied when the held-back fixes say so; the hidden fixes carry the
+//! wander, so each is compared with the dead-reckoned antenna plus the
+//! wander the filter still expects there
+//! ([`crate::outage::through_windows_against_fixes`]), the prediction a
+//! white-fix filter makes implicitly by keeping the offset it followed.
 //! What is chosen is [`crate::timing::Corrections::model`].
 //!
 //! A drive too short for [`MIN_WINDOWS`] windows cannot judge: there each
@@ -270,6 +280,9 @@ pub fn prepare_calibrated(
     // The GNSS delay is chosen on its significance alone (module docs):
     // the held-back fixes keep the receiver's clock, so they cannot judge it.
     let gnss = Correction::Delay(Stream::Gnss);
+    // The calibration of the chosen drive, where the wander's fit ran it
+    // (the wander does not change it: the calibration keeps white fixes).
+    let mut chosen_calibration = None;
     let mut chosen: Vec<Correction> = candidates
         .iter()
         .filter(|(c, _)| *c == gnss)
@@ -282,7 +295,7 @@ pub fn prepare_calibrated(
     let base_drive = known(&corrections, &base, &ModelOptions::default()).apply(drive);
     let base_calibration = calibrate::calibrate(&base_drive, copts).ok();
     let initial = base_calibration.as_ref().map(|c| c.estimate.params);
-    let model_values = match &base_calibration {
+    let mut model_values = match &base_calibration {
         Some(c) => {
             let (m, values) = model_options::candidates(&base_drive, c, min_z);
             // The settings without an estimate (walk, recovery) need the
@@ -392,6 +405,46 @@ pub fn prepare_calibrated(
                 None => break,
             }
         }
+        // The receiver's wander: fitted after the others were chosen, on
+        // the drive with them and its calibration (model_options' docs),
+        // judged last. The calibration keeps white fixes, so the folds
+        // calibrate as without it.
+        let fitted = wander_may_be_fitted(drive).then(|| {
+            let d = known(&corrections, &set, &model_values).apply(drive);
+            let cal = if set == base {
+                base_calibration.clone()
+            } else {
+                calibrate::calibrate(&d, copts).ok()
+            }?;
+            let w = model_options::wander_candidate(&d, &cal.estimate.params, &copts.filter);
+            Some((cal, w))
+        });
+        if let Some((cal, wander)) = fitted.flatten() {
+            if let Some(w) = wander {
+                model_values.gnss_wander = Some(w);
+                let c = Correction::Model(ModelOption::GnssWander);
+                let with: Vec<Correction> = set.iter().copied().chain([c]).collect();
+                let d = known(&corrections, &with, &model_values).apply(drive);
+                let run = held_back_errors(&d, copts, initial, &windows, Some(&current.params))?;
+                let (_, t) = paired(&run.errors, &current.errors);
+                let applied = t <= -MIN_T;
+                tried.push(Judged {
+                    correction: c,
+                    z: f64::NAN,
+                    with_m: mean(&run.errors),
+                    against_m: mean(&current.errors),
+                    t,
+                    applied,
+                    by_significance: false,
+                });
+                if applied {
+                    set.push(c);
+                    won.push(c);
+                    current = run;
+                }
+            }
+            chosen_calibration = Some(cal);
+        }
         if !won.is_empty() {
             held.together_m = Some(mean(&current.errors));
         }
@@ -406,8 +459,14 @@ pub fn prepare_calibrated(
     corrections.held_back = Some(held);
     // Nothing chosen beyond the baseline: `out` is the baseline's drive
     // (the same known corrections), whose calibration is at hand.
-    let calibration = base_calibration.filter(|_| chosen == base);
+    let calibration = chosen_calibration.or(base_calibration.filter(|_| chosen == base));
     Ok((out, corrections, calibration))
+}
+
+/// Whether the receiver's wander can be a candidate: the drive has fixes
+/// and its vehicle carries no wander already.
+fn wander_may_be_fitted(drive: &Drive) -> bool {
+    drive.gnss.len() >= 2 && drive.vehicle.noise.gnss_wander_std_m == 0.0
 }
 
 /// The estimated corrections at least `min_z` standard errors from none,

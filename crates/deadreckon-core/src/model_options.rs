@@ -1,12 +1,14 @@
 //! Additions to the paper's model that a drive's own GNSS may ask for
 //! (issue 28): the rear axle's side slip, the steering's ratio, offset and
 //! understeer, a gyro bias that walks, a GNSS recovery that waits out a
-//! multipath burst, and a yaw rate held through a missed gyro reading.
+//! multipath burst, a yaw rate held through a missed gyro reading, and the
+//! receiver's slowly wandering error carried as filter states.
 //!
 //! Each is built and measured on its own ([`crate::side_slip`],
 //! [`crate::kinematics::steering`], [`crate::gyro_drift`],
 //! [`crate::vehicle::Noise::gnss_recovery_after_s`],
-//! [`crate::vehicle::Noise::gyro_gap_process_yaw_rate_rps`]); none is the paper's,
+//! [`crate::vehicle::Noise::gyro_gap_process_yaw_rate_rps`],
+//! [`crate::gnss_error`]); none is the paper's,
 //! and each costs where its effect is absent (the walking bias 9 % on
 //! held-out cars whose gyro does not drift; the recovery's wait held a
 //! really lost filter out longer on held-out car 108, 3.12 → 6.18 m). So
@@ -19,6 +21,14 @@
 //! judged on the held-back fixes alone, so a drive too short to judge keeps
 //! the paper's model for them.
 //!
+//! The receiver's wander (σ, τ) is fitted on the drive's own fixes
+//! ([`crate::wander_fit`]) after the other options are chosen, with their
+//! calibration; it is a candidate when the fit is not white fixes, judged
+//! on the held-back fixes like the settings (never on a drive too short to
+//! judge), the held-back fixes compared with the dead-reckoned antenna plus
+//! the wander the filter still expects
+//! ([`crate::outage::through_windows_against_fixes`]).
+//!
 //! What is applied is stored with the corrections (params.toml `[model]`,
 //! [`crate::timing::KnownCorrections::model`]) and every command that
 //! applies params.toml sets it on the vehicle
@@ -28,6 +38,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::calibrate::Calibration;
 use crate::drive::Drive;
+use crate::gnss_error::Wander;
 use crate::vehicle::Vehicle;
 
 /// The walking gyro bias's rate random walk a drive is judged with, rad/s
@@ -92,6 +103,11 @@ pub struct ModelOptions {
     /// reading, rad/s.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gyro_gap_process_yaw_rate_rps: Option<f64>,
+    /// The receiver's wander carried as filter states (σ per axis, m, and
+    /// τ, s: the vehicle's `[noise] gnss_wander_std_m`,
+    /// `gnss_wander_tau_s`), as fitted on the calibration drive.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gnss_wander: Option<Wander>,
 }
 
 /// One model addition.
@@ -108,16 +124,20 @@ pub enum ModelOption {
     GnssRecovery,
     /// The yaw rate held through a wheel epoch without a gyro reading.
     GyroGap,
+    /// The receiver's wander as filter states ([`crate::gnss_error`]),
+    /// fitted on the drive's fixes ([`crate::wander_fit`]).
+    GnssWander,
 }
 
 impl ModelOption {
     /// Every option, in the order they are reported.
-    pub const ALL: [ModelOption; 5] = [
+    pub const ALL: [ModelOption; 6] = [
         ModelOption::SideSlip,
         ModelOption::Steering,
         ModelOption::GyroWalk,
         ModelOption::GnssRecovery,
         ModelOption::GyroGap,
+        ModelOption::GnssWander,
     ];
 
     /// Words for people.
@@ -128,6 +148,7 @@ impl ModelOption {
             ModelOption::GyroWalk => "walking gyro bias",
             ModelOption::GnssRecovery => "GNSS recovery after 10 s",
             ModelOption::GyroGap => "yaw rate held through a missed gyro reading",
+            ModelOption::GnssWander => "receiver's wander",
         }
     }
 
@@ -139,6 +160,7 @@ impl ModelOption {
             ModelOption::GyroWalk => "gyro_bias_walk",
             ModelOption::GnssRecovery => "gnss_recovery",
             ModelOption::GyroGap => "gyro_gap",
+            ModelOption::GnssWander => "gnss_wander",
         }
     }
 }
@@ -163,6 +185,7 @@ impl ModelOptions {
             ModelOption::GyroGap => {
                 self.gyro_gap_process_yaw_rate_rps = from.gyro_gap_process_yaw_rate_rps
             }
+            ModelOption::GnssWander => self.gnss_wander = from.gnss_wander,
         }
         self
     }
@@ -175,6 +198,7 @@ impl ModelOptions {
             ModelOption::GyroWalk => self.gyro_bias_walk_rps_per_sqrt_s.is_some(),
             ModelOption::GnssRecovery => self.gnss_recovery_after_s.is_some(),
             ModelOption::GyroGap => self.gyro_gap_process_yaw_rate_rps.is_some(),
+            ModelOption::GnssWander => self.gnss_wander.is_some(),
         }
     }
 
@@ -196,6 +220,10 @@ impl ModelOptions {
         }
         if let Some(q) = self.gyro_gap_process_yaw_rate_rps {
             vehicle.noise.gyro_gap_process_yaw_rate_rps = q;
+        }
+        if let Some(w) = self.gnss_wander {
+            vehicle.noise.gnss_wander_std_m = w.std_m;
+            vehicle.noise.gnss_wander_tau_s = w.tau_s;
         }
     }
 
@@ -231,6 +259,12 @@ impl ModelOptions {
         if let Some(q) = self.gyro_gap_process_yaw_rate_rps {
             parts.push(format!(
                 "yaw rate held through a missed gyro reading ({q} rad/s per 20 ms)"
+            ));
+        }
+        if let Some(w) = self.gnss_wander {
+            parts.push(format!(
+                "receiver's wander {:.2} m over {:.0} s",
+                w.std_m, w.tau_s
             ));
         }
         parts.join(", ")
@@ -314,6 +348,18 @@ pub fn candidates(
     (out, values)
 }
 
+/// The receiver's wander fitted on `drive`'s fixes with `params` and the
+/// filter options `opts` ([`crate::wander_fit::fit`]): `None` when white
+/// fixes are the most likely (or the fit cannot run: no fix after the
+/// filter's start).
+pub fn wander_candidate(
+    drive: &Drive,
+    params: &crate::vehicle::Params,
+    opts: &crate::ekf::FilterOptions,
+) -> Option<Wander> {
+    crate::wander_fit::fit(drive, params, opts).ok()?.best
+}
+
 /// The share of the drive's wheel intervals `(t_{k−1}, t_k]` in which no
 /// gyro reading is stamped (0 without a gyro or with fewer than two wheel
 /// rows): the wheel epochs of the paper's scheme without a gyro reading of
@@ -354,6 +400,10 @@ mod tests {
             gyro_bias_walk_rps_per_sqrt_s: Some(3e-6),
             gnss_recovery_after_s: Some(10.0),
             gyro_gap_process_yaw_rate_rps: Some(0.03),
+            gnss_wander: Some(Wander {
+                std_m: 1.0,
+                tau_s: 60.0,
+            }),
         };
         let only_walk = ModelOptions::default().with(ModelOption::GyroWalk, &all);
         let mut v = v0.clone();
@@ -373,6 +423,11 @@ mod tests {
         assert_eq!(w.steering_offset_rad, 0.02);
         assert_eq!(w.understeer_gradient_rad_per_mps2, 0.003);
         assert_eq!(w.noise.gnss_recovery_after_s, 10.0);
+        assert_eq!(
+            (w.noise.gnss_wander_std_m, w.noise.gnss_wander_tau_s),
+            (1.0, 60.0)
+        );
+        assert_eq!(v.noise.gnss_wander_std_m, 0.0);
         assert!(all.validate().is_ok());
         for o in ModelOption::ALL {
             assert!(all.has(o) && !ModelOptions::default().has(o));

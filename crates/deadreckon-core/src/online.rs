@@ -32,7 +32,8 @@ use crate::bound::BoundFit;
 use crate::bound_pose::{point_bound_m, FixFloor, Pose};
 use crate::ekf::{Event, Feeder, FilterOptions, FilterStats, GnssInit};
 use crate::filter::{AugmentedFilter, CarFilter, Filter};
-use crate::gyro_drift::{CarBiasLayout, N_BIAS};
+use crate::gnss_error::{CarWanderLayout, N_WANDER};
+use crate::gyro_drift::{CarBiasLayout, CarWanderBiasLayout, N_BIAS, N_WANDER_BIAS};
 use crate::live_corrections::LiveCorrections;
 use crate::model::{Mat, State};
 use crate::track::{car_point, TrackPoint};
@@ -115,6 +116,47 @@ enum Stage {
         filter: Box<AugmentedFilter>,
         feeder: Feeder,
     },
+    /// Fixed parameters, the receiver's wander carried
+    /// ([`crate::gnss_error`]).
+    Wander {
+        filter: Box<Filter<CarWanderLayout, N_WANDER>>,
+        feeder: Feeder,
+    },
+    /// Fixed parameters, the receiver's wander and a walking gyro bias.
+    WanderWalking {
+        filter: Box<Filter<CarWanderBiasLayout, N_WANDER_BIAS>>,
+        feeder: Feeder,
+    },
+}
+
+/// `$body` with `$filter` and `$feeder` bound to the running stage's, of
+/// whichever layout; `$waiting` before the start.
+macro_rules! with_stage {
+    ($stage:expr, $waiting:expr, |$filter:ident, $feeder:ident| $body:expr) => {
+        match $stage {
+            Stage::Waiting { .. } => $waiting,
+            Stage::Car {
+                filter: $filter,
+                feeder: $feeder,
+            } => $body,
+            Stage::Walking {
+                filter: $filter,
+                feeder: $feeder,
+            } => $body,
+            Stage::Learning {
+                filter: $filter,
+                feeder: $feeder,
+            } => $body,
+            Stage::Wander {
+                filter: $filter,
+                feeder: $feeder,
+            } => $body,
+            Stage::WanderWalking {
+                filter: $filter,
+                feeder: $feeder,
+            } => $body,
+        }
+    };
 }
 
 /// The filter on a stream; see the module documentation.
@@ -204,7 +246,7 @@ impl Online {
             },
             live: LiveCorrections::default(),
             bound: BoundFit::FILTER,
-            floor: FixFloor::default(),
+            floor: FixFloor::new(crate::bound_pose::carries_wander(&vehicle.noise)),
         };
         if let Start::Given(t, x, p) = start {
             o.stage = o.started(t, x, p)?;
@@ -216,7 +258,23 @@ impl Online {
         let feeder = Feeder::new(&self.opts, t0);
         let form = self.opts.covariance_form;
         let walks = crate::gyro_drift::carries_bias(&self.vehicle.noise);
+        let wanders = self.vehicle.noise.gnss_wander_std_m > 0.0;
+        let walk_prior = walks.then(|| crate::gyro_drift::prior_std(&self.vehicle.noise));
         Ok(match &self.prior_std {
+            None if wanders && walks => Stage::WanderWalking {
+                filter: Box::new(
+                    Filter::new(&self.vehicle, &self.params, walk_prior.as_ref(), t0, x0, p0)?
+                        .with_covariance_form(form),
+                ),
+                feeder,
+            },
+            None if wanders => Stage::Wander {
+                filter: Box::new(
+                    Filter::new(&self.vehicle, &self.params, None, t0, x0, p0)?
+                        .with_covariance_form(form),
+                ),
+                feeder,
+            },
             None if walks => Stage::Walking {
                 filter: Box::new(
                     Filter::new(
@@ -387,15 +445,11 @@ impl Online {
                 }
                 Ok(())
             }
-            Stage::Car { filter, feeder } => feeder.push(filter.as_mut(), ev, &mut |f, _| {
-                emit(car_point(f.time_s(), f.state(), f.covariance()))
-            }),
-            Stage::Walking { filter, feeder } => feeder.push(filter.as_mut(), ev, &mut |f, _| {
-                emit(car_point(f.time_s(), f.state(), f.covariance()))
-            }),
-            Stage::Learning { filter, feeder } => feeder.push(filter.as_mut(), ev, &mut |f, _| {
-                emit(car_point(f.time_s(), f.state(), f.covariance()))
-            }),
+            stage => with_stage!(stage, Ok(()), |filter, feeder| feeder.push(
+                filter.as_mut(),
+                ev,
+                &mut |f, _| emit(car_point(f.time_s(), f.state(), f.covariance()))
+            )),
         }
     }
 
@@ -410,38 +464,22 @@ impl Online {
                 bound_95_m: point_bound_m(&fit, &p, s),
             })
         };
-        match &mut self.stage {
-            Stage::Waiting { .. } => Ok(()),
-            Stage::Car { filter, feeder } => feeder.finish(filter.as_mut(), &mut |f, _| {
-                emit(car_point(f.time_s(), f.state(), f.covariance()))
-            }),
-            Stage::Walking { filter, feeder } => feeder.finish(filter.as_mut(), &mut |f, _| {
-                emit(car_point(f.time_s(), f.state(), f.covariance()))
-            }),
-            Stage::Learning { filter, feeder } => feeder.finish(filter.as_mut(), &mut |f, _| {
-                emit(car_point(f.time_s(), f.state(), f.covariance()))
-            }),
-        }
+        with_stage!(&mut self.stage, Ok(()), |filter, feeder| feeder.finish(
+            filter.as_mut(),
+            &mut |f, _| emit(car_point(f.time_s(), f.state(), f.covariance()))
+        ))
     }
 
     /// The filter's time, s (`None` before the start).
     pub fn time_s(&self) -> Option<f64> {
-        match &self.stage {
-            Stage::Waiting { .. } => None,
-            Stage::Car { filter, .. } => Some(filter.time_s()),
-            Stage::Walking { filter, .. } => Some(filter.time_s()),
-            Stage::Learning { filter, .. } => Some(filter.time_s()),
-        }
+        with_stage!(&self.stage, None, |filter, _feeder| Some(filter.time_s()))
     }
 
     /// Counters so far (`None` before the start).
     pub fn stats(&self) -> Option<FilterStats> {
-        match &self.stage {
-            Stage::Waiting { .. } => None,
-            Stage::Car { filter, feeder } => Some(feeder.stats_with(filter.as_ref())),
-            Stage::Walking { filter, feeder } => Some(feeder.stats_with(filter.as_ref())),
-            Stage::Learning { filter, feeder } => Some(feeder.stats_with(filter.as_ref())),
-        }
+        with_stage!(&self.stage, None, |filter, feeder| Some(
+            feeder.stats_with(filter.as_ref())
+        ))
     }
 
     /// The learned parameters (`None` unless learning and started).

@@ -23,7 +23,7 @@
 //! it): leaving out the windows where the filter is unsure would flatter the
 //! figures.
 
-use crate::bound::Cov2;
+use crate::bound::{Cov2, WanderCov};
 use crate::compared::{Antenna, Position, RearAxle};
 use crate::drive::Drive;
 use crate::ekf::{self, EpochHook, EpochOut, FilterOptions};
@@ -136,12 +136,31 @@ pub fn check_windows(drive: &Drive, windows: &[(f64, f64)]) -> Result<(), Error>
     Ok(())
 }
 
-/// Every epoch's time and car state (the first five states of any layout).
-struct Collect(Vec<(f64, State)>);
+/// Every epoch's time and car state (the first five states of any layout),
+/// and the receiver's wander estimate where the layout has it (at
+/// `wander`, [`Layout::wander_index`]).
+struct Collect {
+    states: Vec<(f64, State)>,
+    wander_at: Option<usize>,
+    wander: Vec<[f64; 2]>,
+}
+
+impl Collect {
+    fn of<L: Layout<N>, const N: usize>() -> Self {
+        Collect {
+            states: Vec::new(),
+            wander_at: L::wander_index(),
+            wander: Vec::new(),
+        }
+    }
+}
 
 impl<const N: usize> EpochHook<N> for Collect {
     fn after_epoch(&mut self, t: f64, x: &mut SVector<f64, N>, _p: &mut SMatrix<f64, N, N>) {
-        self.0.push((t, State::from_fn(|i, _| x[i])));
+        self.states.push((t, State::from_fn(|i, _| x[i])));
+        if let Some(w) = self.wander_at {
+            self.wander.push([x[w], x[w + 1]]);
+        }
     }
 }
 
@@ -364,10 +383,14 @@ fn evaluate_in<L: Layout<N>, const N: usize>(
         let mut states: Vec<(f64, State)> = Vec::new();
         let mut wander: Vec<[f64; 2]> = Vec::new();
         let mut covs: Vec<[[f64; 3]; 3]> = Vec::new();
+        let mut wander_covs: Vec<WanderCov> = Vec::new();
         let mut keep = |g: &mut Filter<L, N>, _: EpochOut<'_, N>| {
             states.push((g.time_s(), g.car_state()));
             wander.push(g.wander_m());
             covs.push(pose_block(g.covariance()));
+            if let Some(w) = L::wander_index() {
+                wander_covs.push(WanderCov::of(g.covariance(), w));
+            }
         };
         while let Some(ev) = next.filter(|e| e.t_s <= end) {
             fd.push(&mut g, ev, &mut keep)?;
@@ -375,19 +398,23 @@ fn evaluate_in<L: Layout<N>, const N: usize>(
         }
         fd.finish(&mut g, &mut keep)?;
         gates.add(&g.gates().since(&before));
-        // The bound's floor: the declared accuracy of the last fix handed over.
+        // The bound's floor: the declared accuracy of the last fix handed
+        // over; none where the filter carries the receiver's wander (its
+        // covariance holds the offset then: counted once).
         let handed = drive.gnss.partition_point(|g| g.t_s <= start);
-        let receiver = Cov2::circular(
+        let receiver = Cov2::circular(if L::wander_index().is_some() {
+            0.0
+        } else {
             handed
                 .checked_sub(1)
-                .map_or(0.0, |i| crate::bound::receiver_std_m(&drive.gnss[i])),
-        );
+                .map_or(0.0, |i| crate::bound::receiver_std_m(&drive.gnss[i]))
+        });
         if let Some(mut w) = window_errors(
             drive,
             truth.as_ref(),
             &states,
             &wander,
-            &covs,
+            (&covs, &wander_covs),
             (fix_std_m, receiver),
             t0,
             start,
@@ -452,18 +479,20 @@ fn pose_block<const N: usize>(p: &SMatrix<f64, N, N>) -> [[f64; 3]; 3] {
 /// over the window `[start, end)`, against the truth or, without it, the GNSS
 /// fixes of the window (compared at the antenna, plus the receiver's wander
 /// the filter still expects, `wander[k]` at `states[k]`, when given: the
-/// fixes carry it). With `covs` (the pose covariance at each state) each
+/// fixes carry it). With `covs` (the pose covariance at each state, and
+/// the wander's part of it where the filter carries the wander) each
 /// error also gets the covariance the error bound is made of (the point
-/// compared, plus `receiver`: the declared accuracy of the last fix before
-/// the outage, [`crate::bound`]) and the reference's (a fix's is
-/// `fix_std_m` per axis). `None` when nothing compares.
+/// compared — against a fix, the antenna plus the wander —, plus
+/// `receiver`: the declared accuracy of the last fix before the outage,
+/// [`crate::bound`]) and the reference's (a fix's is `fix_std_m` per
+/// axis). `None` when nothing compares.
 #[allow(clippy::too_many_arguments)]
 fn window_errors(
     drive: &Drive,
     truth: Option<&Reference>,
     states: &[(f64, State)],
     wander: &[[f64; 2]],
-    covs: &[[[f64; 3]; 3]],
+    (covs, wander_covs): (&[[[f64; 3]; 3]], &[WanderCov]),
     (fix_std_m, receiver): (f64, Cov2),
     t0: f64,
     start: f64,
@@ -474,6 +503,12 @@ fn window_errors(
     let covs: Vec<[[f64; 3]; 3]> = states
         .iter()
         .zip(covs)
+        .filter(|(s, _)| inside(s))
+        .map(|(_, c)| *c)
+        .collect();
+    let wander_covs: Vec<WanderCov> = states
+        .iter()
+        .zip(wander_covs)
         .filter(|(s, _)| inside(s))
         .map(|(_, c)| *c)
         .collect();
@@ -527,7 +562,11 @@ fn window_errors(
                     // The covariance of the last epoch at or before the fix.
                     let k = states.partition_point(|s| s.0 <= g.t_s).saturating_sub(1);
                     if let Some(c) = covs.get(k) {
-                        cov_at.push(Cov2::ahead(c, x[YAW], lever));
+                        let antenna = Cov2::ahead(c, x[YAW], lever);
+                        cov_at.push(match wander_covs.get(k) {
+                            Some(w) => w.fix_cov(antenna, x[YAW], lever),
+                            None => antenna,
+                        });
                         floor_at.push(receiver);
                         reference_at.push(Cov2::circular(fix_std_m));
                     }
@@ -611,31 +650,35 @@ fn through_windows_in(
         record_epochs: false,
         ..base.clone()
     };
-    let mut hook = Collect(Vec::new());
-    // The gyro bias walks where the vehicle says so, as in `run`'s tracks
-    // and `stream` (the receiver's wander is carried by `evaluate` only).
-    let stats = if crate::gyro_drift::carries_bias(&drive.vehicle.noise) {
-        ekf::run_filter(
-            drive,
-            ekf::fixed_filter::<CarBiasLayout, N_BIAS>(drive, params, &opts)?,
-            &opts,
-            &mut hook,
-        )?
-        .stats
-    } else {
-        ekf::run(drive, params, &opts, &mut hook)?.stats
+    // The gyro bias walks and the receiver's wander is carried where the
+    // vehicle says so, as in `evaluate`, `run`'s tracks and `stream`.
+    let n = &drive.vehicle.noise;
+    let (stats, hook) = match (
+        n.gnss_wander_std_m > 0.0,
+        crate::gyro_drift::carries_bias(n),
+    ) {
+        (false, false) => collect::<CarLayout, 5>(drive, params, &opts)?,
+        (true, false) => collect::<CarWanderLayout, N_WANDER>(drive, params, &opts)?,
+        (false, true) => collect::<CarBiasLayout, N_BIAS>(drive, params, &opts)?,
+        (true, true) => collect::<CarWanderBiasLayout, N_WANDER_BIAS>(drive, params, &opts)?,
     };
     let mut out = Vec::new();
     for &(a, b) in windows {
         // Dead reckoning starts at the last epoch before the window.
-        let i = hook.0.partition_point(|s| s.0 < a);
-        let t0 = hook.0.get(i.saturating_sub(1)).map(|s| s.0).unwrap_or(a);
+        let i = hook.states.partition_point(|s| s.0 < a);
+        let t0 = hook
+            .states
+            .get(i.saturating_sub(1))
+            .map(|s| s.0)
+            .unwrap_or(a);
+        // Against hidden fixes, the antenna plus the wander the filter
+        // still expects: the fixes carry it (as `evaluate` compares).
         if let Some(w) = window_errors(
             drive,
             truth.as_ref(),
-            &hook.0,
-            &[],
-            &[],
+            &hook.states,
+            &hook.wander,
+            (&[], &[]),
             (0.0, Cov2::circular(0.0)),
             t0,
             a,
@@ -652,6 +695,24 @@ fn through_windows_in(
         unsettled: Vec::new(),
         heading_limit_rad: f64::INFINITY,
     })
+}
+
+/// The filter of layout `L` run over `drive` with `opts`, collecting every
+/// epoch's car state and wander: its counters and what was collected.
+fn collect<L: Layout<N>, const N: usize>(
+    drive: &Drive,
+    params: &Params,
+    opts: &FilterOptions,
+) -> Result<(ekf::FilterStats, Collect), Error> {
+    let mut hook = Collect::of::<L, N>();
+    let stats = ekf::run_filter(
+        drive,
+        ekf::fixed_filter::<L, N>(drive, params, opts)?,
+        opts,
+        &mut hook,
+    )?
+    .stats;
+    Ok((stats, hook))
 }
 
 #[cfg(test)]

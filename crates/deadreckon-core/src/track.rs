@@ -4,7 +4,8 @@
 
 use crate::ekf::{self, FilterOptions, Init, SensorSet};
 use crate::filter::{CarLayout, Layout};
-use crate::gyro_drift::{CarBiasLayout, N_BIAS};
+use crate::gnss_error::{CarWanderLayout, N_WANDER};
+use crate::gyro_drift::{CarBiasLayout, CarWanderBiasLayout, N_BIAS, N_WANDER_BIAS};
 use crate::model::{Mat, State};
 use crate::vehicle::Origin;
 use crate::{rts, Drive, Error, Need, Params};
@@ -196,10 +197,17 @@ pub fn drive_tracks(
     let mut out = Vec::new();
     let mut smoothed_start = None;
     if drive.gnss.len() >= 2 {
-        let (filtered, smoothed, start) = if crate::gyro_drift::carries_bias(&drive.vehicle.noise) {
-            aided_tracks::<CarBiasLayout, N_BIAS>(drive, params, opts)?
-        } else {
-            aided_tracks::<CarLayout, 5>(drive, params, opts)?
+        let n = &drive.vehicle.noise;
+        let (filtered, smoothed, start) = match (
+            n.gnss_wander_std_m > 0.0,
+            crate::gyro_drift::carries_bias(n),
+        ) {
+            (false, false) => aided_tracks::<CarLayout, 5>(drive, params, opts)?,
+            (false, true) => aided_tracks::<CarBiasLayout, N_BIAS>(drive, params, opts)?,
+            (true, false) => aided_tracks::<CarWanderLayout, N_WANDER>(drive, params, opts)?,
+            (true, true) => {
+                aided_tracks::<CarWanderBiasLayout, N_WANDER_BIAS>(drive, params, opts)?
+            }
         };
         smoothed_start = start;
         out.push(filtered);
@@ -211,7 +219,8 @@ pub fn drive_tracks(
 }
 
 /// The filtered and smoothed tracks of the GNSS-aided filter of layout `L`
-/// (a walking gyro bias: [`crate::gyro_drift`]), and the smoothed start's
+/// (a walking gyro bias: [`crate::gyro_drift`]; the receiver's wander:
+/// [`crate::gnss_error`], smoothed with its `φ`), and the smoothed start's
 /// car state.
 #[allow(clippy::type_complexity)]
 fn aided_tracks<L: Layout<N>, const N: usize>(
@@ -229,7 +238,14 @@ fn aided_tracks<L: Layout<N>, const N: usize>(
         &opts,
         &mut (),
     )?;
-    let s = rts::smooth(&f.epochs)?;
+    let wander = L::wander_index().map(|index| rts::WanderStates {
+        index,
+        wander: crate::gnss_error::Wander {
+            std_m: drive.vehicle.noise.gnss_wander_std_m,
+            tau_s: drive.vehicle.noise.gnss_wander_tau_s,
+        },
+    });
+    let s = rts::smooth_carrying(&f.epochs, wander)?;
     let start = s.first().map(|s| {
         (
             s.t_s,
