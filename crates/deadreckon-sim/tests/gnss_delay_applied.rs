@@ -18,6 +18,8 @@
 //! (`APPLIED_SEEDS=a..=b` for other members; 1–8 by default: the
 //! development members. 201–208 held out.)
 
+use rayon::prelude::*;
+
 use deadreckon_core::calibrate::{self, CalibrationOptions};
 use deadreckon_core::ekf::FilterOptions;
 use deadreckon_core::outage::evaluate;
@@ -26,7 +28,6 @@ use deadreckon_sim::family::CarFamily;
 use deadreckon_sim::simulate;
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64;
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// The true latency of member `seed` (as `gnss_delay_family.rs`).
 fn latency_of(seed: u64) -> f64 {
@@ -109,24 +110,8 @@ fn which_gnss_delay_the_paper_step_should_apply() {
         .iter()
         .flat_map(|&s| [25.0, 100.0].map(|r| (s, r)))
         .collect();
-    let next = AtomicUsize::new(0);
-    let mut rows: Vec<Row> = std::thread::scope(|scope| {
-        let workers: Vec<_> = (0..2)
-            .map(|_| {
-                scope.spawn(|| {
-                    let mut out = Vec::new();
-                    while let Some(&(s, r)) = jobs.get(next.fetch_add(1, Ordering::Relaxed)) {
-                        out.push(member(s, r));
-                    }
-                    out
-                })
-            })
-            .collect();
-        workers
-            .into_iter()
-            .flat_map(|w| w.join().unwrap())
-            .collect()
-    });
+    // Rows as rayon's pool runs them, sorted below.
+    let mut rows: Vec<Row> = jobs.par_iter().map(|&(s, r)| member(s, r)).collect();
     rows.sort_by_key(|r| (r.seed, r.rate_hz as u64));
     eprintln!(
         "member wheels  latency   estimate  std      z    offset   | none    d       d+off   truth (m)"

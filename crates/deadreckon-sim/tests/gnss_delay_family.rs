@@ -25,6 +25,8 @@
 //! cargo test --profile ci -p deadreckon-sim --test gnss_delay_family -- --include-ignored --nocapture
 //! ```
 
+use rayon::prelude::*;
+
 use deadreckon_core::calibrate::CalibrationOptions;
 use deadreckon_core::ekf::{FilterOptions, WheelRows};
 use deadreckon_core::timing::{self, DelayOptions};
@@ -32,7 +34,6 @@ use deadreckon_sim::family::CarFamily;
 use deadreckon_sim::simulate;
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64;
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// The calibration's options: the default (the paper's step,
 /// [`WheelRows::Instant`]); `DELAY_ROWS=interval` for each row used over its
@@ -120,24 +121,8 @@ fn estimate_all(seeds: &[u64]) -> Vec<Row> {
         .iter()
         .flat_map(|&s| RATES_HZ.map(|r| (s, r)))
         .collect();
-    let next = AtomicUsize::new(0);
-    let mut rows: Vec<Row> = std::thread::scope(|scope| {
-        let workers: Vec<_> = (0..2)
-            .map(|_| {
-                scope.spawn(|| {
-                    let mut out = Vec::new();
-                    while let Some(&(s, r)) = jobs.get(next.fetch_add(1, Ordering::Relaxed)) {
-                        out.push(estimate(s, r));
-                    }
-                    out
-                })
-            })
-            .collect();
-        workers
-            .into_iter()
-            .flat_map(|w| w.join().unwrap())
-            .collect()
-    });
+    // Rows as rayon's pool runs them, sorted below.
+    let mut rows: Vec<Row> = jobs.par_iter().map(|&(s, r)| estimate(s, r)).collect();
     rows.sort_by_key(|r| (r.seed, r.rate_hz as u64));
     rows
 }
