@@ -409,16 +409,20 @@ fn comma2k19_held_out_halves() {
         (bound[0].2 - 2.92).abs() < 0.2 && (bound[1].2 - 4.69).abs() < 0.3,
         "{bound:?}"
     );
-    // Measured: first half -> second 0.773 / 0.807 m (mean / median, 4
-    // windows), second -> first 0.593 / 0.511 m (3 windows, the pull-away
-    // reported apart): the README's figures. Within about 10 %.
-    let within = |x: f64, m: f64| (x - m).abs() < 0.1 * m;
+    // Measured: first half -> second 0.811 / 0.837 m (mean / median, 4
+    // windows), second -> first 0.623 / 0.537 m (3 windows, the pull-away
+    // reported apart), at stop 34 after the receiver's GNSS delay and the
+    // wander option (both unchanged by them). They were 0.773 / 0.807 and
+    // 0.593 / 0.511 m when first pinned (stop 30) and drifted by 4-5 %
+    // inside the old 10 % band over stops 31-33, cause not found (not the
+    // GNSS delay's settled steps). Within 5 % now.
+    let within = |x: f64, m: f64| (x - m).abs() < 0.05 * m;
     assert!(
-        within(got[0].0, 0.773) && within(got[0].1, 0.807),
+        within(got[0].0, 0.811) && within(got[0].1, 0.837),
         "{got:?}"
     );
     assert!(
-        within(got[1].0, 0.593) && within(got[1].1, 0.511),
+        within(got[1].0, 0.623) && within(got[1].1, 0.537),
         "{got:?}"
     );
 }
