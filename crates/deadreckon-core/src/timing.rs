@@ -17,7 +17,8 @@
 //! - **GNSS** ([`gnss_delay`]): a parameter of the least squares between the
 //!   fixes and the dead-reckoned track. The drive is calibrated (RTS) with
 //!   the fixes moved back by the current delay, dead-reckoned from the
-//!   smoothed start (wheels and gyro only), and the fixes' residuals against
+//!   smoothed start (every proprioceptive sensor: wheels, gyro, CAN speed and
+//!   steering; `SensorSet::dead_reckoning`), and the fixes' residuals against
 //!   the antenna's dead-reckoned position are regressed on its velocity, with
 //!   a bias, a rotation and a stretch per 20 s window for the dead
 //!   reckoning's drift (`r = −δ·V + b + θ·J(p − p_c) + λ(p − p_c)`), until
