@@ -18,6 +18,8 @@
 //! (`APPLIED_SEEDS=a..=b` for other members; 1–8 by default: the
 //! development members. 201–208 held out.)
 
+mod common;
+
 use rayon::prelude::*;
 
 use deadreckon_core::calibrate::{self, CalibrationOptions};
@@ -26,17 +28,6 @@ use deadreckon_core::outage::evaluate;
 use deadreckon_core::timing::{self, DelayOptions};
 use deadreckon_sim::family::CarFamily;
 use deadreckon_sim::simulate;
-use rand::{RngExt, SeedableRng};
-use rand_pcg::Pcg64;
-
-/// The true latency of member `seed` (as `gnss_delay_family.rs`).
-fn latency_of(seed: u64) -> f64 {
-    if seed.is_multiple_of(2) {
-        0.0
-    } else {
-        Pcg64::seed_from_u64(0x6e55_0000 + seed).random_range(0.05..0.2)
-    }
-}
 
 /// What each applied delay gave one member at one rate: the estimate and its
 /// standard error, s, the step offset, s, and the mean final outage error,
@@ -54,7 +45,7 @@ struct Row {
 }
 
 fn member(seed: u64, rate_hz: f64) -> Row {
-    let latency_s = latency_of(seed);
+    let latency_s = common::gnss_latency_of(seed);
     let mut car = CarFamily::draw(seed);
     car.edge_jitter_m *= car.wheel_rate_hz / rate_hz;
     car.wheel_rate_hz = rate_hz;

@@ -25,6 +25,8 @@
 //! cargo test --profile ci -p deadreckon-sim --test gnss_delay_family -- --include-ignored --nocapture
 //! ```
 
+mod common;
+
 use rayon::prelude::*;
 
 use deadreckon_core::calibrate::CalibrationOptions;
@@ -32,8 +34,6 @@ use deadreckon_core::ekf::{FilterOptions, WheelRows};
 use deadreckon_core::timing::{self, DelayOptions};
 use deadreckon_sim::family::CarFamily;
 use deadreckon_sim::simulate;
-use rand::{RngExt, SeedableRng};
-use rand_pcg::Pcg64;
 
 /// The calibration's options: the default (the paper's step,
 /// [`WheelRows::Instant`]); `DELAY_ROWS=interval` for each row used over its
@@ -79,18 +79,9 @@ impl Row {
     }
 }
 
-/// The true latency of member `seed`: 0 for even members, 0.05–0.2 s for odd.
-fn latency_of(seed: u64) -> f64 {
-    if seed.is_multiple_of(2) {
-        0.0
-    } else {
-        Pcg64::seed_from_u64(0x6e55_0000 + seed).random_range(0.05..0.2)
-    }
-}
-
 /// Member `seed`'s drive with its wheels at `rate_hz` and the delay estimated.
 fn estimate(seed: u64, rate_hz: f64) -> Row {
-    let latency_s = latency_of(seed);
+    let latency_s = common::gnss_latency_of(seed);
     let mut car = CarFamily::draw(seed);
     car.edge_jitter_m *= car.wheel_rate_hz / rate_hz;
     car.wheel_rate_hz = rate_hz;

@@ -99,3 +99,15 @@ pub fn std(x: &[f64]) -> f64 {
     let m = x.iter().sum::<f64>() / n;
     (x.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
 }
+
+/// The true GNSS latency of the car family's member `seed` in the GNSS
+/// delay's tests (`gnss_delay_family.rs`, `gnss_delay_applied.rs`): 0 for
+/// even members, 0.05–0.2 s for odd.
+pub fn gnss_latency_of(seed: u64) -> f64 {
+    use rand::{RngExt, SeedableRng};
+    if seed.is_multiple_of(2) {
+        0.0
+    } else {
+        rand_pcg::Pcg64::seed_from_u64(0x6e55_0000 + seed).random_range(0.05..0.2)
+    }
+}
