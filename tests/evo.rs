@@ -5,7 +5,7 @@
 //!
 //! These tests need evo, so they are `#[ignore]`d in the plain test run and
 //! run by `.ci/run`, which installs evo 1.38.1 in a virtual environment and
-//! runs `cargo test --profile ci --test evo -- --ignored` with
+//! runs `cargo test --workspace --profile ci --test evo -- --ignored` with
 //! `DEADRECKON_EVO_BIN` set to the environment's `bin` directory. Run them
 //! the same way by hand; without the variable they fail, saying so.
 

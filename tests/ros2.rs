@@ -8,8 +8,8 @@
 //! with multicast on), so no packet leaves the machine. These tests need the
 //! peer's Python environment and root for `unshare`, so they are `#[ignore]`d
 //! in the plain test run and run by `.ci/ros2` (called from `.ci/run`), which
-//! builds the environment and runs `cargo test --profile ci --test ros2 --
-//! --ignored` with `DEADRECKON_ROS2_PYTHON` set to its `python`. Without the
+//! builds the environment and runs `cargo test --workspace --profile ci --test ros2
+//! -- --ignored` with `DEADRECKON_ROS2_PYTHON` set to its `python`. Without the
 //! variable they fail, saying so.
 
 mod common;
