@@ -61,7 +61,7 @@ pub struct Imported {
 pub fn import(format: ImportFormat, source: &Path, o: &ImportOptions) -> Result<Imported, Error> {
     let err = |source_err: deadreckon_import::ImportError| Error::Import {
         path: source.to_path_buf(),
-        source: source_err,
+        source: Box::new(source_err),
     };
     Ok(match format {
         ImportFormat::Comma2k19 => {

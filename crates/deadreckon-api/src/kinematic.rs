@@ -87,7 +87,7 @@ pub fn load_tricycle_from(
             deadreckon_import::tricycle::read_tricycle_kinematic(path, &o).map_err(|source| {
                 Error::Tricycle {
                     path: path.to_path_buf(),
-                    source,
+                    source: Box::new(source),
                 }
             })?
         }
@@ -135,7 +135,7 @@ impl TricycleFile {
             deadreckon_import::tricycle::read_tricycle_kinematic(log, &o).map_err(|source| {
                 Error::Tricycle {
                     path: log.to_path_buf(),
-                    source,
+                    source: Box::new(source),
                 }
             })?;
         Ok(TricycleFile {

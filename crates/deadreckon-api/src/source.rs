@@ -69,7 +69,7 @@ pub fn read_drive_with(
         SourceKind::Comma2k19 => {
             deadreckon_import::read_comma2k19(path, None).map_err(|source| Error::Comma2k19 {
                 path: path.to_path_buf(),
-                source,
+                source: Box::new(source),
             })
         }
         // A rosbag2 directory: read through its one .mcap file.
@@ -79,7 +79,7 @@ pub fn read_drive_with(
             Ok(deadreckon_import::tricycle::read_tricycle(path, &o)
                 .map_err(|source| Error::Tricycle {
                     path: path.to_path_buf(),
-                    source,
+                    source: Box::new(source),
                 })?
                 .drive)
         }
@@ -89,7 +89,7 @@ pub fn read_drive_with(
         SourceKind::DriveDirectory => {
             deadreckon_io::read_drive_with(path, options).map_err(|source| Error::Drive {
                 path: path.to_path_buf(),
-                source,
+                source: Box::new(source),
             })
         }
     }
@@ -114,7 +114,7 @@ pub fn read_ros_saying(
 ) -> Result<(Drive, deadreckon_ros::ImportReport, String), Error> {
     let ros_err = |source| Error::Ros {
         path: path.to_path_buf(),
-        source,
+        source: Box::new(source),
     };
     // Read once: the topics choose the built-in mapping, then the same bytes
     // are read with it.
@@ -174,7 +174,7 @@ pub fn mapping_file(m: &Path) -> Result<deadreckon_ros::Mapping, Error> {
     })?;
     deadreckon_ros::Mapping::from_toml_str(&text).map_err(|source| Error::Mapping {
         path: m.to_path_buf(),
-        source,
+        source: Box::new(source),
     })
 }
 
