@@ -105,7 +105,7 @@ fn run_applied_the_parameters_without_the_corrections_they_were_calibrated_with(
 /// where `calibrate` estimates and applies them first.
 #[test]
 fn the_report_ignored_the_corrections_of_its_params_and_estimated_none() {
-    use deadreckon_api::report::{corrected, ReportOptions};
+    use deadreckon_api::report::{corrected, given_file, ReportOptions};
     use deadreckon_core::timing::Which;
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path().join("drive");
@@ -140,8 +140,12 @@ fn the_report_ignored_the_corrections_of_its_params_and_estimated_none() {
 
     // --params with stored corrections: those are applied, none estimated.
     let ps = p.to_str().unwrap();
-    let (with_stored, rows) =
-        corrected(&drive, &options(&dir, Some(ps), Which::Gnss), &()).unwrap();
+    // `--params` read once, as `report` reads it (`given_file`).
+    let corrected = |o: &ReportOptions| {
+        let file = given_file(o).unwrap();
+        corrected(&drive, o, file.as_ref(), &()).unwrap()
+    };
+    let (with_stored, rows) = corrected(&options(&dir, Some(ps), Which::Gnss));
     let rows = rows.expect("stored corrections shown");
     assert_eq!(rows.source, format!("read from {ps}"));
     let stored = deadreckon_api::corrections::stored_in_file(&p).unwrap();
@@ -162,7 +166,7 @@ fn the_report_ignored_the_corrections_of_its_params_and_estimated_none() {
     );
 
     // No --params: estimated on the drive, the tilt with its standard error.
-    let (_, rows) = corrected(&drive, &options(&dir, None, Which::Gnss), &()).unwrap();
+    let (_, rows) = corrected(&options(&dir, None, Which::Gnss));
     let rows = rows.expect("estimated corrections shown");
     assert!(
         rows.source.contains("estimated on this drive"),
@@ -176,8 +180,7 @@ fn the_report_ignored_the_corrections_of_its_params_and_estimated_none() {
         "{v} ± {s} vs {truth:.2}°"
     );
     // --corrections none with nominal parameters: nothing applied or shown.
-    let (same, rows) =
-        corrected(&drive, &options(&dir, Some("nominal"), Which::None), &()).unwrap();
+    let (same, rows) = corrected(&options(&dir, Some("nominal"), Which::None));
     assert!(rows.is_none());
     assert_eq!(same.yaw_rate, drive.yaw_rate);
 }

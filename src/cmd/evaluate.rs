@@ -48,7 +48,7 @@ pub fn run(a: EvaluateArgs, load: &common::Loader) -> Result<()> {
     } else if !a.json {
         outln!(
             "parameters: {}",
-            deadreckon_api::report_labels::given_line(&chosen.source)
+            deadreckon_api::report_labels::given_line(&chosen.source, chosen.file_corrected)
         );
     }
     let mut ev = evaluate::measure(&drive, chosen, a.timing.into(), a.metric())?;

@@ -48,6 +48,9 @@ pub struct Parameters {
     /// The 95 % error bound's factor: the file's `[bound]`, or fitted on
     /// the drive itself with the parameters calibrated on it (in-sample).
     pub bound: deadreckon_core::bound::BoundFit,
+    /// The given file stores corrections, applied to the streams with its
+    /// parameters ([`crate::report_labels::given_line`] says so).
+    pub file_corrected: bool,
 }
 
 /// The one function every command calls for its parameters ([`RULE`]):
@@ -79,6 +82,7 @@ pub fn default_parameters(drive: &Drive, which: Which) -> Result<(Parameters, Dr
                 source: "nominal (no GNSS fix to calibrate on)".into(),
                 note: None,
                 bound: deadreckon_core::bound::BoundFit::FILTER,
+                file_corrected: false,
             },
             drive.clone(),
         ));
@@ -94,6 +98,7 @@ pub fn default_parameters(drive: &Drive, which: Which) -> Result<(Parameters, Dr
             source: format!("{CALIBRATED_HERE}: rts ({} passes)", c.iterations),
             note: None,
             bound: car.bound,
+            file_corrected: false,
         },
         corrected.unwrap_or_else(|| drive.clone()),
     ))
@@ -174,6 +179,7 @@ pub fn given_parameters_bound(
             corrections: None,
             source: spec.to_string(),
             note,
+            file_corrected: file.as_ref().is_some_and(|f| !f.corrections.is_empty()),
             bound: file.map_or(deadreckon_core::bound::BoundFit::FILTER, |f| f.bound),
         },
         drive,

@@ -129,7 +129,7 @@ pub fn params_bound(
 
 /// The parameters of the params.toml `file` (read from `spec`) bound to
 /// the drive's vehicle ([`params_bound`]).
-fn bind(
+pub(crate) fn bind(
     spec: &str,
     file: &ParamsFile,
     drive: &Drive,

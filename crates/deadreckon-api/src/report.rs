@@ -19,6 +19,7 @@ use deadreckon_eval::Progress;
 use deadreckon_report as rp;
 
 use crate::error::While;
+use crate::params_file::ParamsFile;
 use crate::Error;
 
 /// What goes into a drive's report besides the drive.
@@ -43,20 +44,21 @@ pub struct ReportOptions<'a> {
 }
 
 /// The drive with the corrections every section uses applied, and their
-/// rows: those stored in `o.params`, or else those `o.corrections` asks to
-/// estimate (`None` when none are asked).
+/// rows: those stored in `file` (`o.params` read, [`given_file`]), or else
+/// those `o.corrections` asks to estimate (`None` when none are asked).
 pub fn corrected(
     drive: &Drive,
     o: &ReportOptions,
+    file: Option<&ParamsFile>,
     steps: &dyn Progress,
 ) -> Result<(Drive, Option<rp::Corrections>), Error> {
     use deadreckon_core::timing::Which;
-    if let Some(p) = o.params.filter(|p| *p != "nominal") {
-        let stored = crate::corrections::stored_in_file(Path::new(p)).map_err(Error::Invalid)?;
+    if let (Some(p), Some(file)) = (o.params, file) {
+        let stored = &file.corrections;
         if !stored.is_empty() {
             let c = rp::Corrections {
                 source: format!("{} {p}", crate::report_labels::READ_FROM),
-                rows: crate::corrections::stored_rows(&stored)
+                rows: crate::corrections::stored_rows(stored)
                     .into_iter()
                     .map(|r| rp::CorrectionRow {
                         status: format!("{} {p}, applied", crate::report_labels::READ_FROM),
@@ -84,6 +86,15 @@ pub fn corrected(
     Ok((d, Some(rows)))
 }
 
+/// `o.params` read and validated once, for its corrections and its
+/// parameters (`None` without it or for `nominal`).
+pub fn given_file(o: &ReportOptions) -> Result<Option<ParamsFile>, Error> {
+    o.params
+        .filter(|p| *p != "nominal")
+        .map(ParamsFile::read)
+        .transpose()
+}
+
 /// Builds the report of `drive` and writes it to `out`.
 pub fn write(
     drive: &Drive,
@@ -96,14 +107,19 @@ pub fn write(
     if found.shape != deadreckon_core::kinematics::Shape::FourWheel {
         return crate::report_kinematic::write(drive, &found, o, out, steps, footer);
     }
-    let (corrected, corrections) = corrected(drive, o, steps)?;
+    let file = given_file(o)?;
+    let (corrected, corrections) = corrected(drive, o, file.as_ref(), steps)?;
     let drive = &corrected;
     let mut methods = calibrations(drive, steps);
     if let Some(p) = o.params {
+        let params = match &file {
+            Some(f) => crate::load::bind(p, f, drive, false)?.0,
+            None => crate::load::params(p, drive)?,
+        };
         methods.sets.push(NamedParams {
             source: Source::Given,
             params: ParamsWithStd {
-                params: crate::load::params(p, drive)?,
+                params,
                 std: Params::from_array([0.0; 6]),
             },
             calibration: None,

@@ -31,13 +31,12 @@ pub fn label(method: &str, params: Option<&str>, corrected: Option<&str>) -> Str
 
 /// `evaluate`'s line for parameters given with `--params` (`nominal` or a
 /// params.toml), in the report's words: where the values come from and,
-/// when the file stores corrections (applied to the streams), that too.
-pub fn given_line(spec: &str) -> String {
+/// when the file stores corrections (`stored`: applied to the streams,
+/// [`crate::evaluate::Parameters::file_corrected`]), that too.
+pub fn given_line(spec: &str, stored: bool) -> String {
     if spec == "nominal" {
         return label("nominal", None, None);
     }
-    let stored =
-        crate::corrections::stored_in_file(std::path::Path::new(spec)).is_ok_and(|s| !s.is_empty());
     let corrected = stored.then(|| format!("from {spec}"));
     label("given", Some(spec), corrected.as_deref())
 }
