@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use deadreckon_api::calibration::{CalibrationRequest, RequestWords};
 use deadreckon_api::json;
 use deadreckon_api::options::parse_timing;
+use deadreckon_api::params_file::ParamsFile;
 use deadreckon_core::calibrate::Method;
 use deadreckon_core::ekf::FilterOptions;
 use deadreckon_core::metrics;
@@ -24,17 +25,13 @@ fn corrections_which(s: &str) -> PyResult<deadreckon_core::timing::Which> {
     deadreckon_api::options::parse_corrections(s).map_err(to_py_err)
 }
 
-/// The drive with the corrections a params.toml `p` stores applied (none for
-/// `nominal`, a dict or a file without them), as the CLI's `--params`.
-fn with_stored(
-    p: Option<&Bound<'_, PyAny>>,
-    drive: deadreckon_core::Drive,
-) -> PyResult<deadreckon_core::Drive> {
-    let Some(spec) = p.and_then(|p| p.extract::<PathBuf>().ok()) else {
-        return Ok(drive);
-    };
-    let stored = deadreckon_api::corrections::stored_in_file(&spec).map_err(err)?;
-    Ok(stored.apply(&drive))
+/// The drive with the corrections the params.toml `file` stores applied
+/// (none without a file: `nominal` or a dict), as the CLI's `--params`.
+fn with_stored(file: Option<&ParamsFile>, drive: deadreckon_core::Drive) -> deadreckon_core::Drive {
+    match file {
+        Some(f) => f.corrections.apply(&drive),
+        None => drive,
+    }
 }
 
 fn err(e: impl std::fmt::Display) -> PyErr {
@@ -100,6 +97,15 @@ pub fn params_arg(
     p: &Bound<'_, PyAny>,
     vehicle: &deadreckon_core::Vehicle,
 ) -> PyResult<(Params, String)> {
+    params_file_arg(p, vehicle).map(|(params, label, _)| (params, label))
+}
+
+/// [`params_arg`] with the params.toml itself when `p` names one, read and
+/// checked once: its stored corrections and `[bound]` come from it too.
+fn params_file_arg(
+    p: &Bound<'_, PyAny>,
+    vehicle: &deadreckon_core::Vehicle,
+) -> PyResult<(Params, String, Option<ParamsFile>)> {
     if let Ok(d) = p.cast::<PyDict>() {
         let mut a = [0.0; 6];
         for (i, name) in Params::NAMES.iter().enumerate() {
@@ -112,21 +118,21 @@ pub fn params_arg(
         params
             .validate()
             .map_err(|e| err(format!("params: {}", deadreckon_api::chain_text(&e))))?;
-        return Ok((params, "given".into()));
+        return Ok((params, "given".into(), None));
     }
     let spec: PathBuf = p.extract()?;
     let label = spec.display().to_string();
     if label == "nominal" {
-        return Ok((Params::nominal(vehicle), label));
+        return Ok((Params::nominal(vehicle), label, None));
     }
     // Read and checked once (deadreckon_api::params_file), bound to their
     // vehicle as the command line's --params (deadreckon_api::binding):
     // another vehicle's file is refused.
-    let file = deadreckon_api::params_file::ParamsFile::read(&label).map_err(to_py_err)?;
+    let file = ParamsFile::read(&label).map_err(to_py_err)?;
     let params = file.estimate.params;
     deadreckon_api::binding::check(&label, file.vehicle(), &params, vehicle, false)
         .map_err(to_py_err)?;
-    Ok((params, label))
+    Ok((params, label, Some(file)))
 }
 
 /// Every track of a drive (dead-reckoned, filtered, smoothed, and truth),
@@ -150,14 +156,11 @@ pub fn run_tracks<'py>(
     // dict's: the filter's covariance alone), or fitted with the calibration.
     let (params, drive, bound) = match params {
         Some(p) => {
-            let params = params_arg(p, &drive.vehicle)?.0;
-            let bound = match p.extract::<PathBuf>() {
-                Ok(f) if p.cast::<PyDict>().is_err() => {
-                    deadreckon_api::bound::stored_bound(&f.to_string_lossy()).map_err(to_py_err)?
-                }
-                _ => deadreckon_core::bound::BoundFit::FILTER,
-            };
-            (params, with_stored(Some(p), (*drive).clone())?, bound)
+            let (params, _, file) = params_file_arg(p, &drive.vehicle)?;
+            let bound = file
+                .as_ref()
+                .map_or(deadreckon_core::bound::BoundFit::FILTER, |f| f.bound);
+            (params, with_stored(file.as_ref(), (*drive).clone()), bound)
         }
         None => {
             let (c, d) = py
@@ -259,22 +262,19 @@ pub fn evaluate(
     }
     // One rule for every metric (deadreckon_api::evaluate::RULE), as the
     // command applies it.
-    let given = params.map(|p| params_arg(p, &drive.vehicle)).transpose()?;
-    let stored = with_stored(params, (*drive).clone())?;
-    // The error bound's factor, as the command takes it: the file's
-    // `[bound]`, or fitted with the calibration on the drive.
-    let spec: Option<String> = params.and_then(|p| p.extract().ok());
+    // The file read once: its parameters, its stored corrections and the
+    // error bound's factor, as the command takes it (its `[bound]`, or
+    // without a file fitted with the calibration on the drive).
+    let given = params
+        .map(|p| params_file_arg(p, &drive.vehicle))
+        .transpose()?;
     let (params, label, drive, corr, params_source, bound) = py.detach(|| -> PyResult<_> {
         Ok(match given {
-            Some((p, l)) => {
-                let bound = match spec.as_deref() {
-                    Some(f) if f != "nominal" => {
-                        deadreckon_api::params_file::ParamsFile::read(f)
-                            .map_err(to_py_err)?
-                            .bound
-                    }
-                    _ => deadreckon_core::bound::BoundFit::FILTER,
-                };
+            Some((p, l, file)) => {
+                let bound = file
+                    .as_ref()
+                    .map_or(deadreckon_core::bound::BoundFit::FILTER, |f| f.bound);
+                let stored = with_stored(file.as_ref(), (*drive).clone());
                 (p, l.clone(), stored, None, l, bound)
             }
             None => {

@@ -16,7 +16,6 @@ use deadreckon_core::outage::OutageEvaluation;
 use serde_json::{json, Value};
 
 use crate::params_tables::BoundTable;
-use crate::Error;
 
 /// The `[bound]` table of params.toml
 /// ([`crate::params_tables::BoundTable`], the one layout; the kinematic
@@ -38,16 +37,6 @@ pub fn bound_from_extra(extra: &toml::Table) -> Result<BoundFit, String> {
         .try_into()
         .map_err(|e: toml::de::Error| crate::params_file::toml_message("bound", &e))?;
     t.fit()
-}
-
-/// The bound stored in the params.toml `spec` (`nominal`: the filter's
-/// covariance alone), read as every `--params` is
-/// ([`crate::params_file::ParamsFile::read`]).
-pub fn stored_bound(spec: &str) -> Result<BoundFit, Error> {
-    if spec == "nominal" {
-        return Ok(BoundFit::FILTER);
-    }
-    Ok(crate::params_file::ParamsFile::read(spec)?.bound)
 }
 
 /// The bound's `--json` object.
