@@ -135,13 +135,7 @@ fn clock_parts() {
         .map(|&s| {
             let mut car = DynamicCar::draw(s);
             let c = &mut car.clocks;
-            for k in [
-                &mut c.wheels,
-                &mut c.gyro,
-                &mut c.speed,
-                &mut c.steering,
-                &mut c.gnss,
-            ] {
+            for k in c.each_mut() {
                 match variant.as_str() {
                     "nodrift" => k.drift_ppm = 0.0,
                     "nojitter" => k.jitter_std_s = 0.0,

@@ -141,6 +141,20 @@ pub struct Clocks {
     pub gnss: ClockSpec,
 }
 
+impl Clocks {
+    /// Every stream's clock, wheels first, to switch a part of them off
+    /// (an ablation of offsets, drifts or jitter).
+    pub fn each_mut(&mut self) -> [&mut ClockSpec; 5] {
+        [
+            &mut self.wheels,
+            &mut self.gyro,
+            &mut self.speed,
+            &mut self.steering,
+            &mut self.gnss,
+        ]
+    }
+}
+
 /// One car of the dynamic family: a [`CarFamily`] car and the magnitude of
 /// every effect, drawn from `seed`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
