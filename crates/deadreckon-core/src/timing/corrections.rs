@@ -26,10 +26,16 @@ pub fn estimate_with_params(
     copts: &CalibrationOptions,
     o: &DelayOptions,
 ) -> Result<(Delays, Option<Params>), Error> {
+    // The three scalar delays are independent: the gyro's (the longest)
+    // beside the CAN speed's and the steering's (rayon; the same numbers).
+    let (gyro, (speed, steering)) = rayon::join(
+        || gyro_delay(drive, o),
+        || (speed_delay(drive, o), steering_delay(drive, o)),
+    );
     let mut delays = Delays {
-        gyro: gyro_delay(drive, o),
-        speed: speed_delay(drive, o),
-        steering: steering_delay(drive, o),
+        gyro,
+        speed,
+        steering,
         gnss: Delay::not_estimated("not estimated"),
     };
     let true_time = on_true_time(&delays, drive);
