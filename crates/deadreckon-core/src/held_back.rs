@@ -346,7 +346,9 @@ pub fn prepare_calibrated(
         .collect();
     if judged.is_empty() {
         // Nothing to judge: no filter runs.
+        drop(base_drive);
     } else if short {
+        drop(base_drive);
         held.not_judged = Some(format!(
             "{} held-back windows of {:.0} s, at least {MIN_WINDOWS} needed: the drive is too short to judge a correction on its own GNSS, so each is applied on its significance",
             held.windows, held.window_s
@@ -368,6 +370,10 @@ pub fn prepare_calibrated(
         // most -MIN_T over the same windows); the others are tried again
         // with it in the next round.
         let mut current = held_back_errors(&base_drive, copts, [initial; 2], &windows, None)?;
+        // The baseline's drive is not read again (each candidate's drive is
+        // made from `drive`): one copy of the drive less while the
+        // candidates' folds run, the default's peak (issue 30).
+        drop(base_drive);
         held.without_m = mean(&current.errors);
         // A recovery that waits can change nothing where the filter never
         // recovered: then it is no candidate (and costs no run).
@@ -471,7 +477,6 @@ pub fn prepare_calibrated(
         held.judged.extend(tried);
         chosen.extend(won);
     }
-    drop(base_drive);
     mark(&mut corrections, &held, &chosen);
     let applied = known(&corrections, &chosen, &model_values);
     let out = applied.apply(drive);
