@@ -93,7 +93,15 @@ impl Command {
                 use deadreckon_api::evaluate;
                 let drive = load.drive(dir)?;
                 let epochs = drive.wheels.len();
-                let (chosen, drive) = evaluate::default_parameters(&drive, Which::default())?;
+                // As the command line: the drive handed over, so the drive
+                // as read is dropped once the corrected one exists (holding
+                // it put one more copy of the drive under `measure`'s peak).
+                let (chosen, drive) = evaluate::parameters(
+                    None,
+                    drive,
+                    Which::default(),
+                    load.params_for_other_vehicle,
+                )?;
                 let ev = evaluate::measure(
                     &drive,
                     chosen,

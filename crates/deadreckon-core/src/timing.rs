@@ -31,7 +31,10 @@
 //!   0.11 s.) The smoother absorbs
 //!   part of a wrong delay, so one step under-corrects (`δ ≈ (1 − α)(d* − d)`):
 //!   after a first plain step the delay moves by secant steps on `δ(d) = 0`,
-//!   and the standard error of `δ` is divided by the slope `1 − α`.
+//!   and the standard error of `δ` is divided by the slope `1 − α`. Each
+//!   step's calibration starts from the previous step's parameters (a warm
+//!   start: the same fixed point within the calibration's tolerance, in
+//!   fewer passes; issue 30).
 //!
 //! **Status**: a delay is *not estimated* (and not applied) with too few
 //! samples, when the best lag lies on the search bound ([`DelayOptions::max_delay_s`]:

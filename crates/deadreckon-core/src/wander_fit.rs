@@ -22,6 +22,7 @@ use crate::filter::{CarLayout, Filter, Layout, SensorKind};
 use crate::gnss_error::{CarWanderLayout, Wander, N_WANDER};
 use crate::vehicle::{Params, Vehicle};
 use crate::{Error, Input, Task};
+use rayon::prelude::*;
 
 /// The wander standard deviations tried, m per axis.
 pub const STD_GRID_M: [f64; 5] = [0.25, 0.5, 1.0, 1.5, 2.0];
@@ -57,30 +58,31 @@ pub fn fit(drive: &Drive, params: &Params, opts: &FilterOptions) -> Result<Wande
         record_innovations: false,
         ..opts.clone()
     };
-    let mut candidates = vec![likelihood::<CarLayout, 5>(
-        drive,
-        &drive.vehicle,
-        params,
-        None,
-        &opts,
-        None,
-    )?];
-    for tau_s in TAU_GRID_S {
-        for std_m in STD_GRID_M {
-            let w = Wander { std_m, tau_s };
-            let mut v = drive.vehicle.clone();
-            v.noise.gnss_wander_std_m = std_m;
-            v.noise.gnss_wander_tau_s = tau_s;
-            candidates.push(likelihood::<CarWanderLayout, N_WANDER>(
-                drive,
-                &v,
-                params,
-                None,
-                &opts,
-                Some(w),
-            )?);
-        }
-    }
+    // White fixes first, then the grid, τ by τ: each candidate its own
+    // filter run, independent of the others, so they run in parallel
+    // (rayon) and are collected in this order (the same numbers as one
+    // after the other).
+    let grid: Vec<Option<Wander>> = std::iter::once(None)
+        .chain(TAU_GRID_S.iter().flat_map(|&tau_s| {
+            STD_GRID_M
+                .iter()
+                .map(move |&std_m| Some(Wander { std_m, tau_s }))
+        }))
+        .collect();
+    let candidates = grid
+        .into_par_iter()
+        .map(|w| match w {
+            None => likelihood::<CarLayout, 5>(drive, &drive.vehicle, params, None, &opts, None),
+            Some(w) => {
+                let mut v = drive.vehicle.clone();
+                v.noise.gnss_wander_std_m = w.std_m;
+                v.noise.gnss_wander_tau_s = w.tau_s;
+                likelihood::<CarWanderLayout, N_WANDER>(drive, &v, params, None, &opts, Some(w))
+            }
+        })
+        .collect::<Vec<_>>()
+        .into_iter()
+        .collect::<Result<Vec<Candidate>, Error>>()?;
     if candidates[0].fixes == 0 {
         return Err(Error::needs(Task::WanderFit, Input::GnssFixAfterStart));
     }
