@@ -22,6 +22,7 @@
 //! - Every sample carries its own timestamp `t_s` (s); `dt` is derived.
 #![deny(missing_docs)]
 
+pub mod aided;
 pub mod angle;
 pub mod bound;
 pub mod bound_diff;
