@@ -10,6 +10,10 @@
 //! | a gyro bias walk or drive std > 0 ([`crate::gyro_drift::carries_bias`]) | the gyro bias as a state |
 //! | both | the wander and the gyro bias |
 //!
+//! With the bias as a state and `[noise] gyro_bias_switch_llr` above 0, the
+//! constant bias and the bias as a state run side by side and the drive's
+//! own fixes choose between them ([`switch`]: the gyro-bias switch).
+//!
 //! An epoch hands out an [`AidedEpoch`]: the car's block of the state and
 //! covariance, and the receiver's wander where carried, whatever the layout.
 
@@ -25,6 +29,11 @@ use crate::gyro_drift::{CarBiasLayout, CarWanderBiasLayout, N_BIAS, N_WANDER_BIA
 use crate::model::{Mat, State};
 use crate::vehicle::{Noise, Params, Vehicle};
 use crate::Error;
+
+pub mod switch;
+
+pub use switch::BiasSwitch;
+use switch::Switch;
 
 /// What one epoch of the aided filter hands out, of any layout.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -85,7 +94,7 @@ impl<L: Layout<N>, const N: usize> Run<L, N> {
     }
 
     /// Feeds one event; `epoch` after every epoch it completes.
-    fn push(
+    fn push_raw(
         &mut self,
         ev: Event,
         epoch: &mut dyn FnMut(&Filter<L, N>, &EpochOut<'_, N>),
@@ -98,7 +107,7 @@ impl<L: Layout<N>, const N: usize> Run<L, N> {
     }
 
     /// Runs what is waiting.
-    fn finish(
+    fn finish_raw(
         &mut self,
         epoch: &mut dyn FnMut(&Filter<L, N>, &EpochOut<'_, N>),
     ) -> Result<(), Error> {
@@ -107,6 +116,34 @@ impl<L: Layout<N>, const N: usize> Run<L, N> {
             record(epochs, f, &e);
             epoch(f, &e)
         })
+    }
+
+    fn push(&mut self, ev: Event, epoch: &mut dyn FnMut(&AidedEpoch)) -> Result<(), Error> {
+        self.push_raw(ev, &mut |f, _| epoch(&AidedEpoch::of(f)))
+    }
+
+    fn finish(&mut self, epoch: &mut dyn FnMut(&AidedEpoch)) -> Result<(), Error> {
+        self.finish_raw(&mut |f, _| epoch(&AidedEpoch::of(f)))
+    }
+
+    fn dead_reckon(&mut self) {
+        self.feeder.dead_reckon()
+    }
+
+    fn time_s(&self) -> f64 {
+        self.filter.time_s()
+    }
+
+    fn now(&self) -> Option<AidedEpoch> {
+        Some(AidedEpoch::of(&self.filter))
+    }
+
+    fn gates(&self) -> GateCounts {
+        *self.filter.gates()
+    }
+
+    fn stats(&self) -> FilterStats {
+        self.feeder.stats_with(&self.filter)
     }
 
     /// The RTS-smoothed car blocks of the recorded epochs (none unless
@@ -164,6 +201,11 @@ pub enum Aided {
     /// The receiver's wander and the gyro bias.
     #[serde(rename = "WanderWalking")]
     WanderBias(Box<Run<CarWanderBiasLayout, N_WANDER_BIAS>>),
+    /// The constant bias and the bias as a state, switched by the fixes
+    /// ([`switch`]).
+    Switched(Box<Switch<CarLayout, { crate::model::N }, CarBiasLayout, N_BIAS>>),
+    /// The same with the receiver's wander in both.
+    WanderSwitched(Box<Switch<CarWanderLayout, N_WANDER, CarWanderBiasLayout, N_WANDER_BIAS>>),
 }
 
 /// `$body` with `$run` bound to the [`Run`] of whichever layout.
@@ -174,6 +216,8 @@ macro_rules! each {
             Aided::Bias($run) => $body,
             Aided::Wander($run) => $body,
             Aided::WanderBias($run) => $body,
+            Aided::Switched($run) => $body,
+            Aided::WanderSwitched($run) => $body,
         }
     };
 }
@@ -190,6 +234,26 @@ impl Aided {
         start: (f64, State, Mat),
     ) -> Result<Self, Error> {
         let n = &vehicle.noise;
+        if crate::gyro_drift::carries_bias(n) && n.gyro_bias_switch_llr > 0.0 {
+            // The constant hypothesis: the same vehicle with the paper's bias.
+            let mut constant = vehicle.clone();
+            constant.noise.gyro_bias_walk_rps_per_sqrt_s = 0.0;
+            constant.noise.gyro_bias_drive_std_rps = 0.0;
+            let threshold = n.gyro_bias_switch_llr;
+            return Ok(if carries_wander(n) {
+                Aided::WanderSwitched(Box::new(Switch::new(
+                    Run::start(&constant, params, opts, start)?,
+                    Run::start(vehicle, params, opts, start)?,
+                    threshold,
+                )))
+            } else {
+                Aided::Switched(Box::new(Switch::new(
+                    Run::start(&constant, params, opts, start)?,
+                    Run::start(vehicle, params, opts, start)?,
+                    threshold,
+                )))
+            });
+        }
         Ok(
             match (carries_wander(n), crate::gyro_drift::carries_bias(n)) {
                 (false, false) => Aided::Car(Box::new(Run::start(vehicle, params, opts, start)?)),
@@ -235,47 +299,62 @@ impl Aided {
     /// Takes one event (timestamps must not decrease); `epoch` after every
     /// epoch it completes.
     pub fn push(&mut self, ev: Event, epoch: &mut dyn FnMut(&AidedEpoch)) -> Result<(), Error> {
-        each!(self, |r| r.push(ev, &mut |f, _| epoch(&AidedEpoch::of(f))))
+        each!(self, |r| r.push(ev, epoch))
     }
 
     /// Runs what is still waiting (at the end of a stream, or before a
     /// clone dead-reckons).
     pub fn finish(&mut self, epoch: &mut dyn FnMut(&AidedEpoch)) -> Result<(), Error> {
-        each!(self, |r| r.finish(&mut |f, _| epoch(&AidedEpoch::of(f))))
+        each!(self, |r| r.finish(epoch))
     }
 
     /// From now on no GNSS ([`Feeder::dead_reckon`]).
     pub fn dead_reckon(&mut self) {
-        each!(self, |r| r.feeder.dead_reckon())
+        each!(self, |r| r.dead_reckon())
     }
 
     /// The filter's time, s.
     pub fn time_s(&self) -> f64 {
-        each!(self, |r| r.filter.time_s())
+        each!(self, |r| r.time_s())
     }
 
     /// The current state as an epoch hands it out.
-    pub fn now(&self) -> AidedEpoch {
-        each!(self, |r| AidedEpoch::of(&r.filter))
+    pub fn now(&self) -> Option<AidedEpoch> {
+        each!(self, |r| r.now())
     }
 
-    /// The χ² gate counters so far.
+    /// The χ² gate counters so far (of the hypothesis handed out, with the
+    /// gyro-bias switch).
     pub fn gates(&self) -> GateCounts {
-        each!(self, |r| *r.filter.gates())
+        each!(self, |r| r.gates())
     }
 
     /// The feeder's counters with the filter's gate counters folded in.
     pub fn stats(&self) -> FilterStats {
-        each!(self, |r| r.feeder.stats_with(&r.filter))
+        each!(self, |r| r.stats())
+    }
+
+    /// What the gyro-bias switch has seen (`None` without one).
+    pub fn bias_switch(&self) -> Option<BiasSwitch> {
+        match self {
+            Aided::Switched(s) => Some(s.report()),
+            Aided::WanderSwitched(s) => Some(s.report()),
+            _ => None,
+        }
     }
 
     /// Whether the layout carries the receiver's wander.
     pub fn carries_wander(&self) -> bool {
-        matches!(self, Aided::Wander(_) | Aided::WanderBias(_))
+        matches!(
+            self,
+            Aided::Wander(_) | Aided::WanderBias(_) | Aided::WanderSwitched(_)
+        )
     }
 
     /// The RTS-smoothed car blocks of the recorded epochs (empty unless
-    /// started with `opts.record_epochs`).
+    /// started with `opts.record_epochs`); with the gyro-bias switch, of
+    /// the hypothesis the drive ended with (the state's over the whole
+    /// drive once it fired: the smoother sees every fix anyway).
     pub fn smoothed(&self) -> Result<Vec<(f64, State, Mat)>, Error> {
         each!(self, |r| r.smoothed())
     }

@@ -23,7 +23,7 @@
 //! it): leaving out the windows where the filter is unsure would flatter the
 //! figures.
 
-use crate::aided::{Aided, AidedEpoch};
+use crate::aided::{Aided, AidedEpoch, BiasSwitch};
 use crate::bound::{Cov2, WanderCov};
 use crate::compared::{Antenna, Position, RearAxle};
 use crate::drive::Drive;
@@ -59,6 +59,10 @@ pub struct OutageEvaluation {
     /// The yaw standard deviation the aided filter must first reach for
     /// windows to count, rad.
     pub heading_limit_rad: f64,
+    /// What the aided run's gyro-bias switch saw over the drive (`None`
+    /// without one: [`crate::aided::switch`]). Each window dead-reckons
+    /// from the hypothesis chosen at its start.
+    pub bias_switch: Option<BiasSwitch>,
 }
 
 impl OutageEvaluation {
@@ -324,7 +328,9 @@ fn evaluate_in(
         }
         f.finish(&mut noop)?;
         let t0 = f.time_s();
-        let yaw_std = f.now().p[(YAW, YAW)].max(0.0).sqrt();
+        let yaw_std = f
+            .now()
+            .map_or(f64::NAN, |e| e.p[(YAW, YAW)].max(0.0).sqrt());
         let before = f.gates();
         let (mut g, mut evs, mut next) = (f.clone(), events.clone(), upcoming);
         g.dead_reckon();
@@ -408,6 +414,7 @@ fn evaluate_in(
         gates,
         unsettled,
         heading_limit_rad: heading_limit,
+        bias_switch: f.bias_switch(),
     })
 }
 
@@ -639,6 +646,7 @@ fn through_windows_in(
         gates: aided.gates(),
         unsettled: Vec::new(),
         heading_limit_rad: f64::INFINITY,
+        bias_switch: aided.bias_switch(),
     })
 }
 

@@ -117,6 +117,14 @@ pub struct Noise {
     /// re-learn it ([`crate::gyro_drift`]).
     #[serde(skip_serializing_if = "is_zero")]
     pub gyro_bias_drive_std_rps: f64,
+    /// The gyro-bias switch's threshold, a log-likelihood ratio (default 0:
+    /// no switch). Above 0, where the aided filter would carry the gyro
+    /// bias as a state, it runs the calibrated constant bias beside it and
+    /// hands out the constant's state until the drive's fixes, one fix
+    /// ahead, favour the state by this much; from that fix on, the
+    /// state's ([`crate::aided::switch`]).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub gyro_bias_switch_llr: f64,
     /// The yaw rate's process noise per `process_step_s` at a wheel epoch
     /// without a gyro reading of its own while the gyro is live, rad/s
     /// (default 0: `process_yaw_rate_rps`, table I's, at every epoch).
@@ -265,6 +273,7 @@ impl Default for Noise {
             gyro_bias_walk_rps_per_sqrt_s: 0.0,
             gyro_gap_process_yaw_rate_rps: 0.0,
             gyro_bias_drive_std_rps: 0.0,
+            gyro_bias_switch_llr: 0.0,
             wheel_gate_chi2: GROSS_FAULT_CHI2,
             gyro_gate_chi2: GROSS_FAULT_CHI2,
             speed_gate_chi2: GROSS_FAULT_CHI2,
@@ -543,6 +552,15 @@ impl Vehicle {
                 n.gyro_bias_drive_std_rps,
                 Rule::NonNegative {
                     zero_means: Some("the calibrated bias"),
+                },
+            ));
+        }
+        if !(n.gyro_bias_switch_llr.is_finite() && n.gyro_bias_switch_llr >= 0.0) {
+            return Err(Error::vehicle(
+                "noise.gyro_bias_switch_llr",
+                n.gyro_bias_switch_llr,
+                Rule::NonNegative {
+                    zero_means: Some("no switch"),
                 },
             ));
         }
