@@ -127,6 +127,7 @@ fn stream_disagreed_with_run_on_stored_delays() {
         ("all", "all.toml"),
         ("gnss", "gnss.toml"),
         ("edited", "edited.toml"),
+        ("switched", "edited.toml"),
     ] {
         let params = tmp.path().join(p);
         let params = params.to_str().unwrap();
@@ -179,6 +180,33 @@ fn stream_disagreed_with_run_on_stored_delays() {
                 .fold(0.0, f64::max);
             println!("edited: the per-drive gyro bias moved run's track by up to {moved:.3e} m");
             assert!(moved > 1e-6, "gyro_bias_drive_std_rps did not reach run");
+        } else if which == "switched" {
+            // The same file with the gyro-bias switch (issue 28,
+            // `[noise] gyro_bias_switch_llr`): the constant bias and the
+            // bias as a state side by side, switched mid-drive at a fix;
+            // `stream` must switch where `run` does. A low threshold so
+            // that it fires on this drive.
+            let text = std::fs::read_to_string(&vehicle).unwrap();
+            let text = text.replace("[noise]\n", "[noise]\ngyro_bias_switch_llr = 0.5\n");
+            std::fs::write(&vehicle, text).unwrap();
+            let out = tmp.path().join("switched.csv");
+            let j = run_ok(&[
+                "run",
+                d,
+                "--params",
+                params,
+                "--out",
+                out.to_str().unwrap(),
+                "--json",
+            ]);
+            let j: serde_json::Value = serde_json::from_str(&j).unwrap();
+            let s = &j["gyro_bias_switch"];
+            println!("switched: {s}");
+            let fired = s["fired_at_s"].as_f64().expect("the switch fired");
+            // After the first epoch: the fixes must first tell.
+            let first = run_filtered(d, params, "wheel", tmp.path())[0][0];
+            assert!(fired > first + 1.0, "{s}");
+            assert!(s["fixes"].as_u64().is_some_and(|n| n > 10), "{s}");
         } else {
             run_ok(&["calibrate", d, "--corrections", which, "--out", params]);
         }

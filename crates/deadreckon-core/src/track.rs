@@ -2,7 +2,7 @@
 //! reads; and the tracks of a drive ([`drive_tracks`]): dead-reckoned, with GNSS
 //! the filtered and smoothed ones, and the truth as a track of its own.
 
-use crate::aided::Aided;
+use crate::aided::{Aided, BiasSwitch};
 use crate::ekf::{self, FilterOptions, Init, SensorSet};
 use crate::model::{Mat, State};
 use crate::vehicle::Origin;
@@ -192,29 +192,42 @@ pub fn drive_tracks(
     opts: &FilterOptions,
     init_pose: Option<(f64, f64, f64)>,
 ) -> Result<Vec<Track>, Error> {
+    Ok(drive_tracks_and_switch(drive, params, opts, init_pose)?.0)
+}
+
+/// [`drive_tracks`], and what the aided run's gyro-bias switch saw
+/// (`None` without one or without GNSS: [`crate::aided::switch`]).
+pub fn drive_tracks_and_switch(
+    drive: &Drive,
+    params: &Params,
+    opts: &FilterOptions,
+    init_pose: Option<(f64, f64, f64)>,
+) -> Result<(Vec<Track>, Option<BiasSwitch>), Error> {
     let mut out = Vec::new();
     let mut smoothed_start = None;
+    let mut switch = None;
     if drive.gnss.len() >= 2 {
-        let (filtered, smoothed, start) = aided_tracks(drive, params, opts)?;
+        let (filtered, smoothed, start, s) = aided_tracks(drive, params, opts)?;
         smoothed_start = start;
+        switch = s;
         out.push(filtered);
         out.push(smoothed);
     }
     let init = dead_reckoning_init(drive, init_pose, smoothed_start)?;
     out.insert(0, dead_reckoned(drive, params, opts, init)?);
-    Ok(out)
+    Ok((out, switch))
 }
 
 /// The filtered and smoothed tracks of the GNSS-aided filter the vehicle
 /// calls for ([`crate::aided`]: a gyro bias state, [`crate::gyro_drift`];
 /// the receiver's wander, [`crate::gnss_error`], smoothed with its `φ`),
-/// and the smoothed start's car state.
+/// the smoothed start's car state, and the gyro-bias switch's report.
 #[allow(clippy::type_complexity)]
 fn aided_tracks(
     drive: &Drive,
     params: &Params,
     opts: &FilterOptions,
-) -> Result<(Track, Track, Option<(f64, State, Mat)>), Error> {
+) -> Result<(Track, Track, Option<(f64, State, Mat)>, Option<BiasSwitch>), Error> {
     let opts = FilterOptions {
         record_epochs: true,
         ..opts.clone()
@@ -241,6 +254,7 @@ fn aided_tracks(
             origin,
         },
         start,
+        f.bias_switch(),
     ))
 }
 
