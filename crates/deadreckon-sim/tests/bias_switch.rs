@@ -28,13 +28,13 @@ fn drive(seed: u64) -> (Drive, Params) {
 }
 
 /// 30 s outages every 10 s with the calibrated bias `jump` off; with the
-/// switch (the bias free to differ by 5e-5 rad/s, threshold 2) or without.
+/// switch (the bias free to differ by 5e-5 rad/s, threshold 2) or with the
+/// constant bias alone.
 fn outages(d: &Drive, truth: &Params, jump: f64, switch: bool) -> OutageEvaluation {
     let mut d = d.clone();
-    if switch {
-        d.vehicle.noise.gyro_bias_drive_std_rps = 5e-5;
-        d.vehicle.noise.gyro_bias_switch_llr = 2.0;
-    }
+    let (std, llr) = if switch { (5e-5, 2.0) } else { (0.0, 0.0) };
+    d.vehicle.noise.gyro_bias_drive_std_rps = std;
+    d.vehicle.noise.gyro_bias_switch_llr = llr;
     let params = Params {
         gyro_bias_rps: truth.gyro_bias_rps - jump,
         ..*truth
