@@ -355,10 +355,8 @@ pub fn outage_lines(
         ("drift per 100 m (%)", ev.drift_pct()),
         ("distance before 1 m (m)", ev.distance_to_1m()),
     ]));
-    if let Some(line) = unsettled_line(ev) {
-        out.push(line);
-    }
-    out.extend(ev.bias_switch.as_ref().map(bias_switch_line));
+    out.extend(unsettled_line(ev));
+    out.extend(ev.bias_switch.as_ref().map(ToString::to_string));
     out.push(format!(
         "rejected by the χ² gates: {}",
         gated_text(&ev.gates)
@@ -367,23 +365,6 @@ pub fn outage_lines(
         out.extend(corrections_lines(c));
     }
     out
-}
-
-/// What the aided run's gyro-bias switch did, in words
-/// (`deadreckon_core::aided::switch`).
-pub fn bias_switch_line(s: &deadreckon_core::aided::BiasSwitch) -> String {
-    match s.fired_at_s {
-        Some(t) => format!(
-            "gyro-bias switch: fired at {t:.2} s (the fixes favoured the bias as a state by a \
-             log-likelihood ratio of {:.2} over {} fixes, threshold {}): its state from then on",
-            s.llr, s.fixes, s.threshold
-        ),
-        None => format!(
-            "gyro-bias switch: not fired (log-likelihood ratio {:.2} over {} fixes, threshold \
-             {}): the calibrated constant bias throughout",
-            s.llr, s.fixes, s.threshold
-        ),
-    }
 }
 
 /// The windows left out of the summaries because the heading was not yet

@@ -210,7 +210,7 @@ impl Written {
             Some(Err(why)) => out.push(format!("wheel health: not checked ({why})")),
             None => {}
         }
-        out.extend(self.bias_switch.as_ref().map(crate::text::bias_switch_line));
+        out.extend(self.bias_switch.as_ref().map(ToString::to_string));
         out.push(format!("wrote {}", self.path.display()));
         if self.format == TrackFormat::Kitti {
             out.push(format!(

@@ -45,6 +45,7 @@ pub mod gnss_jumps;
 pub mod gyro_drift;
 pub mod gyro_hold;
 pub mod gyro_scale;
+pub mod gyro_switch_defaults;
 pub mod held_back;
 pub mod imu;
 pub mod init;

@@ -3,6 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::gyro_switch_defaults as defaults;
 use crate::{Error, Rule, Value};
 
 /// A geodetic origin for drives recorded in latitude/longitude: the point
@@ -107,25 +108,21 @@ pub struct Noise {
     /// bias the fixes last showed instead of the calibration drive's mean.
     #[serde(skip_serializing_if = "is_zero")]
     pub gyro_bias_walk_rps_per_sqrt_s: f64,
-    /// How far the gyro bias may be on a drive from the calibrated one,
-    /// rad/s (default [`DEFAULT_GYRO_BIAS_DRIVE_STD_RPS`]; 0: the
-    /// calibrated constant, the paper's model). A gyro's bias changes
-    /// between drives (its turn-on repeatability and temperature) by more
-    /// than it moves within one: above 0 the aided filter carries the bias
-    /// as a state that starts at the calibrated value with this standard
-    /// deviation (and walks by `gyro_bias_walk_rps_per_sqrt_s`, if set), so
-    /// each drive's fixes re-learn it ([`crate::gyro_drift`]), once the
-    /// gyro-bias switch says so (`gyro_bias_switch_llr`).
-    #[serde(skip_serializing_if = "is_default_drive_std")]
+    /// How far the gyro bias may be on a drive from the calibrated one
+    /// (turn-on repeatability, temperature), rad/s (default
+    /// [`crate::aided::switch::DEFAULT_DRIVE_STD_RPS`]; 0: the calibrated
+    /// constant, the paper's model): the aided filter's bias state starts at
+    /// the calibrated value with this std, so each drive's fixes re-learn
+    /// it, once the switch below says so ([`crate::gyro_drift`]).
+    #[serde(skip_serializing_if = "defaults::is_default_drive_std")]
     pub gyro_bias_drive_std_rps: f64,
     /// The gyro-bias switch's threshold, a log-likelihood ratio (default
-    /// [`DEFAULT_GYRO_BIAS_SWITCH_LLR`]; 0: no switch, the bias a state
-    /// from the start wherever the keys above say so). Above 0, where the
-    /// aided filter would carry the gyro bias as a state, it runs the
-    /// calibrated constant bias beside it and hands out the constant's
-    /// state until the drive's fixes, one fix ahead, favour the state by
-    /// this much; from that fix on, the state's ([`crate::aided::switch`]).
-    #[serde(skip_serializing_if = "is_default_switch_llr")]
+    /// [`crate::aided::switch::DEFAULT_THRESHOLD_LLR`]; 0: no switch, the
+    /// bias a state from the start where the keys above say so): the
+    /// constant's state until the drive's fixes, one fix ahead, favour the
+    /// bias state by this much, the state's from then on
+    /// ([`crate::aided::switch`]).
+    #[serde(skip_serializing_if = "defaults::is_default_switch_llr")]
     pub gyro_bias_switch_llr: f64,
     /// The yaw rate's process noise per `process_step_s` at a wheel epoch
     /// without a gyro reading of its own while the gyro is live, rad/s
@@ -184,35 +181,6 @@ pub const SCALE_HOLD_YAW_STD_RAD: f64 = 0.035;
 /// of the 20–120 s of the simulator's car family (standalone and SBAS
 /// receivers wander over a minute or two).
 pub const DEFAULT_GNSS_WANDER_TAU_S: f64 = 60.0;
-
-/// The default `[noise] gyro_bias_drive_std_rps`, rad/s: 1e-4 (21 °/h), the
-/// bias state's start std for the gyro-bias switch
-/// ([`crate::aided::switch`]). Chosen with [`DEFAULT_GYRO_BIAS_SWITCH_LLR`]
-/// on the dynamic family's dev cars 1–25 (18 apart; 30 s outages every
-/// 10 s on a drive other than the calibration's; mean final error,
-/// constant → switch at a threshold of 1): std 5e-5: none 0.389 → 0.387,
-/// gyro_drift 0.796 → 0.598, all 2.828 → 2.717 m; 1e-4: 0.385, 0.549,
-/// 2.723 m; 2e-4: 0.387, 0.545, 2.750 m (`deadreckon-sim/tests/bias_switch.rs`,
-/// `bias_switch_on_the_family`). Checked on held-out cars 101–110 (104
-/// apart): none 0.463 → 0.480, gyro_drift 1.229 → 0.709, all 2.781 →
-/// 2.689 m.
-pub const DEFAULT_GYRO_BIAS_DRIVE_STD_RPS: f64 = 1e-4;
-
-/// The default `[noise] gyro_bias_switch_llr`: 1. Chosen on the dev cars
-/// with [`DEFAULT_GYRO_BIAS_DRIVE_STD_RPS`] (std 1e-4; mean final error
-/// none / gyro_drift / all): 0.5: 0.392, 0.545, 2.727 m (fired on 8 of 25
-/// effect-free cars, worse on 6); 1: 0.385, 0.549, 2.723 m (fired on 1,
-/// better); 2: 0.389, 0.589, 2.719 m (never fired); the bias always a
-/// state: 0.411, 0.526, 2.735 m. Checked on the held-out cars (above).
-pub const DEFAULT_GYRO_BIAS_SWITCH_LLR: f64 = 1.0;
-
-fn is_default_drive_std(v: &f64) -> bool {
-    *v == DEFAULT_GYRO_BIAS_DRIVE_STD_RPS
-}
-
-fn is_default_switch_llr(v: &f64) -> bool {
-    *v == DEFAULT_GYRO_BIAS_SWITCH_LLR
-}
 
 fn is_default_wander_tau(v: &f64) -> bool {
     *v == DEFAULT_GNSS_WANDER_TAU_S
@@ -303,8 +271,8 @@ impl Default for Noise {
             gnss_wander_tau_s: DEFAULT_GNSS_WANDER_TAU_S,
             gyro_bias_walk_rps_per_sqrt_s: 0.0,
             gyro_gap_process_yaw_rate_rps: 0.0,
-            gyro_bias_drive_std_rps: DEFAULT_GYRO_BIAS_DRIVE_STD_RPS,
-            gyro_bias_switch_llr: DEFAULT_GYRO_BIAS_SWITCH_LLR,
+            gyro_bias_drive_std_rps: defaults::DEFAULT_DRIVE_STD_RPS,
+            gyro_bias_switch_llr: defaults::DEFAULT_THRESHOLD_LLR,
             wheel_gate_chi2: GROSS_FAULT_CHI2,
             gyro_gate_chi2: GROSS_FAULT_CHI2,
             speed_gate_chi2: GROSS_FAULT_CHI2,
@@ -567,33 +535,27 @@ impl Vehicle {
                 },
             ));
         }
-        if !(n.gyro_bias_walk_rps_per_sqrt_s.is_finite() && n.gyro_bias_walk_rps_per_sqrt_s >= 0.0)
-        {
-            return Err(Error::vehicle(
+        for (k, v, zero_means) in [
+            (
                 "noise.gyro_bias_walk_rps_per_sqrt_s",
                 n.gyro_bias_walk_rps_per_sqrt_s,
-                Rule::NonNegative {
-                    zero_means: Some("a constant bias"),
-                },
-            ));
-        }
-        if !(n.gyro_bias_drive_std_rps.is_finite() && n.gyro_bias_drive_std_rps >= 0.0) {
-            return Err(Error::vehicle(
+                "a constant bias",
+            ),
+            (
                 "noise.gyro_bias_drive_std_rps",
                 n.gyro_bias_drive_std_rps,
-                Rule::NonNegative {
-                    zero_means: Some("the calibrated bias"),
-                },
-            ));
-        }
-        if !(n.gyro_bias_switch_llr.is_finite() && n.gyro_bias_switch_llr >= 0.0) {
-            return Err(Error::vehicle(
+                "the calibrated bias",
+            ),
+            (
                 "noise.gyro_bias_switch_llr",
                 n.gyro_bias_switch_llr,
-                Rule::NonNegative {
-                    zero_means: Some("no switch"),
-                },
-            ));
+                "no switch",
+            ),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                let zero_means = Some(zero_means);
+                return Err(Error::vehicle(k, v, Rule::NonNegative { zero_means }));
+            }
         }
         if !(n.gyro_gap_process_yaw_rate_rps.is_finite() && n.gyro_gap_process_yaw_rate_rps >= 0.0)
         {

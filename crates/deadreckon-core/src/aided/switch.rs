@@ -32,6 +32,8 @@ use crate::filter::{Filter, GateCounts, Layout, SensorKind};
 use crate::model::{Mat, State};
 use crate::Error;
 
+pub use crate::gyro_switch_defaults::{DEFAULT_DRIVE_STD_RPS, DEFAULT_THRESHOLD_LLR};
+
 /// What the gyro-bias switch has seen: its threshold, the ratio so far and
 /// when it fired.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -47,6 +49,26 @@ pub struct BiasSwitch {
     /// The time of the fix at which the state hypothesis took over, s
     /// (`None`: the constant bias throughout).
     pub fired_at_s: Option<f64>,
+}
+
+/// What the switch did, in words (`run`'s and `evaluate --outage`'s line).
+impl std::fmt::Display for BiasSwitch {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let (llr, n, t) = (self.llr, self.fixes, self.threshold);
+        match self.fired_at_s {
+            Some(at) => write!(
+                f,
+                "gyro-bias switch: fired at {at:.2} s (the fixes favoured the bias as a state by a \
+                 log-likelihood ratio of {llr:.2} over {n} fixes, threshold {t}): its state from \
+                 then on"
+            ),
+            None => write!(
+                f,
+                "gyro-bias switch: not fired (log-likelihood ratio {llr:.2} over {n} fixes, \
+                 threshold {t}): the calibrated constant bias throughout"
+            ),
+        }
+    }
 }
 
 /// The two hypotheses of layouts `C` (constant bias) and `S` (bias as a
