@@ -127,6 +127,7 @@ fn stream_disagreed_with_run_on_stored_delays() {
         ("all", "all.toml"),
         ("gnss", "gnss.toml"),
         ("edited", "edited.toml"),
+        ("switched", "edited.toml"),
     ] {
         let params = tmp.path().join(p);
         let params = params.to_str().unwrap();
@@ -169,7 +170,12 @@ fn stream_disagreed_with_run_on_stored_delays() {
             let before = run_filtered(drive, params, "wheel", tmp.path());
             let text = std::fs::read_to_string(&vehicle).unwrap();
             assert!(text.contains("[noise]\n"), "{text}");
-            let text = text.replace("[noise]\n", "[noise]\ngyro_bias_drive_std_rps = 5e-5\n");
+            // (Without the switch, which is on by default: the bias a
+            // state from the start.)
+            let text = text.replace(
+                "[noise]\n",
+                "[noise]\ngyro_bias_drive_std_rps = 5e-5\ngyro_bias_switch_llr = 0.0\n",
+            );
             std::fs::write(&vehicle, text).unwrap();
             let after = run_filtered(drive, params, "wheel", tmp.path());
             let moved = before
@@ -179,6 +185,37 @@ fn stream_disagreed_with_run_on_stored_delays() {
                 .fold(0.0, f64::max);
             println!("edited: the per-drive gyro bias moved run's track by up to {moved:.3e} m");
             assert!(moved > 1e-6, "gyro_bias_drive_std_rps did not reach run");
+        } else if which == "switched" {
+            // The same file with the gyro-bias switch (issue 28,
+            // `[noise] gyro_bias_switch_llr`): the constant bias and the
+            // bias as a state side by side, switched mid-drive at a fix;
+            // `stream` must switch where `run` does. A low threshold so
+            // that it fires on this drive.
+            let text = std::fs::read_to_string(&vehicle).unwrap();
+            assert!(text.contains("gyro_bias_switch_llr = 0.0\n"), "{text}");
+            let text = text.replace(
+                "gyro_bias_switch_llr = 0.0\n",
+                "gyro_bias_switch_llr = 0.5\n",
+            );
+            std::fs::write(&vehicle, text).unwrap();
+            let out = tmp.path().join("switched.csv");
+            let j = run_ok(&[
+                "run",
+                d,
+                "--params",
+                params,
+                "--out",
+                out.to_str().unwrap(),
+                "--json",
+            ]);
+            let j: serde_json::Value = serde_json::from_str(&j).unwrap();
+            let s = &j["gyro_bias_switch"];
+            println!("switched: {s}");
+            let fired = s["fired_at_s"].as_f64().expect("the switch fired");
+            // After the first epoch: the fixes must first tell.
+            let first = run_filtered(d, params, "wheel", tmp.path())[0][0];
+            assert!(fired > first + 1.0, "{s}");
+            assert!(s["fixes"].as_u64().is_some_and(|n| n > 10), "{s}");
         } else {
             run_ok(&["calibrate", d, "--corrections", which, "--out", params]);
         }
@@ -360,7 +397,8 @@ fn stream_says_it_cannot_apply_a_slip_stored_without_its_mean_force() {
 /// applied wrongly or not at all).
 #[test]
 fn online_corrections_equal_the_batch_filter_on_the_corrected_drive_bit_for_bit() {
-    use deadreckon_core::ekf::{self, FilterOptions, Timing};
+    use deadreckon_core::aided::Aided;
+    use deadreckon_core::ekf::{FilterOptions, Timing};
     use deadreckon_core::live_corrections::input_events;
     use deadreckon_core::online::{Online, Start};
     use deadreckon_core::timing::KnownCorrections;
@@ -392,7 +430,13 @@ fn online_corrections_equal_the_batch_filter_on_the_corrected_drive_bit_for_bit(
                 timing,
                 ..Default::default()
             };
-            let batch = ekf::run(&known.apply(&drive), &params, &opts, &mut ()).unwrap();
+            // The batch run of the aided filter the vehicle calls for (the
+            // default gyro-bias switch included: deadreckon_core::aided).
+            let mut batch = Vec::new();
+            Aided::run(&known.apply(&drive), &params, &opts, &mut |e| {
+                batch.push(*e)
+            })
+            .unwrap();
             let mut online = Online::new(&drive.vehicle, &params, &opts, Start::Gnss)
                 .unwrap()
                 .with_corrections(&known)
@@ -402,8 +446,8 @@ fn online_corrections_equal_the_batch_filter_on_the_corrected_drive_bit_for_bit(
                 online.push(*ev, &mut |p| pts.push(p)).unwrap();
             }
             online.end(&mut |p| pts.push(p)).unwrap();
-            assert_eq!(pts.len(), batch.epochs.len(), "{timing:?}");
-            for (p, e) in pts.iter().zip(&batch.epochs) {
+            assert_eq!(pts.len(), batch.len(), "{timing:?}");
+            for (p, e) in pts.iter().zip(&batch) {
                 assert_eq!(p.t_s, e.t_s);
                 assert_eq!(
                     (p.east_m, p.north_m),

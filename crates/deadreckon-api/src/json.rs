@@ -253,6 +253,20 @@ pub fn outage_json(outage_s: f64, params: &str, ev: &OutageEvaluation) -> Value 
         "outages": ev.windows.iter().map(outage_window_json).collect::<Vec<_>>(),
         "heading_limit_deg": ev.heading_limit_rad.is_finite().then(|| ev.heading_limit_rad.to_degrees()),
         "unsettled": ev.unsettled.iter().map(outage_window_json).collect::<Vec<_>>(),
+        "gyro_bias_switch": ev.bias_switch.as_ref().map(bias_switch_json),
+    })
+}
+
+/// The gyro-bias switch of an aided run (`run` and `evaluate --outage`
+/// `--json`): its threshold, the log-likelihood ratio and the fixes it
+/// counted, and when it fired (`null`: the constant bias throughout;
+/// `deadreckon_core::aided::switch`).
+pub fn bias_switch_json(s: &deadreckon_core::aided::BiasSwitch) -> Value {
+    json!({
+        "threshold_llr": s.threshold,
+        "llr": s.llr,
+        "fixes": s.fixes,
+        "fired_at_s": s.fired_at_s,
     })
 }
 

@@ -355,9 +355,8 @@ pub fn outage_lines(
         ("drift per 100 m (%)", ev.drift_pct()),
         ("distance before 1 m (m)", ev.distance_to_1m()),
     ]));
-    if let Some(line) = unsettled_line(ev) {
-        out.push(line);
-    }
+    out.extend(unsettled_line(ev));
+    out.extend(ev.bias_switch.as_ref().map(ToString::to_string));
     out.push(format!(
         "rejected by the χ² gates: {}",
         gated_text(&ev.gates)

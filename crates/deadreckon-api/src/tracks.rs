@@ -7,6 +7,7 @@
 
 use std::path::{Path, PathBuf};
 
+use deadreckon_core::aided::BiasSwitch;
 use deadreckon_core::bound::BoundFit;
 use deadreckon_core::ekf::FilterOptions;
 use deadreckon_core::wheel_health::WheelHealth;
@@ -35,9 +36,21 @@ pub fn drive_tracks(
     opts: &FilterOptions,
     init_pose: Option<(f64, f64, f64)>,
 ) -> Result<Vec<Track>, Error> {
-    let mut t = track::drive_tracks(drive, params, opts, init_pose)?;
+    Ok(drive_tracks_and_switch(drive, params, opts, init_pose)?.0)
+}
+
+/// [`drive_tracks`], and what the aided run's gyro-bias switch saw
+/// (`None` without one: `[noise] gyro_bias_switch_llr`,
+/// [`deadreckon_core::aided::switch`]).
+pub fn drive_tracks_and_switch(
+    drive: &Drive,
+    params: &Params,
+    opts: &FilterOptions,
+    init_pose: Option<(f64, f64, f64)>,
+) -> Result<(Vec<Track>, Option<BiasSwitch>), Error> {
+    let (mut t, switch) = track::drive_tracks_and_switch(drive, params, opts, init_pose)?;
     t.extend(Track::from_truth(drive));
-    Ok(t)
+    Ok((t, switch))
 }
 
 /// The 95 % bound of each pose of each of `tracks` (those of
@@ -170,6 +183,8 @@ pub struct Written {
     /// The wheel monitor over the GNSS-aided run, or why it was not run
     /// (`None`: not asked, as for a tricycle).
     pub health: Option<Result<WheelHealth, String>>,
+    /// What the aided run's gyro-bias switch saw (`None` without one).
+    pub bias_switch: Option<BiasSwitch>,
 }
 
 impl Written {
@@ -179,6 +194,7 @@ impl Written {
             "wrote": self.path.display().to_string(),
             "tracks": self.tracks.iter().map(|(name, n)| serde_json::json!({"name": name, "poses": n})).collect::<Vec<_>>(),
             "wheel_health": self.health.as_ref().and_then(|h| h.as_ref().ok()).map(crate::json::wheel_health_json),
+            "gyro_bias_switch": self.bias_switch.as_ref().map(crate::json::bias_switch_json),
         })
     }
 
@@ -194,6 +210,7 @@ impl Written {
             Some(Err(why)) => out.push(format!("wheel health: not checked ({why})")),
             None => {}
         }
+        out.extend(self.bias_switch.as_ref().map(ToString::to_string));
         out.push(format!("wrote {}", self.path.display()));
         if self.format == TrackFormat::Kitti {
             out.push(format!(
@@ -220,7 +237,7 @@ pub fn write_car(
     bound: &BoundFit,
 ) -> Result<Written, Error> {
     let format = TrackFormat::from_path(out)?;
-    let all = drive_tracks(drive, params, opts, init_pose)?;
+    let (all, bias_switch) = drive_tracks_and_switch(drive, params, opts, init_pose)?;
     let t = select(&all, s, out, format)?;
     let bounds = if format == TrackFormat::Csv {
         bounds_95_m(drive, &t, bound, opts, init_pose)
@@ -240,6 +257,7 @@ pub fn write_car(
         format,
         tracks: t.iter().map(|t| (t.name.clone(), t.points.len())).collect(),
         health: Some(health),
+        bias_switch,
     })
 }
 
@@ -274,5 +292,6 @@ pub fn write_tracks(
         format,
         tracks: t.iter().map(|t| (t.name.clone(), t.points.len())).collect(),
         health: None,
+        bias_switch: None,
     })
 }

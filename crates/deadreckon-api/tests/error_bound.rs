@@ -151,7 +151,9 @@ fn measure(cars: &[u64], drive_s: f64) -> (f64, f64, usize) {
 fn the_bound_covers_95_percent_of_outages_on_development_cars() {
     let (coverage, sharpness, n) = measure(&(301..=306).collect::<Vec<_>>(), 300.0);
     // Measured: 166 of 177 windows within (0.938), median bound / median
-    // final error 2.81, since the GNSS delay's steps stop once settled
+    // final error 2.63, since the gyro-bias switch is on by default
+    // (issue 28, deadreckon_core::aided::switch; the same coverage). Before
+    // that: 166 of 177, 2.81, since the GNSS delay's steps stop once settled
     // (`timing::gnss::GNSS_SETTLED_FRACTION_OF_STD`, issue 30: the delays
     // of these cars' calibrations moved by fractions of their standard
     // errors, and with them each car's k). Before that: 162 of 177
@@ -163,7 +165,7 @@ fn the_bound_covers_95_percent_of_outages_on_development_cars() {
     // floor: 150 of 177 (0.847), 2.77.
     assert_eq!(n, 177);
     assert!((0.92..=0.96).contains(&coverage), "{coverage}");
-    assert!((2.7..=2.95).contains(&sharpness), "{sharpness}");
+    assert!((2.5..=2.8).contains(&sharpness), "{sharpness}");
 }
 
 #[test]

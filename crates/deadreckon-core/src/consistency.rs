@@ -20,17 +20,15 @@
 //! under-confident. The windows should be far enough apart for the errors of
 //! two windows to be nearly independent (GNSS between them resets the pose).
 
-use nalgebra::{Matrix2, Matrix3, SMatrix, SVector, Vector2, Vector3};
+use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 use statrs::distribution::{ChiSquared, ContinuousCDF};
 
+use crate::aided::Aided;
 use crate::angle;
 use crate::drive::Drive;
-use crate::ekf::{self, EpochHook, FilterOptions};
-use crate::filter::{CarLayout, Layout};
-use crate::gnss_error::{CarWanderLayout, N_WANDER};
-use crate::gyro_drift::{CarBiasLayout, CarWanderBiasLayout, N_BIAS, N_WANDER_BIAS};
-use crate::model::{self, Mat, State, V, X, Y, YAW, YAW_RATE};
+use crate::ekf::FilterOptions;
+use crate::model::{Mat, State, V, X, Y, YAW, YAW_RATE};
 use crate::reference::Reference;
 use crate::vehicle::Params;
 use crate::{Error, Input, Need, Task};
@@ -200,21 +198,6 @@ fn point(fraction: f64, n: usize, values: &[f64]) -> Result<NeesPoint, Error> {
     })
 }
 
-/// Collects `(t, x, P)` of the car block `[x, y, ψ, v, ψ̇]` at every epoch
-/// of a filter of any layout.
-struct Collect(Vec<(f64, State, Mat)>);
-
-impl<const N: usize> EpochHook<N> for Collect {
-    fn after_epoch(&mut self, t: f64, x: &mut SVector<f64, N>, p: &mut SMatrix<f64, N, N>) {
-        self.0.push((
-            t,
-            x.fixed_rows::<{ model::N }>(0).into_owned(),
-            p.fixed_view::<{ model::N }, { model::N }>(0, 0)
-                .into_owned(),
-        ));
-    }
-}
-
 /// Windows of `outage_s` every `step_s` from `warmup_s` after the drive's
 /// first wheel row to the end of the truth.
 pub fn windows(drive: &Drive, outage_s: f64, step_s: f64, warmup_s: f64) -> Vec<(f64, f64)> {
@@ -234,8 +217,9 @@ pub fn windows(drive: &Drive, outage_s: f64, step_s: f64, warmup_s: f64) -> Vec<
 /// The NEES of pose and motion through `windows` (GNSS hidden in each, `base`
 /// otherwise), against the drive's truth.
 ///
-/// The filter is the one the vehicle's noise settings call for, as in the
-/// outage evaluation ([`crate::outage::evaluate`]): with
+/// The filter is the one the vehicle's noise settings call for
+/// ([`crate::aided`]), as in the outage evaluation
+/// ([`crate::outage::evaluate`]): with
 /// `noise.gnss_wander_std_m` above 0 it carries the receiver's wander
 /// ([`crate::gnss_error`]), with `noise.gyro_bias_walk_rps_per_sqrt_s`
 /// above 0 a walking gyro bias ([`crate::gyro_drift`]); the NEES is taken
@@ -257,16 +241,10 @@ pub fn nees_through_windows(
         record_epochs: false,
         ..base.clone()
     };
-    let n = &drive.vehicle.noise;
-    let states = match (
-        n.gnss_wander_std_m > 0.0,
-        crate::gyro_drift::carries_bias(n),
-    ) {
-        (false, false) => epochs::<CarLayout, { model::N }>(drive, params, &opts)?,
-        (true, false) => epochs::<CarWanderLayout, N_WANDER>(drive, params, &opts)?,
-        (false, true) => epochs::<CarBiasLayout, N_BIAS>(drive, params, &opts)?,
-        (true, true) => epochs::<CarWanderBiasLayout, N_WANDER_BIAS>(drive, params, &opts)?,
-    };
+    let mut states: Vec<(f64, State, Mat)> = Vec::new();
+    Aided::run(drive, params, &opts, &mut |e| {
+        states.push((e.t_s, e.x, e.p))
+    })?;
     let mut pose = vec![Vec::new(); WINDOW_POINTS.len()];
     let mut motion = vec![Vec::new(); WINDOW_POINTS.len()];
     for &(a, b) in windows {
@@ -301,22 +279,6 @@ pub fn nees_through_windows(
         pose: BlockNees::from_values("pose", 3, pose)?,
         motion: BlockNees::from_values("motion", 2, motion)?,
     })
-}
-
-/// Every epoch's car block of the filter of layout `L` over `drive`.
-fn epochs<L: Layout<N>, const N: usize>(
-    drive: &Drive,
-    params: &Params,
-    opts: &FilterOptions,
-) -> Result<Vec<(f64, State, Mat)>, Error> {
-    let mut hook = Collect(Vec::new());
-    ekf::run_filter(
-        drive,
-        ekf::fixed_filter::<L, N>(drive, params, opts)?,
-        opts,
-        &mut hook,
-    )?;
-    Ok(hook.0)
 }
 
 #[cfg(test)]

@@ -20,7 +20,8 @@
 //! (the length of a calibration drive: how far the bias can be from that
 //! drive's mean). [`CarWanderBiasLayout`] adds it to the receiver's wander
 //! ([`crate::gnss_error`]). `gyro_bias_walk_rps_per_sqrt_s = 0` (the
-//! default) is the paper's constant bias and the five-state filter.
+//! default) with `gyro_bias_drive_std_rps = 0` is the paper's constant bias
+//! and the five-state filter.
 //!
 //! `[noise] gyro_bias_drive_std_rps` above 0 carries the bias as the same
 //! state for another reason: a gyro's bias on a new drive is not the
@@ -31,7 +32,11 @@
 //! outages on a drive other than the calibration's; `deadreckon-sim/tests/walk_evidence.rs`):
 //! it takes most of what the walk takes back where the gyro drifts, and the
 //! calibration drive's own fixes cannot tell whether it will help
-//! ([`walk_evidence`]): the bias that differs is the next drive's.
+//! ([`walk_evidence`]): the bias that differs is the next drive's. Its own
+//! fixes can, one fix ahead: by default (`gyro_bias_drive_std_rps` 1e-4,
+//! `gyro_bias_switch_llr` 1) the aided filter runs the constant and the
+//! state side by side and takes the state from the fix at which they favour
+//! it ([`crate::aided::switch`]).
 
 use crate::drive::Drive;
 use crate::ekf::FilterOptions;
@@ -174,6 +179,8 @@ mod tests {
     fn walking(walk: f64) -> Filter<CarBiasLayout, N_BIAS> {
         let mut v = Vehicle::paper_car();
         v.noise.gyro_bias_walk_rps_per_sqrt_s = walk;
+        // The walk alone (no per-drive std).
+        v.noise.gyro_bias_drive_std_rps = 0.0;
         let x0 = State::from([1.0, -2.0, 0.3, 12.0, 0.08]);
         let p0 = Mat::from_diagonal(&State::from([1.0, 1.0, 0.01, 1.0, 0.01]));
         let params = Params {
@@ -186,6 +193,7 @@ mod tests {
     #[test]
     fn a_bias_that_differs_per_drive_starts_with_its_std_and_stays_put() {
         let mut v = Vehicle::paper_car();
+        v.noise.gyro_bias_drive_std_rps = 0.0;
         assert!(!carries_bias(&v.noise));
         v.noise.gyro_bias_drive_std_rps = 5e-5;
         assert!(carries_bias(&v.noise));
@@ -246,9 +254,11 @@ mod tests {
 
     #[test]
     fn a_walking_bias_filter_without_a_walk_is_refused() {
-        // prior_std is 0 with no walk: the filter refuses a zero prior
-        // (the commands take the five-state filter then).
-        let v = Vehicle::paper_car();
+        // prior_std is 0 with no walk and no per-drive std: the filter
+        // refuses a zero prior (the commands take the five-state filter
+        // then).
+        let mut v = Vehicle::paper_car();
+        v.noise.gyro_bias_drive_std_rps = 0.0;
         let x0 = State::from([0.0, 0.0, 0.0, 10.0, 0.0]);
         let r = Filter::<CarBiasLayout, N_BIAS>::new(
             &v,

@@ -22,6 +22,7 @@
 //! - Every sample carries its own timestamp `t_s` (s); `dt` is derived.
 #![deny(missing_docs)]
 
+pub mod aided;
 pub mod angle;
 pub mod bound;
 pub mod bound_diff;
@@ -44,6 +45,7 @@ pub mod gnss_jumps;
 pub mod gyro_drift;
 pub mod gyro_hold;
 pub mod gyro_scale;
+pub mod gyro_switch_defaults;
 pub mod held_back;
 pub mod imu;
 pub mod init;

@@ -28,12 +28,11 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::aided::Aided;
 use crate::bound::BoundFit;
 use crate::bound_pose::{point_bound_m, FixFloor, Pose};
 use crate::ekf::{Event, Feeder, FilterOptions, FilterStats, GnssInit};
-use crate::filter::{AugmentedFilter, CarFilter, Filter};
-use crate::gnss_error::{CarWanderLayout, N_WANDER};
-use crate::gyro_drift::{CarBiasLayout, CarWanderBiasLayout, N_BIAS, N_WANDER_BIAS};
+use crate::filter::AugmentedFilter;
 use crate::live_corrections::LiveCorrections;
 use crate::model::{Mat, State};
 use crate::track::{car_point, TrackPoint};
@@ -103,60 +102,15 @@ impl Learned {
 enum Stage {
     /// Waiting for the GNSS initialisation; the events since the first fix.
     Waiting { init: GnssInit, buffer: Vec<Event> },
-    Car {
-        filter: Box<CarFilter>,
-        feeder: Feeder,
-    },
-    /// Fixed parameters but a walking gyro bias ([`crate::gyro_drift`]).
-    Walking {
-        filter: Box<Filter<CarBiasLayout, N_BIAS>>,
-        feeder: Feeder,
-    },
     Learning {
         filter: Box<AugmentedFilter>,
-        feeder: Feeder,
+        feeder: Box<Feeder>,
     },
-    /// Fixed parameters, the receiver's wander carried
-    /// ([`crate::gnss_error`]).
-    Wander {
-        filter: Box<Filter<CarWanderLayout, N_WANDER>>,
-        feeder: Feeder,
-    },
-    /// Fixed parameters, the receiver's wander and a walking gyro bias.
-    WanderWalking {
-        filter: Box<Filter<CarWanderBiasLayout, N_WANDER_BIAS>>,
-        feeder: Feeder,
-    },
-}
-
-/// `$body` with `$filter` and `$feeder` bound to the running stage's, of
-/// whichever layout; `$waiting` before the start.
-macro_rules! with_stage {
-    ($stage:expr, $waiting:expr, |$filter:ident, $feeder:ident| $body:expr) => {
-        match $stage {
-            Stage::Waiting { .. } => $waiting,
-            Stage::Car {
-                filter: $filter,
-                feeder: $feeder,
-            } => $body,
-            Stage::Walking {
-                filter: $filter,
-                feeder: $feeder,
-            } => $body,
-            Stage::Learning {
-                filter: $filter,
-                feeder: $feeder,
-            } => $body,
-            Stage::Wander {
-                filter: $filter,
-                feeder: $feeder,
-            } => $body,
-            Stage::WanderWalking {
-                filter: $filter,
-                feeder: $feeder,
-            } => $body,
-        }
-    };
+    /// Fixed parameters: the aided filter the vehicle calls for
+    /// ([`crate::aided`]; serialised as its layout's name, as the stages
+    /// of each layout were before).
+    #[serde(untagged)]
+    Aided(Aided),
 }
 
 /// The filter on a stream; see the module documentation.
@@ -255,53 +209,19 @@ impl Online {
     }
 
     fn started(&self, t0: f64, x0: State, p0: Mat) -> Result<Stage, Error> {
-        let feeder = Feeder::new(&self.opts, t0);
-        let form = self.opts.covariance_form;
-        let walks = crate::gyro_drift::carries_bias(&self.vehicle.noise);
-        let wanders = self.vehicle.noise.gnss_wander_std_m > 0.0;
-        let walk_prior = walks.then(|| crate::gyro_drift::prior_std(&self.vehicle.noise));
         Ok(match &self.prior_std {
-            None if wanders && walks => Stage::WanderWalking {
-                filter: Box::new(
-                    Filter::new(&self.vehicle, &self.params, walk_prior.as_ref(), t0, x0, p0)?
-                        .with_covariance_form(form),
-                ),
-                feeder,
-            },
-            None if wanders => Stage::Wander {
-                filter: Box::new(
-                    Filter::new(&self.vehicle, &self.params, None, t0, x0, p0)?
-                        .with_covariance_form(form),
-                ),
-                feeder,
-            },
-            None if walks => Stage::Walking {
-                filter: Box::new(
-                    Filter::new(
-                        &self.vehicle,
-                        &self.params,
-                        Some(&crate::gyro_drift::prior_std(&self.vehicle.noise)),
-                        t0,
-                        x0,
-                        p0,
-                    )?
-                    .with_covariance_form(form),
-                ),
-                feeder,
-            },
-            None => Stage::Car {
-                filter: Box::new(
-                    CarFilter::new(&self.vehicle, &self.params, None, t0, x0, p0)?
-                        .with_covariance_form(form),
-                ),
-                feeder,
-            },
+            None => Stage::Aided(Aided::start(
+                &self.vehicle,
+                &self.params,
+                &self.opts,
+                (t0, x0, p0),
+            )?),
             Some(sd) => Stage::Learning {
                 filter: Box::new(
                     AugmentedFilter::new(&self.vehicle, &self.params, Some(sd), t0, x0, p0)?
-                        .with_covariance_form(form),
+                        .with_covariance_form(self.opts.covariance_form),
                 ),
-                feeder,
+                feeder: Box::new(Feeder::new(&self.opts, t0)),
             },
         })
     }
@@ -445,11 +365,10 @@ impl Online {
                 }
                 Ok(())
             }
-            stage => with_stage!(stage, Ok(()), |filter, feeder| feeder.push(
-                filter.as_mut(),
-                ev,
-                &mut |f, _| emit(car_point(f.time_s(), f.state(), f.covariance()))
-            )),
+            Stage::Learning { filter, feeder } => feeder.push(filter.as_mut(), ev, &mut |f, _| {
+                emit(car_point(f.time_s(), f.state(), f.covariance()))
+            }),
+            Stage::Aided(a) => a.push(ev, &mut |e| emit(TrackPoint::from_state(e.t_s, &e.x, &e.p))),
         }
     }
 
@@ -464,22 +383,31 @@ impl Online {
                 bound_95_m: point_bound_m(&fit, &p, s),
             })
         };
-        with_stage!(&mut self.stage, Ok(()), |filter, feeder| feeder.finish(
-            filter.as_mut(),
-            &mut |f, _| emit(car_point(f.time_s(), f.state(), f.covariance()))
-        ))
+        match &mut self.stage {
+            Stage::Waiting { .. } => Ok(()),
+            Stage::Learning { filter, feeder } => feeder.finish(filter.as_mut(), &mut |f, _| {
+                emit(car_point(f.time_s(), f.state(), f.covariance()))
+            }),
+            Stage::Aided(a) => a.finish(&mut |e| emit(TrackPoint::from_state(e.t_s, &e.x, &e.p))),
+        }
     }
 
     /// The filter's time, s (`None` before the start).
     pub fn time_s(&self) -> Option<f64> {
-        with_stage!(&self.stage, None, |filter, _feeder| Some(filter.time_s()))
+        match &self.stage {
+            Stage::Waiting { .. } => None,
+            Stage::Learning { filter, .. } => Some(filter.time_s()),
+            Stage::Aided(a) => Some(a.time_s()),
+        }
     }
 
     /// Counters so far (`None` before the start).
     pub fn stats(&self) -> Option<FilterStats> {
-        with_stage!(&self.stage, None, |filter, feeder| Some(
-            feeder.stats_with(filter.as_ref())
-        ))
+        match &self.stage {
+            Stage::Waiting { .. } => None,
+            Stage::Learning { filter, feeder } => Some(feeder.stats_with(filter.as_ref())),
+            Stage::Aided(a) => Some(a.stats()),
+        }
     }
 
     /// The learned parameters (`None` unless learning and started).

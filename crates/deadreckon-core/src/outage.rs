@@ -23,19 +23,18 @@
 //! it): leaving out the windows where the filter is unsure would flatter the
 //! figures.
 
+use crate::aided::{Aided, AidedEpoch, BiasSwitch};
 use crate::bound::{Cov2, WanderCov};
 use crate::compared::{Antenna, Position, RearAxle};
 use crate::drive::Drive;
-use crate::ekf::{self, EpochHook, EpochOut, FilterOptions};
-use crate::filter::{CarLayout, Filter, GateCounts, Layout};
-use crate::gnss_error::{CarWanderLayout, N_WANDER};
-use crate::gyro_drift::{CarBiasLayout, CarWanderBiasLayout, N_BIAS, N_WANDER_BIAS};
+use crate::ekf::FilterOptions;
+use crate::filter::GateCounts;
 use crate::metrics::Summary;
 use crate::model::{State, V, X, Y, YAW};
 use crate::reference::Reference;
 use crate::vehicle::Params;
 use crate::{Error, Input, Need, Rule, Task, Value};
-use nalgebra::{SMatrix, SVector};
+use nalgebra::SMatrix;
 
 pub use crate::compared::{Against, OutageResult};
 
@@ -60,6 +59,10 @@ pub struct OutageEvaluation {
     /// The yaw standard deviation the aided filter must first reach for
     /// windows to count, rad.
     pub heading_limit_rad: f64,
+    /// What the aided run's gyro-bias switch saw over the drive (`None`
+    /// without one: [`crate::aided::switch`]). Each window dead-reckons
+    /// from the hypothesis chosen at its start.
+    pub bias_switch: Option<BiasSwitch>,
 }
 
 impl OutageEvaluation {
@@ -136,37 +139,9 @@ pub fn check_windows(drive: &Drive, windows: &[(f64, f64)]) -> Result<(), Error>
     Ok(())
 }
 
-/// Every epoch's time and car state (the first five states of any layout),
-/// and the receiver's wander estimate where the layout has it (at
-/// `wander`, [`Layout::wander_index`]).
-struct Collect {
-    states: Vec<(f64, State)>,
-    wander_at: Option<usize>,
-    wander: Vec<[f64; 2]>,
-}
-
-impl Collect {
-    fn of<L: Layout<N>, const N: usize>() -> Self {
-        Collect {
-            states: Vec::new(),
-            wander_at: L::wander_index(),
-            wander: Vec::new(),
-        }
-    }
-}
-
-impl<const N: usize> EpochHook<N> for Collect {
-    fn after_epoch(&mut self, t: f64, x: &mut SVector<f64, N>, _p: &mut SMatrix<f64, N, N>) {
-        self.states.push((t, State::from_fn(|i, _| x[i])));
-        if let Some(w) = self.wander_at {
-            self.wander.push([x[w], x[w + 1]]);
-        }
-    }
-}
-
 /// What the aided run tells the windows: its first and last epochs, when
 /// the vehicle first moves and when the heading is first known.
-struct Aided {
+struct AidedPass {
     first_t: f64,
     last_t: f64,
     moving_t: Option<f64>,
@@ -174,7 +149,7 @@ struct Aided {
     yaw_var: Vec<(f64, f64)>,
 }
 
-impl Aided {
+impl AidedPass {
     /// The yaw standard deviation at which the heading counts as known, rad:
     /// [`HEADING_KNOWN_YAW_STD_RAD`], or twice the run's median where that
     /// is higher (a filter without a gyro may never reach 2°: its pull-away
@@ -198,16 +173,17 @@ impl Aided {
     }
 }
 
-impl<const N: usize> EpochHook<N> for Aided {
-    fn after_epoch(&mut self, t: f64, x: &mut SVector<f64, N>, p: &mut SMatrix<f64, N, N>) {
+impl AidedPass {
+    fn after_epoch(&mut self, e: &AidedEpoch) {
+        let t = e.t_s;
         if self.first_t.is_nan() {
             self.first_t = t;
         }
         self.last_t = t;
-        if self.moving_t.is_none() && x[V].abs() > MOVING_MPS {
+        if self.moving_t.is_none() && e.x[V].abs() > MOVING_MPS {
             self.moving_t = Some(t);
         }
-        self.yaw_var.push((t, p[(YAW, YAW)]));
+        self.yaw_var.push((t, e.p[(YAW, YAW)]));
     }
 }
 
@@ -259,28 +235,11 @@ fn evaluate_with(
     base: &FilterOptions,
     use_truth: bool,
 ) -> Result<OutageEvaluation, Error> {
-    let n = &drive.vehicle.noise;
-    match (
-        n.gnss_wander_std_m > 0.0,
-        crate::gyro_drift::carries_bias(n),
-    ) {
-        (false, false) => {
-            evaluate_in::<CarLayout, 5>(drive, params, outage_s, step_s, warmup_s, base, use_truth)
-        }
-        (true, false) => evaluate_in::<CarWanderLayout, N_WANDER>(
-            drive, params, outage_s, step_s, warmup_s, base, use_truth,
-        ),
-        (false, true) => evaluate_in::<CarBiasLayout, N_BIAS>(
-            drive, params, outage_s, step_s, warmup_s, base, use_truth,
-        ),
-        (true, true) => evaluate_in::<CarWanderBiasLayout, N_WANDER_BIAS>(
-            drive, params, outage_s, step_s, warmup_s, base, use_truth,
-        ),
-    }
+    evaluate_in(drive, params, outage_s, step_s, warmup_s, base, use_truth)
 }
 
-/// [`evaluate`] with the aided filter of layout `L`.
-fn evaluate_in<L: Layout<N>, const N: usize>(
+/// [`evaluate`] with the aided filter the vehicle calls for ([`Aided`]).
+fn evaluate_in(
     drive: &Drive,
     params: &Params,
     outage_s: f64,
@@ -315,18 +274,13 @@ fn evaluate_in<L: Layout<N>, const N: usize>(
         record_innovations: false,
         ..base.clone()
     };
-    let mut aided = Aided {
+    let mut aided = AidedPass {
         first_t: f64::NAN,
         last_t: f64::NAN,
         moving_t: None,
         yaw_var: Vec::new(),
     };
-    ekf::run_filter(
-        drive,
-        ekf::fixed_filter::<L, N>(drive, params, &aided_opts)?,
-        &aided_opts,
-        &mut aided,
-    )?;
+    Aided::run(drive, params, &aided_opts, &mut |e| aided.after_epoch(e))?;
     if aided.first_t.is_nan() {
         return Err(Need::FilterEpochs.into());
     }
@@ -359,10 +313,9 @@ fn evaluate_in<L: Layout<N>, const N: usize>(
     // to the window's end. The clone keeps what the aided run had learnt, the
     // wheel monitor's verdicts included (a fresh filter started from the
     // aided state forgot that a wheel was out).
-    let mut f = ekf::fixed_filter::<L, N>(drive, params, &aided_opts)?;
-    let (mut feeder, mut events) = ekf::feed(drive, &aided_opts, f.time_s());
+    let (mut f, mut events) = Aided::on_drive(drive, params, &aided_opts)?;
     let mut upcoming = events.next();
-    let mut noop = |_: &mut Filter<L, N>, _: EpochOut<'_, N>| {};
+    let mut noop = |_: &AidedEpoch| {};
     let mut windows = Vec::new();
     let mut unsettled = Vec::new();
     let mut gates = GateCounts::default();
@@ -370,39 +323,40 @@ fn evaluate_in<L: Layout<N>, const N: usize>(
         let end = start + outage_s;
         // Every epoch at or before the start, then the pending ones.
         while let Some(ev) = upcoming.filter(|e| e.t_s <= start) {
-            feeder.push(&mut f, ev, &mut noop)?;
+            f.push(ev, &mut noop)?;
             upcoming = events.next();
         }
-        feeder.finish(&mut f, &mut noop)?;
+        f.finish(&mut noop)?;
         let t0 = f.time_s();
-        let yaw_std = f.covariance()[(YAW, YAW)].max(0.0).sqrt();
-        let before = *f.gates();
-        let (mut g, mut fd, mut evs, mut next) =
-            (f.clone(), feeder.clone(), events.clone(), upcoming);
-        fd.dead_reckon();
+        let yaw_std = f
+            .now()
+            .map_or(f64::NAN, |e| e.p[(YAW, YAW)].max(0.0).sqrt());
+        let before = f.gates();
+        let (mut g, mut evs, mut next) = (f.clone(), events.clone(), upcoming);
+        g.dead_reckon();
         let mut states: Vec<(f64, State)> = Vec::new();
         let mut wander: Vec<[f64; 2]> = Vec::new();
         let mut covs: Vec<[[f64; 3]; 3]> = Vec::new();
         let mut wander_covs: Vec<WanderCov> = Vec::new();
-        let mut keep = |g: &mut Filter<L, N>, _: EpochOut<'_, N>| {
-            states.push((g.time_s(), g.car_state()));
-            wander.push(g.wander_m());
-            covs.push(pose_block(g.covariance()));
-            if let Some(w) = L::wander_index() {
-                wander_covs.push(WanderCov::of(g.covariance(), w));
+        let mut keep = |e: &AidedEpoch| {
+            states.push((e.t_s, e.x));
+            wander.push(e.wander_m);
+            covs.push(pose_block(&e.p));
+            if let Some(w) = e.wander_cov {
+                wander_covs.push(w);
             }
         };
         while let Some(ev) = next.filter(|e| e.t_s <= end) {
-            fd.push(&mut g, ev, &mut keep)?;
+            g.push(ev, &mut keep)?;
             next = evs.next();
         }
-        fd.finish(&mut g, &mut keep)?;
+        g.finish(&mut keep)?;
         gates.add(&g.gates().since(&before));
         // The bound's floor: the declared accuracy of the last fix handed
         // over; none where the filter carries the receiver's wander (its
         // covariance holds the offset then: counted once).
         let handed = drive.gnss.partition_point(|g| g.t_s <= start);
-        let receiver = Cov2::circular(if L::wander_index().is_some() {
+        let receiver = Cov2::circular(if f.carries_wander() {
             0.0
         } else {
             handed
@@ -430,11 +384,11 @@ fn evaluate_in<L: Layout<N>, const N: usize>(
     }
     // The aided run's own counts, through the end of the drive.
     while let Some(ev) = upcoming {
-        feeder.push(&mut f, ev, &mut noop)?;
+        f.push(ev, &mut noop)?;
         upcoming = events.next();
     }
-    feeder.finish(&mut f, &mut noop)?;
-    gates.add(f.gates());
+    f.finish(&mut noop)?;
+    gates.add(&f.gates());
     if windows.is_empty() && unsettled.is_empty() {
         return Err(Need::OutageWindow {
             outage_s,
@@ -460,6 +414,7 @@ fn evaluate_in<L: Layout<N>, const N: usize>(
         gates,
         unsettled,
         heading_limit_rad: heading_limit,
+        bias_switch: f.bias_switch(),
     })
 }
 
@@ -650,18 +605,15 @@ fn through_windows_in(
         record_epochs: false,
         ..base.clone()
     };
-    // The gyro bias walks and the receiver's wander is carried where the
+    // The gyro bias and the receiver's wander are carried where the
     // vehicle says so, as in `evaluate`, `run`'s tracks and `stream`.
-    let n = &drive.vehicle.noise;
-    let (stats, hook) = match (
-        n.gnss_wander_std_m > 0.0,
-        crate::gyro_drift::carries_bias(n),
-    ) {
-        (false, false) => collect::<CarLayout, 5>(drive, params, &opts)?,
-        (true, false) => collect::<CarWanderLayout, N_WANDER>(drive, params, &opts)?,
-        (false, true) => collect::<CarBiasLayout, N_BIAS>(drive, params, &opts)?,
-        (true, true) => collect::<CarWanderBiasLayout, N_WANDER_BIAS>(drive, params, &opts)?,
-    };
+    let mut hook = Collect::default();
+    let aided = Aided::run(drive, params, &opts, &mut |e| {
+        hook.states.push((e.t_s, e.x));
+        if e.wander_cov.is_some() {
+            hook.wander.push(e.wander_m);
+        }
+    })?;
     let mut out = Vec::new();
     for &(a, b) in windows {
         // Dead reckoning starts at the last epoch before the window.
@@ -691,28 +643,19 @@ fn through_windows_in(
         outage_s: windows.iter().map(|w| w.1 - w.0).fold(0.0, f64::max),
         reference,
         windows: out,
-        gates: stats.gates,
+        gates: aided.gates(),
         unsettled: Vec::new(),
         heading_limit_rad: f64::INFINITY,
+        bias_switch: aided.bias_switch(),
     })
 }
 
-/// The filter of layout `L` run over `drive` with `opts`, collecting every
-/// epoch's car state and wander: its counters and what was collected.
-fn collect<L: Layout<N>, const N: usize>(
-    drive: &Drive,
-    params: &Params,
-    opts: &FilterOptions,
-) -> Result<(ekf::FilterStats, Collect), Error> {
-    let mut hook = Collect::of::<L, N>();
-    let stats = ekf::run_filter(
-        drive,
-        ekf::fixed_filter::<L, N>(drive, params, opts)?,
-        opts,
-        &mut hook,
-    )?
-    .stats;
-    Ok((stats, hook))
+/// Every epoch's time and car state, and the receiver's wander estimate
+/// where the filter carries it.
+#[derive(Default)]
+struct Collect {
+    states: Vec<(f64, State)>,
+    wander: Vec<[f64; 2]>,
 }
 
 #[cfg(test)]

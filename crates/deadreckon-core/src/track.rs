@@ -2,13 +2,11 @@
 //! reads; and the tracks of a drive ([`drive_tracks`]): dead-reckoned, with GNSS
 //! the filtered and smoothed ones, and the truth as a track of its own.
 
+use crate::aided::{Aided, BiasSwitch};
 use crate::ekf::{self, FilterOptions, Init, SensorSet};
-use crate::filter::{CarLayout, Layout};
-use crate::gnss_error::{CarWanderLayout, N_WANDER};
-use crate::gyro_drift::{CarBiasLayout, CarWanderBiasLayout, N_BIAS, N_WANDER_BIAS};
 use crate::model::{Mat, State};
 use crate::vehicle::Origin;
-use crate::{rts, Drive, Error, Need, Params};
+use crate::{Drive, Error, Need, Params};
 
 /// The names of the tracks [`drive_tracks`] builds, in its order.
 pub mod names {
@@ -194,70 +192,69 @@ pub fn drive_tracks(
     opts: &FilterOptions,
     init_pose: Option<(f64, f64, f64)>,
 ) -> Result<Vec<Track>, Error> {
+    Ok(drive_tracks_and_switch(drive, params, opts, init_pose)?.0)
+}
+
+/// [`drive_tracks`], and what the aided run's gyro-bias switch saw
+/// (`None` without one or without GNSS: [`crate::aided::switch`]).
+pub fn drive_tracks_and_switch(
+    drive: &Drive,
+    params: &Params,
+    opts: &FilterOptions,
+    init_pose: Option<(f64, f64, f64)>,
+) -> Result<(Vec<Track>, Option<BiasSwitch>), Error> {
     let mut out = Vec::new();
     let mut smoothed_start = None;
+    let mut switch = None;
     if drive.gnss.len() >= 2 {
-        let n = &drive.vehicle.noise;
-        let (filtered, smoothed, start) = match (
-            n.gnss_wander_std_m > 0.0,
-            crate::gyro_drift::carries_bias(n),
-        ) {
-            (false, false) => aided_tracks::<CarLayout, 5>(drive, params, opts)?,
-            (false, true) => aided_tracks::<CarBiasLayout, N_BIAS>(drive, params, opts)?,
-            (true, false) => aided_tracks::<CarWanderLayout, N_WANDER>(drive, params, opts)?,
-            (true, true) => {
-                aided_tracks::<CarWanderBiasLayout, N_WANDER_BIAS>(drive, params, opts)?
-            }
-        };
+        let (filtered, smoothed, start, s) = aided_tracks(drive, params, opts)?;
         smoothed_start = start;
+        switch = s;
         out.push(filtered);
         out.push(smoothed);
     }
     let init = dead_reckoning_init(drive, init_pose, smoothed_start)?;
     out.insert(0, dead_reckoned(drive, params, opts, init)?);
-    Ok(out)
+    Ok((out, switch))
 }
 
-/// The filtered and smoothed tracks of the GNSS-aided filter of layout `L`
-/// (a walking gyro bias: [`crate::gyro_drift`]; the receiver's wander:
-/// [`crate::gnss_error`], smoothed with its `φ`), and the smoothed start's
-/// car state.
+/// The filtered and smoothed tracks of the GNSS-aided filter the vehicle
+/// calls for ([`crate::aided`]: a gyro bias state, [`crate::gyro_drift`];
+/// the receiver's wander, [`crate::gnss_error`], smoothed with its `φ`),
+/// the smoothed start's car state, and the gyro-bias switch's report.
 #[allow(clippy::type_complexity)]
-fn aided_tracks<L: Layout<N>, const N: usize>(
+fn aided_tracks(
     drive: &Drive,
     params: &Params,
     opts: &FilterOptions,
-) -> Result<(Track, Track, Option<(f64, State, Mat)>), Error> {
+) -> Result<(Track, Track, Option<(f64, State, Mat)>, Option<BiasSwitch>), Error> {
     let opts = FilterOptions {
         record_epochs: true,
         ..opts.clone()
     };
-    let f = ekf::run_filter(
-        drive,
-        ekf::fixed_filter::<L, N>(drive, params, &opts)?,
-        &opts,
-        &mut (),
-    )?;
-    let wander = L::wander_index().map(|index| rts::WanderStates {
-        index,
-        wander: crate::gnss_error::Wander {
-            std_m: drive.vehicle.noise.gnss_wander_std_m,
-            tau_s: drive.vehicle.noise.gnss_wander_tau_s,
-        },
-    });
-    let s = rts::smooth_carrying(&f.epochs, wander)?;
-    let start = s.first().map(|s| {
-        (
-            s.t_s,
-            s.x.fixed_rows::<5>(0).into_owned(),
-            s.p.fixed_view::<5, 5>(0, 0).into_owned(),
-        )
-    });
+    let mut filtered = Vec::new();
+    let f = Aided::run(drive, params, &opts, &mut |e| {
+        filtered.push(TrackPoint::from_state(e.t_s, &e.x, &e.p))
+    })?;
+    let s = f.smoothed()?;
+    let start = s.first().copied();
     let origin = drive.vehicle.origin;
     Ok((
-        Track::from_epochs(names::FILTERED, &f.epochs, origin),
-        Track::from_smoothed(names::SMOOTHED, &s, origin),
+        Track {
+            name: names::FILTERED.into(),
+            points: filtered,
+            origin,
+        },
+        Track {
+            name: names::SMOOTHED.into(),
+            points: s
+                .iter()
+                .map(|(t, x, p)| TrackPoint::from_state(*t, x, p))
+                .collect(),
+            origin,
+        },
         start,
+        f.bias_switch(),
     ))
 }
 

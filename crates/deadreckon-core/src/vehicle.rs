@@ -3,6 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::gyro_switch_defaults as defaults;
 use crate::{Error, Rule, Value};
 
 /// A geodetic origin for drives recorded in latitude/longitude: the point
@@ -107,16 +108,22 @@ pub struct Noise {
     /// bias the fixes last showed instead of the calibration drive's mean.
     #[serde(skip_serializing_if = "is_zero")]
     pub gyro_bias_walk_rps_per_sqrt_s: f64,
-    /// How far the gyro bias may be on a drive from the calibrated one,
-    /// rad/s (default 0: the calibrated constant, the paper's model). A
-    /// gyro's bias changes between drives (its turn-on repeatability and
-    /// temperature) by more than it moves within one: above 0 the aided
-    /// filter carries the bias as a state that starts at the calibrated
-    /// value with this standard deviation (and walks by
-    /// `gyro_bias_walk_rps_per_sqrt_s`, if set), so each drive's fixes
-    /// re-learn it ([`crate::gyro_drift`]).
-    #[serde(skip_serializing_if = "is_zero")]
+    /// How far the gyro bias may be on a drive from the calibrated one
+    /// (turn-on repeatability, temperature), rad/s (default
+    /// [`crate::aided::switch::DEFAULT_DRIVE_STD_RPS`]; 0: the calibrated
+    /// constant, the paper's model): the aided filter's bias state starts at
+    /// the calibrated value with this std, so each drive's fixes re-learn
+    /// it, once the switch below says so ([`crate::gyro_drift`]).
+    #[serde(skip_serializing_if = "defaults::is_default_drive_std")]
     pub gyro_bias_drive_std_rps: f64,
+    /// The gyro-bias switch's threshold, a log-likelihood ratio (default
+    /// [`crate::aided::switch::DEFAULT_THRESHOLD_LLR`]; 0: no switch, the
+    /// bias a state from the start where the keys above say so): the
+    /// constant's state until the drive's fixes, one fix ahead, favour the
+    /// bias state by this much, the state's from then on
+    /// ([`crate::aided::switch`]).
+    #[serde(skip_serializing_if = "defaults::is_default_switch_llr")]
+    pub gyro_bias_switch_llr: f64,
     /// The yaw rate's process noise per `process_step_s` at a wheel epoch
     /// without a gyro reading of its own while the gyro is live, rad/s
     /// (default 0: `process_yaw_rate_rps`, table I's, at every epoch).
@@ -264,7 +271,8 @@ impl Default for Noise {
             gnss_wander_tau_s: DEFAULT_GNSS_WANDER_TAU_S,
             gyro_bias_walk_rps_per_sqrt_s: 0.0,
             gyro_gap_process_yaw_rate_rps: 0.0,
-            gyro_bias_drive_std_rps: 0.0,
+            gyro_bias_drive_std_rps: defaults::DEFAULT_DRIVE_STD_RPS,
+            gyro_bias_switch_llr: defaults::DEFAULT_THRESHOLD_LLR,
             wheel_gate_chi2: GROSS_FAULT_CHI2,
             gyro_gate_chi2: GROSS_FAULT_CHI2,
             speed_gate_chi2: GROSS_FAULT_CHI2,
@@ -527,24 +535,27 @@ impl Vehicle {
                 },
             ));
         }
-        if !(n.gyro_bias_walk_rps_per_sqrt_s.is_finite() && n.gyro_bias_walk_rps_per_sqrt_s >= 0.0)
-        {
-            return Err(Error::vehicle(
+        for (k, v, zero_means) in [
+            (
                 "noise.gyro_bias_walk_rps_per_sqrt_s",
                 n.gyro_bias_walk_rps_per_sqrt_s,
-                Rule::NonNegative {
-                    zero_means: Some("a constant bias"),
-                },
-            ));
-        }
-        if !(n.gyro_bias_drive_std_rps.is_finite() && n.gyro_bias_drive_std_rps >= 0.0) {
-            return Err(Error::vehicle(
+                "a constant bias",
+            ),
+            (
                 "noise.gyro_bias_drive_std_rps",
                 n.gyro_bias_drive_std_rps,
-                Rule::NonNegative {
-                    zero_means: Some("the calibrated bias"),
-                },
-            ));
+                "the calibrated bias",
+            ),
+            (
+                "noise.gyro_bias_switch_llr",
+                n.gyro_bias_switch_llr,
+                "no switch",
+            ),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                let zero_means = Some(zero_means);
+                return Err(Error::vehicle(k, v, Rule::NonNegative { zero_means }));
+            }
         }
         if !(n.gyro_gap_process_yaw_rate_rps.is_finite() && n.gyro_gap_process_yaw_rate_rps >= 0.0)
         {

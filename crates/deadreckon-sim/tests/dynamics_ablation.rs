@@ -92,6 +92,11 @@ fn ablate(car: &DynamicCar, effects: Option<&Effects>, drive_s: f64, walk: f64) 
     let mut ev = simulate(&scenario(2000 + seed), 2000 + seed)
         .map_err(|e| format!("evaluation drive: {e}"))?;
     ev.drive.vehicle.noise.gyro_bias_walk_rps_per_sqrt_s = walk;
+    // The paper's constant bias (or the walk alone), not the default
+    // gyro-bias switch: these figures are what each effect costs the
+    // paper's filter (the switch's are in bias_switch.rs).
+    ev.drive.vehicle.noise.gyro_bias_drive_std_rps = 0.0;
+    ev.drive.vehicle.noise.gyro_bias_switch_llr = 0.0;
     let c = calibrate(&cal.drive, &CalibrationOptions::default())
         .map_err(|e| format!("calibration: {e}"))?;
     let out = evaluate(

@@ -35,7 +35,9 @@
 //!   0.427, 0.532 m. The walk at 3e-6 with 2e-4: 0.434, 0.523 m.
 //!
 //! Nothing here is a default: every figure is with `--corrections` none
-//! and the core calibration, for the choice of what to build next.
+//! and the core calibration, for the choice of what to build next. What
+//! was built on it, the causal gyro-bias switch on the evaluation drive's
+//! running ratio (on by default), is measured in `bias_switch.rs`.
 
 use rayon::prelude::*;
 

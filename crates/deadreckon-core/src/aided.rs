@@ -1,0 +1,366 @@
+//! The GNSS-aided filter of the layout the vehicle's noise settings call
+//! for, as one object: every place that runs the aided filter over a drive
+//! or a stream (the outage evaluation, `run`'s tracks, the NEES, the online
+//! filter) goes through [`Aided`], so a choice of layout is made here once.
+//!
+//! | `[noise]` | layout |
+//! |---|---|
+//! | neither | the car's five states ([`CarLayout`]) |
+//! | `gnss_wander_std_m` > 0 | the receiver's wander ([`crate::gnss_error`]) |
+//! | a gyro bias walk or drive std > 0 ([`crate::gyro_drift::carries_bias`]) | the gyro bias as a state |
+//! | both | the wander and the gyro bias |
+//!
+//! With the bias as a state and `[noise] gyro_bias_switch_llr` above 0, the
+//! constant bias and the bias as a state run side by side and the drive's
+//! own fixes choose between them ([`switch`]: the gyro-bias switch).
+//!
+//! An epoch hands out an [`AidedEpoch`]: the car's block of the state and
+//! covariance, and the receiver's wander where carried, whatever the layout.
+
+use serde::{Deserialize, Serialize};
+
+use crate::bound::WanderCov;
+use crate::drive::Drive;
+use crate::ekf::{self, Epoch, EpochOut, Event, Feeder, FilterOptions, FilterStats};
+use crate::event::DriveEvents;
+use crate::filter::{CarLayout, Filter, GateCounts, Layout};
+use crate::gnss_error::{CarWanderLayout, N_WANDER};
+use crate::gyro_drift::{CarBiasLayout, CarWanderBiasLayout, N_BIAS, N_WANDER_BIAS};
+use crate::model::{Mat, State};
+use crate::vehicle::{Noise, Params, Vehicle};
+use crate::Error;
+
+pub mod switch;
+
+pub use switch::BiasSwitch;
+use switch::Switch;
+
+/// What one epoch of the aided filter hands out, of any layout.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AidedEpoch {
+    /// The epoch's time, s.
+    pub t_s: f64,
+    /// The car's block of the state `[x, y, ψ, v, ψ̇]`.
+    pub x: State,
+    /// The car's block of the covariance.
+    pub p: Mat,
+    /// The receiver's wander estimate `[e_E, e_N]`, m (zeros when not carried).
+    pub wander_m: [f64; 2],
+    /// The wander's part of the covariance, where carried.
+    pub(crate) wander_cov: Option<WanderCov>,
+}
+
+impl AidedEpoch {
+    fn of<L: Layout<N>, const N: usize>(f: &Filter<L, N>) -> Self {
+        let p = f.covariance();
+        AidedEpoch {
+            t_s: f.time_s(),
+            x: f.car_state(),
+            p: p.fixed_view::<{ crate::model::N }, { crate::model::N }>(0, 0)
+                .into_owned(),
+            wander_m: f.wander_m(),
+            wander_cov: L::wander_index().map(|w| WanderCov::of(p, w)),
+        }
+    }
+}
+
+/// One filter of layout `L` with its feeder, and its epochs when recorded
+/// (for the smoother).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(bound = "")]
+pub struct Run<L: Layout<N>, const N: usize> {
+    filter: Filter<L, N>,
+    feeder: Feeder,
+    #[serde(skip)]
+    epochs: Option<Vec<Epoch<N>>>,
+}
+
+impl<L: Layout<N>, const N: usize> Run<L, N> {
+    fn start(
+        vehicle: &Vehicle,
+        params: &Params,
+        opts: &FilterOptions,
+        (t0, x0, p0): (f64, State, Mat),
+    ) -> Result<Self, Error> {
+        // A gyro bias state starts at the calibrated value (crate::gyro_drift).
+        let prior = L::bias_walks().then(|| crate::gyro_drift::prior_std(&vehicle.noise));
+        let filter = Filter::<L, N>::new(vehicle, params, prior.as_ref(), t0, x0, p0)?
+            .with_covariance_form(opts.covariance_form);
+        Ok(Run {
+            feeder: Feeder::new(opts, t0),
+            filter,
+            epochs: opts.record_epochs.then(Vec::new),
+        })
+    }
+
+    /// Feeds one event; `epoch` after every epoch it completes.
+    fn push_raw(
+        &mut self,
+        ev: Event,
+        epoch: &mut dyn FnMut(&Filter<L, N>, &EpochOut<'_, N>),
+    ) -> Result<(), Error> {
+        let epochs = &mut self.epochs;
+        self.feeder.push(&mut self.filter, ev, &mut |f, e| {
+            record(epochs, f, &e);
+            epoch(f, &e)
+        })
+    }
+
+    /// Runs what is waiting.
+    fn finish_raw(
+        &mut self,
+        epoch: &mut dyn FnMut(&Filter<L, N>, &EpochOut<'_, N>),
+    ) -> Result<(), Error> {
+        let epochs = &mut self.epochs;
+        self.feeder.finish(&mut self.filter, &mut |f, e| {
+            record(epochs, f, &e);
+            epoch(f, &e)
+        })
+    }
+
+    fn push(&mut self, ev: Event, epoch: &mut dyn FnMut(&AidedEpoch)) -> Result<(), Error> {
+        self.push_raw(ev, &mut |f, _| epoch(&AidedEpoch::of(f)))
+    }
+
+    fn finish(&mut self, epoch: &mut dyn FnMut(&AidedEpoch)) -> Result<(), Error> {
+        self.finish_raw(&mut |f, _| epoch(&AidedEpoch::of(f)))
+    }
+
+    fn dead_reckon(&mut self) {
+        self.feeder.dead_reckon()
+    }
+
+    fn time_s(&self) -> f64 {
+        self.filter.time_s()
+    }
+
+    fn now(&self) -> Option<AidedEpoch> {
+        Some(AidedEpoch::of(&self.filter))
+    }
+
+    fn gates(&self) -> GateCounts {
+        *self.filter.gates()
+    }
+
+    fn stats(&self) -> FilterStats {
+        self.feeder.stats_with(&self.filter)
+    }
+
+    /// The RTS-smoothed car blocks of the recorded epochs (none unless
+    /// recorded), with the receiver's wander smoothed with its `φ`.
+    fn smoothed(&self) -> Result<Vec<(f64, State, Mat)>, Error> {
+        let Some(epochs) = &self.epochs else {
+            return Ok(Vec::new());
+        };
+        let n = self.filter.noise();
+        let wander = L::wander_index().map(|index| crate::rts::WanderStates {
+            index,
+            wander: crate::gnss_error::Wander {
+                std_m: n.gnss_wander_std_m,
+                tau_s: n.gnss_wander_tau_s,
+            },
+        });
+        Ok(crate::rts::smooth_carrying(epochs, wander)?
+            .iter()
+            .map(|s| {
+                (
+                    s.t_s,
+                    s.x.fixed_rows::<{ crate::model::N }>(0).into_owned(),
+                    s.p.fixed_view::<{ crate::model::N }, { crate::model::N }>(0, 0)
+                        .into_owned(),
+                )
+            })
+            .collect())
+    }
+}
+
+/// Keeps the epoch for the smoother when recording.
+fn record<L: Layout<N>, const N: usize>(
+    epochs: &mut Option<Vec<Epoch<N>>>,
+    f: &Filter<L, N>,
+    e: &EpochOut<'_, N>,
+) {
+    if let (Some(v), Some(prediction)) = (epochs.as_mut(), e.prediction) {
+        v.push(Epoch::after(f, prediction));
+    }
+}
+
+/// The GNSS-aided filter of the layout the vehicle's noise settings call
+/// for (see the module documentation), with its feeder. Serialisable: the
+/// online filter stops and resumes through it (the variants keep the names
+/// the online filter's stages had).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum Aided {
+    /// The car's five states.
+    Car(Box<Run<CarLayout, { crate::model::N }>>),
+    /// The gyro bias as a state ([`crate::gyro_drift`]).
+    #[serde(rename = "Walking")]
+    Bias(Box<Run<CarBiasLayout, N_BIAS>>),
+    /// The receiver's wander ([`crate::gnss_error`]).
+    Wander(Box<Run<CarWanderLayout, N_WANDER>>),
+    /// The receiver's wander and the gyro bias.
+    #[serde(rename = "WanderWalking")]
+    WanderBias(Box<Run<CarWanderBiasLayout, N_WANDER_BIAS>>),
+    /// The constant bias and the bias as a state, switched by the fixes
+    /// ([`switch`]).
+    Switched(Box<Switch<CarLayout, { crate::model::N }, CarBiasLayout, N_BIAS>>),
+    /// The same with the receiver's wander in both.
+    WanderSwitched(Box<Switch<CarWanderLayout, N_WANDER, CarWanderBiasLayout, N_WANDER_BIAS>>),
+}
+
+/// `$body` with `$run` bound to the [`Run`] of whichever layout.
+macro_rules! each {
+    ($aided:expr, |$run:ident| $body:expr) => {
+        match $aided {
+            Aided::Car($run) => $body,
+            Aided::Bias($run) => $body,
+            Aided::Wander($run) => $body,
+            Aided::WanderBias($run) => $body,
+            Aided::Switched($run) => $body,
+            Aided::WanderSwitched($run) => $body,
+        }
+    };
+}
+
+impl Aided {
+    /// The aided filter `vehicle`'s noise settings call for, started at
+    /// `start` (time, car state, covariance) with `params`; `opts` as for
+    /// [`Feeder::new`] (epochs are kept for [`Aided::smoothed`] when
+    /// `opts.record_epochs`).
+    pub fn start(
+        vehicle: &Vehicle,
+        params: &Params,
+        opts: &FilterOptions,
+        start: (f64, State, Mat),
+    ) -> Result<Self, Error> {
+        let n = &vehicle.noise;
+        if crate::gyro_drift::carries_bias(n) && n.gyro_bias_switch_llr > 0.0 {
+            // The constant hypothesis: the same vehicle with the paper's bias.
+            let mut constant = vehicle.clone();
+            constant.noise.gyro_bias_walk_rps_per_sqrt_s = 0.0;
+            constant.noise.gyro_bias_drive_std_rps = 0.0;
+            let threshold = n.gyro_bias_switch_llr;
+            return Ok(if carries_wander(n) {
+                Aided::WanderSwitched(Box::new(Switch::new(
+                    Run::start(&constant, params, opts, start)?,
+                    Run::start(vehicle, params, opts, start)?,
+                    threshold,
+                )))
+            } else {
+                Aided::Switched(Box::new(Switch::new(
+                    Run::start(&constant, params, opts, start)?,
+                    Run::start(vehicle, params, opts, start)?,
+                    threshold,
+                )))
+            });
+        }
+        Ok(
+            match (carries_wander(n), crate::gyro_drift::carries_bias(n)) {
+                (false, false) => Aided::Car(Box::new(Run::start(vehicle, params, opts, start)?)),
+                (false, true) => Aided::Bias(Box::new(Run::start(vehicle, params, opts, start)?)),
+                (true, false) => Aided::Wander(Box::new(Run::start(vehicle, params, opts, start)?)),
+                (true, true) => {
+                    Aided::WanderBias(Box::new(Run::start(vehicle, params, opts, start)?))
+                }
+            },
+        )
+    }
+
+    /// The aided filter on `drive` at the start `opts.init` gives, and the
+    /// drive's events it needs (as [`ekf::feed`]).
+    pub fn on_drive<'a>(
+        drive: &'a Drive,
+        params: &Params,
+        opts: &FilterOptions,
+    ) -> Result<(Self, DriveEvents<'a>), Error> {
+        let start = ekf::start(drive, opts)?;
+        let a = Self::start(&drive.vehicle, params, opts, start)?;
+        let (_, events) = ekf::feed(drive, opts, start.0);
+        Ok((a, events))
+    }
+
+    /// The batch loop: the aided filter over every event of `drive` up to
+    /// `opts.end_s`, `epoch` after each epoch; the filter at the end.
+    pub fn run(
+        drive: &Drive,
+        params: &Params,
+        opts: &FilterOptions,
+        epoch: &mut dyn FnMut(&AidedEpoch),
+    ) -> Result<Self, Error> {
+        let (mut a, events) = Self::on_drive(drive, params, opts)?;
+        let end = opts.end_s.unwrap_or(f64::INFINITY);
+        for ev in events.take_while(|e| e.t_s <= end) {
+            a.push(ev, epoch)?;
+        }
+        a.finish(epoch)?;
+        Ok(a)
+    }
+
+    /// Takes one event (timestamps must not decrease); `epoch` after every
+    /// epoch it completes.
+    pub fn push(&mut self, ev: Event, epoch: &mut dyn FnMut(&AidedEpoch)) -> Result<(), Error> {
+        each!(self, |r| r.push(ev, epoch))
+    }
+
+    /// Runs what is still waiting (at the end of a stream, or before a
+    /// clone dead-reckons).
+    pub fn finish(&mut self, epoch: &mut dyn FnMut(&AidedEpoch)) -> Result<(), Error> {
+        each!(self, |r| r.finish(epoch))
+    }
+
+    /// From now on no GNSS ([`Feeder::dead_reckon`]).
+    pub fn dead_reckon(&mut self) {
+        each!(self, |r| r.dead_reckon())
+    }
+
+    /// The filter's time, s.
+    pub fn time_s(&self) -> f64 {
+        each!(self, |r| r.time_s())
+    }
+
+    /// The current state as an epoch hands it out.
+    pub fn now(&self) -> Option<AidedEpoch> {
+        each!(self, |r| r.now())
+    }
+
+    /// The χ² gate counters so far (of the hypothesis handed out, with the
+    /// gyro-bias switch).
+    pub fn gates(&self) -> GateCounts {
+        each!(self, |r| r.gates())
+    }
+
+    /// The feeder's counters with the filter's gate counters folded in.
+    pub fn stats(&self) -> FilterStats {
+        each!(self, |r| r.stats())
+    }
+
+    /// What the gyro-bias switch has seen (`None` without one).
+    pub fn bias_switch(&self) -> Option<BiasSwitch> {
+        match self {
+            Aided::Switched(s) => Some(s.report()),
+            Aided::WanderSwitched(s) => Some(s.report()),
+            _ => None,
+        }
+    }
+
+    /// Whether the layout carries the receiver's wander.
+    pub fn carries_wander(&self) -> bool {
+        matches!(
+            self,
+            Aided::Wander(_) | Aided::WanderBias(_) | Aided::WanderSwitched(_)
+        )
+    }
+
+    /// The RTS-smoothed car blocks of the recorded epochs (empty unless
+    /// started with `opts.record_epochs`); with the gyro-bias switch, of
+    /// the hypothesis the drive ended with (the state's over the whole
+    /// drive once it fired: the smoother sees every fix anyway).
+    pub fn smoothed(&self) -> Result<Vec<(f64, State, Mat)>, Error> {
+        each!(self, |r| r.smoothed())
+    }
+}
+
+/// Whether the aided filter carries the receiver's wander.
+fn carries_wander(noise: &Noise) -> bool {
+    noise.gnss_wander_std_m > 0.0
+}
