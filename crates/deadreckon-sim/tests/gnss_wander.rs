@@ -199,11 +199,15 @@ fn the_wander_states_cut_the_outage_error_of_a_wandering_receiver() {
     let setups = [(Model::White, 0.0), (Model::Fitted, 0.0)];
     let rows = table(&DEV, &effects, &setups, DRIVE_S);
     print("wander only, cars 1–6", &DEV, &setups, &rows);
-    // Measured (cars 1–6, 300 s): white 1.995 m, fitted 1.669 m (every car
-    // better; the drawn σ and τ give 1.574 m).
+    // Measured (cars 1–6, 300 s): white 2.143 m, fitted 1.655 m (every car
+    // better; the drawn σ and τ gave 1.574 m). With the gyro-bias switch
+    // on by default (stop 35, `deadreckon_core::aided::switch`): before
+    // it, white 1.995 m and fitted 1.669 m. On a wandering receiver taken
+    // as white fixes the switch reads part of the wander as a bias that
+    // differs and costs 7 %; with the wander carried it does not.
     let (white, fitted) = (mean(&rows[0]), mean(&rows[1]));
-    assert!((white - 1.995).abs() < 0.05, "{white}");
-    assert!((fitted - 1.669).abs() < 0.05, "{fitted}");
+    assert!((white - 2.143).abs() < 0.05, "{white}");
+    assert!((fitted - 1.655).abs() < 0.05, "{fitted}");
     for (w, f) in rows[0].iter().zip(&rows[1]) {
         let (w, f) = (w.as_ref().unwrap(), f.as_ref().unwrap());
         assert!(f.mean_m < w.mean_m, "{} vs {}", f.mean_m, w.mean_m);
