@@ -201,7 +201,7 @@ fn the_wander_states_cut_the_outage_error_of_a_wandering_receiver() {
     print("wander only, cars 1–6", &DEV, &setups, &rows);
     // Measured (cars 1–6, 300 s): white 2.143 m, fitted 1.655 m (every car
     // better; the drawn σ and τ gave 1.574 m). With the gyro-bias switch
-    // on by default (stop 35, `deadreckon_core::aided::switch`): before
+    // on by default (this stop, `deadreckon_core::aided::switch`): before
     // it, white 1.995 m and fitted 1.669 m. On a wandering receiver taken
     // as white fixes the switch reads part of the wander as a bias that
     // differs and costs 7 %; with the wander carried it does not.
