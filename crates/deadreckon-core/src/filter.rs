@@ -518,6 +518,23 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
         })
     }
 
+    /// A standing car does not turn: the pseudo-measurement `ψ̇ = 0` with
+    /// standard deviation [`crate::standstill::STANDSTILL_YAW_RATE_STD_RPS`]
+    /// ([`crate::standstill`]). Not gated and not counted: it is the
+    /// model's, not a sensor's.
+    pub fn update_standstill(&mut self) -> Result<(), Error> {
+        let r = crate::standstill::STANDSTILL_YAW_RATE_STD_RPS.powi(2);
+        let y = -self.x[model::YAW_RATE];
+        let pre =
+            kalman::ScalarInnovation::sparse(&self.p, &[(model::YAW_RATE, 1.0)], r, y, self.t_s)?;
+        match self.held() {
+            None => pre.apply(&mut self.x, &mut self.p, kalman::CovarianceForm::Joseph),
+            Some(hold) => pre.apply_holding(&mut self.x, &mut self.p, &hold),
+        }
+        self.refresh_params();
+        Ok(())
+    }
+
     /// Eq. (6)/(8): the ticks of wheel `i` over `interval_s`. `None` when the
     /// wheel has no sensor (`wheels_present`) or is out of the fusion
     /// ([`Filter::set_wheel_excluded`]).

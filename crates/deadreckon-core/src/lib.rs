@@ -64,6 +64,7 @@ pub mod reference;
 pub mod rts;
 mod series;
 pub mod side_slip;
+pub mod standstill;
 mod status;
 pub mod tick_interval;
 pub mod timing;

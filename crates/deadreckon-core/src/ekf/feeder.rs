@@ -11,6 +11,7 @@ use crate::event::{Event, Measurement};
 use crate::filter::{Filter, Layout, Prediction, SensorKind, Update};
 use crate::gyro_hold::GyroHold;
 use crate::model::Mat;
+use crate::standstill::Standstill;
 use crate::tick_interval::CountingInterval;
 use crate::wheel_health::{WheelHealth, WheelMonitor, WheelReading};
 use crate::Error;
@@ -75,6 +76,9 @@ pub struct Feeder {
     /// for the next wheel row's update at its time.
     #[serde(default)]
     held: Option<HeldEpoch>,
+    /// Whether the car stands ([`crate::standstill`]).
+    #[serde(default)]
+    standstill: Standstill,
 }
 
 /// An epoch waiting for the next wheel row ([`WheelRows::Interval`]): its
@@ -160,6 +164,7 @@ impl Feeder {
             monitor: opts.wheel_monitor.map(WheelMonitor::new),
             wheel_rows: opts.wheel_rows,
             held: None,
+            standstill: Standstill::default(),
         }
     }
 
@@ -426,6 +431,11 @@ impl Feeder {
                 }
             }
             _ => {}
+        }
+        // A standing car does not turn (crate::standstill).
+        let t = f.time_s();
+        if self.standstill.push(t, m, |i| f.wheel_present(i)) {
+            f.update_standstill()?;
         }
         Ok(())
     }
