@@ -121,7 +121,11 @@ fn family_member(seed: u64, effects: &str, std: f64, thresholds: &[f64]) -> Resu
     let fx = match effects {
         "none" => Effects::none(),
         "all" => Effects::all(),
-        n => Effects::only(n).ok_or(format!("no effect {n}"))?,
+        n => match n.strip_prefix("all_but_") {
+            Some(but) => Effects::all_but(but),
+            None => Effects::only(n),
+        }
+        .ok_or(format!("no effect {n}"))?,
     };
     let cal =
         simulate(&car.drive(1000 + seed, 300.0, &fx), 1000 + seed).map_err(|e| e.to_string())?;
@@ -157,7 +161,9 @@ fn family_member(seed: u64, effects: &str, std: f64, thresholds: &[f64]) -> Resu
 
 /// The switch on the dynamic family (issue 28): per effect, the mean over
 /// cars of the mean 30 s outage error with the constant bias, the bias
-/// always a state, and the switch at each threshold.
+/// always a state, and the switch at each threshold. `SWITCH_EFFECTS`
+/// takes `none`, `all`, an effect's name or `all_but_NAME` (every effect
+/// but that one).
 ///
 /// ```text
 /// RAYON_NUM_THREADS=2 SWITCH_CARS=1,…,25 SWITCH_EFFECTS=none,gyro_drift,all \
