@@ -87,7 +87,8 @@ impl<L: Layout<N>, const N: usize> Run<L, N> {
         let filter = Filter::<L, N>::new(vehicle, params, prior.as_ref(), t0, x0, p0)?
             .with_covariance_form(opts.covariance_form);
         Ok(Run {
-            feeder: Feeder::new(opts, t0),
+            // A standing car does not turn (crate::standstill).
+            feeder: Feeder::new(opts, t0).with_standstill(),
             filter,
             epochs: opts.record_epochs.then(Vec::new),
         })

@@ -76,9 +76,10 @@ pub struct Feeder {
     /// for the next wheel row's update at its time.
     #[serde(default)]
     held: Option<HeldEpoch>,
-    /// Whether the car stands ([`crate::standstill`]).
+    /// Whether the car stands ([`crate::standstill`]), in the GNSS-aided
+    /// filter only ([`Feeder::with_standstill`]; `None`: not asked).
     #[serde(default)]
-    standstill: Standstill,
+    standstill: Option<Standstill>,
 }
 
 /// An epoch waiting for the next wheel row ([`WheelRows::Interval`]): its
@@ -164,8 +165,19 @@ impl Feeder {
             monitor: opts.wheel_monitor.map(WheelMonitor::new),
             wheel_rows: opts.wheel_rows,
             held: None,
-            standstill: Standstill::default(),
+            standstill: None,
         }
+    }
+
+    /// The feeder with the standstill's `ψ̇ = 0` ([`crate::standstill`]):
+    /// the GNSS-aided filter's ([`crate::aided`]), not the calibration's
+    /// passes, whose estimators of the delays, the gyro scale and the
+    /// circumferences it moved (a simulated drive of `tests/corrections.rs`:
+    /// a gyro delay of 90 ms applied where none was estimated, the
+    /// circumferences +2.4 mm).
+    pub fn with_standstill(mut self) -> Self {
+        self.standstill = Some(Standstill::default());
+        self
     }
 
     /// Whether an epoch is run but not yet handed out ([`WheelRows::Interval`]),
@@ -433,9 +445,10 @@ impl Feeder {
             _ => {}
         }
         // A standing car does not turn (crate::standstill).
-        let t = f.time_s();
-        if self.standstill.push(t, m, |i| f.wheel_present(i)) {
-            f.update_standstill()?;
+        if let Some(standstill) = &mut self.standstill {
+            if standstill.push(f.time_s(), m, |i| f.wheel_present(i)) {
+                f.update_standstill()?;
+            }
         }
         Ok(())
     }
