@@ -183,12 +183,14 @@ fn multipath_bursts_pulled_the_filter_through_gnss_recoveries() {
     let rows = table(&DEV, &effects, &setups, DRIVE_S);
     print("multipath only, cars 1–6", &DEV, &setups, &rows);
     // Measured (cars 1–6, 300 s): 8 recoveries, mean 0.496 m; with 10 s
-    // none and 0.400 m (every effect off: 0.405 m).
+    // none and 0.400 m (every effect off: 0.405 m). With the gyro-bias
+    // switch and the standstill's ψ̇ = 0 (issue 28): 0.478 and 0.380 m
+    // (main with the switch alone: 0.479 and 0.380 m).
     assert!(recoveries(&rows[0]) >= 4, "{}", recoveries(&rows[0]));
     assert_eq!(recoveries(&rows[1]), 0);
     let (before, after) = (mean(&rows[0]), mean(&rows[1]));
-    assert!((before - 0.496).abs() < 0.02, "{before}");
-    assert!((after - 0.400).abs() < 0.02, "{after}");
+    assert!((before - 0.478).abs() < 0.02, "{before}");
+    assert!((after - 0.380).abs() < 0.02, "{after}");
 }
 
 /// The wander as states, fitted on the evaluation drive's own fixes, against
