@@ -23,22 +23,30 @@
 //! [`STANDSTILL_YAW_RATE_STD_RPS`]: the heading holds still, and where the
 //! gyro bias is a state the gyro's readings at rest show the bias (the
 //! classic zero-angular-rate update). The detector is causal and part of
-//! the [`crate::ekf::Feeder`]'s state, so the online filter and the batch
-//! run apply it at the same epochs, in every command, during outages too.
+//! the [`crate::ekf::Feeder`]'s state; the GNSS-aided filter asks for it
+//! ([`crate::ekf::Feeder::with_standstill`] in [`crate::aided`]), so the
+//! online filter and the batch run apply it at the same epochs, in every
+//! command's outages, tracks, NEES and error-bound windows. The
+//! calibration's passes do not: there it moved the estimators of the
+//! delays, the gyro scale and the circumferences (`tests/corrections.rs`'s
+//! tilted drive: a 90 ms gyro delay applied where none was estimated).
+//!
 //! On car 107 the yaw standard deviation now stays at 2.35° through the
-//! stop, the window starts 0.56° off and ends 1.59 m off
-//! (`deadreckon-api/tests/dynamic_family_defaults.rs`); `tests/standstill.rs`
-//! pins it on a drive built by hand (`fixes_at_a_standstill_rotated_the_heading`).
+//! stop, the window starts 0.56° off and ends 1.63 m off
+//! (`deadreckon-api/tests/dynamic_family_defaults.rs`);
+//! `tests/standstill.rs` pins it on a drive built by hand
+//! (`fixes_at_a_standstill_rotated_the_heading`).
 //!
 //! Not done: the fixes at rest still move the heading through the lever
 //! arm, as much as their declared noise allows (a 1 m multipath burst for
 //! 10 s in the stop of that drive, its fixes otherwise exact, turned it
-//! 5.3°; 16.7° before). Holding every state but the
-//! position (and the receiver's wander) at a fix while the car stands
-//! stopped that (0.0°; car 107's window 0.65 m) but was not kept: on dev
-//! cars 1–25 with every effect but the wander it changed little on 23
-//! cars (1.621 → 1.612 m) and took car 20, whose calibration fails either
-//! way, from 1.96 to 60.7 m (docs/dynamics.md).
+//! 5.3°; 16.7° before). Holding every state but the position (and the
+//! receiver's wander) at a fix while the car stands stopped that (0.0°;
+//! car 107's window 0.65 m) but was not kept: on dev cars 1–25 with every
+//! effect but the wander it changed little on 23 cars (1.621 → 1.612 m)
+//! and took car 20, whose calibration fails either way, from 1.96 to 60.7
+//! m (docs/dynamics.md; measured with `ψ̇ = 0` in the calibration's passes
+//! too).
 
 use serde::{Deserialize, Serialize};
 
@@ -49,9 +57,11 @@ use crate::event::Measurement;
 /// passes no edge: about 4 cm/s on a 48-tooth ring of 1.9 m, at which a
 /// car turning at its tightest (5 m) yaws at 0.008 rad/s, and only until
 /// its next edge ends the standstill. Not tuned: the physics above; wheel
-/// speed ECUs read exactly zero only at rest anyway. Checked by
-/// `tests/standstill.rs` and on the dynamic family
-/// (`deadreckon-api/tests/dynamic_family_defaults.rs`).
+/// speed ECUs read exactly zero only at rest anyway; no other value was
+/// tried. Checked by `tests/standstill.rs`, and measured (not chosen) on
+/// dev cars 1–25 (`deadreckon-sim/tests/bias_switch.rs`'s
+/// `bias_switch_on_the_family`) and once on held-out cars 101–110 through
+/// `auto` (`deadreckon-api/tests/dynamic_family_defaults.rs`; docs/dynamics.md).
 pub const STANDSTILL_AFTER_S: f64 = 1.0;
 
 /// The standard deviation of the standstill's `ψ̇ = 0`, rad/s: a tenth of
