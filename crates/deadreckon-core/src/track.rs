@@ -312,6 +312,48 @@ pub fn dead_reckoned(
     })
 }
 
+/// The five-state (paper's) filter over `drive` with `params` and `opts`:
+/// its output (innovations as `opts` asks; no epochs), its filtered track
+/// and its smoothed track. The smoother runs the filter again segment by
+/// segment ([`crate::checkpoint::smooth_each`]): the tracks of recording
+/// every epoch and smoothing them, bit for bit, in O(√N) memory (the
+/// report's filter health).
+pub fn five_state_tracks(
+    drive: &Drive,
+    params: &Params,
+    opts: &FilterOptions,
+) -> Result<(ekf::FilterOutput, Track, Track), Error> {
+    let opts = FilterOptions {
+        record_epochs: false,
+        ..opts.clone()
+    };
+    let mut points = Points(Vec::new());
+    let out = ekf::run(drive, params, &opts, &mut points)?;
+    let mut smoothed = Vec::with_capacity(points.0.len());
+    crate::checkpoint::smooth_each(
+        drive,
+        ekf::car_filter(drive, params, &opts)?,
+        &opts,
+        None,
+        |s| smoothed.push(car_point(s.t_s, &s.x, &s.p)),
+    )?;
+    smoothed.reverse();
+    let origin = drive.vehicle.origin;
+    Ok((
+        out,
+        Track {
+            name: names::FILTERED.into(),
+            points: points.0,
+            origin,
+        },
+        Track {
+            name: names::SMOOTHED.into(),
+            points: smoothed,
+            origin,
+        },
+    ))
+}
+
 /// The track point of every epoch of a run, in order.
 struct Points(Vec<TrackPoint>);
 
