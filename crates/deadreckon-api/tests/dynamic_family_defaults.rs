@@ -47,6 +47,18 @@
 //! | all | 3.411 | 3.178 (1.623) | 8.23 | 2.979 | 1.724 (0.946) | 3.67 |
 //! | all_but_wander | — | 1.084 (0.296) | 2.81 | — | 1.249 (0.341) | 2.66 |
 //!
+//! Without the steering (`DEFAULTS_NO_STEERING=1`, same commit, command and
+//! configurations `none,steering_offset,all`; 212 s): mean final error with
+//! / without, m, and the per-car paired difference (with − without), mean ±
+//! standard error; docs/dynamics.md has the per-window scatter and the
+//! windows that move (held-out car 102's, after a shunt):
+//!
+//! | effects | dev 1–6 | held-out 101–110 (104 apart) |
+//! |---|---|---|
+//! | none | 0.386 / 0.413, −0.028 ± 0.013 | 0.470 / 0.467, +0.002 ± 0.018 |
+//! | steering_offset | 0.414 / 0.413, +0.001 ± 0.013 | 0.483 / 0.467, +0.016 ± 0.030 |
+//! | all | 3.178 / 3.141, +0.037 ± 0.128 | 1.724 / 1.856, −0.132 ± 0.088 |
+//!
 //! The tables below are history, stop by stop, kept for the diagnoses in
 //! them; each was measured on the code of its day.
 //!
