@@ -69,15 +69,11 @@ fn circumferences(car: &DynamicCar, effects: &Effects) -> Option<([f64; 4], [f64
     ))
 }
 
-/// `None` for a wheel-speed car, or one whose drive does not calibrate.
-fn moves(seed: u64) -> Option<Moves> {
-    let car = DynamicCar::draw(seed);
-    if car.wheel_kind != WheelKind::Ticks {
-        return None;
-    }
-    let clocks = Effects::only("clocks").expect("the clocks effect");
-    let mut jitter_only = car.clone();
-    let c = &mut jitter_only.clocks;
+/// `car` with only its wheel clock's jitter (with [`Effects::clocks`]):
+/// every clock's offset and drift and the other streams' jitter zeroed.
+fn jitter_only(car: &DynamicCar) -> DynamicCar {
+    let mut car = car.clone();
+    let c = &mut car.clocks;
     for k in [
         &mut c.wheels,
         &mut c.gyro,
@@ -91,6 +87,17 @@ fn moves(seed: u64) -> Option<Moves> {
     for k in [&mut c.gyro, &mut c.speed, &mut c.steering, &mut c.gnss] {
         k.jitter_std_s = 0.0;
     }
+    car
+}
+
+/// `None` for a wheel-speed car, or one whose drive does not calibrate.
+fn moves(seed: u64) -> Option<Moves> {
+    let car = DynamicCar::draw(seed);
+    if car.wheel_kind != WheelKind::Ticks {
+        return None;
+    }
+    let clocks = Effects::only("clocks").expect("the clocks effect");
+    let jitter_only = jitter_only(&car);
     let (a, std) = circumferences(&car, &Effects::none())?;
     let (j, std_jitter) = circumferences(&jitter_only, &clocks)?;
     let (all, _) = circumferences(&car, &clocks)?;
@@ -184,21 +191,7 @@ fn seeds(seed: u64) -> Option<Seeds> {
         1000 + seed,
     )
     .ok()?;
-    let mut jitter_only = car.clone();
-    let c = &mut jitter_only.clocks;
-    for k in [
-        &mut c.wheels,
-        &mut c.gyro,
-        &mut c.speed,
-        &mut c.steering,
-        &mut c.gnss,
-    ] {
-        k.offset_s = 0.0;
-        k.drift_ppm = 0.0;
-    }
-    for k in [&mut c.gyro, &mut c.speed, &mut c.steering, &mut c.gnss] {
-        k.jitter_std_s = 0.0;
-    }
+    let jitter_only = jitter_only(&car);
     let clocks = Effects::only("clocks").expect("the clocks effect");
     let sim = simulate(&jitter_only.drive(1000 + seed, 300.0, &clocks), 1000 + seed).ok()?;
     // The simulator's jitter-only drive is the plain drive with other wheel
