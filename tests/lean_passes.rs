@@ -127,3 +127,112 @@ fn checkpointed_smoothing_with_interval_wheel_rows_equals_the_recorded_run() {
         .zip(&full.epochs)
         .any(|(a, b)| a.x != b.x));
 }
+
+/// The smoothed track of `run` (and of the report) as it was made before
+/// issue 30's fourth round: the aided filter of layout `L` recorded every
+/// epoch (with the gyro-bias switch, both hypotheses did: 1.6 KB per wheel
+/// epoch) and the smoother went back over them.
+fn recorded_smoothed<L, const N: usize>(
+    d: &Drive,
+    vehicle: &deadreckon_core::Vehicle,
+    params: &Params,
+    prior: Option<&Params>,
+    wander: Option<deadreckon_core::rts::WanderStates>,
+) -> Vec<deadreckon_core::TrackPoint>
+where
+    L: deadreckon_core::filter::Layout<N>,
+{
+    let opts = FilterOptions::default();
+    let car = ekf::car_filter(d, params, &opts).unwrap();
+    let f = deadreckon_core::filter::Filter::<L, N>::new(
+        vehicle,
+        params,
+        prior,
+        car.time_s(),
+        *car.state(),
+        *car.covariance(),
+    )
+    .unwrap()
+    .with_covariance_form(opts.covariance_form);
+    let out = ekf::run_filter(d, f, &opts, &mut ()).unwrap();
+    deadreckon_core::rts::smooth_carrying(&out.epochs, wander)
+        .unwrap()
+        .iter()
+        .map(|s| {
+            deadreckon_core::TrackPoint::from_state(
+                s.t_s,
+                &s.x.fixed_rows::<5>(0).into_owned(),
+                &s.p.fixed_view::<5, 5>(0, 0).into_owned(),
+            )
+        })
+        .collect()
+}
+
+/// `run` kept every epoch of the aided run, of both hypotheses with the
+/// gyro-bias switch (1.6 KB per wheel epoch, `run` on the bench's hour
+/// peaked at 346 MB), to smooth the one the drive ended with. It now runs
+/// that hypothesis again from the start and smooths it segment by segment
+/// (`Aided::smoothed_each`): the same track, bit for bit, whichever the
+/// layout.
+#[test]
+fn run_kept_every_aided_epoch_of_both_hypotheses_for_its_smoothed_track() {
+    use deadreckon_core::filter::Layout;
+    use deadreckon_core::gnss_error::{CarWanderLayout, Wander, N_WANDER};
+    use deadreckon_core::gyro_drift::{prior_std, CarBiasLayout, N_BIAS};
+    use deadreckon_core::track::{self, names};
+
+    let smoothed_of = |d: &Drive, params: &Params| {
+        let (tracks, switch) =
+            track::drive_tracks_and_switch(d, params, &FilterOptions::default(), None).unwrap();
+        let t = track::find(&tracks, names::SMOOTHED)
+            .unwrap()
+            .points
+            .clone();
+        assert!(t.len() > 10_000, "several segments: {}", t.len());
+        (t, switch.expect("the switch runs by default"))
+    };
+    let mut d = drive(7, 240.0);
+    let truth = Params::nominal(&d.vehicle);
+
+    // The calibrated bias 3e-4 rad/s off this drive's: the switch fires and
+    // the drive ends with the bias as a state.
+    let off = Params {
+        gyro_bias_rps: truth.gyro_bias_rps - 3e-4,
+        ..truth
+    };
+    let (got, switch) = smoothed_of(&d, &off);
+    assert!(switch.fired_at_s.is_some(), "{switch:?}");
+    let want = recorded_smoothed::<CarBiasLayout, N_BIAS>(
+        &d,
+        &d.vehicle,
+        &off,
+        Some(&prior_std(&d.vehicle.noise)),
+        None,
+    );
+    assert!(got == want, "the switched track differs");
+
+    // The receiver's wander carried, the switch out of reach: the drive
+    // ends with the constant bias, smoothed with the wander's φ.
+    d.vehicle.noise.gnss_wander_std_m = 0.8;
+    d.vehicle.noise.gnss_wander_tau_s = 60.0;
+    d.vehicle.noise.gyro_bias_switch_llr = 1e9;
+    let (got, switch) = smoothed_of(&d, &truth);
+    assert!(switch.fired_at_s.is_none(), "{switch:?}");
+    let mut constant = d.vehicle.clone();
+    constant.noise.gyro_bias_drive_std_rps = 0.0;
+    constant.noise.gyro_bias_walk_rps_per_sqrt_s = 0.0;
+    let want = recorded_smoothed::<CarWanderLayout, N_WANDER>(
+        &d,
+        &constant,
+        &truth,
+        None,
+        Some(deadreckon_core::rts::WanderStates {
+            index: <CarWanderLayout as Layout<N_WANDER>>::wander_index().unwrap(),
+            wander: Wander {
+                std_m: 0.8,
+                tau_s: 60.0,
+            },
+        }),
+    );
+    assert!(got == want, "the wander's track differs");
+}

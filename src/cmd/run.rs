@@ -39,7 +39,7 @@ pub fn run(a: RunArgs, load: &common::Loader) -> Result<()> {
             drive.as_ref(),
             a.params.as_deref(),
         )?;
-        let w = tracks::write_tracks(&tracks, &a.out, &a.selection(), a.mcap.into())?;
+        let w = tracks::write_tracks(tracks, &a.out, &a.selection(), a.mcap.into())?;
         (w, source)
     } else {
         if found.shape == Shape::DiffDrive {

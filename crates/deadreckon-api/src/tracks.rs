@@ -107,39 +107,40 @@ pub fn bounds_95_m(
         .collect()
 }
 
-/// The tracks to write into `out`: those named, or every estimated track;
-/// for TUM and KITTI exactly one, optionally synced with another.
+/// The tracks to write into `out`: those named, or every estimated track
+/// (moved out of `all`, not copied); for TUM and KITTI exactly one,
+/// optionally synced with another.
 pub fn select(
-    all: &[Track],
+    all: Vec<Track>,
     s: &Selection,
     out: &Path,
     format: TrackFormat,
 ) -> Result<Vec<Track>, Error> {
+    let have: Vec<String> = all.iter().map(|t| t.name.clone()).collect();
+    // The track to sync with, taken before `all` is moved from.
+    let other = s.sync_with.as_ref().map(|w| track::find(&all, w).cloned());
     let mut chosen: Vec<Track> = if s.names.is_empty() {
-        all.iter()
+        all.into_iter()
             .filter(|t| t.name != track::names::TRUTH)
-            .cloned()
             .collect()
     } else {
         s.names
             .iter()
-            .map(|n| track::find(all, n).cloned())
+            .map(|n| track::find(&all, n).cloned())
             .collect::<Result<_, _>>()?
     };
     if format.holds_one_track() && chosen.len() != 1 {
-        let have: Vec<&str> = all.iter().map(|t| t.name.as_str()).collect();
         invalid!(
             "{} holds one track: choose it with --track NAME ({})",
             out.display(),
             have.join(", ")
         );
     }
-    if let Some(with) = &s.sync_with {
+    if let Some(other) = other {
         if !format.holds_one_track() {
             invalid!("--sync-with is for TUM and KITTI files (one track)");
         }
-        let other = track::find(all, with)?;
-        chosen[0] = evo::synced(&chosen[0], other, s.max_diff_s)?;
+        chosen[0] = evo::synced(&chosen[0], &other?, s.max_diff_s)?;
     }
     Ok(chosen)
 }
@@ -237,8 +238,16 @@ pub fn write_car(
     bound: &BoundFit,
 ) -> Result<Written, Error> {
     let format = TrackFormat::from_path(out)?;
-    let (all, bias_switch) = drive_tracks_and_switch(drive, params, opts, init_pose)?;
-    let t = select(&all, s, out, format)?;
+    // The truth's track only where it can be chosen: every estimated track
+    // is written by default, the truth only when named (its track is twice
+    // the size of an estimated one at 100 Hz).
+    let (all, bias_switch) =
+        if s.names.is_empty() && s.sync_with.is_none() && !format.holds_one_track() {
+            track::drive_tracks_and_switch(drive, params, opts, init_pose)?
+        } else {
+            drive_tracks_and_switch(drive, params, opts, init_pose)?
+        };
+    let t = select(all, s, out, format)?;
     let bounds = if format == TrackFormat::Csv {
         bounds_95_m(drive, &t, bound, opts, init_pose)
     } else {
@@ -273,13 +282,13 @@ pub fn write_tricycle(
     mcap: deadreckon_ros::McapOptions,
 ) -> Result<Written, Error> {
     let (all, _) = crate::kinematic::tricycle_tracks(log, drive, params)?;
-    write_tracks(&all, out, s, mcap)
+    write_tracks(all, out, s, mcap)
 }
 
 /// Writes the chosen tracks of `all` (no wheel health: a kinematic
 /// shape's tracks).
 pub fn write_tracks(
-    all: &[Track],
+    all: Vec<Track>,
     out: &Path,
     s: &Selection,
     mcap: deadreckon_ros::McapOptions,

@@ -87,7 +87,7 @@ fn one_track_formats_refuse_several_tracks_and_name_those_there_are() {
     let names: Vec<&str> = all.iter().map(|t| t.name.as_str()).collect();
     assert_eq!(names, ["dead-reckoned", "filtered", "smoothed", "truth"]);
     let out = dir.path().join("t.tum");
-    let e = tracks::select(&all, &Default::default(), &out, TrackFormat::Tum).unwrap_err();
+    let e = tracks::select(all.clone(), &Default::default(), &out, TrackFormat::Tum).unwrap_err();
     assert!(
         e.to_string().ends_with("holds one track: choose it with --track NAME (dead-reckoned, filtered, smoothed, truth)"),
         "{e}"
@@ -96,7 +96,8 @@ fn one_track_formats_refuse_several_tracks_and_name_those_there_are() {
         names: vec!["truth".into(), "filtered".into()],
         ..Default::default()
     };
-    let chosen = tracks::select(&all, &s, &dir.path().join("t.csv"), TrackFormat::Csv).unwrap();
+    let chosen =
+        tracks::select(all.clone(), &s, &dir.path().join("t.csv"), TrackFormat::Csv).unwrap();
     assert_eq!(chosen[0].name, "truth");
     assert_eq!(chosen[1].name, "filtered");
 }

@@ -21,7 +21,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::bound::WanderCov;
 use crate::drive::Drive;
-use crate::ekf::{self, Epoch, EpochOut, Event, Feeder, FilterOptions, FilterStats};
+use crate::ekf::{self, EpochOut, Event, Feeder, FilterOptions, FilterStats};
 use crate::event::DriveEvents;
 use crate::filter::{CarLayout, Filter, GateCounts, Layout};
 use crate::gnss_error::{CarWanderLayout, N_WANDER};
@@ -64,15 +64,13 @@ impl AidedEpoch {
     }
 }
 
-/// One filter of layout `L` with its feeder, and its epochs when recorded
-/// (for the smoother).
+/// One filter of layout `L` with its feeder. It keeps no epochs: the
+/// smoother runs it again ([`Aided::smoothed_each`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(bound = "")]
 pub struct Run<L: Layout<N>, const N: usize> {
     filter: Filter<L, N>,
     feeder: Feeder,
-    #[serde(skip)]
-    epochs: Option<Vec<Epoch<N>>>,
 }
 
 impl<L: Layout<N>, const N: usize> Run<L, N> {
@@ -90,7 +88,6 @@ impl<L: Layout<N>, const N: usize> Run<L, N> {
             // A standing car does not turn (crate::standstill).
             feeder: Feeder::new(opts, t0).with_standstill(),
             filter,
-            epochs: opts.record_epochs.then(Vec::new),
         })
     }
 
@@ -100,11 +97,8 @@ impl<L: Layout<N>, const N: usize> Run<L, N> {
         ev: Event,
         epoch: &mut dyn FnMut(&Filter<L, N>, &EpochOut<'_, N>),
     ) -> Result<(), Error> {
-        let epochs = &mut self.epochs;
-        self.feeder.push(&mut self.filter, ev, &mut |f, e| {
-            record(epochs, f, &e);
-            epoch(f, &e)
-        })
+        self.feeder
+            .push(&mut self.filter, ev, &mut |f, e| epoch(f, &e))
     }
 
     /// Runs what is waiting.
@@ -112,11 +106,8 @@ impl<L: Layout<N>, const N: usize> Run<L, N> {
         &mut self,
         epoch: &mut dyn FnMut(&Filter<L, N>, &EpochOut<'_, N>),
     ) -> Result<(), Error> {
-        let epochs = &mut self.epochs;
-        self.feeder.finish(&mut self.filter, &mut |f, e| {
-            record(epochs, f, &e);
-            epoch(f, &e)
-        })
+        self.feeder
+            .finish(&mut self.filter, &mut |f, e| epoch(f, &e))
     }
 
     fn push(&mut self, ev: Event, epoch: &mut dyn FnMut(&AidedEpoch)) -> Result<(), Error> {
@@ -147,12 +138,19 @@ impl<L: Layout<N>, const N: usize> Run<L, N> {
         self.feeder.stats_with(&self.filter)
     }
 
-    /// The RTS-smoothed car blocks of the recorded epochs (none unless
-    /// recorded), with the receiver's wander smoothed with its `φ`.
-    fn smoothed(&self) -> Result<Vec<(f64, State, Mat)>, Error> {
-        let Some(epochs) = &self.epochs else {
-            return Ok(Vec::new());
-        };
+    /// This run's filter as it stands run again over `drive`, its smoothed
+    /// car blocks handed to `visit` from the last epoch to the first
+    /// ([`crate::checkpoint::smooth_each`]), the receiver's wander smoothed
+    /// with its `φ`. Returns the number of epochs.
+    fn smooth_each(
+        &self,
+        drive: &Drive,
+        opts: &FilterOptions,
+        visit: &mut (dyn FnMut(f64, &State, &Mat) + Send),
+    ) -> Result<usize, Error>
+    where
+        L: Send + Sync,
+    {
         let n = self.filter.noise();
         let wander = L::wander_index().map(|index| crate::rts::WanderStates {
             index,
@@ -161,28 +159,14 @@ impl<L: Layout<N>, const N: usize> Run<L, N> {
                 tau_s: n.gnss_wander_tau_s,
             },
         });
-        Ok(crate::rts::smooth_carrying(epochs, wander)?
-            .iter()
-            .map(|s| {
-                (
-                    s.t_s,
-                    s.x.fixed_rows::<{ crate::model::N }>(0).into_owned(),
-                    s.p.fixed_view::<{ crate::model::N }, { crate::model::N }>(0, 0)
-                        .into_owned(),
-                )
-            })
-            .collect())
-    }
-}
-
-/// Keeps the epoch for the smoother when recording.
-fn record<L: Layout<N>, const N: usize>(
-    epochs: &mut Option<Vec<Epoch<N>>>,
-    f: &Filter<L, N>,
-    e: &EpochOut<'_, N>,
-) {
-    if let (Some(v), Some(prediction)) = (epochs.as_mut(), e.prediction) {
-        v.push(Epoch::after(f, prediction));
+        crate::checkpoint::smooth_each(drive, self.filter.clone(), opts, wander, true, |s| {
+            visit(
+                s.t_s,
+                &s.x.fixed_rows::<{ crate::model::N }>(0).into_owned(),
+                &s.p.fixed_view::<{ crate::model::N }, { crate::model::N }>(0, 0)
+                    .into_owned(),
+            )
+        })
     }
 }
 
@@ -352,12 +336,37 @@ impl Aided {
         )
     }
 
-    /// The RTS-smoothed car blocks of the recorded epochs (empty unless
-    /// started with `opts.record_epochs`); with the gyro-bias switch, of
-    /// the hypothesis the drive ended with (the state's over the whole
-    /// drive once it fired: the smoother sees every fix anyway).
-    pub fn smoothed(&self) -> Result<Vec<(f64, State, Mat)>, Error> {
-        each!(self, |r| r.smoothed())
+    /// The RTS-smoothed car blocks of `drive`, which this filter ran over
+    /// with `params` and `opts` ([`Aided::run`]), handed to `visit` from
+    /// the last epoch to the first. With the gyro-bias switch, of the
+    /// hypothesis the drive ended with (the state's over the whole drive
+    /// once it fired: the smoother sees every fix anyway). That hypothesis
+    /// runs again from the start and is smoothed segment by segment
+    /// ([`crate::checkpoint`]): equal bit for bit to smoothing every epoch
+    /// of the run, in O(√N) memory, so a run keeps no epochs. Returns the
+    /// number of epochs.
+    pub fn smoothed_each(
+        &self,
+        drive: &Drive,
+        params: &Params,
+        opts: &FilterOptions,
+        visit: &mut (dyn FnMut(f64, &State, &Mat) + Send),
+    ) -> Result<usize, Error> {
+        let (fresh, _) = Self::on_drive(drive, params, opts)?;
+        match (self, &fresh) {
+            (Aided::Car(_), Aided::Car(r)) => r.smooth_each(drive, opts, visit),
+            (Aided::Bias(_), Aided::Bias(r)) => r.smooth_each(drive, opts, visit),
+            (Aided::Wander(_), Aided::Wander(r)) => r.smooth_each(drive, opts, visit),
+            (Aided::WanderBias(_), Aided::WanderBias(r)) => r.smooth_each(drive, opts, visit),
+            (Aided::Switched(s), Aided::Switched(f)) => s.smooth_each(f, drive, opts, visit),
+            (Aided::WanderSwitched(s), Aided::WanderSwitched(f)) => {
+                s.smooth_each(f, drive, opts, visit)
+            }
+            _ => Err(Error::Numerical {
+                t_s: self.time_s(),
+                what: "the aided filter's layout differs from the run it smooths".into(),
+            }),
+        }
     }
 }
 

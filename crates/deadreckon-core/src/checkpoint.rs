@@ -22,7 +22,7 @@ use crate::drive::Drive;
 use crate::ekf::{self, DriveEvents, Epoch, Feeder, FilterOptions, FilterStats};
 use crate::filter::{Filter, Layout};
 use crate::model::State;
-use crate::rts::Smoothed;
+use crate::rts::{Smoothed, WanderStates};
 use crate::Error;
 
 /// Smallest segment length, epochs.
@@ -43,8 +43,15 @@ fn forward<'a, L: Layout<N>, const N: usize>(
     drive: &'a Drive,
     f: Filter<L, N>,
     opts: &FilterOptions,
+    standstill: bool,
 ) -> Result<(Vec<Checkpoint<'a, L, N>>, usize, FilterStats), Error> {
-    let (mut feeder, events) = ekf::feed(drive, opts, f.time_s());
+    let (feeder, events) = ekf::feed(drive, opts, f.time_s());
+    // The aided filter's standstill (crate::standstill), as its run had it.
+    let mut feeder = if standstill {
+        feeder.with_standstill()
+    } else {
+        feeder
+    };
     // The forward pass keeps no predictions; the re-runs do.
     feeder.keep_predictions(false);
     let total_events = drive.wheels.len()
@@ -208,7 +215,7 @@ pub fn smooth_car_columns<L: Layout<N> + Send + Sync, const N: usize>(
     f: Filter<L, N>,
     opts: &FilterOptions,
 ) -> Result<(Vec<f64>, Vec<State>, FilterStats), Error> {
-    let (cps, total, stats) = forward(drive, f, opts)?;
+    let (cps, total, stats) = forward(drive, f, opts, false)?;
     if total == 0 {
         return Ok((Vec::new(), Vec::new(), stats));
     }
@@ -262,32 +269,60 @@ pub fn smoothed_start<L: Layout<N> + Send + Sync, const N: usize>(
     f: Filter<L, N>,
     opts: &FilterOptions,
 ) -> Result<Option<Smoothed<N>>, Error> {
-    let (cps, total, _) = forward(drive, f, opts)?;
+    let mut first = None;
+    smooth_each(drive, f, opts, None, false, |s| first = Some(*s))?;
+    Ok(first)
+}
+
+/// Runs `f` over `drive` and hands the smoothed state and covariance of
+/// every epoch to `visit`, from the last epoch to the first: equal bit for
+/// bit to [`crate::rts::smooth_carrying`] over the recorded run (the
+/// receiver's wander smoothed with its `φ` where `wander` is given), in
+/// O(√N) memory instead of every epoch (the smoothed track of `run` and of
+/// the report: [`crate::aided::Aided::smoothed_each`]). Returns the number
+/// of epochs. `standstill`: the filter's feeder takes the standstill's
+/// `ψ̇ = 0` ([`crate::ekf::Feeder::with_standstill`]), as the GNSS-aided
+/// filter's does.
+pub fn smooth_each<L: Layout<N> + Send + Sync, const N: usize>(
+    drive: &Drive,
+    f: Filter<L, N>,
+    opts: &FilterOptions,
+    wander: Option<WanderStates>,
+    standstill: bool,
+    mut visit: impl FnMut(&Smoothed<N>) + Send,
+) -> Result<usize, Error> {
+    let (cps, total, _) = forward(drive, f, opts, standstill)?;
     if total == 0 {
-        return Ok(None);
+        return Ok(0);
     }
     // The first epoch of the following segment and its smoothed state.
     let mut next: Option<(Epoch<N>, Smoothed<N>)> = None;
     backward(&cps, total, |_, buf| {
         let (carried, mut s1) = match next.take() {
+            Some(n) => n,
             None => {
-                let last = buf.pop().expect("a segment has epochs");
+                let last = buf.pop().ok_or_else(|| Error::Numerical {
+                    t_s: f64::NAN,
+                    what: "a smoothing segment re-ran no epoch".into(),
+                })?;
                 let s = Smoothed {
                     t_s: last.t_s,
                     x: last.x,
                     p: last.p,
                 };
+                visit(&s);
                 (last, s)
             }
-            Some(n) => n,
         };
         // The following epoch read in place, not copied.
         for k in (0..buf.len()).rev() {
-            let e1 = buf.get(k + 1).unwrap_or(&carried);
-            s1 = crate::rts::step(&buf[k], e1, &s1)?;
+            let (e, e1) = (&buf[k], buf.get(k + 1).unwrap_or(&carried));
+            let phi = wander.map(|w| (w.index, w.wander.phi((e1.t_s - e.t_s).max(0.0))));
+            s1 = crate::rts::step_with(e, e1, &s1, phi)?;
+            visit(&s1);
         }
         next = Some((buf.first().copied().unwrap_or(carried), s1));
         Ok(())
     })?;
-    Ok(next.map(|(_, s)| s))
+    Ok(total)
 }

@@ -79,7 +79,7 @@ pub fn step<const N: usize>(
 
 /// [`step`] with the wander's block of `F`, `(index, φ)`, where the state
 /// carries the receiver's wander.
-fn step_with<const N: usize>(
+pub(crate) fn step_with<const N: usize>(
     k: &Epoch<N>,
     k1: &Epoch<N>,
     s1: &Smoothed<N>,

@@ -228,16 +228,24 @@ fn aided_tracks(
     params: &Params,
     opts: &FilterOptions,
 ) -> Result<(Track, Track, Option<(f64, State, Mat)>, Option<BiasSwitch>), Error> {
+    // The run keeps no epochs: the smoother runs the filter again
+    // ([`Aided::smoothed_each`]).
     let opts = FilterOptions {
-        record_epochs: true,
+        record_epochs: false,
         ..opts.clone()
     };
     let mut filtered = Vec::new();
     let f = Aided::run(drive, params, &opts, &mut |e| {
         filtered.push(TrackPoint::from_state(e.t_s, &e.x, &e.p))
     })?;
-    let s = f.smoothed()?;
-    let start = s.first().copied();
+    // Smoothed from the last epoch to the first.
+    let mut smoothed = Vec::with_capacity(filtered.len());
+    let mut start = None;
+    f.smoothed_each(drive, params, &opts, &mut |t, x, p| {
+        smoothed.push(TrackPoint::from_state(t, x, p));
+        start = Some((t, *x, *p));
+    })?;
+    smoothed.reverse();
     let origin = drive.vehicle.origin;
     Ok((
         Track {
@@ -247,10 +255,7 @@ fn aided_tracks(
         },
         Track {
             name: names::SMOOTHED.into(),
-            points: s
-                .iter()
-                .map(|(t, x, p)| TrackPoint::from_state(*t, x, p))
-                .collect(),
+            points: smoothed,
             origin,
         },
         start,
@@ -287,22 +292,76 @@ pub fn dead_reckoned(
     opts: &FilterOptions,
     init: Init,
 ) -> Result<Track, Error> {
-    let dr = ekf::run(
+    // Each epoch's point, not the epoch (a sixth of the memory).
+    let mut points = Points(Vec::new());
+    ekf::run(
         drive,
         params,
         &FilterOptions {
             init,
             sensors: SensorSet::dead_reckoning(),
-            record_epochs: true,
+            record_epochs: false,
             ..opts.clone()
         },
-        &mut (),
+        &mut points,
     )?;
-    Ok(Track::from_epochs(
-        names::DEAD_RECKONED,
-        &dr.epochs,
-        drive.vehicle.origin,
+    Ok(Track {
+        name: names::DEAD_RECKONED.into(),
+        points: points.0,
+        origin: drive.vehicle.origin,
+    })
+}
+
+/// The five-state (paper's) filter over `drive` with `params` and `opts`:
+/// its output (innovations as `opts` asks; no epochs), its filtered track
+/// and its smoothed track. The smoother runs the filter again segment by
+/// segment ([`crate::checkpoint::smooth_each`]): the tracks of recording
+/// every epoch and smoothing them, bit for bit, in O(√N) memory (the
+/// report's filter health).
+pub fn five_state_tracks(
+    drive: &Drive,
+    params: &Params,
+    opts: &FilterOptions,
+) -> Result<(ekf::FilterOutput, Track, Track), Error> {
+    let opts = FilterOptions {
+        record_epochs: false,
+        ..opts.clone()
+    };
+    let mut points = Points(Vec::new());
+    let out = ekf::run(drive, params, &opts, &mut points)?;
+    let mut smoothed = Vec::with_capacity(points.0.len());
+    crate::checkpoint::smooth_each(
+        drive,
+        ekf::car_filter(drive, params, &opts)?,
+        &opts,
+        None,
+        false,
+        |s| smoothed.push(car_point(s.t_s, &s.x, &s.p)),
+    )?;
+    smoothed.reverse();
+    let origin = drive.vehicle.origin;
+    Ok((
+        out,
+        Track {
+            name: names::FILTERED.into(),
+            points: points.0,
+            origin,
+        },
+        Track {
+            name: names::SMOOTHED.into(),
+            points: smoothed,
+            origin,
+        },
     ))
+}
+
+/// The track point of every epoch of a run, in order.
+struct Points(Vec<TrackPoint>);
+
+impl ekf::EpochHook for Points {
+    fn after_epoch(&mut self, t_s: f64, x: &mut State, p: &mut Mat) {
+        self.0.push(TrackPoint::from_state(t_s, x, p));
+    }
 }
 
 /// The track named `name` among `tracks`, or an error listing the names there are.

@@ -4,7 +4,7 @@
 //! (moved unchanged from the command line's `report`).
 
 use deadreckon_core::calibrate::{self, Calibration, CalibrationOptions, Method};
-use deadreckon_core::ekf::{self, FilterOptions, FilterStats, SensorKind};
+use deadreckon_core::ekf::{FilterOptions, FilterStats, SensorKind};
 use deadreckon_core::metrics;
 use deadreckon_core::track as tracks;
 use deadreckon_core::{outage, Drive, Params, ParamsWithStd, Track};
@@ -208,16 +208,10 @@ pub type Health = (rp::FilterHealth, FilterStats, Vec<Track>, Vec<usize>);
 pub fn health(drive: &Drive, params: &Params) -> Result<Health, Error> {
     let opts = FilterOptions {
         record_innovations: true,
-        record_epochs: true,
         ..Default::default()
     };
-    let out = ekf::run(drive, params, &opts, &mut ())?;
-    let sm = deadreckon_core::rts::smooth(&out.epochs)?;
-    let origin = drive.vehicle.origin;
-    let tracks = vec![
-        Track::from_epochs("filtered", &out.epochs, origin),
-        Track::from_smoothed("smoothed", &sm, origin),
-    ];
+    let (out, filtered, smoothed) = tracks::five_state_tracks(drive, params, &opts)?;
+    let tracks = vec![filtered, smoothed];
     let ticks = matches!(drive.wheels, deadreckon_core::drive::Wheels::Ticks(_));
     let mut kinds: Vec<SensorKind> = out.innovations.iter().map(|i| i.sensor).collect();
     kinds.sort();

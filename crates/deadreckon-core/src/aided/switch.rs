@@ -27,7 +27,8 @@ use std::collections::VecDeque;
 use serde::{Deserialize, Serialize};
 
 use super::{AidedEpoch, Run};
-use crate::ekf::{EpochOut, Event, FilterStats};
+use crate::drive::Drive;
+use crate::ekf::{EpochOut, Event, FilterOptions, FilterStats};
 use crate::filter::{Filter, GateCounts, Layout, SensorKind};
 use crate::model::{Mat, State};
 use crate::Error;
@@ -244,8 +245,27 @@ impl<C: Layout<NC>, const NC: usize, S: Layout<NS>, const NS: usize> Switch<C, N
             .unwrap_or_default()
     }
 
-    pub(super) fn smoothed(&self) -> Result<Vec<(f64, State, Mat)>, Error> {
-        self.chosen(|c| c.smoothed(), |s| s.smoothed())
-            .unwrap_or(Ok(Vec::new()))
+    /// The smoothed car blocks of the hypothesis the drive ended with
+    /// ([`super::Aided::smoothed_each`]), run again from `fresh`: this
+    /// switch as it started.
+    pub(super) fn smooth_each(
+        &self,
+        fresh: &Self,
+        drive: &Drive,
+        opts: &FilterOptions,
+        visit: &mut (dyn FnMut(f64, &State, &Mat) + Send),
+    ) -> Result<usize, Error>
+    where
+        C: Send + Sync,
+        S: Send + Sync,
+    {
+        match (&self.constant, &self.state, &fresh.constant, &fresh.state) {
+            (Some(_), _, Some(c), _) => c.smooth_each(drive, opts, visit),
+            (None, Some(_), _, Some(s)) => s.smooth_each(drive, opts, visit),
+            _ => Err(Error::Numerical {
+                t_s: self.time_s(),
+                what: "the gyro-bias switch has no hypothesis to smooth".into(),
+            }),
+        }
     }
 }
