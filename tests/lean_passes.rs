@@ -128,9 +128,9 @@ fn checkpointed_smoothing_with_interval_wheel_rows_equals_the_recorded_run() {
         .any(|(a, b)| a.x != b.x));
 }
 
-/// The smoothed track of `run` (and of the report) as it was made before
-/// issue 30's fourth round: the aided filter of layout `L` recorded every
-/// epoch (with the gyro-bias switch, both hypotheses did: 1.6 KB per wheel
+/// The smoothed track of `run` as it was made before issue 30's fourth
+/// round: the aided filter of layout `L` (its feeder with the standstill,
+/// `deadreckon_core::standstill`) recorded every epoch (with the gyro-bias switch, both hypotheses did: 1.6 KB per wheel
 /// epoch) and the smoother went back over them.
 fn recorded_smoothed<L, const N: usize>(
     d: &Drive,
@@ -154,8 +154,18 @@ where
     )
     .unwrap()
     .with_covariance_form(opts.covariance_form);
-    let out = ekf::run_filter(d, f, &opts, &mut ()).unwrap();
-    deadreckon_core::rts::smooth_carrying(&out.epochs, wander)
+    // Every epoch recorded, the feeder with the aided filter's standstill.
+    let (feeder, events) = ekf::feed(d, &opts, car.time_s());
+    let (mut feeder, mut f, mut epochs) = (feeder.with_standstill(), f, Vec::new());
+    feeder.keep_predictions(true);
+    let mut record = |f: &mut deadreckon_core::filter::Filter<L, N>, e: ekf::EpochOut<'_, N>| {
+        epochs.push(ekf::Epoch::after(f, e.prediction.unwrap()))
+    };
+    for ev in events {
+        feeder.push(&mut f, ev, &mut record).unwrap();
+    }
+    feeder.finish(&mut f, &mut record).unwrap();
+    deadreckon_core::rts::smooth_carrying(&epochs, wander)
         .unwrap()
         .iter()
         .map(|s| {
