@@ -481,10 +481,27 @@ fn decomposed(
         deadreckon_core::ekf::run_filter(drive, f, &opts, &mut hook).unwrap();
     } else if drive.vehicle.noise.gnss_wander_std_m > 0.0 {
         use deadreckon_core::gnss_error::{CarWanderLayout, N_WANDER};
-        let f =
+        let mut f =
             deadreckon_core::ekf::fixed_filter::<CarWanderLayout, N_WANDER>(drive, params, &opts)
                 .unwrap();
-        deadreckon_core::ekf::run_filter(drive, f, &opts, &mut hook).unwrap();
+        // As the aided filter runs it: its feeder takes the standstill
+        // (deadreckon_core::standstill).
+        let (feeder, events) = deadreckon_core::ekf::feed(drive, &opts, f.time_s());
+        let mut feeder = feeder.with_standstill();
+        let mut each = |f: &mut deadreckon_core::filter::Filter<CarWanderLayout, N_WANDER>,
+                        _: deadreckon_core::ekf::EpochOut<'_, N_WANDER>| {
+            let (mut x, mut p) = (*f.state(), *f.covariance());
+            deadreckon_core::ekf::EpochHook::<N_WANDER>::after_epoch(
+                &mut hook,
+                f.time_s(),
+                &mut x,
+                &mut p,
+            );
+        };
+        for ev in events {
+            feeder.push(&mut f, ev, &mut each).unwrap();
+        }
+        feeder.finish(&mut f, &mut each).unwrap();
     } else {
         deadreckon_core::ekf::run(drive, params, &opts, &mut hook).unwrap();
     }
