@@ -7,7 +7,10 @@
 //! nominal one, millimetres for metres), is refused with an error naming
 //! both vehicles and the values, unless the user says so
 //! (`--params-for-other-vehicle`). A file written before the record existed
-//! is still taken, with a note that it names no vehicle.
+//! is still taken, with a note that it names no vehicle. `calibrate` itself
+//! rejects a fit outside the same bound ([`implausible_circumference`] in
+//! [`crate::calibration::calibrate`]): it does not write what the other
+//! commands refuse.
 
 use deadreckon_core::{Params, Vehicle};
 
@@ -158,26 +161,38 @@ pub fn check(
 /// the key, both values and the likely mistake.
 pub fn check_circumferences(spec: &str, p: &Params, vehicle: &Vehicle) -> Result<(), String> {
     let nominal = vehicle.wheel_circumference_m;
-    for (name, c) in Params::NAMES[2..].iter().zip(p.circumferences()) {
-        let factor = c / nominal;
-        if (factor - 1.0).abs() > MAX_CIRCUMFERENCE_DEVIATION {
-            let hint = if (factor / 1000.0 - 1.0).abs() < 0.5 {
-                " (millimetres?)"
-            } else if (factor / 100.0 - 1.0).abs() < 0.5 {
-                " (centimetres?)"
-            } else {
-                " (another vehicle's parameters?)"
-            };
-            return Err(format!(
-                "{spec}: {name} = {c} m is {:+.1} % from the vehicle's nominal \
-                 wheel_circumference_m = {nominal} m{hint}, more than the {} % a \
-                 tyre varies",
-                100.0 * (factor - 1.0),
-                100.0 * MAX_CIRCUMFERENCE_DEVIATION
-            ));
-        }
-    }
-    Ok(())
+    let Some((name, c, factor)) = implausible_circumference(p, vehicle) else {
+        return Ok(());
+    };
+    let hint = if (factor / 1000.0 - 1.0).abs() < 0.5 {
+        " (millimetres?)"
+    } else if (factor / 100.0 - 1.0).abs() < 0.5 {
+        " (centimetres?)"
+    } else {
+        " (another vehicle's parameters?)"
+    };
+    Err(format!(
+        "{spec}: {name} = {c} m is {:+.1} % from the vehicle's nominal \
+         wheel_circumference_m = {nominal} m{hint}, more than the {} % a \
+         tyre varies",
+        100.0 * (factor - 1.0),
+        100.0 * MAX_CIRCUMFERENCE_DEVIATION
+    ))
+}
+
+/// The first circumference of `p` further than
+/// [`MAX_CIRCUMFERENCE_DEVIATION`] from `vehicle`'s nominal: its name, its
+/// value (m) and its ratio to the nominal.
+pub fn implausible_circumference(
+    p: &Params,
+    vehicle: &Vehicle,
+) -> Option<(&'static str, f64, f64)> {
+    let nominal = vehicle.wheel_circumference_m;
+    Params::NAMES[2..]
+        .iter()
+        .zip(p.circumferences())
+        .map(|(name, c)| (*name, c, c / nominal))
+        .find(|(_, _, factor)| (factor - 1.0).abs() > MAX_CIRCUMFERENCE_DEVIATION)
 }
 
 #[cfg(test)]

@@ -207,6 +207,25 @@ pub fn calibrate_corrected(
             source,
         })?,
     };
+    // A fit no tyre can have is rejected, not written: `evaluate --params`
+    // would refuse it (crate::binding). On drives with several effects at
+    // once the calibration can settle at such a point with no other check
+    // firing (a dynamic family car: +10 %, the distance scale right).
+    if let Some((which, c, factor)) =
+        crate::binding::implausible_circumference(&calibration.estimate.params, &drive.vehicle)
+    {
+        return Err(Error::Invalid(format!(
+            "calibrating {name}: estimate rejected: {which} = {c:.4} m is {:+.1} % from the \
+             vehicle's nominal wheel_circumference_m = {} m, more than the {} % a tyre varies \
+             (speed scale {:.4}, gyro bias {:.5} rad/s): the calibration did not settle at the \
+             vehicle's values",
+            100.0 * (factor - 1.0),
+            drive.vehicle.wheel_circumference_m,
+            100.0 * crate::binding::MAX_CIRCUMFERENCE_DEVIATION,
+            calibration.estimate.params.speed_scale,
+            calibration.estimate.params.gyro_bias_rps,
+        )));
+    }
     let steering = crate::json::car_steering(drive, options.method, options.min_speed_mps)
         .map_err(|source| Error::Step {
             step: "calibrating the steering".into(),

@@ -52,3 +52,49 @@ fn what_calibrate_writes_reads_back_through_the_one_reader() {
         assert_eq!(listed, s == ParamStatus::NotEstimated, "{name}");
     }
 }
+
+/// On a drive with several effects at once (dynamic family car 20, every
+/// effect but the receiver's wander) the RTS calibration settled at
+/// circumferences 10 % above the vehicle's nominal (2.06–2.08 m against a
+/// true 1.86 m), a speed scale of 0.90 and a gyro bias of 0.009 rad/s, the
+/// distance scale right so that the chord check passed, and `calibrate`
+/// wrote them, though `evaluate --params` refuses a file 5 % off. The fit
+/// is now rejected with the values.
+#[test]
+fn calibrate_wrote_circumferences_that_evaluate_refuses() {
+    use deadreckon_sim::family::{DynamicCar, Effects};
+    let car = DynamicCar::draw(20);
+    let fx = Effects::all_but("wander").unwrap();
+    let sim = simulate(&car.drive(1020, 300.0, &fx), 1020).unwrap();
+    let e = calibrate(
+        &sim.drive,
+        &CalibrationRequest::with_corrections(Which::None),
+        "car 20",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.starts_with("calibrating car 20: estimate rejected: circumference_")
+            && e.contains("% from the vehicle's nominal wheel_circumference_m")
+            && e.contains("more than the 5 % a tyre varies"),
+        "{e}"
+    );
+    // The same car without the effects calibrates.
+    let plain = simulate(&car.drive(1020, 300.0, &Effects::none()), 1020).unwrap();
+    let c = calibrate(
+        &plain.drive,
+        &CalibrationRequest::with_corrections(Which::None),
+        "car 20",
+    )
+    .unwrap();
+    for (got, want) in c
+        .calibration
+        .estimate
+        .params
+        .circumferences()
+        .iter()
+        .zip(plain.truth_params.circumferences())
+    {
+        assert!((got - want).abs() < 3e-3, "{got} against {want}");
+    }
+}
