@@ -107,6 +107,16 @@ pub fn bounds_95_m(
         .collect()
 }
 
+impl Selection {
+    /// Whether [`select`] may take the truth's track into `format`: when
+    /// tracks are named or synced, or the format holds one track (its
+    /// error lists the names to choose from). Otherwise it writes every
+    /// estimated track and never the truth.
+    pub fn may_choose_truth(&self, format: TrackFormat) -> bool {
+        !self.names.is_empty() || self.sync_with.is_some() || format.holds_one_track()
+    }
+}
+
 /// The tracks to write into `out`: those named, or every estimated track
 /// (moved out of `all`, not copied); for TUM and KITTI exactly one,
 /// optionally synced with another.
@@ -238,15 +248,13 @@ pub fn write_car(
     bound: &BoundFit,
 ) -> Result<Written, Error> {
     let format = TrackFormat::from_path(out)?;
-    // The truth's track only where it can be chosen: every estimated track
-    // is written by default, the truth only when named (its track is twice
-    // the size of an estimated one at 100 Hz).
-    let (all, bias_switch) =
-        if s.names.is_empty() && s.sync_with.is_none() && !format.holds_one_track() {
-            track::drive_tracks_and_switch(drive, params, opts, init_pose)?
-        } else {
-            drive_tracks_and_switch(drive, params, opts, init_pose)?
-        };
+    // The truth's track only where `select` can choose it (its track is
+    // twice the size of an estimated one at 100 Hz).
+    let (all, bias_switch) = if s.may_choose_truth(format) {
+        drive_tracks_and_switch(drive, params, opts, init_pose)?
+    } else {
+        track::drive_tracks_and_switch(drive, params, opts, init_pose)?
+    };
     let t = select(all, s, out, format)?;
     let bounds = if format == TrackFormat::Csv {
         bounds_95_m(drive, &t, bound, opts, init_pose)
