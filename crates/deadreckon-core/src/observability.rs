@@ -199,7 +199,8 @@ impl Manoeuvres {
                 out.push(Lack {
                     what: format!("{t:.0} s of {name} turns (want {MIN_TURN_S:.0} s)"),
                     weakens: vec!["gyro_scale"],
-                    why: "the gyro's scale error is estimated from turns (at least 3 of 20°); \
+                    why: "the gyro's scale error is estimated from turns (at least 2 of 20° \
+                          between 5 stretches of straight driving); \
                           measured on the simulated calibration drive without turns: the six \
                           parameters of the RTS calibration are not weakened (errors ×0.7–1.0)",
                 });
@@ -212,7 +213,7 @@ impl Manoeuvres {
                     self.straight_s
                 ),
                 weakens: vec!["gyro_scale"],
-                why: "the gyro's scale error compares the heading between two straight stretches",
+                why: "the gyro's scale error compares the heading between stretches of straight driving",
             });
         }
         if self.stops < MIN_STOPS {
