@@ -26,7 +26,9 @@
 //!    corrections is the start; each round tries every candidate left added
 //!    to those chosen so far and adds the one that lowers the mean held-back
 //!    error most, if its paired t statistic over the windows is at most
-//!    −[`MIN_T`]; the selection stops when no candidate does. Corrections
+//!    −[`MIN_T`] (the gyro scale: below
+//!    −[`crate::gyro_scale::HELD_BACK_MIN_T`]); the
+//!    selection stops when no candidate does. Corrections
 //!    interact (a gyro's delay and its scale error both turn the heading in
 //!    turns): judged one by one from none, a gyro 0.12 s late and 1.5 % off
 //!    scale showed the delay as a loss until the scale was applied.
@@ -154,6 +156,15 @@ pub const SHORT_MIN_Z: f64 = std::f64::consts::SQRT_2;
 /// family (`deadreckon-api/tests/dynamic_family_defaults.rs`), held out on
 /// cars 101–110.
 pub const MIN_T: f64 = 1.0;
+
+/// Whether candidate `c` judged at paired t `t` is applied: at most −[`MIN_T`],
+/// below −[`crate::gyro_scale::HELD_BACK_MIN_T`] for the gyro scale.
+fn wins(c: Correction, t: f64) -> bool {
+    match c {
+        Correction::GyroScale => t < -crate::gyro_scale::HELD_BACK_MIN_T,
+        _ => t <= -MIN_T,
+    }
+}
 
 /// The corrections a drive can be judged with.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -413,7 +424,7 @@ pub fn prepare_calibrated(
                     Some(x) => *x = j,
                     None => tried.push(j),
                 }
-                if t <= -MIN_T && best.as_ref().is_none_or(|b| diff_m < b.2) {
+                if wins(c, t) && best.as_ref().is_none_or(|b| diff_m < b.2) {
                     best = Some((i, run, diff_m));
                 }
             }
