@@ -307,7 +307,11 @@ pub fn prepare_calibrated(
     // The drive with the GNSS delay (if chosen) and the paper's model, and
     // its calibration: the start of every fold's passes, and the estimates
     // of the model's additions (side slip, steering) that are candidates.
-    let base_drive = known(&corrections, &base, &ModelOptions::default()).apply(drive);
+    let base_drive = judged_drive(
+        &known(&corrections, &base, &ModelOptions::default()),
+        drive,
+        copts,
+    );
     let base_calibration = calibrate::calibrate(&base_drive, copts).ok();
     let initial = base_calibration.as_ref().map(|c| c.estimate.params);
     let mut model_values = match &base_calibration {
@@ -389,7 +393,7 @@ pub fn prepare_calibrated(
             let mut best: Option<(usize, HeldBackRun, f64)> = None;
             for (i, &(c, z)) in left.iter().enumerate() {
                 let with: Vec<Correction> = set.iter().copied().chain([c]).collect();
-                let d = known(&corrections, &with, &model_values).apply(drive);
+                let d = judged_drive(&known(&corrections, &with, &model_values), drive, copts);
                 // The calibration holds the gyro bias constant: with a
                 // walking bias the folds calibrate as without it.
                 let same_calibration =
@@ -435,7 +439,7 @@ pub fn prepare_calibrated(
         // judged last. The calibration keeps white fixes, so the folds
         // calibrate as without it.
         let fitted = wander_may_be_fitted(drive).then(|| {
-            let d = known(&corrections, &set, &model_values).apply(drive);
+            let d = judged_drive(&known(&corrections, &set, &model_values), drive, copts);
             let cal = if set == base {
                 base_calibration.clone()
             } else {
@@ -449,7 +453,7 @@ pub fn prepare_calibrated(
                 model_values.gnss_wander = Some(w);
                 let c = Correction::Model(ModelOption::GnssWander);
                 let with: Vec<Correction> = set.iter().copied().chain([c]).collect();
-                let d = known(&corrections, &with, &model_values).apply(drive);
+                let d = judged_drive(&known(&corrections, &with, &model_values), drive, copts);
                 let run =
                     held_back_errors(&d, copts, [initial; 2], &windows, Some(&current.params))?;
                 let (_, t) = paired(&run.errors, &current.errors);
@@ -486,6 +490,22 @@ pub fn prepare_calibrated(
     // (the same known corrections), whose calibration is at hand.
     let calibration = chosen_calibration.or(base_calibration.filter(|_| chosen == base));
     Ok((out, corrections, calibration))
+}
+
+/// The drive a judgement's passes run on: `drive` with the corrections
+/// `k`, copied without its truth unless the calibration reads it (the truth
+/// method, a filter started from the truth): nothing else in the choice
+/// does, and a drive read with its truth (`evaluate`) copied it for every
+/// candidate (docs/performance.md, "Fifth round"). The drive returned is
+/// made from `drive` whole.
+fn judged_drive(k: &KnownCorrections, drive: &Drive, copts: &CalibrationOptions) -> Drive {
+    let reads_truth = copts.method == calibrate::Method::Truth
+        || matches!(copts.filter.init, crate::ekf::Init::Truth);
+    k.apply_to(if reads_truth {
+        drive.clone()
+    } else {
+        drive.clone_without_truth()
+    })
 }
 
 /// Whether the receiver's wander can be a candidate: the drive has fixes

@@ -270,15 +270,28 @@ pub fn apply_known(
 ) -> Drive {
     // One copy of the drive, corrected in place (a copy per step held up to
     // three copies at once).
-    let mut d = match up {
-        Some(u) => crate::imu::level_with(drive, u),
-        None => drive.clone(),
-    };
-    shift_in_place(&mut d, delays_s);
-    if gyro_scale_error != 0.0 {
-        crate::gyro_scale::apply_in_place(&mut d, gyro_scale_error);
-    }
+    let mut d = drive.clone();
+    apply_known_in_place(&mut d, delays_s, up, gyro_scale_error);
     d
+}
+
+/// [`apply_known`] to a drive in place (no copy): the yaw rate about `up`
+/// (as [`crate::imu::level_with`]), the delays, the gyro's scale.
+pub fn apply_known_in_place(
+    d: &mut Drive,
+    delays_s: [f64; 4],
+    up: Option<[f64; 3]>,
+    gyro_scale_error: f64,
+) {
+    if let Some(u) = up {
+        if !d.imu.gyro.is_empty() {
+            d.yaw_rate = crate::imu::vertical_rate(&d.imu.gyro, u);
+        }
+    }
+    shift_in_place(d, delays_s);
+    if gyro_scale_error != 0.0 {
+        crate::gyro_scale::apply_in_place(d, gyro_scale_error);
+    }
 }
 
 /// Corrections known beforehand and applied as they are: those a
@@ -315,18 +328,23 @@ impl KnownCorrections {
     /// Applies them to `drive`: the slip first ([`crate::traction::apply`]),
     /// then [`apply_known`], in [`prepare_with`]'s order.
     pub fn apply(&self, drive: &Drive) -> Drive {
-        let slipped;
-        let drive = if self.traction_slip_per_mps2 != 0.0 {
-            slipped = crate::traction::apply_at(
-                drive,
+        self.apply_to(drive.clone())
+    }
+
+    /// [`KnownCorrections::apply`] to a drive handed over: corrected in
+    /// place (a copy only for the traction slip's wheel speeds), e.g. a copy
+    /// made without the truth ([`Drive::clone_without_truth`]).
+    pub fn apply_to(&self, drive: Drive) -> Drive {
+        let mut out = if self.traction_slip_per_mps2 != 0.0 {
+            crate::traction::apply_at(
+                &drive,
                 self.traction_slip_per_mps2,
                 self.traction_mean_force_mps2,
-            );
-            &slipped
+            )
         } else {
             drive
         };
-        let mut out = apply_known(drive, self.delays_s, self.up, self.gyro_scale_error);
+        apply_known_in_place(&mut out, self.delays_s, self.up, self.gyro_scale_error);
         self.model.apply_to(&mut out.vehicle);
         out
     }
