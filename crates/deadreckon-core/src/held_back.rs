@@ -492,16 +492,11 @@ pub fn prepare_calibrated(
     Ok((out, corrections, calibration))
 }
 
-/// The drive a judgement's passes run on: `drive` with the corrections
-/// `k`, copied without its truth unless the calibration reads it (the truth
-/// method, a filter started from the truth): nothing else in the choice
-/// does, and a drive read with its truth (`evaluate`) copied it for every
-/// candidate (docs/performance.md, "Fifth round"). The drive returned is
-/// made from `drive` whole.
+/// `drive` with the corrections `k` for a judgement's passes: copied without
+/// its truth unless the calibration reads it
+/// ([`CalibrationOptions::reads_truth`]); the drive returned keeps it.
 fn judged_drive(k: &KnownCorrections, drive: &Drive, copts: &CalibrationOptions) -> Drive {
-    let reads_truth = copts.method == calibrate::Method::Truth
-        || matches!(copts.filter.init, crate::ekf::Init::Truth);
-    k.apply_to(if reads_truth {
+    k.apply_to(if copts.reads_truth() {
         drive.clone()
     } else {
         drive.clone_without_truth()

@@ -441,12 +441,17 @@ pub fn level(drive: &Drive) -> (Drive, Option<Tilt>) {
 /// than hold a copy of it through the GNSS delay's calibrations).
 pub fn levelled(drive: &Drive, tilt: Option<&Tilt>) -> Drive {
     let mut d = drive.clone();
+    level_in_place(&mut d, tilt);
+    d
+}
+
+/// [`levelled`] in place (no copy).
+pub fn level_in_place(d: &mut Drive, tilt: Option<&Tilt>) {
     if let Some(t) = tilt {
         if t.is_estimated() {
-            d.yaw_rate = vertical_rate(&drive.imu.gyro, t.up);
+            d.yaw_rate = vertical_rate(&d.imu.gyro, t.up);
         }
     }
-    d
 }
 
 /// The drive with the yaw rate projected on a known vertical `up` (sensor

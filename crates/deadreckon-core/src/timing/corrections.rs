@@ -219,9 +219,17 @@ pub fn prepare_with(
         }
         _ => drive,
     };
-    let (levelled, tilt) = crate::imu::level(drive);
-    // The levelled drive is handed to the GNSS delay's steps and made again
-    // afterwards (bit for bit: `imu::levelled`), not held beside their copy.
+    // The levelled drive (as `imu::level`) is handed to the GNSS delay's
+    // steps and made again afterwards (bit for bit: `imu::levelled`), not
+    // held beside their copy; without the truth unless the calibration
+    // reads it.
+    let tilt = crate::imu::estimate_tilt(drive);
+    let mut levelled = if copts.reads_truth() {
+        drive.clone()
+    } else {
+        drive.clone_without_truth()
+    };
+    crate::imu::level_in_place(&mut levelled, tilt.as_ref());
     let (mut delays, params) = estimate_with_params_owned(levelled, copts, o)?;
     if which == Which::Gnss {
         for d in [&mut delays.gyro, &mut delays.speed, &mut delays.steering] {
