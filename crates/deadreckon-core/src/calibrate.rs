@@ -213,6 +213,16 @@ pub struct CalibrationOptions {
     pub smoothing_process_yaw_rad: Option<f64>,
 }
 
+impl CalibrationOptions {
+    /// Whether a calibration with these options reads the drive's truth:
+    /// the truth method, or a filter started from the truth. Otherwise the
+    /// passes that only calibrate (the corrections' estimation and choice)
+    /// run on copies of the drive without it ([`crate::Drive::clone_without_truth`]).
+    pub fn reads_truth(&self) -> bool {
+        self.method == Method::Truth || matches!(self.filter.init, ekf::Init::Truth)
+    }
+}
+
 impl Default for CalibrationOptions {
     fn default() -> Self {
         CalibrationOptions {

@@ -14,7 +14,9 @@
 //! states). The re-runs go two at a time in parallel while the segments
 //! before them are smoothed (the same numbers: each re-run is the forward
 //! pass's own steps), so the backward pass takes about half the forward
-//! pass's wall time more on two cores.
+//! pass's wall time more on two cores; a pass that already runs in parallel
+//! with others (on one of rayon's workers: the held-back folds) re-runs its
+//! segments one after the other through one buffer.
 
 use nalgebra::{Cholesky, SVector};
 
@@ -144,7 +146,10 @@ impl<L: Layout<N>, const N: usize> Checkpoint<'_, L, N> {
 /// (rayon), while `visit` smooths through the two before them: the same
 /// epochs and the same order as one segment after the other (bit for bit),
 /// in about half the wall time on two cores, with four segments' epochs in
-/// memory instead of one.
+/// memory instead of one. Called on one of rayon's workers (a pass already
+/// running in parallel with others), the segments go one after the other
+/// through one buffer: the threads are busy, and the four buffers were the
+/// memory of nothing gained.
 fn backward<'a, L: Layout<N>, const N: usize>(
     cps: &[Checkpoint<'a, L, N>],
     total: usize,
@@ -154,6 +159,20 @@ where
     Checkpoint<'a, L, N>: Sync,
 {
     let end_of = |j: usize| cps.get(j + 1).map_or(total, |c| c.epochs_before);
+    // Already on one of rayon's workers (the held-back folds, the wander
+    // fit's runs: passes in parallel with others), the pool's threads are
+    // busy: the segments one after the other through one buffer, the same
+    // epochs in the same order, with one segment's epochs in memory instead
+    // of four (the default `calibrate`'s peak is two fold calibrations at
+    // once: docs/performance.md, "Fifth round").
+    if rayon::current_thread_index().is_some() {
+        let mut buf = Vec::new();
+        for j in (0..cps.len()).rev() {
+            cps[j].rerun(end_of(j), &mut buf)?;
+            visit(j, &mut buf)?;
+        }
+        return Ok(());
+    }
     // Segments `lo..hi` (at most two) re-run into `bufs`: `bufs[0]` takes
     // segment `hi − 1`, `bufs[1]` segment `hi − 2`.
     let rerun = |lo: usize, hi: usize, bufs: &mut [Vec<Epoch<N>>; 2]| -> Result<(), Error> {

@@ -193,6 +193,24 @@ pub fn in_windows(t: f64, windows: &[(f64, f64)]) -> bool {
 }
 
 impl Drive {
+    /// A copy of the drive without its truth (every other stream copied):
+    /// for passes that never read it, e.g. the held-back choice's
+    /// calibrations ([`crate::held_back`]), so a drive read with its truth
+    /// does not copy it too (`evaluate --outage`'s peak on the bench's hour:
+    /// docs/performance.md, "Fifth round").
+    pub fn clone_without_truth(&self) -> Drive {
+        Drive {
+            vehicle: self.vehicle.clone(),
+            wheels: self.wheels.clone(),
+            yaw_rate: self.yaw_rate.clone(),
+            speed: self.speed.clone(),
+            steering: self.steering.clone(),
+            gnss: self.gnss.clone(),
+            truth: Vec::new(),
+            imu: self.imu.clone(),
+        }
+    }
+
     /// The drive without the GNSS fixes inside `windows` ([`in_windows`]);
     /// every other stream kept.
     pub fn without_gnss_in(&self, windows: &[(f64, f64)]) -> Drive {

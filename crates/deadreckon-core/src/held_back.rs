@@ -318,7 +318,11 @@ pub fn prepare_calibrated(
     // The drive with the GNSS delay (if chosen) and the paper's model, and
     // its calibration: the start of every fold's passes, and the estimates
     // of the model's additions (side slip, steering) that are candidates.
-    let base_drive = known(&corrections, &base, &ModelOptions::default()).apply(drive);
+    let base_drive = judged_drive(
+        &known(&corrections, &base, &ModelOptions::default()),
+        drive,
+        copts,
+    );
     let base_calibration = calibrate::calibrate(&base_drive, copts).ok();
     let initial = base_calibration.as_ref().map(|c| c.estimate.params);
     let mut model_values = match &base_calibration {
@@ -400,7 +404,7 @@ pub fn prepare_calibrated(
             let mut best: Option<(usize, HeldBackRun, f64)> = None;
             for (i, &(c, z)) in left.iter().enumerate() {
                 let with: Vec<Correction> = set.iter().copied().chain([c]).collect();
-                let d = known(&corrections, &with, &model_values).apply(drive);
+                let d = judged_drive(&known(&corrections, &with, &model_values), drive, copts);
                 // The calibration holds the gyro bias constant: with a
                 // walking bias the folds calibrate as without it.
                 let same_calibration =
@@ -446,7 +450,7 @@ pub fn prepare_calibrated(
         // judged last. The calibration keeps white fixes, so the folds
         // calibrate as without it.
         let fitted = wander_may_be_fitted(drive).then(|| {
-            let d = known(&corrections, &set, &model_values).apply(drive);
+            let d = judged_drive(&known(&corrections, &set, &model_values), drive, copts);
             let cal = if set == base {
                 base_calibration.clone()
             } else {
@@ -460,7 +464,7 @@ pub fn prepare_calibrated(
                 model_values.gnss_wander = Some(w);
                 let c = Correction::Model(ModelOption::GnssWander);
                 let with: Vec<Correction> = set.iter().copied().chain([c]).collect();
-                let d = known(&corrections, &with, &model_values).apply(drive);
+                let d = judged_drive(&known(&corrections, &with, &model_values), drive, copts);
                 let run =
                     held_back_errors(&d, copts, [initial; 2], &windows, Some(&current.params))?;
                 let (_, t) = paired(&run.errors, &current.errors);
@@ -497,6 +501,17 @@ pub fn prepare_calibrated(
     // (the same known corrections), whose calibration is at hand.
     let calibration = chosen_calibration.or(base_calibration.filter(|_| chosen == base));
     Ok((out, corrections, calibration))
+}
+
+/// `drive` with the corrections `k` for a judgement's passes: copied without
+/// its truth unless the calibration reads it
+/// ([`CalibrationOptions::reads_truth`]); the drive returned keeps it.
+fn judged_drive(k: &KnownCorrections, drive: &Drive, copts: &CalibrationOptions) -> Drive {
+    k.apply_to(if copts.reads_truth() {
+        drive.clone()
+    } else {
+        drive.clone_without_truth()
+    })
 }
 
 /// Whether the receiver's wander can be a candidate: the drive has fixes

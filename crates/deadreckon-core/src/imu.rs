@@ -431,13 +431,27 @@ pub fn vertical_rate(gyro: &[Axes], up: [f64; 3]) -> Vec<Scalar> {
 /// without three-axis IMU data). An unestimated tilt leaves the drive as it is.
 pub fn level(drive: &Drive) -> (Drive, Option<Tilt>) {
     let tilt = estimate_tilt(drive);
+    (levelled(drive, tilt.as_ref()), tilt)
+}
+
+/// The drive [`level`] returns with the tilt it estimated, `tilt`: a copy
+/// of `drive` with the yaw rate about `tilt`'s vertical when it is
+/// estimated, bit for bit [`level`]'s (without estimating the tilt again:
+/// [`crate::timing::prepare_with`] makes the levelled drive again rather
+/// than hold a copy of it through the GNSS delay's calibrations).
+pub fn levelled(drive: &Drive, tilt: Option<&Tilt>) -> Drive {
     let mut d = drive.clone();
-    if let Some(t) = &tilt {
+    level_in_place(&mut d, tilt);
+    d
+}
+
+/// [`levelled`] in place (no copy).
+pub fn level_in_place(d: &mut Drive, tilt: Option<&Tilt>) {
+    if let Some(t) = tilt {
         if t.is_estimated() {
-            d.yaw_rate = vertical_rate(&drive.imu.gyro, t.up);
+            d.yaw_rate = vertical_rate(&d.imu.gyro, t.up);
         }
     }
-    (d, tilt)
 }
 
 /// The drive with the yaw rate projected on a known vertical `up` (sensor

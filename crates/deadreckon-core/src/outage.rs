@@ -555,6 +555,13 @@ fn window_errors(
         out.floor_m2 = floor_at;
         out.reference_m2 = reference_at;
     }
+    // Every window is kept to the end of the evaluation (an error per epoch
+    // against the truth): without the pushes' spare capacity, up to as much
+    // again (docs/performance.md, "Fifth round").
+    out.errors.shrink_to_fit();
+    out.covariances_m2.shrink_to_fit();
+    out.floor_m2.shrink_to_fit();
+    out.reference_m2.shrink_to_fit();
     Some(out)
 }
 

@@ -3,7 +3,7 @@
 
 use super::gnss::gnss_delay_of;
 use super::scalar::{gyro_delay, speed_delay, steering_delay};
-use super::{shift, Delay, DelayOptions, Delays, Status, Stream, MEASURED_NOT_APPLIED};
+use super::{shift_in_place, Delay, DelayOptions, Delays, Status, Stream, MEASURED_NOT_APPLIED};
 use crate::calibrate::{self, CalibrationOptions};
 use crate::drive::Drive;
 use crate::{Error, Params};
@@ -26,6 +26,19 @@ pub fn estimate_with_params(
     copts: &CalibrationOptions,
     o: &DelayOptions,
 ) -> Result<(Delays, Option<Params>), Error> {
+    estimate_with_params_owned(drive.clone(), copts, o)
+}
+
+/// [`estimate_with_params`] on a drive handed over: the GNSS delay's steps
+/// run on it, moved in place to the scalar streams' true time, instead of
+/// on a copy (one copy of the drive less through the GNSS delay's
+/// calibrations, the default `calibrate`'s peak: docs/performance.md,
+/// "Fifth round").
+pub fn estimate_with_params_owned(
+    mut drive: Drive,
+    copts: &CalibrationOptions,
+    o: &DelayOptions,
+) -> Result<(Delays, Option<Params>), Error> {
     // One after the other on the calling thread: run in parallel (rayon)
     // they saved 0.1 s of wall time on the bench's 10-minute drive but
     // their temporaries went to a worker thread's malloc arena, which the
@@ -33,13 +46,14 @@ pub fn estimate_with_params(
     // with `--corrections gnss` rose from 113.6 to 138.0 MB with one
     // thread (issue 30; the same with MALLOC_ARENA_MAX=1: 111 MB).
     let mut delays = Delays {
-        gyro: gyro_delay(drive, o),
-        speed: speed_delay(drive, o),
-        steering: steering_delay(drive, o),
+        gyro: gyro_delay(&drive, o),
+        speed: speed_delay(&drive, o),
+        steering: steering_delay(&drive, o),
         gnss: Delay::not_estimated("not estimated"),
     };
-    let true_time = on_true_time(&delays, drive);
-    let partly = true_time.apply(drive);
+    let true_time = on_true_time(&delays, &drive);
+    true_time.apply_in_place(&mut drive);
+    let partly = drive;
     // The filter's streams are moved by the delays as estimated.
     let view = [Stream::Gyro, Stream::Speed, Stream::Steering]
         .map(|s| delays.get(s).applied_s() - true_time.get(s).applied_s());
@@ -205,8 +219,18 @@ pub fn prepare_with(
         }
         _ => drive,
     };
-    let (levelled, tilt) = crate::imu::level(drive);
-    let (mut delays, params) = estimate_with_params(&levelled, copts, o)?;
+    // The levelled drive (as `imu::level`) is handed to the GNSS delay's
+    // steps and made again afterwards (bit for bit: `imu::levelled`), not
+    // held beside their copy; without the truth unless the calibration
+    // reads it.
+    let tilt = crate::imu::estimate_tilt(drive);
+    let mut levelled = if copts.reads_truth() {
+        drive.clone()
+    } else {
+        drive.clone_without_truth()
+    };
+    crate::imu::level_in_place(&mut levelled, tilt.as_ref());
+    let (mut delays, params) = estimate_with_params_owned(levelled, copts, o)?;
     if which == Which::Gnss {
         for d in [&mut delays.gyro, &mut delays.speed, &mut delays.steering] {
             if d.status.is_estimated() {
@@ -215,8 +239,7 @@ pub fn prepare_with(
             }
         }
     }
-    // The levelled drive becomes the output (moved, not copied).
-    let mut out = levelled;
+    let mut out = crate::imu::levelled(drive, tilt.as_ref());
     delays.apply_in_place(&mut out);
     // The bias of the calibration at the final GNSS delay (a time shift of
     // the gyro does not change its bias), else of a calibration here.
@@ -253,15 +276,29 @@ pub fn apply_known(
     up: Option<[f64; 3]>,
     gyro_scale_error: f64,
 ) -> Drive {
-    let d = match up {
-        Some(u) => crate::imu::level_with(drive, u),
-        None => drive.clone(),
-    };
-    let d = shift(&d, delays_s);
+    // One copy of the drive, corrected in place (a copy per step held up to
+    // three copies at once).
+    let mut d = drive.clone();
+    apply_known_in_place(&mut d, delays_s, up, gyro_scale_error);
+    d
+}
+
+/// [`apply_known`] to a drive in place (no copy): the yaw rate about `up`
+/// (as [`crate::imu::level_with`]), the delays, the gyro's scale.
+pub fn apply_known_in_place(
+    d: &mut Drive,
+    delays_s: [f64; 4],
+    up: Option<[f64; 3]>,
+    gyro_scale_error: f64,
+) {
+    if let Some(u) = up {
+        if !d.imu.gyro.is_empty() {
+            d.yaw_rate = crate::imu::vertical_rate(&d.imu.gyro, u);
+        }
+    }
+    shift_in_place(d, delays_s);
     if gyro_scale_error != 0.0 {
-        crate::gyro_scale::apply(&d, gyro_scale_error)
-    } else {
-        d
+        crate::gyro_scale::apply_in_place(d, gyro_scale_error);
     }
 }
 
@@ -299,18 +336,23 @@ impl KnownCorrections {
     /// Applies them to `drive`: the slip first ([`crate::traction::apply`]),
     /// then [`apply_known`], in [`prepare_with`]'s order.
     pub fn apply(&self, drive: &Drive) -> Drive {
-        let slipped;
-        let drive = if self.traction_slip_per_mps2 != 0.0 {
-            slipped = crate::traction::apply_at(
-                drive,
+        self.apply_to(drive.clone())
+    }
+
+    /// [`KnownCorrections::apply`] to a drive handed over: corrected in
+    /// place (a copy only for the traction slip's wheel speeds), e.g. a copy
+    /// made without the truth ([`Drive::clone_without_truth`]).
+    pub fn apply_to(&self, drive: Drive) -> Drive {
+        let mut out = if self.traction_slip_per_mps2 != 0.0 {
+            crate::traction::apply_at(
+                &drive,
                 self.traction_slip_per_mps2,
                 self.traction_mean_force_mps2,
-            );
-            &slipped
+            )
         } else {
             drive
         };
-        let mut out = apply_known(drive, self.delays_s, self.up, self.gyro_scale_error);
+        apply_known_in_place(&mut out, self.delays_s, self.up, self.gyro_scale_error);
         self.model.apply_to(&mut out.vehicle);
         out
     }
