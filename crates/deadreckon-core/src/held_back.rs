@@ -69,20 +69,15 @@
 //! Every candidate's two figures and the decision are returned
 //! ([`HeldBack`]) for the JSON, the text and params.toml.
 //!
-//! **Warm starts** (issue 30: each calibration is two or more smoothing
-//! passes, the default's largest cost). A calibration stops when a pass
-//! moves no parameter by a tolerance unit, wherever it started, so each
-//! candidate's fold calibration starts from the same fold's calibration
-//! without it (the baseline folds from the baseline's parameters, as
-//! before), and the GNSS delay's steps each from the step before
-//! ([`crate::timing::gnss_delay`]). On the bench's 10-minute drive
-//! (`command_cost`) the CAN speed delay's second fold then settles in one
-//! pass instead of two, and the GNSS delay's second step too, with the
-//! same choice; the judged figures move within the tolerance (the
-//! candidate's t by 3e-7 relative; docs/performance.md). The baseline's
-//! calibration and the chosen drive's still start from the request's
-//! start: they are the calibration the caller gets, `calibrate`'s of the
-//! returned drive bit for bit.
+//! **Warm starts** (issue 30). Each candidate's fold calibration starts
+//! from the same fold's calibration without it (the baseline folds from
+//! the baseline's parameters), and the GNSS delay's steps each from the
+//! step before ([`crate::timing::gnss_delay`]): a calibration stops when a
+//! pass moves no parameter by a tolerance unit, wherever it started, so
+//! the choice is the same and the judged figures move within the
+//! tolerance (docs/performance.md). The baseline's calibration and the
+//! chosen drive's start from the request's start: they are the calibration
+//! the caller gets, `calibrate`'s of the returned drive bit for bit.
 //!
 //! What the judgement does not hold back: the correction's value is the
 //! whole drive's estimate, which saw every fix (each correction is one or a
