@@ -153,7 +153,12 @@ fn fit_runs(runs: &[Run]) -> Option<(f64, f64)> {
     let within_dof: f64 = runs.iter().map(|r| r.n - 1.0).sum();
     let floor = if within_dof > 0.0 {
         let var_c = runs.iter().map(|r| r.ss).sum::<f64>() / within_dof;
-        var_c * runs.iter().map(|r| r.n.min(MAX_RUN_WEIGHT_FIXES) / r.n).sum::<f64>() / k as f64
+        var_c
+            * runs
+                .iter()
+                .map(|r| r.n.min(MAX_RUN_WEIGHT_FIXES) / r.n)
+                .sum::<f64>()
+            / k as f64
     } else {
         0.0
     };
@@ -234,7 +239,9 @@ pub fn estimate(drive: &Drive, bias_rps: f64) -> GyroScale {
     if turns < MIN_TURNS {
         return GyroScale::not_estimated(
             turns,
-            format!("{turns} turns of more than {MIN_TURN_DEG}° between straights, need {MIN_TURNS}"),
+            format!(
+                "{turns} turns of more than {MIN_TURN_DEG}° between straights, need {MIN_TURNS}"
+            ),
         );
     }
     let Some((a, std_a)) = fit_runs(&runs) else {
@@ -284,4 +291,3 @@ pub fn apply_in_place(d: &mut Drive, scale_error: f64) {
         a.z /= k;
     }
 }
-

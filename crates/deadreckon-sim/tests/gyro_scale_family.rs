@@ -57,7 +57,11 @@ fn one(seed: u64) -> Result<(f64, gyro_scale::GyroScale), String> {
     let cal = simulate(&car.drive(cal_seed, 300.0, &effects), cal_seed).expect("simulated");
     let c = calibrate(&cal.drive, &CalibrationOptions::default()).map_err(|e| e.to_string())?;
     Ok((
-        if effects.gyro_scale { car.gyro_scale_error } else { 0.0 },
+        if effects.gyro_scale {
+            car.gyro_scale_error
+        } else {
+            0.0
+        },
         gyro_scale::estimate(&cal.drive, c.estimate.params.gyro_bias_rps),
     ))
 }
@@ -72,7 +76,11 @@ fn one(seed: u64) -> Result<(f64, gyro_scale::GyroScale), String> {
 fn gyro_scale_read_the_calibrated_bias_as_scale() {
     for (seed, within) in [(12, 0.0005), (22, 0.0005)] {
         let (truth, g) = one(seed).expect("calibrated");
-        assert!(g.is_estimated() || g.std.is_finite(), "car {seed}: {:?}", g.status);
+        assert!(
+            g.is_estimated() || g.std.is_finite(),
+            "car {seed}: {:?}",
+            g.status
+        );
         let err = g.scale_error - truth;
         assert!(
             err.abs() < within && err.abs() < 3.0 * g.std,
@@ -103,7 +111,11 @@ fn gyro_scale_on_the_family() {
             }
         };
         if !g.std.is_finite() {
-            println!("car {seed}: true {:+.3} %, not estimated: {:?}", 100.0 * truth, g.status);
+            println!(
+                "car {seed}: true {:+.3} %, not estimated: {:?}",
+                100.0 * truth,
+                g.status
+            );
             continue;
         }
         let err = g.scale_error - truth;
