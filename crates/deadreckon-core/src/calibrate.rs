@@ -221,6 +221,16 @@ impl CalibrationOptions {
     pub fn reads_truth(&self) -> bool {
         self.method == Method::Truth || matches!(self.filter.init, ekf::Init::Truth)
     }
+
+    /// A copy of `drive` for passes that only calibrate with these options:
+    /// without its truth unless the calibration reads it ([`Self::reads_truth`]).
+    pub fn working_copy(&self, drive: &Drive) -> Drive {
+        if self.reads_truth() {
+            drive.clone()
+        } else {
+            drive.clone_without_truth()
+        }
+    }
 }
 
 impl Default for CalibrationOptions {

@@ -89,6 +89,14 @@ struct Run {
     ss: f64,
 }
 
+impl Run {
+    /// The run's weight in the fit: its fixes, at most
+    /// [`MAX_RUN_WEIGHT_FIXES`].
+    fn weight(&self) -> f64 {
+        self.n.min(MAX_RUN_WEIGHT_FIXES)
+    }
+}
+
 /// Groups the straight moments `(t, course, integrated gyro)` into runs.
 fn straight_runs(straight: &[(f64, f64, f64)]) -> Vec<Run> {
     let mut runs = Vec::new();
@@ -100,13 +108,15 @@ fn straight_runs(straight: &[(f64, f64, f64)]) -> Vec<Run> {
         let run = &straight[start..i];
         let o0 = angle::wrap(run[0].1 - run[0].2);
         let n = run.len() as f64;
-        let o = o0 + run.iter().map(|m| angle::wrap(m.1 - m.2 - o0)).sum::<f64>() / n;
+        // `o` of each fix, unwrapped about the run's first.
+        let os: Vec<f64> = run
+            .iter()
+            .map(|m| o0 + angle::wrap(m.1 - m.2 - o0))
+            .collect();
+        let o = os.iter().sum::<f64>() / n;
         let h = run.iter().map(|m| m.2).sum::<f64>() / n;
         let t = run.iter().map(|m| m.0).sum::<f64>() / n;
-        let ss = run
-            .iter()
-            .map(|m| (o0 + angle::wrap(m.1 - m.2 - o0) - o).powi(2))
-            .sum::<f64>();
+        let ss = os.iter().map(|x| (x - o).powi(2)).sum::<f64>();
         runs.push(Run { t, h, o, n, ss });
         start = i;
     }
@@ -127,22 +137,17 @@ fn fit_runs(runs: &[Run]) -> Option<(f64, f64)> {
     if k < MIN_RUNS {
         return None;
     }
-    let mut o = Vec::with_capacity(k);
-    o.push(runs[0].o);
-    for w in runs.windows(2) {
-        let prev = *o.last().expect("one pushed");
-        o.push(prev + angle::wrap(w[1].o - w[0].o));
-    }
+    let o = angle::unwrap(&runs.iter().map(|r| r.o).collect::<Vec<_>>());
     let t0 = runs[0].t;
     let x = DMatrix::from_fn(k, 3, |i, j| {
-        let w = runs[i].n.min(MAX_RUN_WEIGHT_FIXES).sqrt();
-        w * match j {
-            0 => runs[i].h,
-            1 => runs[i].t - t0,
-            _ => 1.0,
-        }
+        runs[i].weight().sqrt()
+            * match j {
+                0 => runs[i].h,
+                1 => runs[i].t - t0,
+                _ => 1.0,
+            }
     });
-    let y = DVector::from_fn(k, |i, _| runs[i].n.min(MAX_RUN_WEIGHT_FIXES).sqrt() * o[i]);
+    let y = DVector::from_fn(k, |i, _| runs[i].weight().sqrt() * o[i]);
     let xtx = x.transpose() * &x;
     let inv = xtx.try_inverse()?;
     let theta = &inv * (x.transpose() * &y);
@@ -153,12 +158,7 @@ fn fit_runs(runs: &[Run]) -> Option<(f64, f64)> {
     let within_dof: f64 = runs.iter().map(|r| r.n - 1.0).sum();
     let floor = if within_dof > 0.0 {
         let var_c = runs.iter().map(|r| r.ss).sum::<f64>() / within_dof;
-        var_c
-            * runs
-                .iter()
-                .map(|r| r.n.min(MAX_RUN_WEIGHT_FIXES) / r.n)
-                .sum::<f64>()
-            / k as f64
+        var_c * runs.iter().map(|r| r.weight() / r.n).sum::<f64>() / k as f64
     } else {
         0.0
     };
@@ -250,7 +250,6 @@ pub fn estimate(drive: &Drive, bias_rps: f64) -> GyroScale {
     // o = a·h − δb·t/(1+s) + const with a = 1/(1+s) − 1.
     let scale_error = 1.0 / (1.0 + a) - 1.0;
     let std = std_a / (1.0 + a).powi(2);
-    let n = turns;
     let status = if !(std.is_finite() && std <= MAX_STD) {
         Status::NotEstimated(format!(
             "too little turning: standard error {:.2}% above {:.1}%",
@@ -269,7 +268,7 @@ pub fn estimate(drive: &Drive, bias_rps: f64) -> GyroScale {
     GyroScale {
         scale_error,
         std,
-        turns: n,
+        turns,
         status,
     }
 }

@@ -502,11 +502,7 @@ pub fn prepare_calibrated(
 /// its truth unless the calibration reads it
 /// ([`CalibrationOptions::reads_truth`]); the drive returned keeps it.
 fn judged_drive(k: &KnownCorrections, drive: &Drive, copts: &CalibrationOptions) -> Drive {
-    k.apply_to(if copts.reads_truth() {
-        drive.clone()
-    } else {
-        drive.clone_without_truth()
-    })
+    k.apply_to(copts.working_copy(drive))
 }
 
 /// Whether the receiver's wander can be a candidate: the drive has fixes

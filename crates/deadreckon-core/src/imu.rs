@@ -458,8 +458,13 @@ pub fn level_in_place(d: &mut Drive, tilt: Option<&Tilt>) {
 /// axes), e.g. a tilt from params.toml; unchanged without three-axis gyro data.
 pub fn level_with(drive: &Drive, up: [f64; 3]) -> Drive {
     let mut d = drive.clone();
-    if !drive.imu.gyro.is_empty() {
-        d.yaw_rate = vertical_rate(&drive.imu.gyro, up);
-    }
+    level_with_in_place(&mut d, up);
     d
+}
+
+/// [`level_with`] in place (no copy).
+pub fn level_with_in_place(d: &mut Drive, up: [f64; 3]) {
+    if !d.imu.gyro.is_empty() {
+        d.yaw_rate = vertical_rate(&d.imu.gyro, up);
+    }
 }

@@ -224,11 +224,7 @@ pub fn prepare_with(
     // held beside their copy; without the truth unless the calibration
     // reads it.
     let tilt = crate::imu::estimate_tilt(drive);
-    let mut levelled = if copts.reads_truth() {
-        drive.clone()
-    } else {
-        drive.clone_without_truth()
-    };
+    let mut levelled = copts.working_copy(drive);
     crate::imu::level_in_place(&mut levelled, tilt.as_ref());
     let (mut delays, params) = estimate_with_params_owned(levelled, copts, o)?;
     if which == Which::Gnss {
@@ -292,9 +288,7 @@ pub fn apply_known_in_place(
     gyro_scale_error: f64,
 ) {
     if let Some(u) = up {
-        if !d.imu.gyro.is_empty() {
-            d.yaw_rate = crate::imu::vertical_rate(&d.imu.gyro, u);
-        }
+        crate::imu::level_with_in_place(d, u);
     }
     shift_in_place(d, delays_s);
     if gyro_scale_error != 0.0 {
