@@ -132,10 +132,12 @@ fn straight_runs(straight: &[(f64, f64, f64)]) -> Vec<Run> {
 /// const`: the time term takes the bias error (on a drive that turns more
 /// one way than the other, the calibrated bias holds `s` times the mean
 /// yaw rate), which a regression on the turns alone reads as scale.
-fn fit_runs(runs: &[Run]) -> Option<(f64, f64)> {
+fn fit_runs(runs: &[Run]) -> Result<(f64, f64), String> {
     let k = runs.len();
     if k < MIN_RUNS {
-        return None;
+        return Err(format!(
+            "{k} stretches of straight driving with a GNSS course, need {MIN_RUNS}"
+        ));
     }
     let o = angle::unwrap(&runs.iter().map(|r| r.o).collect::<Vec<_>>());
     let t0 = runs[0].t;
@@ -149,7 +151,9 @@ fn fit_runs(runs: &[Run]) -> Option<(f64, f64)> {
     });
     let y = DVector::from_fn(k, |i, _| runs[i].weight().sqrt() * o[i]);
     let xtx = x.transpose() * &x;
-    let inv = xtx.try_inverse()?;
+    let inv = xtx
+        .try_inverse()
+        .ok_or("the stretches of straight driving do not determine a scale")?;
     let theta = &inv * (x.transpose() * &y);
     let r = &y - &x * &theta;
     // The residual variance, at least what the fixes' course noise within
@@ -164,7 +168,7 @@ fn fit_runs(runs: &[Run]) -> Option<(f64, f64)> {
     };
     let s2 = (r.norm_squared() / (k - 3) as f64).max(floor);
     let std = (s2 * inv[(0, 0)]).sqrt();
-    Some((theta[0], std))
+    Ok((theta[0], std))
 }
 
 /// The estimated gyro scale error.
@@ -244,8 +248,9 @@ pub fn estimate(drive: &Drive, bias_rps: f64) -> GyroScale {
             ),
         );
     }
-    let Some((a, std_a)) = fit_runs(&runs) else {
-        return GyroScale::not_estimated(turns, "the runs do not determine a scale".into());
+    let (a, std_a) = match fit_runs(&runs) {
+        Ok(fit) => fit,
+        Err(why) => return GyroScale::not_estimated(turns, why),
     };
     // o = a·h − δb·t/(1+s) + const with a = 1/(1+s) − 1.
     let scale_error = 1.0 / (1.0 + a) - 1.0;
