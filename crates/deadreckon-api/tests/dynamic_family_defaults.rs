@@ -71,6 +71,16 @@
 //! state needs the gyro as the heading's input (the scale on the
 //! integrated yaw), not as one more measurement of a yaw-rate state.
 //!
+//! **Also tried and not kept: heading noise that grows with the angle
+//! turned**, `σ_s²·(π/2)·|ψ̇|·dt` added to the yaw's process variance in the
+//! evaluation's filter (a walk with a constant scale error's variance at a
+//! quarter turn), so that it would claim what car 6's loop makes of the
+//! heading. Dev cars 1–6, `none,gyro_scale,side_slip,all_but_wander`:
+//! σ_s = 0.5 % gave 0.452 / 0.635 / 0.556 / 1.072 m and 1 % 0.537 / 0.697 /
+//! 0.620 / 1.128 m, against 0.385 / 0.636 / 0.511 (stop 47's table) /
+//! 1.079 m without: the fixes' noise then reaches the heading an outage
+//! starts from.
+//!
 //! Measured now (commit b168122: `auto` and the gyro-bias switch, both
 //! defaults; 300 s drives; 22 min on two shared cores with
 //! `RAYON_NUM_THREADS=2 DEFAULTS_SAY=1 DEFAULTS_ONLY_AUTO=1
