@@ -160,10 +160,10 @@ pub fn check(
 /// within [`MAX_CIRCUMFERENCE_DEVIATION`], or the message naming the file,
 /// the key, both values and the likely mistake.
 pub fn check_circumferences(spec: &str, p: &Params, vehicle: &Vehicle) -> Result<(), String> {
-    let nominal = vehicle.wheel_circumference_m;
-    let Some((name, c, factor)) = implausible_circumference(p, vehicle) else {
+    let Some(bad) = implausible_circumference(p, vehicle) else {
         return Ok(());
     };
+    let factor = bad.factor();
     let hint = if (factor / 1000.0 - 1.0).abs() < 0.5 {
         " (millimetres?)"
     } else if (factor / 100.0 - 1.0).abs() < 0.5 {
@@ -171,28 +171,64 @@ pub fn check_circumferences(spec: &str, p: &Params, vehicle: &Vehicle) -> Result
     } else {
         " (another vehicle's parameters?)"
     };
-    Err(format!(
-        "{spec}: {name} = {c} m is {:+.1} % from the vehicle's nominal \
-         wheel_circumference_m = {nominal} m{hint}, more than the {} % a \
-         tyre varies",
-        100.0 * (factor - 1.0),
-        100.0 * MAX_CIRCUMFERENCE_DEVIATION
-    ))
+    Err(format!("{spec}: {}", bad.describe(None, hint)))
+}
+
+/// A circumference further than [`MAX_CIRCUMFERENCE_DEVIATION`] from its
+/// vehicle's nominal one; [`ImplausibleCircumference::describe`] is the one
+/// wording of that refusal (a params.toml given to a drive, and a
+/// calibration that settled there).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ImplausibleCircumference {
+    /// The parameter's name (`circumference_fl_m`, …).
+    pub name: &'static str,
+    /// Its value, m.
+    pub value_m: f64,
+    /// The vehicle's nominal circumference, m.
+    pub nominal_m: f64,
+}
+
+impl ImplausibleCircumference {
+    /// The value over the nominal.
+    pub fn factor(&self) -> f64 {
+        self.value_m / self.nominal_m
+    }
+
+    /// "`name` = value m is ±x % from the vehicle's nominal
+    /// wheel_circumference_m = n m`hint`, more than the 5 % a tyre varies",
+    /// the value with `decimals` decimals (`None`: as it is).
+    pub fn describe(&self, decimals: Option<usize>, hint: &str) -> String {
+        let value = match decimals {
+            Some(d) => format!("{:.*}", d, self.value_m),
+            None => format!("{}", self.value_m),
+        };
+        format!(
+            "{} = {value} m is {:+.1} % from the vehicle's nominal wheel_circumference_m = {} \
+             m{hint}, more than the {} % a tyre varies",
+            self.name,
+            100.0 * (self.factor() - 1.0),
+            self.nominal_m,
+            100.0 * MAX_CIRCUMFERENCE_DEVIATION
+        )
+    }
 }
 
 /// The first circumference of `p` further than
-/// [`MAX_CIRCUMFERENCE_DEVIATION`] from `vehicle`'s nominal: its name, its
-/// value (m) and its ratio to the nominal.
+/// [`MAX_CIRCUMFERENCE_DEVIATION`] from `vehicle`'s nominal.
 pub fn implausible_circumference(
     p: &Params,
     vehicle: &Vehicle,
-) -> Option<(&'static str, f64, f64)> {
-    let nominal = vehicle.wheel_circumference_m;
+) -> Option<ImplausibleCircumference> {
+    let nominal_m = vehicle.wheel_circumference_m;
     Params::NAMES[2..]
         .iter()
         .zip(p.circumferences())
-        .map(|(name, c)| (*name, c, c / nominal))
-        .find(|(_, _, factor)| (factor - 1.0).abs() > MAX_CIRCUMFERENCE_DEVIATION)
+        .map(|(name, value_m)| ImplausibleCircumference {
+            name,
+            value_m,
+            nominal_m,
+        })
+        .find(|c| (c.factor() - 1.0).abs() > MAX_CIRCUMFERENCE_DEVIATION)
 }
 
 #[cfg(test)]

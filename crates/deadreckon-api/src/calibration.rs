@@ -211,17 +211,13 @@ pub fn calibrate_corrected(
     // would refuse it (crate::binding). On drives with several effects at
     // once the calibration can settle at such a point with no other check
     // firing (a dynamic family car: +10 %, the distance scale right).
-    if let Some((which, c, factor)) =
+    if let Some(bad) =
         crate::binding::implausible_circumference(&calibration.estimate.params, &drive.vehicle)
     {
         return Err(Error::Invalid(format!(
-            "calibrating {name}: estimate rejected: {which} = {c:.4} m is {:+.1} % from the \
-             vehicle's nominal wheel_circumference_m = {} m, more than the {} % a tyre varies \
-             (speed scale {:.4}, gyro bias {:.5} rad/s): the calibration did not settle at the \
-             vehicle's values",
-            100.0 * (factor - 1.0),
-            drive.vehicle.wheel_circumference_m,
-            100.0 * crate::binding::MAX_CIRCUMFERENCE_DEVIATION,
+            "calibrating {name}: estimate rejected: {} (speed scale {:.4}, gyro bias {:.5} \
+             rad/s): the calibration did not settle at the vehicle's values",
+            bad.describe(Some(4), ""),
             calibration.estimate.params.speed_scale,
             calibration.estimate.params.gyro_bias_rps,
         )));
