@@ -73,6 +73,10 @@ static GRACEFUL: AtomicBool = AtomicBool::new(false);
 static STOP: AtomicBool = AtomicBool::new(false);
 
 fn main() {
+    // Large blocks freed go back to the system (the peak RSS of
+    // `evaluate --outage` and `calibrate` on long drives:
+    // deadreckon_api::process).
+    deadreckon_api::process::return_large_blocks_when_freed();
     let cli = Cli::parse();
     // An interrupted command leaves no temporary file or directory behind:
     // the writes register them (deadreckon_io::temporaries). Exit status as

@@ -75,6 +75,7 @@ pub mod model_keys;
 pub mod options;
 pub mod params_file;
 pub mod params_tables;
+pub mod process;
 pub mod report;
 pub mod report_kinematic;
 pub mod report_labels;

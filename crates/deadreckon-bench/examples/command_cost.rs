@@ -91,6 +91,9 @@ fn run_child(c: Command, dir: &Path) -> (f64, f64, u64, usize) {
 }
 
 fn main() {
+    // As the command line's process does first
+    // (deadreckon_api::process::return_large_blocks_when_freed).
+    deadreckon_api::process::return_large_blocks_when_freed();
     let args: Vec<String> = std::env::args().skip(1).collect();
     let usage =
         "usage: command_cost write DIR DURATION_S | COMMAND DIR | table SHORT_DIR LONG_DIR \

@@ -589,26 +589,20 @@ pub fn samples(ev: &crate::outage::OutageEvaluation) -> Vec<Sample> {
 }
 
 impl crate::compared::OutageResult {
-    /// The receiver's floor at error `i` (zero when not recorded).
-    fn floor_at(&self, i: usize) -> Cov2 {
-        self.floor_m2.get(i).copied().unwrap_or(Cov2::circular(0.0))
-    }
-
     /// The 95 % bound at each error, m (empty when the estimator gave no
     /// covariance): [`BoundFit::floored_bound_m`] of the estimator's
     /// covariance and the receiver's floor.
     pub fn bounds_95_m(&self, fit: &BoundFit) -> Vec<f64> {
         self.covariances_m2
             .iter()
-            .enumerate()
-            .map(|(i, c)| fit.floored_bound_m(c, &self.floor_at(i)))
+            .map(|c| fit.floored_bound_m(c, &self.floor_m2))
             .collect()
     }
 
     /// The 95 % bound at the window's end (the last error), m.
     pub fn bound_95_m(&self, fit: &BoundFit) -> Option<f64> {
         let i = self.covariances_m2.len().checked_sub(1)?;
-        Some(fit.floored_bound_m(&self.covariances_m2[i], &self.floor_at(i)))
+        Some(fit.floored_bound_m(&self.covariances_m2[i], &self.floor_m2))
     }
 
     /// The sample the final error makes for [`fit`] and the coverage: the
@@ -620,9 +614,9 @@ impl crate::compared::OutageResult {
     /// reference's covariance). `None` without covariances.
     pub fn final_sample(&self) -> Option<Sample> {
         let i = self.covariances_m2.len().checked_sub(1)?;
-        let floor = self.floor_at(i);
+        let floor = self.floor_m2;
         let reference = match self.against {
-            crate::compared::Against::Gnss => floor.scaled_plus(2.0, self.reference_m2.get(i)?),
+            crate::compared::Against::Gnss => floor.scaled_plus(2.0, &self.reference_m2),
             _ => floor,
         };
         Some(Sample {

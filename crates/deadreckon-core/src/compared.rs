@@ -164,14 +164,17 @@ pub struct OutageResult {
     /// (empty when the estimator has none): the part of the error bound
     /// the factor inflates ([`crate::bound`]).
     pub covariances_m2: Vec<crate::bound::Cov2>,
-    /// The receiver's offset at each error, m² (the declared accuracy of
-    /// the last fix before the outage, [`crate::bound`]'s floor, not
-    /// inflated; zero where the estimator carries it in its state; empty
-    /// with `covariances_m2`).
-    pub floor_m2: Vec<crate::bound::Cov2>,
-    /// The reference's own covariance at each error, m² (a hidden fix's
-    /// noise; zero for the truth; empty with `covariances_m2`).
-    pub reference_m2: Vec<crate::bound::Cov2>,
+    /// The receiver's offset, m², the same at every error of the window
+    /// (the declared accuracy of the last fix before the outage,
+    /// [`crate::bound`]'s floor, not inflated; zero where the estimator
+    /// carries it in its state, and without `covariances_m2`). Once per
+    /// window, not per error: 48 B an error less with `reference_m2`
+    /// (docs/performance.md, "Sixth round").
+    pub floor_m2: crate::bound::Cov2,
+    /// The reference's own covariance, m², the same at every error (a
+    /// hidden fix's noise; zero for the truth, and without
+    /// `covariances_m2`).
+    pub reference_m2: crate::bound::Cov2,
 }
 
 impl OutageResult {
@@ -196,8 +199,8 @@ impl OutageResult {
             distance_m,
             start_yaw_std_rad: None,
             covariances_m2: Vec::new(),
-            floor_m2: Vec::new(),
-            reference_m2: Vec::new(),
+            floor_m2: crate::bound::Cov2::circular(0.0),
+            reference_m2: crate::bound::Cov2::circular(0.0),
         }
     }
 

@@ -31,7 +31,7 @@ use crate::ekf::FilterOptions;
 use crate::filter::GateCounts;
 use crate::metrics::Summary;
 use crate::model::{State, V, X, Y, YAW};
-use crate::reference::Reference;
+use crate::reference::{Reference, TruthPositions};
 use crate::vehicle::Params;
 use crate::{Error, Input, Need, Rule, Task, Value};
 use nalgebra::SMatrix;
@@ -255,8 +255,9 @@ fn evaluate_in(
             Rule::Positive,
         ));
     }
+    // The truth's positions, borrowed: the windows read nothing else of it.
     let truth = if use_truth {
-        Reference::from_truth(&drive.truth)
+        TruthPositions::new(&drive.truth)
     } else {
         None
     };
@@ -437,14 +438,15 @@ fn pose_block<const N: usize>(p: &SMatrix<f64, N, N>) -> [[f64; 3]; 3] {
 /// fixes carry it). With `covs` (the pose covariance at each state, and
 /// the wander's part of it where the filter carries the wander) each
 /// error also gets the covariance the error bound is made of (the point
-/// compared — against a fix, the antenna plus the wander —, plus
-/// `receiver`: the declared accuracy of the last fix before the outage,
-/// [`crate::bound`]) and the reference's (a fix's is `fix_std_m` per
-/// axis). `None` when nothing compares.
+/// compared — against a fix, the antenna plus the wander), and the window
+/// the two parts that hold for all of it: `receiver`, the declared accuracy
+/// of the last fix before the outage ([`crate::bound`]), and the
+/// reference's own (a fix's is `fix_std_m` per axis). `None` when nothing
+/// compares.
 #[allow(clippy::too_many_arguments)]
 fn window_errors(
     drive: &Drive,
-    truth: Option<&Reference>,
+    truth: Option<&TruthPositions>,
     states: &[(f64, State)],
     wander: &[[f64; 2]],
     (covs, wander_covs): (&[[[f64; 3]; 3]], &[WanderCov]),
@@ -468,8 +470,6 @@ fn window_errors(
         .map(|(_, c)| *c)
         .collect();
     let mut cov_at = Vec::new();
-    let mut floor_at = Vec::new();
-    let mut reference_at = Vec::new();
     // The antenna the fixes see: the car's plus the wander expected.
     let seen: Vec<(f64, State)> = states
         .iter()
@@ -489,16 +489,14 @@ fn window_errors(
     match truth {
         Some(t) => {
             for (k, (ts, x)) in states.iter().enumerate() {
-                if let Some(r) = t.state_at(*ts) {
+                if let Some((east, north)) = t.position_at(*ts) {
                     let (est, truth) = (
                         Position::<RearAxle>::new(x[X], x[Y]),
-                        Position::<RearAxle>::new(r[X], r[Y]),
+                        Position::<RearAxle>::new(east, north),
                     );
                     errors.push((*ts - t0, est.distance_to(&truth)));
                     if let Some(c) = covs.get(k) {
                         cov_at.push(Cov2::rear_axle(c));
-                        floor_at.push(receiver);
-                        reference_at.push(Cov2::circular(0.0));
                     }
                 }
             }
@@ -522,8 +520,6 @@ fn window_errors(
                             Some(w) => w.fix_cov(antenna, x[YAW], lever),
                             None => antenna,
                         });
-                        floor_at.push(receiver);
-                        reference_at.push(Cov2::circular(fix_std_m));
                     }
                 }
             }
@@ -552,16 +548,19 @@ fn window_errors(
     };
     if cov_at.len() == out.errors.len() {
         out.covariances_m2 = cov_at;
-        out.floor_m2 = floor_at;
-        out.reference_m2 = reference_at;
+        // The floor and the reference's own covariance hold for the whole
+        // window: stored once.
+        out.floor_m2 = receiver;
+        out.reference_m2 = Cov2::circular(match truth {
+            Some(_) => 0.0,
+            None => fix_std_m,
+        });
     }
     // Every window is kept to the end of the evaluation (an error per epoch
     // against the truth): without the pushes' spare capacity, up to as much
     // again (docs/performance.md, "Fifth round").
     out.errors.shrink_to_fit();
     out.covariances_m2.shrink_to_fit();
-    out.floor_m2.shrink_to_fit();
-    out.reference_m2.shrink_to_fit();
     Some(out)
 }
 
@@ -598,7 +597,7 @@ fn through_windows_in(
 ) -> Result<OutageEvaluation, Error> {
     check_windows(drive, windows)?;
     let truth = if use_truth {
-        Reference::from_truth(&drive.truth)
+        TruthPositions::new(&drive.truth)
     } else {
         None
     };

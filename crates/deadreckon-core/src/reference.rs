@@ -114,6 +114,59 @@ impl Reference {
     }
 }
 
+/// The truth's positions borrowed from the drive's poses, interpolated at
+/// any time: [`Reference::from_truth`]'s east and north, bit for bit,
+/// without its copy of every pose as a state (48 B a pose: 17.3 MB on the
+/// bench's hour of 100 Hz truth, held by `evaluate --outage` beside the
+/// drive; docs/performance.md, "Sixth round"). For what reads only the
+/// positions (the outage windows' errors against the truth).
+#[derive(Debug)]
+pub struct TruthPositions<'a> {
+    poses: &'a [TruthPose],
+    /// Where the last search ended (a hint only, as [`Reference`]'s).
+    hint: AtomicUsize,
+}
+
+impl<'a> TruthPositions<'a> {
+    /// The positions of `truth`; `None` with fewer than 3 poses, as
+    /// [`Reference::from_truth`].
+    pub fn new(truth: &'a [TruthPose]) -> Option<Self> {
+        (truth.len() >= 3).then(|| TruthPositions {
+            poses: truth,
+            hint: AtomicUsize::new(0),
+        })
+    }
+
+    /// The interpolated `(east, north)` at `t`, m, or `None` outside the
+    /// covered time span: [`Reference::state_at`]'s `X` and `Y`.
+    pub fn position_at(&self, t: f64) -> Option<(f64, f64)> {
+        let p = self.poses;
+        let n = p.len();
+        if n == 0 || !(t >= p[0].t_s && t <= p[n - 1].t_s) {
+            return None;
+        }
+        let i =
+            crate::cursor::partition_from(n, |k| p[k].t_s, t, self.hint.load(Ordering::Relaxed));
+        self.hint.store(i, Ordering::Relaxed);
+        if i >= n {
+            return Some((p[n - 1].east_m, p[n - 1].north_m));
+        }
+        let i = i.max(1);
+        let (t0, t1) = (p[i - 1].t_s, p[i].t_s);
+        let a = if t1 > t0 { (t - t0) / (t1 - t0) } else { 0.0 };
+        // Term by term as `State * f64 + State * f64` is, so the same bits.
+        Some((
+            p[i - 1].east_m * (1.0 - a) + p[i].east_m * a,
+            p[i - 1].north_m * (1.0 - a) + p[i].north_m * a,
+        ))
+    }
+
+    /// Time span covered.
+    pub fn span(&self) -> Option<(f64, f64)> {
+        Some((self.poses.first()?.t_s, self.poses.last()?.t_s))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -141,5 +194,42 @@ mod tests {
         assert!((s[V] - v).abs() < 1e-3, "{}", s[V]);
         assert!((s[YAW_RATE] - w).abs() < 1e-6);
         assert!(rf.state_at(-1.0).is_none());
+    }
+
+    #[test]
+    fn truth_positions_are_the_references_east_and_north_bit_for_bit() {
+        // Uneven times, a repeated time, positions far from the origin.
+        let truth: Vec<TruthPose> = (0..500)
+            .map(|i| {
+                let t = i as f64 * 0.01 + if i % 7 == 0 { 0.003 } else { 0.0 };
+                TruthPose {
+                    t_s: if i == 250 { 249.0 * 0.01 } else { t },
+                    east_m: 4.0e5 + (i as f64 * 0.37).sin() * 30.0,
+                    north_m: -2.0e5 + i as f64 * 0.11,
+                    yaw_rad: 0.1 * i as f64,
+                    speed_mps: None,
+                }
+            })
+            .collect();
+        let rf = Reference::from_truth(&truth).unwrap();
+        let tp = TruthPositions::new(&truth).unwrap();
+        assert_eq!(tp.span(), rf.span());
+        // Times in a scrambled order (the hint must not matter), inside
+        // and outside the span, on samples and between them.
+        let mut k: u64 = 0x9e37_79b9_7f4a_7c15;
+        for j in 0..3000 {
+            k = k
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            let t = if j % 3 == 0 {
+                truth[(k >> 33) as usize % truth.len()].t_s
+            } else {
+                (k >> 11) as f64 / (1u64 << 53) as f64 * 5.2 - 0.1
+            };
+            let want = rf.state_at(t).map(|x| (x[X].to_bits(), x[Y].to_bits()));
+            let got = tp.position_at(t).map(|(e, n)| (e.to_bits(), n.to_bits()));
+            assert_eq!(got, want, "at t = {t}");
+        }
+        assert!(TruthPositions::new(&truth[..2]).is_none());
     }
 }
