@@ -45,7 +45,8 @@ pub struct ReportOptions<'a> {
     /// The step between the four-wheel outage windows, s (default half
     /// their length).
     pub step_s: Option<f64>,
-    /// The corrections estimated on the drive when `params` stores none.
+    /// The corrections estimated on the drive without `params` (with it,
+    /// those the file stores: [`corrected`]).
     pub corrections: deadreckon_core::timing::Which,
     /// The shape asked for (`--shape`; `None`: found from the data,
     /// [`crate::shape`]).
