@@ -58,9 +58,14 @@ fn run_tracks(
     (t, d.vehicle.noise)
 }
 
-/// The report's filtered and smoothed paths, and its GNSS NIS series's
-/// length (`report D [--params P] --out r.html`, as data).
-fn report_paths(dir: &Path, drive: &Drive, params: Option<&str>) -> (EnPath, EnPath, usize) {
+/// The report's filtered and smoothed paths, the parameters it says they
+/// ran with, and its GNSS NIS series's length (`report D [--params P] --out
+/// r.html`, as data).
+fn report_paths(
+    dir: &Path,
+    drive: &Drive,
+    params: Option<&str>,
+) -> (EnPath, EnPath, String, usize) {
     let o = ReportOptions {
         dir,
         params,
@@ -82,6 +87,7 @@ fn report_paths(dir: &Path, drive: &Drive, params: Option<&str>) -> (EnPath, EnP
     (
         t.filtered.expect("a filtered track"),
         t.smoothed.expect("a smoothed track"),
+        t.aided_with.expect("the parameters named"),
         gnss_nis,
     )
 }
@@ -121,15 +127,21 @@ fn report_drew_the_five_state_filter_where_run_carried_the_wander() {
     for params in [Some(declared.as_path()), Some(plain.as_path()), None] {
         let params = params.map(|p| p.to_str().unwrap());
         let (run, noise) = run_tracks(&drive, params);
-        let (filtered, smoothed, gnss_nis) = report_paths(tmp.path(), &drive, params);
+        let (filtered, smoothed, with, gnss_nis) = report_paths(tmp.path(), &drive, params);
         let (f, s) = (
             largest_gap_m(&filtered, &run[1]),
             largest_gap_m(&smoothed, &run[2]),
         );
         eprintln!(
             "{params:?}: wander {} m, walk {:e}: the report's tracks {f:.3e} m (filtered) and \
-             {s:.3e} m (smoothed) from run's; {gnss_nis} GNSS NIS",
+             {s:.3e} m (smoothed) from run's, drawn with {with:?}; {gnss_nis} GNSS NIS",
             noise.gnss_wander_std_m, noise.gyro_bias_walk_rps_per_sqrt_s
+        );
+        // The page says with which parameters: the given file's, or the
+        // calibration on the drive.
+        assert!(
+            with.starts_with(params.unwrap_or("RTS, this drive")),
+            "{with}"
         );
         assert!(f <= 1e-9 && s <= 1e-9, "{params:?}: {f} m, {s} m");
         // The health is of the same run: a NIS per fix it took or gated.

@@ -329,11 +329,10 @@ pub fn four_wheel_input(
         .iter()
         .find(|m| m.source == Source::Given)
         .or_else(|| methods.iter().find(|m| m.source == Source::Rts))
-        .or_else(|| methods.last())
-        .map(|m| m.params.params);
-    if let (Some(best), true) = (best, drive.gnss.len() >= 2) {
+        .or_else(|| methods.last());
+    if let (Some(params), true) = (best.map(|m| m.params.params), drive.gnss.len() >= 2) {
         steps.step("filter health");
-        let health = health(drive, &best);
+        let health = health(drive, &params);
         if let Err(e) = &health {
             input
                 .not_computed
@@ -357,6 +356,7 @@ pub fn four_wheel_input(
             }
             traj.filtered = tracks.first().map(path_of);
             traj.smoothed = tracks.get(1).map(path_of);
+            traj.aided_with = best.map(|m| m.source.name().to_string());
             input.health = Some(h);
         }
     }
