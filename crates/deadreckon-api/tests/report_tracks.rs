@@ -58,14 +58,20 @@ fn run_tracks(
     (t, d.vehicle.noise)
 }
 
-/// The report's filtered and smoothed paths, the parameters it says they
-/// ran with, and its GNSS NIS series's length (`report D [--params P] --out
-/// r.html`, as data).
-fn report_paths(
-    dir: &Path,
-    drive: &Drive,
-    params: Option<&str>,
-) -> (EnPath, EnPath, String, usize) {
+/// What the report of `drive` shows (`report D [--params P] --out r.html`,
+/// as data).
+struct Shown {
+    filtered: EnPath,
+    smoothed: EnPath,
+    /// The parameters it says the tracks ran with.
+    with: String,
+    /// Its GNSS NIS series's length.
+    gnss_nis: usize,
+    /// The corrections table's rows.
+    corrections: Vec<String>,
+}
+
+fn report_paths(dir: &Path, drive: &Drive, params: Option<&str>) -> Shown {
     let o = ReportOptions {
         dir,
         params,
@@ -76,6 +82,10 @@ fn report_paths(
         shape: None,
     };
     let input = car_input(drive, &o, &()).expect("the report's data");
+    let corrections = input
+        .calibration
+        .and_then(|c| c.corrections)
+        .map_or(Vec::new(), |c| c.rows.into_iter().map(|r| r.what).collect());
     let t = input.trajectories.expect("trajectories");
     let gnss_nis = input
         .health
@@ -84,12 +94,13 @@ fn report_paths(
         .iter()
         .find(|n| n.sensor == "gnss")
         .map_or(0, |n| n.nis.len());
-    (
-        t.filtered.expect("a filtered track"),
-        t.smoothed.expect("a smoothed track"),
-        t.aided_with.expect("the parameters named"),
+    Shown {
+        filtered: t.filtered.expect("a filtered track"),
+        smoothed: t.smoothed.expect("a smoothed track"),
+        with: t.aided_with.expect("the parameters named"),
         gnss_nis,
-    )
+        corrections,
+    }
 }
 
 /// Bug: on a drive whose params.toml declares the receiver's wander and the
@@ -127,7 +138,13 @@ fn report_drew_the_five_state_filter_where_run_carried_the_wander() {
     for params in [Some(declared.as_path()), Some(plain.as_path()), None] {
         let params = params.map(|p| p.to_str().unwrap());
         let (run, noise) = run_tracks(&drive, params);
-        let (filtered, smoothed, with, gnss_nis) = report_paths(tmp.path(), &drive, params);
+        let Shown {
+            filtered,
+            smoothed,
+            with,
+            gnss_nis,
+            corrections,
+        } = report_paths(tmp.path(), &drive, params);
         let (f, s) = (
             largest_gap_m(&filtered, &run[1]),
             largest_gap_m(&smoothed, &run[2]),
@@ -150,6 +167,13 @@ fn report_drew_the_five_state_filter_where_run_carried_the_wander() {
             // The declared file's run carries both.
             assert_eq!(noise.gnss_wander_std_m, 1.5);
             assert_eq!(noise.gyro_bias_walk_rps_per_sqrt_s, 3e-6);
+            // And the page says so among the corrections applied.
+            assert!(
+                corrections.iter().any(|r| r.starts_with("model: ")
+                    && r.contains("receiver's wander 1.50 m over 60 s")
+                    && r.contains("gyro bias walking")),
+                "{corrections:?}"
+            );
         }
     }
 }
