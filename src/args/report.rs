@@ -21,10 +21,10 @@ pub struct ReportArgs {
     /// Step between the outage windows, s (default: half the outage length), as `evaluate --step`.
     #[arg(long, value_parser = super::positive, requires = "outage")]
     pub step: Option<f64>,
-    /// The timing and mounting corrections estimated on the drive and applied
-    /// for every section when --params stores none: auto, all, gnss or none
-    /// (as `calibrate --corrections`). A params.toml that stores corrections
-    /// applies those instead.
+    /// Without --params: the timing and mounting corrections estimated on the
+    /// drive and applied for every section: auto, all, gnss or none (as
+    /// `calibrate --corrections`). With --params: those stored in the file
+    /// are applied (none for nominal), as `run --params` applies them.
     #[arg(long, value_enum, default_value_t = super::CorrectionsArg::Auto)]
     pub corrections: super::CorrectionsArg,
     /// The vehicle shape (default: found from the data). A tricycle or a

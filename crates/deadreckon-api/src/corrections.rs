@@ -129,7 +129,8 @@ pub type Stored = timing::KnownCorrections;
 
 /// The report's rows of what is applied: each stored delay, the tilt of
 /// the stored vertical, the gyro scale error, the driven axle's slip (no
-/// standard errors: params.toml keeps the values applied).
+/// standard errors: params.toml keeps the values applied), and the
+/// additions to the paper's model in words (`[model]`).
 pub fn stored_rows(stored: &Stored) -> Vec<deadreckon_report::CorrectionRow> {
     let row = |what: String, unit: &str, value: f64| deadreckon_report::CorrectionRow {
         what,
@@ -166,6 +167,15 @@ pub fn stored_rows(stored: &Stored) -> Vec<deadreckon_report::CorrectionRow> {
             "%",
             100.0 * k.abs(),
         ));
+    }
+    // The additions to the paper's model (`[model]`: the receiver's wander,
+    // the walking gyro bias, ...) set on the vehicle with them.
+    if !stored.model.is_empty() {
+        rows.push(deadreckon_report::CorrectionRow {
+            what: format!("model: {}", stored.model.words()),
+            status: "stored, applied".into(),
+            ..Default::default()
+        });
     }
     rows
 }

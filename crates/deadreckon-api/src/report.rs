@@ -5,9 +5,18 @@
 //! TedriS sections; written whole by [`deadreckon_report::write_report`].
 //!
 //! Every section reads the drive with the same timing and mounting
-//! corrections, shown in the calibration section: those a `--params` file
-//! stores (its parameters were calibrated on streams corrected so), or
-//! else those estimated on the drive as `calibrate --corrections` would.
+//! corrections, shown in the calibration section: with `--params`, those
+//! the file stores (its parameters were calibrated on streams corrected
+//! so; none for `nominal` or a file without them), as `run --params`
+//! applies them; without it, those estimated on the drive as `calibrate
+//! --corrections` would.
+//!
+//! The filtered and smoothed tracks and the filter health come from
+//! `run`'s function ([`deadreckon_core::track::aided_tracks`], through
+//! [`deadreckon_eval::report::health`]) with the parameters `run` applies:
+//! the given ones, or without `--params` the RTS calibration on the drive.
+//! The same drive and params file give `run`'s tracks
+//! (`report_drew_the_five_state_filter_where_run_carried_the_wander`).
 
 use std::path::Path;
 
@@ -36,7 +45,8 @@ pub struct ReportOptions<'a> {
     /// The step between the four-wheel outage windows, s (default half
     /// their length).
     pub step_s: Option<f64>,
-    /// The corrections estimated on the drive when `params` stores none.
+    /// The corrections estimated on the drive without `params` (with it,
+    /// those the file stores: [`corrected`]).
     pub corrections: deadreckon_core::timing::Which,
     /// The shape asked for (`--shape`; `None`: found from the data,
     /// [`crate::shape`]).
@@ -44,8 +54,10 @@ pub struct ReportOptions<'a> {
 }
 
 /// The drive with the corrections every section uses applied, and their
-/// rows: those stored in `file` (`o.params` read, [`given_file`]), or else
-/// those `o.corrections` asks to estimate (`None` when none are asked).
+/// rows: with `o.params`, those stored in `file` (`o.params` read,
+/// [`given_file`]; `None` for `nominal` or a file storing none), as
+/// [`crate::evaluate::parameters`] applies them for `run`; without it, those
+/// `o.corrections` asks to estimate (`None` when none are asked).
 pub fn corrected(
     drive: &Drive,
     o: &ReportOptions,
@@ -53,21 +65,21 @@ pub fn corrected(
     steps: &dyn Progress,
 ) -> Result<(Drive, Option<rp::Corrections>), Error> {
     use deadreckon_core::timing::Which;
-    if let (Some(p), Some(file)) = (o.params, file) {
-        let stored = &file.corrections;
-        if !stored.is_empty() {
-            let c = rp::Corrections {
-                source: format!("{} {p}", crate::report_labels::READ_FROM),
-                rows: crate::corrections::stored_rows(stored)
-                    .into_iter()
-                    .map(|r| rp::CorrectionRow {
-                        status: format!("{} {p}, applied", crate::report_labels::READ_FROM),
-                        ..r
-                    })
-                    .collect(),
-            };
-            return Ok((stored.apply(drive), Some(c)));
-        }
+    if let Some(p) = o.params {
+        let Some(stored) = file.map(|f| &f.corrections).filter(|c| !c.is_empty()) else {
+            return Ok((drive.clone(), None));
+        };
+        let c = rp::Corrections {
+            source: format!("{} {p}", crate::report_labels::READ_FROM),
+            rows: crate::corrections::stored_rows(stored)
+                .into_iter()
+                .map(|r| rp::CorrectionRow {
+                    status: format!("{} {p}, applied", crate::report_labels::READ_FROM),
+                    ..r
+                })
+                .collect(),
+        };
+        return Ok((stored.apply(drive), Some(c)));
     }
     if o.corrections == Which::None {
         return Ok((drive.clone(), None));
@@ -107,6 +119,18 @@ pub fn write(
     if found.shape != deadreckon_core::kinematics::Shape::FourWheel {
         return crate::report_kinematic::write(drive, &found, o, out, steps, footer);
     }
+    let mut input = car_input(drive, o, steps)?;
+    input.footer = footer.clone();
+    rp::write_report(out, &input).doing(|| format!("writing {}", out.display()))
+}
+
+/// The report of a car's `drive` as data (what [`write`] renders for a
+/// car, without the footer).
+pub fn car_input(
+    drive: &Drive,
+    o: &ReportOptions,
+    steps: &dyn Progress,
+) -> Result<rp::ReportInput, Error> {
     let file = given_file(o)?;
     let (corrected, corrections) = corrected(drive, o, file.as_ref(), steps)?;
     let drive = &corrected;
@@ -145,8 +169,7 @@ pub fn write(
         &name,
         vec![("drive".into(), o.dir.display().to_string())],
     );
-    input.footer = footer.clone();
-    rp::write_report(out, &input).doing(|| format!("writing {}", out.display()))
+    Ok(input)
 }
 
 /// The TedriS sections for a drive and a trained model: the

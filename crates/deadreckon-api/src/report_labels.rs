@@ -68,6 +68,9 @@ pub fn say_what_was_applied(
         t.dead_reckoned
             .iter_mut()
             .for_each(|m| rename(&mut m.method));
+        if let Some(m) = &mut t.aided_with {
+            rename(m);
+        }
     }
     if let Some(c) = &mut input.calibration {
         c.rows.iter_mut().for_each(|r| rename(&mut r.method));

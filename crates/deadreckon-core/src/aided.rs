@@ -15,7 +15,10 @@
 //! own fixes choose between them ([`switch`]: the gyro-bias switch).
 //!
 //! An epoch hands out an [`AidedEpoch`]: the car's block of the state and
-//! covariance, and the receiver's wander where carried, whatever the layout.
+//! covariance, and the receiver's wander where carried, whatever the layout;
+//! [`Aided::run_observed`] also hands out its [`EpochUpdates`] (each
+//! sensor's innovation and the fix the gate rejected: the report's filter
+//! health, of the filter whose tracks `run` writes).
 
 use serde::{Deserialize, Serialize};
 
@@ -23,7 +26,7 @@ use crate::bound::WanderCov;
 use crate::drive::Drive;
 use crate::ekf::{self, EpochOut, Event, Feeder, FilterOptions, FilterStats};
 use crate::event::DriveEvents;
-use crate::filter::{CarLayout, Filter, GateCounts, Layout};
+use crate::filter::{CarLayout, Filter, GateCounts, Layout, Update};
 use crate::gnss_error::{CarWanderLayout, N_WANDER};
 use crate::gyro_drift::{CarBiasLayout, CarWanderBiasLayout, N_BIAS, N_WANDER_BIAS};
 use crate::model::{Mat, State};
@@ -49,6 +52,29 @@ pub struct AidedEpoch {
     /// The wander's part of the covariance, where carried.
     pub(crate) wander_cov: Option<WanderCov>,
 }
+
+/// What one epoch of the aided filter did, of the hypothesis handed out
+/// (with the gyro-bias switch, the one whose state the epoch hands out).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EpochUpdates<'a> {
+    /// The updates applied (or rejected by the χ² gate) at the epoch.
+    pub updates: &'a [Update],
+    /// The time of the GNSS fix the gate rejected at this epoch (its own
+    /// time, which identifies it in the drive).
+    pub gated_fix_t_s: Option<f64>,
+}
+
+impl<'a> EpochUpdates<'a> {
+    fn of<const N: usize>(e: &EpochOut<'a, N>) -> Self {
+        EpochUpdates {
+            updates: e.updates,
+            gated_fix_t_s: e.gated_fix_t_s,
+        }
+    }
+}
+
+/// What [`Aided::run_observed`] hands out after each epoch.
+pub type Observe<'c> = dyn FnMut(&AidedEpoch, &EpochUpdates<'_>) + 'c;
 
 impl AidedEpoch {
     fn of<L: Layout<N>, const N: usize>(f: &Filter<L, N>) -> Self {
@@ -110,12 +136,14 @@ impl<L: Layout<N>, const N: usize> Run<L, N> {
             .finish(&mut self.filter, &mut |f, e| epoch(f, &e))
     }
 
-    fn push(&mut self, ev: Event, epoch: &mut dyn FnMut(&AidedEpoch)) -> Result<(), Error> {
-        self.push_raw(ev, &mut |f, _| epoch(&AidedEpoch::of(f)))
+    fn push(&mut self, ev: Event, epoch: &mut Observe<'_>) -> Result<(), Error> {
+        self.push_raw(ev, &mut |f, e| {
+            epoch(&AidedEpoch::of(f), &EpochUpdates::of(e))
+        })
     }
 
-    fn finish(&mut self, epoch: &mut dyn FnMut(&AidedEpoch)) -> Result<(), Error> {
-        self.finish_raw(&mut |f, _| epoch(&AidedEpoch::of(f)))
+    fn finish(&mut self, epoch: &mut Observe<'_>) -> Result<(), Error> {
+        self.finish_raw(&mut |f, e| epoch(&AidedEpoch::of(f), &EpochUpdates::of(e)))
     }
 
     fn dead_reckon(&mut self) {
@@ -272,25 +300,35 @@ impl Aided {
         opts: &FilterOptions,
         epoch: &mut dyn FnMut(&AidedEpoch),
     ) -> Result<Self, Error> {
+        Self::run_observed(drive, params, opts, &mut |e, _| epoch(e))
+    }
+
+    /// [`Aided::run`], `epoch` also given what the epoch's updates were.
+    pub fn run_observed(
+        drive: &Drive,
+        params: &Params,
+        opts: &FilterOptions,
+        epoch: &mut Observe<'_>,
+    ) -> Result<Self, Error> {
         let (mut a, events) = Self::on_drive(drive, params, opts)?;
         let end = opts.end_s.unwrap_or(f64::INFINITY);
         for ev in events.take_while(|e| e.t_s <= end) {
-            a.push(ev, epoch)?;
+            each!(&mut a, |r| r.push(ev, epoch))?;
         }
-        a.finish(epoch)?;
+        each!(&mut a, |r| r.finish(epoch))?;
         Ok(a)
     }
 
     /// Takes one event (timestamps must not decrease); `epoch` after every
     /// epoch it completes.
     pub fn push(&mut self, ev: Event, epoch: &mut dyn FnMut(&AidedEpoch)) -> Result<(), Error> {
-        each!(self, |r| r.push(ev, epoch))
+        each!(self, |r| r.push(ev, &mut |e, _| epoch(e)))
     }
 
     /// Runs what is still waiting (at the end of a stream, or before a
     /// clone dead-reckons).
     pub fn finish(&mut self, epoch: &mut dyn FnMut(&AidedEpoch)) -> Result<(), Error> {
-        each!(self, |r| r.finish(epoch))
+        each!(self, |r| r.finish(&mut |e, _| epoch(e)))
     }
 
     /// From now on no GNSS ([`Feeder::dead_reckon`]).

@@ -177,14 +177,8 @@ pub fn run_filter<L: Layout<N>, const N: usize>(
             hook.after_epoch(f.time_s(), &mut x, &mut p);
             f.set_state(x, p);
         }
-        if let Some(t) = e.gated_fix_t_s {
-            // Fix times are strictly increasing in a valid drive: the time
-            // is the fix's key.
-            let i = drive.gnss.partition_point(|g| g.t_s < t);
-            if drive.gnss.get(i).is_some_and(|g| g.t_s == t) {
-                out.gnss_gated.push(i);
-            }
-        }
+        out.gnss_gated
+            .extend(e.gated_fix_t_s.and_then(|t| fix_index(drive, t)));
         if opts.record_innovations {
             out.innovations
                 .extend(e.updates.iter().map(|u| InnovationRecord {
@@ -209,6 +203,13 @@ pub fn run_filter<L: Layout<N>, const N: usize>(
     out.stats = feeder.stats_with(&f);
     out.wheel_health = feeder.wheel_health();
     Ok(out)
+}
+
+/// The index in `drive.gnss` of the fix at `t_s` (fix times are strictly
+/// increasing in a valid drive: the time is the fix's key).
+pub(crate) fn fix_index(drive: &Drive, t_s: f64) -> Option<usize> {
+    let i = drive.gnss.partition_point(|g| g.t_s < t_s);
+    drive.gnss.get(i).is_some_and(|g| g.t_s == t_s).then_some(i)
 }
 
 /// The wheel-health monitor's report ([`crate::wheel_health`]) of one run of the 5-state filter over `drive` with

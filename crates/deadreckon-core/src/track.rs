@@ -207,27 +207,47 @@ pub fn drive_tracks_and_switch(
     let mut smoothed_start = None;
     let mut switch = None;
     if drive.gnss.len() >= 2 {
-        let (filtered, smoothed, start, s) = aided_tracks(drive, params, opts)?;
-        smoothed_start = start;
-        switch = s;
-        out.push(filtered);
-        out.push(smoothed);
+        let a = aided_tracks(drive, params, opts)?;
+        smoothed_start = a.smoothed_start;
+        switch = a.switch;
+        out.push(a.filtered);
+        out.push(a.smoothed);
     }
     let init = dead_reckoning_init(drive, init_pose, smoothed_start)?;
     out.insert(0, dead_reckoned(drive, params, opts, init)?);
     Ok((out, switch))
 }
 
+/// The GNSS-aided run of [`aided_tracks`]: its two tracks and what it saw.
+#[derive(Debug, Clone)]
+pub struct AidedTracks {
+    /// The filtered track ([`names::FILTERED`]).
+    pub filtered: Track,
+    /// The smoothed track ([`names::SMOOTHED`]).
+    pub smoothed: Track,
+    /// The smoothed first epoch's time, car state and covariance (where
+    /// dead reckoning starts without a pose or the truth).
+    pub smoothed_start: Option<(f64, State, Mat)>,
+    /// What the gyro-bias switch saw (`None` without one).
+    pub switch: Option<BiasSwitch>,
+    /// The run's innovations (as `opts.record_innovations` asks; of the
+    /// hypothesis handed out with the switch), its counters and the
+    /// indices of the fixes the gate rejected; no epochs, and no wheel
+    /// monitor's report ([`ekf::check_wheels`] gives `run`'s).
+    pub output: ekf::FilterOutput,
+}
+
 /// The filtered and smoothed tracks of the GNSS-aided filter the vehicle
 /// calls for ([`crate::aided`]: a gyro bias state, [`crate::gyro_drift`];
-/// the receiver's wander, [`crate::gnss_error`], smoothed with its `φ`),
-/// the smoothed start's car state, and the gyro-bias switch's report.
-#[allow(clippy::type_complexity)]
-fn aided_tracks(
+/// the receiver's wander, [`crate::gnss_error`], smoothed with its `φ`;
+/// the gyro-bias switch), and what its run saw: the one source of these
+/// tracks, for `run` ([`drive_tracks`]) and for the report's trajectories
+/// and filter health.
+pub fn aided_tracks(
     drive: &Drive,
     params: &Params,
     opts: &FilterOptions,
-) -> Result<(Track, Track, Option<(f64, State, Mat)>, Option<BiasSwitch>), Error> {
+) -> Result<AidedTracks, Error> {
     // The run keeps no epochs: the smoother runs the filter again
     // ([`Aided::smoothed_each`]).
     let opts = FilterOptions {
@@ -235,9 +255,26 @@ fn aided_tracks(
         ..opts.clone()
     };
     let mut filtered = Vec::new();
-    let f = Aided::run(drive, params, &opts, &mut |e| {
-        filtered.push(TrackPoint::from_state(e.t_s, &e.x, &e.p))
+    let mut output = ekf::FilterOutput::default();
+    let f = Aided::run_observed(drive, params, &opts, &mut |e, u| {
+        filtered.push(TrackPoint::from_state(e.t_s, &e.x, &e.p));
+        output
+            .gnss_gated
+            .extend(u.gated_fix_t_s.and_then(|t| ekf::fix_index(drive, t)));
+        if opts.record_innovations {
+            output
+                .innovations
+                .extend(u.updates.iter().map(|u| ekf::InnovationRecord {
+                    t_s: e.t_s,
+                    sensor: u.sensor,
+                    y: u.y,
+                    s: u.s,
+                    nis: u.nis,
+                    accepted: u.accepted,
+                }));
+        }
     })?;
+    output.stats = f.stats();
     // Smoothed from the last epoch to the first.
     let mut smoothed = Vec::with_capacity(filtered.len());
     let mut start = None;
@@ -247,20 +284,21 @@ fn aided_tracks(
     })?;
     smoothed.reverse();
     let origin = drive.vehicle.origin;
-    Ok((
-        Track {
+    Ok(AidedTracks {
+        filtered: Track {
             name: names::FILTERED.into(),
             points: filtered,
             origin,
         },
-        Track {
+        smoothed: Track {
             name: names::SMOOTHED.into(),
             points: smoothed,
             origin,
         },
-        start,
-        f.bias_switch(),
-    ))
+        smoothed_start: start,
+        switch: f.bias_switch(),
+        output,
+    })
 }
 
 /// Where dead reckoning starts: the given pose, else the truth, else the
@@ -310,49 +348,6 @@ pub fn dead_reckoned(
         points: points.0,
         origin: drive.vehicle.origin,
     })
-}
-
-/// The five-state (paper's) filter over `drive` with `params` and `opts`:
-/// its output (innovations as `opts` asks; no epochs), its filtered track
-/// and its smoothed track. The smoother runs the filter again segment by
-/// segment ([`crate::checkpoint::smooth_each`]): the tracks of recording
-/// every epoch and smoothing them, bit for bit, in O(√N) memory (the
-/// report's filter health).
-pub fn five_state_tracks(
-    drive: &Drive,
-    params: &Params,
-    opts: &FilterOptions,
-) -> Result<(ekf::FilterOutput, Track, Track), Error> {
-    let opts = FilterOptions {
-        record_epochs: false,
-        ..opts.clone()
-    };
-    let mut points = Points(Vec::new());
-    let out = ekf::run(drive, params, &opts, &mut points)?;
-    let mut smoothed = Vec::with_capacity(points.0.len());
-    crate::checkpoint::smooth_each(
-        drive,
-        ekf::car_filter(drive, params, &opts)?,
-        &opts,
-        None,
-        false,
-        |s| smoothed.push(car_point(s.t_s, &s.x, &s.p)),
-    )?;
-    smoothed.reverse();
-    let origin = drive.vehicle.origin;
-    Ok((
-        out,
-        Track {
-            name: names::FILTERED.into(),
-            points: points.0,
-            origin,
-        },
-        Track {
-            name: names::SMOOTHED.into(),
-            points: smoothed,
-            origin,
-        },
-    ))
 }
 
 /// The track point of every epoch of a run, in order.

@@ -20,11 +20,13 @@ pub enum Source {
     /// The ZUPT calibration (gyro bias at standstill).
     Zupt,
     /// The RTS calibration against GNSS (the paper's method; the report's
-    /// filter health and iterations are drawn with it).
+    /// iterations are drawn with it, and without given parameters its
+    /// filter health and aided tracks, as `run` without --params).
     Rts,
     /// The calibration against the truth.
     Truth,
-    /// Given by the user (a params.toml).
+    /// Given by the user (a params.toml, or `nominal`): the filter health
+    /// and the aided tracks are drawn with them, as `run --params` writes.
     Given,
 }
 
@@ -204,14 +206,20 @@ fn sensor_unit(k: SensorKind, ticks: bool) -> &'static str {
 /// fixes the gate rejected.
 pub type Health = (rp::FilterHealth, FilterStats, Vec<Track>, Vec<usize>);
 
-/// Filter health from a GNSS-aided run with innovations recorded.
+/// Filter health from the GNSS-aided run whose filtered and smoothed
+/// tracks `run` writes ([`tracks::aided_tracks`], the filter of the layout
+/// the vehicle's noise settings call for: the receiver's wander, the gyro
+/// bias as a state, the gyro-bias switch), with its innovations recorded;
+/// the wheel monitor's lines are `run`'s ([`deadreckon_core::ekf::check_wheels`]).
 pub fn health(drive: &Drive, params: &Params) -> Result<Health, Error> {
     let opts = FilterOptions {
         record_innovations: true,
         ..Default::default()
     };
-    let (out, filtered, smoothed) = tracks::five_state_tracks(drive, params, &opts)?;
-    let tracks = vec![filtered, smoothed];
+    let aided = tracks::aided_tracks(drive, params, &opts)?;
+    let out = aided.output;
+    let tracks = vec![aided.filtered, aided.smoothed];
+    let wheel_health = deadreckon_core::ekf::check_wheels(drive, params, &opts)?;
     let ticks = matches!(drive.wheels, deadreckon_core::drive::Wheels::Ticks(_));
     let mut kinds: Vec<SensorKind> = out.innovations.iter().map(|i| i.sensor).collect();
     kinds.sort();
@@ -241,7 +249,8 @@ pub fn health(drive: &Drive, params: &Params) -> Result<Health, Error> {
         });
     }
     h.consistency = consistency(drive, params);
-    if let Some(w) = &out.wheel_health {
+    {
+        let w = &wheel_health;
         h.wheel_health = w.lines();
         for (name, r) in deadreckon_core::wheel_health::WHEEL_NAMES
             .iter()
@@ -313,15 +322,17 @@ pub fn four_wheel_input(
             t_s: r.t.clone(),
         });
     }
-    // Filter health and the aided tracks with the best parameters available.
+    // Filter health and the aided tracks with the parameters `run` applies
+    // to this drive (`deadreckon_api::evaluate::parameters`): the given
+    // ones, or else those calibrated on the drive (RTS), or else the last.
     let best = methods
         .iter()
-        .find(|m| m.source == Source::Rts)
-        .or_else(|| methods.last())
-        .map(|m| m.params.params);
-    if let (Some(best), true) = (best, drive.gnss.len() >= 2) {
+        .find(|m| m.source == Source::Given)
+        .or_else(|| methods.iter().find(|m| m.source == Source::Rts))
+        .or_else(|| methods.last());
+    if let (Some(params), true) = (best.map(|m| m.params.params), drive.gnss.len() >= 2) {
         steps.step("filter health");
-        let health = health(drive, &best);
+        let health = health(drive, &params);
         if let Err(e) = &health {
             input
                 .not_computed
@@ -345,6 +356,7 @@ pub fn four_wheel_input(
             }
             traj.filtered = tracks.first().map(path_of);
             traj.smoothed = tracks.get(1).map(path_of);
+            traj.aided_with = best.map(|m| m.source.name().to_string());
             input.health = Some(h);
         }
     }
@@ -426,7 +438,9 @@ pub fn four_wheel_input(
             methods: Vec::new(),
             bound: None,
         };
-        // The 95 % bound is drawn for the parameters the filter health uses.
+        // The 95 % bound is drawn for the RTS calibration's parameters
+        // (fitted in-sample, as `evaluate` without --params fits it), or
+        // the last set's.
         let bounded = methods
             .iter()
             .position(|m| m.source == Source::Rts)

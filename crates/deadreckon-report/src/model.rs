@@ -142,6 +142,9 @@ pub struct Trajectories {
     pub filtered: Option<EnPath>,
     /// The smoothed (RTS) trajectory.
     pub smoothed: Option<EnPath>,
+    /// The parameter set the filtered and smoothed trajectories ran with
+    /// (a method's label, as the calibration table names it).
+    pub aided_with: Option<String>,
     /// Dead reckoning from the start with each calibration.
     pub dead_reckoned: Vec<MethodPath>,
 }

@@ -141,6 +141,7 @@ pub fn sample_input(duration_s: f64) -> ReportInput {
         gnss_gated: Some(gated),
         filtered: Some(filtered),
         smoothed: Some(smoothed),
+        aided_with: Some("RTS".into()),
         dead_reckoned: vec![
             MethodPath {
                 method: "nominal".into(),

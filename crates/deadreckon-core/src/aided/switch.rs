@@ -26,10 +26,10 @@ use std::collections::VecDeque;
 
 use serde::{Deserialize, Serialize};
 
-use super::{AidedEpoch, Run};
+use super::{AidedEpoch, EpochUpdates, Observe, Run};
 use crate::drive::Drive;
 use crate::ekf::{EpochOut, Event, FilterOptions, FilterStats};
-use crate::filter::{Filter, GateCounts, Layout, SensorKind};
+use crate::filter::{Filter, GateCounts, Layout, SensorKind, Update};
 use crate::model::{Mat, State};
 use crate::Error;
 
@@ -88,6 +88,18 @@ pub struct Switch<C: Layout<NC>, const NC: usize, S: Layout<NS>, const NS: usize
     cap: f64,
 }
 
+/// An epoch of the state hypothesis waiting to be paired with the
+/// constant's ([`Switch::push`]).
+struct Waiting {
+    t_s: f64,
+    /// The capped log-likelihood of its fixes, and how many.
+    log_likelihood: (f64, usize),
+    epoch: AidedEpoch,
+    /// Its updates' range in the step's buffer.
+    updates: std::ops::Range<usize>,
+    gated_fix_t_s: Option<f64>,
+}
+
 /// The capped log-likelihood of the GNSS fixes of one epoch, and how many.
 fn fix_log_likelihood<const N: usize>(e: &EpochOut<'_, N>, cap: f64) -> (f64, usize) {
     e.updates
@@ -123,22 +135,18 @@ impl<C: Layout<NC>, const NC: usize, S: Layout<NS>, const NS: usize> Switch<C, N
     }
 
     /// Feeds one event to both hypotheses; `epoch` after every epoch with
-    /// the chosen one's state.
-    pub(super) fn push(
-        &mut self,
-        ev: Event,
-        epoch: &mut dyn FnMut(&AidedEpoch),
-    ) -> Result<(), Error> {
+    /// the chosen one's state and updates.
+    pub(super) fn push(&mut self, ev: Event, epoch: &mut Observe<'_>) -> Result<(), Error> {
         self.step(Some(ev), epoch)
     }
 
     /// Runs what is waiting in both.
-    pub(super) fn finish(&mut self, epoch: &mut dyn FnMut(&AidedEpoch)) -> Result<(), Error> {
+    pub(super) fn finish(&mut self, epoch: &mut Observe<'_>) -> Result<(), Error> {
         self.step(None, epoch)
     }
 
     /// [`Switch::push`] (`Some`) or [`Switch::finish`] (`None`).
-    fn step(&mut self, ev: Option<Event>, epoch: &mut dyn FnMut(&AidedEpoch)) -> Result<(), Error> {
+    fn step(&mut self, ev: Option<Event>, epoch: &mut Observe<'_>) -> Result<(), Error> {
         let (c, s) = match (&mut self.constant, &mut self.state) {
             (Some(c), Some(s)) => (c, s),
             (Some(c), None) => {
@@ -156,11 +164,21 @@ impl<C: Layout<NC>, const NC: usize, S: Layout<NS>, const NS: usize> Switch<C, N
             (None, None) => return Ok(()),
         };
         // The state hypothesis's epochs wait to be paired with the
-        // constant's (both run the same epochs).
+        // constant's (both run the same epochs), their updates in one
+        // buffer (handed out with the state's epoch once it fired).
         let cap = self.cap;
-        let mut waiting: VecDeque<(f64, (f64, usize), AidedEpoch)> = VecDeque::new();
+        let mut waiting: VecDeque<Waiting> = VecDeque::new();
+        let mut updates: Vec<Update> = Vec::new();
         let mut keep = |f: &Filter<S, NS>, e: &EpochOut<'_, NS>| {
-            waiting.push_back((f.time_s(), fix_log_likelihood(e, cap), AidedEpoch::of(f)))
+            let at = updates.len();
+            updates.extend_from_slice(e.updates);
+            waiting.push_back(Waiting {
+                t_s: f.time_s(),
+                log_likelihood: fix_log_likelihood(e, cap),
+                epoch: AidedEpoch::of(f),
+                updates: at..updates.len(),
+                gated_fix_t_s: e.gated_fix_t_s,
+            })
         };
         match ev {
             Some(ev) => s.push_raw(ev, &mut keep)?,
@@ -169,10 +187,10 @@ impl<C: Layout<NC>, const NC: usize, S: Layout<NS>, const NS: usize> Switch<C, N
         let report = &mut self.report;
         let mut pair = |f: &Filter<C, NC>, e: &EpochOut<'_, NC>| {
             let t = f.time_s();
-            let other = waiting.pop_front().filter(|w| w.0 == t);
+            let other = waiting.pop_front().filter(|w| w.t_s == t);
             if report.fired_at_s.is_none() {
                 let (lc, nc) = fix_log_likelihood(e, cap);
-                if let Some((_, (ls, ns), _)) = other {
+                if let Some((ls, ns)) = other.as_ref().map(|w| w.log_likelihood) {
                     if nc > 0 && ns == nc {
                         report.llr += ls - lc;
                         report.fixes += nc;
@@ -183,8 +201,14 @@ impl<C: Layout<NC>, const NC: usize, S: Layout<NS>, const NS: usize> Switch<C, N
                 }
             }
             match (report.fired_at_s, other) {
-                (Some(_), Some((_, _, chosen))) => epoch(&chosen),
-                _ => epoch(&AidedEpoch::of(f)),
+                (Some(_), Some(chosen)) => epoch(
+                    &chosen.epoch,
+                    &EpochUpdates {
+                        updates: &updates[chosen.updates],
+                        gated_fix_t_s: chosen.gated_fix_t_s,
+                    },
+                ),
+                _ => epoch(&AidedEpoch::of(f), &EpochUpdates::of(e)),
             }
         };
         match ev {

@@ -199,6 +199,16 @@ pub(crate) fn section(
     let mut caption = "Trajectories in the local east-north frame, equal scales on both axes. DR: dead reckoning \
                        from the start with each calibration (figure 6 of the four-wheel paper)."
         .to_string();
+    if let (Some(m), true) = (
+        &t.aided_with,
+        usable(&t.filtered).or(usable(&t.smoothed)).is_some(),
+    ) {
+        caption.push_str(&format!(
+            " filtered and smoothed: the GNSS-aided filter and its RTS smoothing with the \
+             parameters of the calibration table's row “{m}”, the tracks `deadreckon run` writes \
+             with them."
+        ));
+    }
     if !counts.is_empty() {
         caption.push(' ');
         caption.push_str(&counts.join(", "));
