@@ -185,3 +185,63 @@ fn run_and_evaluate_had_two_defaults_for_no_params() {
         "{text}"
     );
 }
+
+/// `compare` without --params calibrated RTS on the drive with no
+/// corrections estimated (and printed neither the corrections nor the
+/// parameters), while `evaluate`, `run` and `report` calibrate after the
+/// default corrections (`auto`) and measure on the corrected drive. Now
+/// `compare` goes through the same rule (`evaluate::default_parameters`,
+/// with the outages hidden). With its one outage after the drive's last fix
+/// (672.637 s; the drive ends at 672.944 s) nothing is hidden, so its parameters and corrections are exactly
+/// `calibrate`'s and `evaluate`'s on the whole drive. The simulated
+/// evaluation drive of seed 2 is one where `auto` applies the GNSS and gyro
+/// delays, so the corrections are not empty.
+#[test]
+fn compare_calibrated_without_the_corrections_evaluate_applies() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path().join("s2");
+    let d = d.to_str().unwrap();
+    run_ok(&[
+        "simulate",
+        "--scenario",
+        "evaluation",
+        "--seed",
+        "2",
+        "--out",
+        d,
+    ]);
+    let cal = json(&["calibrate", d, "--json"]);
+    let ev = json(&["evaluate", d, "--outage", "30", "--step", "120", "--json"]);
+    let cmp = json(&["compare", d, "--outage", "672.7:672.9", "--json"]);
+    // The corrections: evaluate's, and some applied.
+    assert_eq!(cmp["corrections"], ev["corrections"], "{cmp}");
+    assert_eq!(cmp["corrections"], cal["corrections"], "{cmp}");
+    let applied = cmp["corrections"]["delays"]["gnss"]["applied_s"]
+        .as_f64()
+        .unwrap();
+    assert!(applied.abs() > 0.01, "{cmp}");
+    // The six parameters: calibrate's (the same calibration evaluate makes).
+    let values = &cmp["four_wheel_values"];
+    for k in [
+        "gyro_bias_rps",
+        "speed_scale",
+        "circumference_fl_m",
+        "circumference_fr_m",
+        "circumference_rl_m",
+        "circumference_rr_m",
+    ] {
+        let (a, b) = (values[k].as_f64().unwrap(), cal[k].as_f64().unwrap());
+        assert!((a - b).abs() <= 1e-12 * b.abs().max(1.0), "{k}: {a} vs {b}");
+    }
+    // Said as `evaluate` and `run` say it, the outages hidden.
+    let source = cmp["params_source"].as_str().unwrap();
+    let evaluated = ev["params_source"].as_str().unwrap();
+    assert_eq!(source, format!("{evaluated}, outages hidden"));
+    let text = run_ok(&["compare", d, "--outage", "300:330"]);
+    assert!(
+        text.contains("parameters: calibrated on this drive: rts")
+            && text.contains("outages hidden (without --params")
+            && text.contains("corrections chosen on held-back GNSS"),
+        "{text}"
+    );
+}

@@ -26,30 +26,28 @@ pub fn run(a: CompareArgs, load: &common::Loader) -> Result<()> {
         .iter()
         .map(|s| s.parse::<Outage>())
         .collect::<Result<_, _>>()?;
-    // A params.toml's stored corrections apply to the drive both estimators read.
-    // The one rule for "no --params" (deadreckon_api::evaluate::RULE), with
-    // the outages hidden from the calibration.
-    let (params, drive, source) = match &a.params {
-        Some(p) => {
-            let (params, drive, note) = deadreckon_api::load::params_corrected_bound(
-                p,
-                drive,
-                load.params_for_other_vehicle,
-            )?;
-            if let Some(n) = note {
-                note!("note: {n}");
-            }
-            (Some((params, p.clone())), drive, p.clone())
-        }
-        None => (
-            None,
-            drive,
-            format!(
-                "{} with the outages hidden (rts)",
-                deadreckon_api::evaluate::CALIBRATED_HERE
-            ),
-        ),
+    // The one rule for "no --params" (deadreckon_api::evaluate::RULE), as
+    // `evaluate` applies it, with the outages hidden from the calibration; a
+    // params.toml's stored corrections applied to the drive both read.
+    let windows: Vec<(f64, f64)> = outages.iter().map(|o| (o.start_s, o.end_s)).collect();
+    let (chosen, drive) = deadreckon_api::evaluate::parameters_outages_hidden(
+        a.params.as_deref(),
+        drive,
+        a.corrections.into(),
+        load.params_for_other_vehicle,
+        &windows,
+    )?;
+    if let Some(n) = &chosen.note {
+        note!("note: {n}");
+    }
+    let line = match &a.params {
+        // `run`'s words (the source) and `evaluate`'s rule.
+        None => format!("{} ({})", chosen.source, deadreckon_api::evaluate::RULE),
+        Some(_) => deadreckon_api::report_labels::given_line(&chosen.source, chosen.file_corrected),
     };
+    let source = chosen.source.clone();
+    let corrections = chosen.corrections.clone();
+    let params = Some((chosen.params, chosen.label));
     let model = match &a.model {
         Some(m) => Some((
             deadreckon_api::tedris::read_model(m)?,
@@ -61,12 +59,21 @@ pub fn run(a: CompareArgs, load: &common::Loader) -> Result<()> {
     if a.json {
         let mut v = deadreckon_api::json::comparison_json(&c);
         v["params_source"] = source.into();
+        if let Some(c) = &corrections {
+            v["corrections"] = deadreckon_api::corrections::corrections_json(c);
+        }
         v["shape_found"] = found.json();
         common::print_json(load, v)?;
     } else {
         outln!("drive: {}", load.checks().span_text());
         outln!("{}", found.line());
-        outln!("parameters: {source}");
+        outln!("parameters: {line}");
+        for l in corrections
+            .iter()
+            .flat_map(deadreckon_api::text::corrections_lines)
+        {
+            outln!("{l}");
+        }
         common::print_comparison(&c, 0.0)?;
     }
     Ok(())

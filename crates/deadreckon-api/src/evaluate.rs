@@ -69,6 +69,42 @@ pub fn parameters(
     }
 }
 
+/// [`parameters`] for a comparison through GNSS outages (`compare`): with
+/// `spec`, the same; without it, [`RULE`]'s calibration
+/// ([`default_parameters`]) on the drive with the fixes inside `windows`
+/// hidden, and the corrections it applied there applied to the whole drive
+/// as `run` applies a params.toml's ([`applied_corrections`]), so both
+/// estimators read the drive the parameters hold on.
+pub fn parameters_outages_hidden(
+    spec: Option<&str>,
+    drive: Drive,
+    which: Which,
+    allow_other: bool,
+    windows: &[(f64, f64)],
+) -> Result<(Parameters, Drive), Error> {
+    if spec.is_some() {
+        return parameters(spec, drive, which, allow_other);
+    }
+    let (mut chosen, _) = default_parameters(&drive.without_gnss_in(windows), which)?;
+    chosen.label = format!("{}, outages hidden", chosen.label);
+    chosen.source = format!("{}, outages hidden", chosen.source);
+    let drive = match &chosen.corrections {
+        Some(c) => applied_corrections(c)?.apply_to(drive),
+        None => drive,
+    };
+    Ok((chosen, drive))
+}
+
+/// The corrections `c` applied (those estimated and, with `auto`, chosen),
+/// as the params.toml a calibration writes stores them
+/// ([`crate::params_tables::corrections_tables`]) and `--params` reads
+/// them back ([`crate::corrections::stored_of`]).
+pub fn applied_corrections(c: &Corrections) -> Result<crate::corrections::Stored, Error> {
+    let mut t = crate::params_tables::ParamsTables::default();
+    crate::params_tables::corrections_tables(c, &mut t);
+    crate::corrections::stored_of(&t).map_err(Error::Invalid)
+}
+
 /// [`RULE`]: the RTS calibration on `drive` after the corrections `which`
 /// asks for (returned with the drive they were applied to), or the nominal
 /// parameters of a drive without GNSS fixes.

@@ -406,6 +406,11 @@ pub fn comparison_json(c: &deadreckon_eval::compare::Comparison) -> Value {
     json!({
         "reference": {"four_wheel": c.four_wheel_reference, "tedris": c.tedris_reference},
         "four_wheel_params": c.params_source,
+        "four_wheel_values": deadreckon_core::Params::NAMES
+            .iter()
+            .zip(c.params.to_array())
+            .map(|(k, v)| (k.to_string(), json!(v)))
+            .collect::<serde_json::Map<_, _>>(),
         "tedris_model": c.model_source,
         "four_wheel_gates": gates_json(&c.four_wheel_gates),
         "tedris_checks": c.tedris_checks,

@@ -14,6 +14,8 @@ use crate::Error;
 pub struct Comparison {
     /// Where the four-wheel parameters came from.
     pub params_source: String,
+    /// The four-wheel parameters the filter ran with.
+    pub params: Params,
     /// Where the TedriS model came from.
     pub model_source: String,
     /// The four-wheel reference (the truth, or the hidden fixes at the antenna).
@@ -52,8 +54,11 @@ pub fn default_windows(drive: &Drive, len: f64) -> Result<Vec<Outage>, Error> {
 }
 
 /// Runs both methods through `outages`. Without `params`, the four-wheel
-/// parameters are calibrated (RTS) on the drive with the outages hidden; without
-/// `model`, TedriS is trained on the drive with the outages hidden.
+/// parameters are calibrated (RTS) on the drive with the outages hidden, no
+/// corrections estimated (the demo and the report's TedriS section; `compare`
+/// passes the parameters of `deadreckon_api::evaluate`'s rule for "no
+/// --params", with the corrections applied to `drive`); without `model`,
+/// TedriS is trained on the drive with the outages hidden.
 pub fn compare(
     drive: &Drive,
     outages: &[Outage],
@@ -95,6 +100,7 @@ pub fn compare(
     }
     Ok(Comparison {
         params_source,
+        params,
         model_source,
         four_wheel_reference: fw.reference,
         tedris_reference: td.reference,
