@@ -98,3 +98,40 @@ fn calibrate_wrote_circumferences_that_evaluate_refuses() {
         assert!((got - want).abs() < 3e-3, "{got} against {want}");
     }
 }
+
+/// Issue 29, item 6: `compare` without --params calibrates by the one rule
+/// (`evaluate::default_parameters`) on the drive with the outages hidden,
+/// and applies the corrections the rule chose to the whole drive (both
+/// estimators read it) as a params.toml's are applied
+/// (`evaluate::applied_corrections`). The whole drive so corrected, with
+/// the outages hidden, is the drive the rule calibrated on: every stream
+/// equal. The simulated evaluation drive of seed 2 is one where `auto`
+/// applies the GNSS and gyro delays.
+#[test]
+fn compare_applies_to_the_whole_drive_the_corrections_the_rule_applied_with_the_outages_hidden() {
+    use deadreckon_api::evaluate::{default_parameters, parameters_outages_hidden};
+    let sc = deadreckon_sim::Scenario::builtin("evaluation").expect("built in");
+    let drive = simulate(&sc, 2).expect("simulated").drive;
+    let windows = [(100.0, 130.0), (200.0, 230.0)];
+    let (chosen, whole) =
+        parameters_outages_hidden(None, drive.clone(), Which::Auto, false, &windows)
+            .expect("compare's parameters");
+    let (rule, hidden) =
+        default_parameters(&drive.without_gnss_in(&windows), Which::Auto).expect("the rule");
+    assert_eq!(chosen.params, rule.params);
+    let json = |p: &deadreckon_api::evaluate::Parameters| {
+        deadreckon_api::corrections::corrections_json(p.corrections.as_ref().expect("estimated"))
+    };
+    assert_eq!(json(&chosen), json(&rule));
+    let gnss = &json(&chosen)["delays"]["gnss"]["applied_s"];
+    assert!(gnss.as_f64().expect("a delay").abs() > 0.01, "{gnss}");
+    let whole_hidden = whole.without_gnss_in(&windows);
+    assert_eq!(whole_hidden.gnss.len(), hidden.gnss.len());
+    assert!(whole.gnss.len() > hidden.gnss.len());
+    assert_eq!(whole_hidden, hidden);
+    assert!(
+        chosen.source.ends_with(", outages hidden"),
+        "{}",
+        chosen.source
+    );
+}
