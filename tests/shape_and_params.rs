@@ -200,16 +200,8 @@ fn run_and_evaluate_had_two_defaults_for_no_params() {
 fn compare_calibrated_without_the_corrections_evaluate_applies() {
     let tmp = tempfile::tempdir().unwrap();
     let d = tmp.path().join("s2");
+    common::simulate_into(&d, "evaluation", "2");
     let d = d.to_str().unwrap();
-    run_ok(&[
-        "simulate",
-        "--scenario",
-        "evaluation",
-        "--seed",
-        "2",
-        "--out",
-        d,
-    ]);
     let cal = json(&["calibrate", d, "--json"]);
     let ev = json(&["evaluate", d, "--outage", "30", "--step", "120", "--json"]);
     let cmp = json(&["compare", d, "--outage", "672.7:672.9", "--json"]);
@@ -222,14 +214,7 @@ fn compare_calibrated_without_the_corrections_evaluate_applies() {
     assert!(applied.abs() > 0.01, "{cmp}");
     // The six parameters: calibrate's (the same calibration evaluate makes).
     let values = &cmp["four_wheel_values"];
-    for k in [
-        "gyro_bias_rps",
-        "speed_scale",
-        "circumference_fl_m",
-        "circumference_fr_m",
-        "circumference_rl_m",
-        "circumference_rr_m",
-    ] {
+    for k in deadreckon_core::Params::NAMES {
         let (a, b) = (values[k].as_f64().unwrap(), cal[k].as_f64().unwrap());
         assert!((a - b).abs() <= 1e-12 * b.abs().max(1.0), "{k}: {a} vs {b}");
     }
