@@ -86,10 +86,13 @@ pub fn parameters_outages_hidden(
         return parameters(spec, drive, which, allow_other);
     }
     let (mut chosen, _) = default_parameters(&drive.without_gnss_in(windows), which)?;
-    chosen.label = format!("{}, outages hidden", chosen.label);
-    chosen.source = format!("{}, outages hidden", chosen.source);
+    // Calibrated (not nominal for want of fixes): say the outages were hidden.
     let drive = match &chosen.corrections {
-        Some(c) => applied_corrections(c)?.apply_to(drive),
+        Some(c) => {
+            chosen.label = format!("{}, outages hidden", chosen.label);
+            chosen.source = format!("{}, outages hidden", chosen.source);
+            applied_corrections(c)?.apply_to(drive)
+        }
         None => drive,
     };
     Ok((chosen, drive))
