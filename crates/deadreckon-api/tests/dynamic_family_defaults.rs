@@ -364,9 +364,7 @@ fn user_path(
                         .partition_point(|p| p.t_s < e.t_s)
                         .min(truth.len() - 1);
                     let p = &truth[i];
-                    let dyaw = (e.x[2] - p.yaw_rad + std::f64::consts::PI)
-                        .rem_euclid(std::f64::consts::TAU)
-                        - std::f64::consts::PI;
+                    let dyaw = deadreckon_core::angle::diff(e.x[2], p.yaw_rad);
                     lines.push(format!(
                         "{:.0}:{:.1}m/s,{:.1}° yaw {:+.2}°±{:.2} pos {:.2}m",
                         e.t_s,

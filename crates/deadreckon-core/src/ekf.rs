@@ -180,15 +180,11 @@ pub fn run_filter<L: Layout<N>, const N: usize>(
         out.gnss_gated
             .extend(e.gated_fix_t_s.and_then(|t| fix_index(drive, t)));
         if opts.record_innovations {
-            out.innovations
-                .extend(e.updates.iter().map(|u| InnovationRecord {
-                    t_s: f.time_s(),
-                    sensor: u.sensor,
-                    y: u.y,
-                    s: u.s,
-                    nis: u.nis,
-                    accepted: u.accepted,
-                }));
+            out.innovations.extend(
+                e.updates
+                    .iter()
+                    .map(|u| InnovationRecord::of(f.time_s(), u)),
+            );
         }
         if let Some(prediction) = e.prediction {
             out.epochs.push(Epoch::after(f, prediction));

@@ -79,20 +79,10 @@ impl Reference {
 
     /// The interpolated state at `t`, or `None` outside the covered time span.
     pub fn state_at(&self, t: f64) -> Option<State> {
-        let n = self.t.len();
-        if n == 0 || !(t >= self.t[0] && t <= self.t[n - 1]) {
-            return None;
-        }
-        let i =
-            crate::cursor::partition_from(n, |k| self.t[k], t, self.hint.load(Ordering::Relaxed));
-        self.hint.store(i, Ordering::Relaxed);
-        if i >= n {
-            return Some(self.x[n - 1]);
-        }
-        let i = i.max(1);
-        let (t0, t1) = (self.t[i - 1], self.t[i]);
-        let a = if t1 > t0 { (t - t0) / (t1 - t0) } else { 0.0 };
-        Some(self.x[i - 1] * (1.0 - a) + self.x[i] * a)
+        Some(match bracket(&self.t, |k| self.t[k], t, &self.hint)? {
+            Bracket::Last => self.x[self.t.len() - 1],
+            Bracket::Between(i, a) => self.x[i - 1] * (1.0 - a) + self.x[i] * a,
+        })
     }
 
     /// Cumulative travelled distance (m) at each sample, from the positions.
@@ -141,30 +131,50 @@ impl<'a> TruthPositions<'a> {
     /// covered time span: [`Reference::state_at`]'s `X` and `Y`.
     pub fn position_at(&self, t: f64) -> Option<(f64, f64)> {
         let p = self.poses;
-        let n = p.len();
-        if n == 0 || !(t >= p[0].t_s && t <= p[n - 1].t_s) {
-            return None;
-        }
-        let i =
-            crate::cursor::partition_from(n, |k| p[k].t_s, t, self.hint.load(Ordering::Relaxed));
-        self.hint.store(i, Ordering::Relaxed);
-        if i >= n {
-            return Some((p[n - 1].east_m, p[n - 1].north_m));
-        }
-        let i = i.max(1);
-        let (t0, t1) = (p[i - 1].t_s, p[i].t_s);
-        let a = if t1 > t0 { (t - t0) / (t1 - t0) } else { 0.0 };
-        // Term by term as `State * f64 + State * f64` is, so the same bits.
-        Some((
-            p[i - 1].east_m * (1.0 - a) + p[i].east_m * a,
-            p[i - 1].north_m * (1.0 - a) + p[i].north_m * a,
-        ))
+        Some(match bracket(p, |k| p[k].t_s, t, &self.hint)? {
+            Bracket::Last => (p[p.len() - 1].east_m, p[p.len() - 1].north_m),
+            // Term by term as `State * f64 + State * f64` is, so the same bits.
+            Bracket::Between(i, a) => (
+                p[i - 1].east_m * (1.0 - a) + p[i].east_m * a,
+                p[i - 1].north_m * (1.0 - a) + p[i].north_m * a,
+            ),
+        })
     }
 
     /// Time span covered.
     pub fn span(&self) -> Option<(f64, f64)> {
         Some((self.poses.first()?.t_s, self.poses.last()?.t_s))
     }
+}
+
+/// Where `t` falls among `n = samples.len()` increasing sample times
+/// (`time_at(k)`): past the last sample, or between samples `i − 1` and
+/// `i` at fraction `a`; `None` outside the span. The search starts from
+/// `hint` and leaves it where it ended ([`crate::cursor::partition_from`]).
+enum Bracket {
+    Last,
+    Between(usize, f64),
+}
+
+fn bracket<T>(
+    samples: &[T],
+    time_at: impl Fn(usize) -> f64,
+    t: f64,
+    hint: &AtomicUsize,
+) -> Option<Bracket> {
+    let n = samples.len();
+    if n == 0 || !(t >= time_at(0) && t <= time_at(n - 1)) {
+        return None;
+    }
+    let i = crate::cursor::partition_from(n, &time_at, t, hint.load(Ordering::Relaxed));
+    hint.store(i, Ordering::Relaxed);
+    if i >= n {
+        return Some(Bracket::Last);
+    }
+    let i = i.max(1);
+    let (t0, t1) = (time_at(i - 1), time_at(i));
+    let a = if t1 > t0 { (t - t0) / (t1 - t0) } else { 0.0 };
+    Some(Bracket::Between(i, a))
 }
 
 #[cfg(test)]

@@ -262,16 +262,11 @@ pub fn aided_tracks(
             .gnss_gated
             .extend(u.gated_fix_t_s.and_then(|t| ekf::fix_index(drive, t)));
         if opts.record_innovations {
-            output
-                .innovations
-                .extend(u.updates.iter().map(|u| ekf::InnovationRecord {
-                    t_s: e.t_s,
-                    sensor: u.sensor,
-                    y: u.y,
-                    s: u.s,
-                    nis: u.nis,
-                    accepted: u.accepted,
-                }));
+            output.innovations.extend(
+                u.updates
+                    .iter()
+                    .map(|u| ekf::InnovationRecord::of(e.t_s, u)),
+            );
         }
     })?;
     output.stats = f.stats();

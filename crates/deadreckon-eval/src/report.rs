@@ -249,22 +249,19 @@ pub fn health(drive: &Drive, params: &Params) -> Result<Health, Error> {
         });
     }
     h.consistency = consistency(drive, params);
+    h.wheel_health = wheel_health.lines();
+    for (name, r) in deadreckon_core::wheel_health::WHEEL_NAMES
+        .iter()
+        .zip(&wheel_health.wheels)
     {
-        let w = &wheel_health;
-        h.wheel_health = w.lines();
-        for (name, r) in deadreckon_core::wheel_health::WHEEL_NAMES
-            .iter()
-            .zip(&w.wheels)
-        {
-            h.wheel_health.extend(r.intervals.iter().map(|i| {
-                format!(
-                    "wheel {name} out {:.2}..{:.2} s ({})",
-                    i.start_s,
-                    i.end_s,
-                    i.reason.name()
-                )
-            }));
-        }
+        h.wheel_health.extend(r.intervals.iter().map(|i| {
+            format!(
+                "wheel {name} out {:.2}..{:.2} s ({})",
+                i.start_s,
+                i.end_s,
+                i.reason.name()
+            )
+        }));
     }
     Ok((h, out.stats, tracks, out.gnss_gated))
 }

@@ -61,6 +61,20 @@ pub struct InnovationRecord {
     pub accepted: bool,
 }
 
+impl InnovationRecord {
+    /// The record of update `u` of the epoch at `t_s`.
+    pub fn of(t_s: f64, u: &crate::filter::Update) -> Self {
+        InnovationRecord {
+            t_s,
+            sensor: u.sensor,
+            y: u.y,
+            s: u.s,
+            nis: u.nis,
+            accepted: u.accepted,
+        }
+    }
+}
+
 /// Counts of what the filter used, gated and skipped.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub struct FilterStats {
