@@ -75,17 +75,6 @@ fn forward<'a, L: Layout<N>, const N: usize>(
         feeder.push(&mut f, ev, &mut noop)?;
         let n = feeder.stats().epochs;
         if n >= cps.last().map_or(0, |c| c.epochs_before) + segment {
-            // An epoch held for the next wheel row (`ekf::WheelRows::Interval`)
-            // is handed out by the re-run, which needs its prediction: the
-            // checkpoint waits until the held epoch has one.
-            match feeder.holds_epoch() {
-                Some(false) => {
-                    feeder.keep_predictions(true);
-                    continue;
-                }
-                Some(true) => feeder.keep_predictions(false),
-                None => {}
-            }
             cps.push(Checkpoint {
                 filter: f.clone(),
                 feeder: feeder.clone(),

@@ -2,7 +2,6 @@
 //! the two timing schemes, causally (see the module documentation of
 //! [`crate::ekf`]).
 
-use nalgebra::{SMatrix, SVector};
 use serde::{Deserialize, Serialize};
 
 use super::{FilterOptions, FilterStats, SensorSet, Timing, WheelRows};
@@ -10,7 +9,6 @@ use crate::drive::GnssFix;
 use crate::event::{Event, Measurement};
 use crate::filter::{Filter, Layout, Prediction, SensorKind, Update};
 use crate::gyro_hold::GyroHold;
-use crate::model::Mat;
 use crate::standstill::Standstill;
 use crate::tick_interval::CountingInterval;
 use crate::wheel_health::{WheelHealth, WheelMonitor, WheelReading};
@@ -72,49 +70,21 @@ pub struct Feeder {
     /// goes on as it began: [`WheelRows::Instant`]).
     #[serde(default = "instant")]
     wheel_rows: WheelRows,
-    /// [`WheelRows::Interval`]: the epoch run but not yet handed out, waiting
-    /// for the next wheel row's update at its time.
+    /// [`WheelRows::Interval`]: the gyro's and the CAN speed's readings
+    /// stamped inside the open wheel interval, in their order, which
+    /// update the state of the interval's start when its row arrives.
     #[serde(default)]
-    held: Option<HeldEpoch>,
+    interval_gyro: Vec<f64>,
+    #[serde(default)]
+    interval_speed: Vec<f64>,
+    /// [`WheelRows::Interval`]: the GNSS fix that arrived in the interval
+    /// before the open one, due at the open interval's start.
+    #[serde(default)]
+    due_gnss: Option<GnssFix>,
     /// Whether the car stands ([`crate::standstill`]), in the GNSS-aided
     /// filter only ([`Feeder::with_standstill`]; `None`: not asked).
     #[serde(default)]
     standstill: Option<Standstill>,
-}
-
-/// An epoch waiting for the next wheel row ([`WheelRows::Interval`]): its
-/// prediction (when the feeder keeps predictions), flattened so the feeder
-/// stays independent of the state's size.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
-struct HeldEpoch {
-    /// x̂_{k|k-1}, then P_{k|k-1} column by column, then the car block of F
-    /// column by column; empty without a prediction.
-    prediction: Vec<f64>,
-}
-
-impl HeldEpoch {
-    fn new<const N: usize>(prediction: Option<&Prediction<N>>) -> Self {
-        let mut v = Vec::new();
-        if let Some(p) = prediction {
-            v.reserve(N + N * N + 25);
-            v.extend_from_slice(p.x.as_slice());
-            v.extend_from_slice(p.p.as_slice());
-            v.extend_from_slice(p.f.as_slice());
-        }
-        HeldEpoch { prediction: v }
-    }
-
-    fn prediction<const N: usize>(&self) -> Option<Prediction<N>> {
-        let v = &self.prediction;
-        if v.len() != N + N * N + 25 {
-            return None;
-        }
-        Some(Prediction {
-            x: SVector::from_column_slice(&v[..N]),
-            p: SMatrix::from_column_slice(&v[N..N + N * N]),
-            f: Mat::from_column_slice(&v[N + N * N..]),
-        })
-    }
 }
 
 fn instant() -> WheelRows {
@@ -164,7 +134,9 @@ impl Feeder {
             predictions: opts.record_epochs,
             monitor: opts.wheel_monitor.map(WheelMonitor::new),
             wheel_rows: opts.wheel_rows,
-            held: None,
+            interval_gyro: Vec::new(),
+            interval_speed: Vec::new(),
+            due_gnss: None,
             standstill: None,
         }
     }
@@ -178,12 +150,6 @@ impl Feeder {
     pub fn with_standstill(mut self) -> Self {
         self.standstill = Some(Standstill::default());
         self
-    }
-
-    /// Whether an epoch is run but not yet handed out ([`WheelRows::Interval`]),
-    /// and whether it carries its prediction.
-    pub fn holds_epoch(&self) -> Option<bool> {
-        self.held.as_ref().map(|h| !h.prediction.is_empty())
     }
 
     /// Hands one epoch out: counts it and passes its prediction, updates and
@@ -203,21 +169,6 @@ impl Feeder {
                 gated_fix_t_s: self.gated_fix_t_s,
             },
         );
-    }
-
-    /// Hands out the held epoch, if any.
-    fn release<L: Layout<N>, const N: usize>(
-        &mut self,
-        f: &mut Filter<L, N>,
-        epoch: &mut dyn FnMut(&mut Filter<L, N>, EpochOut<'_, N>),
-    ) {
-        let Some(held) = self.held.take() else {
-            return;
-        };
-        let prediction = held.prediction::<N>();
-        self.hand_out(f, prediction.as_ref(), epoch);
-        self.updates.clear();
-        self.gated_fix_t_s = None;
     }
 
     /// Whether the epochs passed to the callback carry their prediction (by
@@ -287,6 +238,7 @@ impl Feeder {
         self.sensors.gnss = false;
         self.sensors.gnss_course = false;
         self.pending_gnss = None;
+        self.due_gnss = None;
     }
 
     /// Counters so far (the gate counters are the filter's: see [`Feeder::stats_with`]).
@@ -359,7 +311,9 @@ impl Feeder {
         epoch: &mut dyn FnMut(&mut Filter<L, N>, EpochOut<'_, N>),
     ) -> Result<(), Error> {
         self.process_batch(f, epoch)?;
-        self.release(f, epoch);
+        if self.wheel_rows == WheelRows::Interval {
+            self.last_interval_epoch(f, epoch)?;
+        }
         // The epochs' scratch (not serialised): a feeder that has finished
         // equals its saved and loaded copy.
         self.updates.clear();
@@ -413,6 +367,100 @@ impl Feeder {
             return Some((interval, gap));
         }
         Some((self.counting.push(interval), false))
+    }
+
+    /// [`WheelRows::Interval`]: the epoch at `start`, the start of the
+    /// interval that the wheel row `m` at `end` closes. The state is
+    /// predicted to `start`, then updated by everything that describes the
+    /// interval (the row over its counting `interval`, and the gyro's and
+    /// the CAN speed's readings stamped inside it: the step from `start`
+    /// carries their rates), and by the GNSS fix that arrived before
+    /// `start`. A gyro live but silent through the interval leaves the
+    /// steering waiting, and the step into it takes the gyro gap's yaw-rate
+    /// noise ([`crate::gyro_hold`]), as in the paper's scheme.
+    #[allow(clippy::too_many_arguments)]
+    fn interval_epoch<L: Layout<N>, const N: usize>(
+        &mut self,
+        f: &mut Filter<L, N>,
+        m: &Measurement,
+        start: f64,
+        end: f64,
+        interval: f64,
+        gap: bool,
+        epoch: &mut dyn FnMut(&mut Filter<L, N>, EpochOut<'_, N>),
+    ) -> Result<(), Error> {
+        let use_ = self.sensors;
+        // The first interval (the gap rule's first interval seen) starts at
+        // the first wheel row after the filter's start.
+        let first = self.stats.epochs == 0 && self.intervals.len() == 1;
+        let fresh_gyro = !self.interval_gyro.is_empty();
+        let gyro_live = use_.gyro && self.gyro.is_live(end);
+        let gap_q = f.noise().gyro_gap_process_yaw_rate_rps;
+        let prediction = if gap_q > 0.0 && gyro_live && !fresh_gyro {
+            self.stats.gyro_gap_epochs += 1;
+            let q = gap_q.min(f.noise().process_yaw_rate_rps);
+            f.predict_to_with_yaw_rate_noise(start, q, self.predictions)
+        } else {
+            self.predict(f, start)
+        };
+        if use_.wheels {
+            if gap {
+                self.stats.wheel_gaps += 1;
+            } else {
+                self.wheel_updates(f, m, interval)?;
+            }
+        }
+        for i in 0..self.interval_gyro.len() {
+            self.updates.push(f.update_gyro(self.interval_gyro[i])?);
+        }
+        for i in 0..self.interval_speed.len() {
+            self.updates.push(f.update_speed(self.interval_speed[i])?);
+        }
+        self.interval_gyro.clear();
+        self.interval_speed.clear();
+        if fresh_gyro || !gyro_live {
+            if let Some(v) = self.pending_steering.take() {
+                self.updates.push(f.update_steering(v)?);
+            }
+        } else if self.pending_steering.is_some() {
+            self.stats.steering_deferred += 1;
+        }
+        if let Some(fix) = self.due_gnss.take() {
+            self.gnss_update(f, &fix)?;
+        }
+        if use_.wheels && !gap {
+            self.monitor_wheels(f, m, interval);
+        }
+        // The first interval's start is not an epoch (the paper's scheme
+        // hands out its first epoch at the end of the first interval too).
+        if !first {
+            self.hand_out(f, prediction.as_ref(), epoch);
+        }
+        self.due_gnss = self.pending_gnss.take();
+        Ok(())
+    }
+
+    /// [`WheelRows::Interval`], at the end of the stream: the epoch at the
+    /// last wheel row, which no row closes (no rates of its own: the
+    /// readings after it are not used), with the fix due there.
+    fn last_interval_epoch<L: Layout<N>, const N: usize>(
+        &mut self,
+        f: &mut Filter<L, N>,
+        epoch: &mut dyn FnMut(&mut Filter<L, N>, EpochOut<'_, N>),
+    ) -> Result<(), Error> {
+        self.interval_gyro.clear();
+        self.interval_speed.clear();
+        let Some(t) = self.last_wheel_s.filter(|&t| t > f.time_s()) else {
+            return Ok(());
+        };
+        self.updates.clear();
+        self.gated_fix_t_s = None;
+        let prediction = self.predict(f, t);
+        if let Some(fix) = self.due_gnss.take() {
+            self.gnss_update(f, &fix)?;
+        }
+        self.hand_out(f, prediction.as_ref(), epoch);
+        Ok(())
     }
 
     fn wheel_updates<L: Layout<N>, const N: usize>(
@@ -484,11 +532,9 @@ impl Feeder {
             return Ok(());
         }
         let use_ = self.sensors;
-        // A held epoch keeps its updates until it is handed out.
-        if self.held.is_none() {
-            self.updates.clear();
-            self.gated_fix_t_s = None;
-        }
+        self.updates.clear();
+        self.gated_fix_t_s = None;
+        let over_interval = self.wheel_rows == WheelRows::Interval;
         let supersede = |slot: &mut Option<f64>, v: f64, n: &mut usize| {
             if slot.replace(v).is_some() {
                 *n += 1;
@@ -497,18 +543,28 @@ impl Feeder {
         match self.timing {
             Timing::WheelEpochs => match ev.measurement {
                 Measurement::YawRate { yaw_rate_rps } if use_.gyro => {
-                    supersede(
-                        &mut self.pending_gyro,
-                        yaw_rate_rps,
-                        &mut self.stats.readings_superseded,
-                    );
+                    if over_interval {
+                        self.interval_gyro.push(yaw_rate_rps);
+                    } else {
+                        supersede(
+                            &mut self.pending_gyro,
+                            yaw_rate_rps,
+                            &mut self.stats.readings_superseded,
+                        );
+                    }
                     self.gyro.push(t, yaw_rate_rps);
                 }
-                Measurement::Speed { speed_mps } if use_.speed => supersede(
-                    &mut self.pending_speed,
-                    speed_mps,
-                    &mut self.stats.readings_superseded,
-                ),
+                Measurement::Speed { speed_mps } if use_.speed => {
+                    if over_interval {
+                        self.interval_speed.push(speed_mps);
+                    } else {
+                        supersede(
+                            &mut self.pending_speed,
+                            speed_mps,
+                            &mut self.stats.readings_superseded,
+                        );
+                    }
+                }
                 Measurement::Steering { steering_wheel_rad } if use_.steering => supersede(
                     &mut self.pending_steering,
                     steering_wheel_rad,
@@ -523,24 +579,24 @@ impl Feeder {
                 }
                 Measurement::WheelTicks { .. } | Measurement::WheelSpeeds { .. } => {
                     let ticks = matches!(ev.measurement, Measurement::WheelTicks { .. });
+                    let start = self.last_wheel_s;
                     let Some((interval, gap)) = self.wheel_interval(t, ticks) else {
+                        // The first row opens the first interval.
+                        self.interval_gyro.clear();
+                        self.interval_speed.clear();
                         return Ok(());
                     };
-                    let at_start = self.wheel_rows == WheelRows::Interval;
-                    if at_start {
-                        // The row describes the interval that ends now: it
-                        // updates the state at the interval's start, which
-                        // the step below carries over the interval; the
-                        // epoch there is then complete.
-                        if use_.wheels {
-                            if gap {
-                                self.stats.wheel_gaps += 1;
-                            } else {
-                                self.wheel_updates(f, &ev.measurement, interval)?;
-                                self.monitor_wheels(f, &ev.measurement, interval);
-                            }
-                        }
-                        self.release(f, epoch);
+                    if over_interval {
+                        let start = start.unwrap_or(t);
+                        return self.interval_epoch(
+                            f,
+                            &ev.measurement,
+                            start,
+                            t,
+                            interval,
+                            gap,
+                            epoch,
+                        );
                     }
                     // A gyro reading late by a few milliseconds leaves this
                     // epoch without one: the yaw rate keeps the last
@@ -557,7 +613,7 @@ impl Feeder {
                     } else {
                         self.predict(f, t)
                     };
-                    if use_.wheels && !at_start {
+                    if use_.wheels {
                         if gap {
                             self.stats.wheel_gaps += 1;
                         } else {
@@ -582,10 +638,6 @@ impl Feeder {
                     }
                     if let Some(fix) = self.pending_gnss.take() {
                         self.gnss_update(f, &fix)?;
-                    }
-                    if at_start {
-                        self.held = Some(HeldEpoch::new(prediction.as_ref()));
-                        return Ok(());
                     }
                     if use_.wheels && !gap {
                         self.monitor_wheels(f, &ev.measurement, interval);

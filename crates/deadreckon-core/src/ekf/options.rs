@@ -32,9 +32,12 @@ pub enum Timing {
 /// true delay of 0, issue 28).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub enum WheelRows {
-    /// The row updates the state at the start of its interval, `t_{k−1}`;
-    /// the step to `t_k` then carries the interval's own speed. Each epoch
-    /// is handed out when the next wheel row (or the end of the stream)
+    /// The row updates the state at the start of its interval, `t_{k−1}`,
+    /// together with the gyro's and the CAN speed's readings stamped inside
+    /// the interval (each one, in order) and the steering's latest; the step
+    /// to `t_k` then carries the interval's own rates. A GNSS fix updates
+    /// the state at the first interval start after it. The epoch at
+    /// `t_{k−1}` is predicted, updated and handed out when the row at `t_k`
     /// has arrived, one wheel period later than with [`WheelRows::Instant`].
     /// Not the default: on the comma2k19 segment it loses (see
     /// docs/calibration.md, "When a wheel row is used").

@@ -16,12 +16,16 @@ pub const GNSS_SETTLED_FRACTION_OF_STD: f64 = 0.1;
 
 /// How the GNSS delay's dead-reckoned reference uses the wheel rows,
 /// whichever step the calibrating filter takes: each row over the interval
-/// it describes ([`WheelRows::Interval`]). With the paper's step
+/// it describes ([`WheelRows::Interval`]), with the gyro's and the CAN
+/// speed's readings stamped inside that interval. With the paper's step
 /// ([`WheelRows::Instant`], the filter's default) the reference carries the
 /// previous interval's speed, its positions trail by about a wheel period
 /// while the speed changes, and the fixes read that as a negative receiver
 /// delay (issues 28 and 29: −29, −16 and −9 ms at 25, 50 and 100 Hz on
-/// family car 1 with a true delay of 0). The delay estimated is the
+/// family car 1 with a true delay of 0); with the readings taken into the
+/// interval after theirs, the CAN speed, which outweighs 48-tooth tick
+/// counts, did the same (the evaluation scenario: −21.7, −16.8 and
+/// −10.1 ms; `tests/gnss_delay_family.rs`). The delay estimated is the
 /// receiver's.
 pub const REFERENCE_WHEEL_ROWS: WheelRows = WheelRows::Interval;
 
@@ -102,13 +106,17 @@ pub(super) fn gnss_delay_of(
         let Some(s0) = s0 else {
             return Ok((Delay::not_estimated("no smoothed track"), None));
         };
-        // The reference integrates the yaw with the trapezoid: with eq. 3's
-        // Euler step its yaw lags half a step of yaw-rate change in every
-        // turn, which the fixes read as time (family car 7, 25 Hz wheels,
-        // 0.18 s true: 0.162 ± 0.003 s, −6σ; with the trapezoid 0.179 s).
+        // The reference integrates the yaw with eq. 3's Euler step, exact
+        // for rates held over each wheel interval, as the reference's rows
+        // and readings are ([`REFERENCE_WHEEL_ROWS`]). (The trapezoid, which
+        // moves the yaw by half a step of each yaw-rate update, made up for
+        // the gyro's readings arriving one interval late before they were
+        // taken into their own interval; with them there, it turned the
+        // heading half a step early: family car 1, wheel speeds at 25, 50
+        // and 100 Hz, 0.03 m fixes, no delay: +5.2 ± 3.7, +2.7 ± 1.9 and
+        // +1.4 ± 1.1 ms, with Euler −0.9 ± 0.5, −0.3 ± 0.5, −0.1 ± 0.5 ms.)
         // (The calibration and the smoothing above are done with `shifted`;
         // only its fixes are read below.)
-        shifted.vehicle.noise.yaw_integration = crate::vehicle::YawIntegration::Trapezoidal;
         let dr_opts = FilterOptions {
             record_epochs: true,
             init: Init::Given {
