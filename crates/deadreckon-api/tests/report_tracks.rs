@@ -81,7 +81,7 @@ fn report_paths(dir: &Path, drive: &Drive, params: Option<&str>) -> Shown {
         corrections: Which::Auto,
         shape: None,
     };
-    let input = car_input(drive, &o, &()).expect("the report's data");
+    let input = car_input(drive.clone(), &o, &()).expect("the report's data");
     let corrections = input
         .calibration
         .and_then(|c| c.corrections)
