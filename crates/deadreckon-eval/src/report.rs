@@ -226,24 +226,34 @@ pub fn health(drive: &Drive, params: &Params) -> Result<Health, Error> {
         nis_bound_probability: Some(0.95),
         ..Default::default()
     };
-    for (k, c) in taken.by_sensor {
-        h.nis.push(rp::NisSeries {
-            sensor: k.name().into(),
-            dof: k.dof() as u32,
-            t_s: c.t_s.clone(),
-            nis: c.nis,
-            gated: c.gated.clone(),
-            gate_chi2: Some(deadreckon_core::filter::gate_chi2(&drive.vehicle.noise, k))
-                .filter(|g| g.is_finite()),
-        });
-        h.innovations.push(rp::InnovationSeries {
+    // Each sensor's series reduced to what its figures draw and say (the
+    // same figures as the whole series', [`rp::DrawnInnovations::of`]) and
+    // dropped before the next: the report holds no series to the end.
+    let p = h.nis_probability();
+    for (k, c) in std::mem::take(&mut taken.by_sensor) {
+        let mut innovations = rp::InnovationSeries {
             sensor: k.name().into(),
             unit: sensor_unit(k, ticks).into(),
             t_s: c.t_s,
             innovation: c.y,
             std: c.std,
             gated: c.gated,
-        });
+        };
+        h.drawn_innovations
+            .push(rp::DrawnInnovations::of(&innovations)?);
+        innovations.innovation = Vec::new();
+        innovations.std = Vec::new();
+        let nis = rp::NisSeries {
+            sensor: k.name().into(),
+            dof: k.dof() as u32,
+            t_s: innovations.t_s,
+            nis: c.nis,
+            gated: innovations.gated,
+            gate_chi2: Some(deadreckon_core::filter::gate_chi2(&drive.vehicle.noise, k))
+                .filter(|g| g.is_finite()),
+        };
+        h.drawn_nis
+            .push(rp::DrawnNis::of(&nis, p)?);
     }
     h.consistency = consistency;
     h.wheel_health = wheel_health.lines();
