@@ -231,12 +231,13 @@ pub fn health(drive: &Drive, params: &Params) -> Result<Health, Error> {
     // dropped before the next: the report holds no series to the end.
     let p = h.nis_probability();
     for (k, c) in std::mem::take(&mut taken.by_sensor) {
+        let nis = c.nis();
         let mut innovations = rp::InnovationSeries {
             sensor: k.name().into(),
             unit: sensor_unit(k, ticks).into(),
+            std: c.s.iter().map(|s| s.sqrt()).collect(),
             t_s: c.t_s,
             innovation: c.y,
-            std: c.std,
             gated: c.gated,
         };
         h.drawn_innovations
@@ -247,7 +248,7 @@ pub fn health(drive: &Drive, params: &Params) -> Result<Health, Error> {
             sensor: k.name().into(),
             dof: k.dof() as u32,
             t_s: innovations.t_s,
-            nis: c.nis,
+            nis,
             gated: innovations.gated,
             gate_chi2: Some(deadreckon_core::filter::gate_chi2(&drive.vehicle.noise, k))
                 .filter(|g| g.is_finite()),
@@ -308,23 +309,37 @@ impl tracks::AidedObserver for Taken {
 }
 
 /// One sensor's innovations as the run makes them: the columns of its
-/// [`rp::InnovationSeries`] and [`rp::NisSeries`].
+/// [`rp::InnovationSeries`] and [`rp::NisSeries`], the NIS kept only where
+/// it is not `y²/S` (a scalar observation's is, bit for bit: 8 bytes an
+/// innovation less, 10 MB on the hour; a GNSS fix's is not).
 #[derive(Default)]
 struct Columns {
     t_s: Vec<f64>,
     y: Vec<f64>,
-    std: Vec<f64>,
-    nis: Vec<f64>,
+    s: Vec<f64>,
     gated: Vec<bool>,
+    /// The NIS where it is not `y²/S`, by index.
+    nis_otherwise: Vec<(usize, f64)>,
 }
 
 impl Columns {
     fn push(&mut self, r: &deadreckon_core::ekf::InnovationRecord) {
+        if (r.y * r.y / r.s).to_bits() != r.nis.to_bits() {
+            self.nis_otherwise.push((self.t_s.len(), r.nis));
+        }
         self.t_s.push(r.t_s);
         self.y.push(r.y);
-        self.std.push(r.s.sqrt());
-        self.nis.push(r.nis);
+        self.s.push(r.s);
         self.gated.push(!r.accepted);
+    }
+
+    /// Every NIS, as recorded.
+    fn nis(&self) -> Vec<f64> {
+        let mut v: Vec<f64> = self.y.iter().zip(&self.s).map(|(y, s)| y * y / s).collect();
+        for &(k, nis) in &self.nis_otherwise {
+            v[k] = nis;
+        }
+        v
     }
 }
 
@@ -374,13 +389,6 @@ pub fn four_wheel_input(
         ..Default::default()
     };
     let mut traj = rp::Trajectories::default();
-    if let Some(r) = deadreckon_core::reference::Reference::from_truth(&drive.truth) {
-        traj.truth = Some(rp::EnPath {
-            east_m: r.x.iter().map(|x| x[0]).collect(),
-            north_m: r.x.iter().map(|x| x[1]).collect(),
-            t_s: r.t.clone(),
-        });
-    }
     // Filter health and the aided tracks with the parameters `run` applies
     // to this drive (`deadreckon_api::evaluate::parameters`): the given
     // ones, or else those calibrated on the drive (RTS), or else the last.
@@ -419,6 +427,15 @@ pub fn four_wheel_input(
             traj.aided_with = best.map(|m| m.source.name().to_string());
             input.health = Some(h);
         }
+    }
+    // The truth's positions (the reference's east and north are the
+    // poses'), made after the filter health's peak (issue 30).
+    if deadreckon_core::reference::TruthPositions::new(&drive.truth).is_some() {
+        traj.truth = Some(rp::EnPath {
+            east_m: drive.truth.iter().map(|p| p.east_m).collect(),
+            north_m: drive.truth.iter().map(|p| p.north_m).collect(),
+            t_s: drive.truth.iter().map(|p| p.t_s).collect(),
+        });
     }
     // Dead reckoning with each parameter set.
     let opts = FilterOptions::default();
