@@ -90,10 +90,10 @@ fn report_paths(dir: &Path, drive: &Drive, params: Option<&str>) -> Shown {
     let gnss_nis = input
         .health
         .expect("filter health")
-        .nis
+        .drawn_nis
         .iter()
         .find(|n| n.sensor == "gnss")
-        .map_or(0, |n| n.nis.len());
+        .map_or(0, |n| n.observations);
     Shown {
         filtered: t.filtered.expect("a filtered track"),
         smoothed: t.smoothed.expect("a smoothed track"),
