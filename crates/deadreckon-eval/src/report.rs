@@ -253,8 +253,7 @@ pub fn health(drive: &Drive, params: &Params) -> Result<Health, Error> {
             gate_chi2: Some(deadreckon_core::filter::gate_chi2(&drive.vehicle.noise, k))
                 .filter(|g| g.is_finite()),
         };
-        h.drawn_nis
-            .push(rp::DrawnNis::of(&nis, p)?);
+        h.drawn_nis.push(rp::DrawnNis::of(&nis, p)?);
     }
     h.consistency = consistency;
     h.wheel_health = wheel_health.lines();

@@ -5,7 +5,9 @@
 use plotters::prelude::*;
 
 use super::{rel_time, time_desc};
-use crate::model::{DrawnInnovations, DrawnNis, FilterHealth, InnovationSeries, NisSeries, WideBand};
+use crate::model::{
+    DrawnInnovations, DrawnNis, FilterHealth, InnovationSeries, NisSeries, WideBand,
+};
 use crate::page::{Block, FigureView, RowView, SectionView, TableView};
 use crate::plot::{
     data_begin, data_end, draw_hline, fmt_sig, padded_range, render_chart, segments, Frame, Legend,
@@ -390,7 +392,7 @@ impl DrawnNis {
             .map(|(k, v)| if is_gated(k) { f64::NAN } else { *v })
             .collect();
         let acc_sorted = sorted_finite(&accepted);
-        let drawable = !(acc_sorted.is_empty() && !s.nis.iter().any(|v| v.is_finite()));
+        let drawable = !acc_sorted.is_empty() || s.nis.iter().any(|v| v.is_finite());
         let inside = acc_sorted.iter().filter(|v| **v >= lo && **v <= hi).count();
         let mean = if acc_sorted.is_empty() {
             f64::NAN
