@@ -143,7 +143,7 @@ fn the_report_ignored_the_corrections_of_its_params_and_estimated_none() {
     // `--params` read once, as `report` reads it (`given_file`).
     let corrected = |o: &ReportOptions| {
         let file = given_file(o).unwrap();
-        corrected(&drive, o, file.as_ref(), &()).unwrap()
+        corrected(drive.clone(), o, file.as_ref(), &()).unwrap()
     };
     let (with_stored, rows) = corrected(&options(&dir, Some(ps), Which::Gnss));
     let rows = rows.expect("stored corrections shown");

@@ -37,7 +37,7 @@ pub fn run(a: ReportArgs, quiet: bool, load: &common::Loader) -> Result<()> {
             .as_deref()
             .map_or(String::new(), |p| format!(", and {p} as given"))
     );
-    deadreckon_api::report::write(&drive, &o, &a.out, &steps, &common::footer())?;
+    deadreckon_api::report::write(drive, &o, &a.out, &steps, &common::footer())?;
     steps.finish();
     outln!("wrote {}", a.out.display());
     Ok(())

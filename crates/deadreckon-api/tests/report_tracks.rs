@@ -81,7 +81,7 @@ fn report_paths(dir: &Path, drive: &Drive, params: Option<&str>) -> Shown {
         corrections: Which::Auto,
         shape: None,
     };
-    let input = car_input(drive, &o, &()).expect("the report's data");
+    let input = car_input(drive.clone(), &o, &()).expect("the report's data");
     let corrections = input
         .calibration
         .and_then(|c| c.corrections)
@@ -90,10 +90,10 @@ fn report_paths(dir: &Path, drive: &Drive, params: Option<&str>) -> Shown {
     let gnss_nis = input
         .health
         .expect("filter health")
-        .nis
+        .drawn_nis
         .iter()
         .find(|n| n.sensor == "gnss")
-        .map_or(0, |n| n.nis.len());
+        .map_or(0, |n| n.observations);
     Shown {
         filtered: t.filtered.expect("a filtered track"),
         smoothed: t.smoothed.expect("a smoothed track"),

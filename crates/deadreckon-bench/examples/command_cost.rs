@@ -97,7 +97,7 @@ fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let usage =
         "usage: command_cost write DIR DURATION_S | COMMAND DIR | table SHORT_DIR LONG_DIR \
-                 (COMMAND: calibrate, calibrate-none, evaluate-outage, run)";
+                 (COMMAND: calibrate, calibrate-gnss, calibrate-none, evaluate-outage, run, report)";
     match args
         .iter()
         .map(String::as_str)

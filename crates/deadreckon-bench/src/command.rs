@@ -1,5 +1,5 @@
 //! The commands' own library path, end to end: what `deadreckon calibrate`,
-//! `evaluate --outage` and `run` call in `deadreckon-api`, reading the drive
+//! `evaluate --outage`, `run` and `report` call in `deadreckon-api`, reading the drive
 //! directory included (with the plausibility checks, as the command line
 //! reads it). The command-line parsing and printing are left out: they cost
 //! nothing next to these.
@@ -27,20 +27,26 @@ pub enum Command {
     /// `deadreckon run DIR --params nominal --out tracks.csv` (the
     /// dead-reckoned, filtered and smoothed tracks, and the wheel health).
     Run,
+    /// `deadreckon report DIR --out report.html` (the default corrections,
+    /// the calibrations, the filter health, dead reckoning and drift: the
+    /// HTML page written to `out`).
+    Report,
 }
 
 impl Command {
     /// Every command, in the order of the tables.
-    pub const ALL: [Command; 5] = [
+    pub const ALL: [Command; 6] = [
         Command::Calibrate,
         Command::CalibrateGnss,
         Command::CalibrateNone,
         Command::EvaluateOutage,
         Command::Run,
+        Command::Report,
     ];
 
     /// The name on the example's command line (`calibrate`,
-    /// `calibrate-gnss`, `calibrate-none`, `evaluate-outage`, `run`).
+    /// `calibrate-gnss`, `calibrate-none`, `evaluate-outage`, `run`,
+    /// `report`).
     pub fn name(self) -> &'static str {
         match self {
             Command::Calibrate => "calibrate",
@@ -48,6 +54,7 @@ impl Command {
             Command::CalibrateNone => "calibrate-none",
             Command::EvaluateOutage => "evaluate-outage",
             Command::Run => "run",
+            Command::Report => "report",
         }
     }
 
@@ -59,6 +66,7 @@ impl Command {
             Command::CalibrateNone => "deadreckon calibrate DIR --corrections none",
             Command::EvaluateOutage => "deadreckon evaluate DIR --outage 30 --step 10",
             Command::Run => "deadreckon run DIR --params nominal --out tracks.csv",
+            Command::Report => "deadreckon report DIR --out report.html",
         }
     }
 
@@ -68,8 +76,8 @@ impl Command {
     }
 
     /// Runs the command's library path on the drive directory `dir`
-    /// (`out`: where `run` writes its tracks) and returns the drive's
-    /// wheel epochs.
+    /// (`out`: where `run` writes its tracks and `report` its page) and
+    /// returns the drive's wheel epochs.
     pub fn run(self, dir: &Path, out: &Path) -> Result<usize, deadreckon_api::Error> {
         let load = Loader::default();
         match self {
@@ -130,6 +138,22 @@ impl Command {
                     &deadreckon_core::bound::BoundFit::FILTER,
                 )?;
                 std::hint::black_box(written.json());
+                Ok(epochs)
+            }
+            Command::Report => {
+                let drive = load.drive(dir)?;
+                let epochs = drive.wheels.len();
+                // As the command line's `report` with its defaults.
+                let o = deadreckon_api::report::ReportOptions {
+                    dir,
+                    params: None,
+                    model: None,
+                    outage_s: None,
+                    step_s: None,
+                    corrections: Which::default(),
+                    shape: None,
+                };
+                deadreckon_api::report::write(drive, &o, out, &(), &Default::default())?;
                 Ok(epochs)
             }
         }

@@ -11,8 +11,35 @@ use crate::{Error, Input, Task};
 
 /// Interpolated reference pose from the truth at `t`, as a full state (speed and
 /// yaw rate derived by finite differences where not given).
+///
+/// [`Reference::from_truth`]'s `state_at(t)`, bit for bit, from the poses
+/// up to two past `t`: a pose's state reads its neighbours and the yaw
+/// unwrapped from the first pose, never a later one, and whether every
+/// pose has its speed (checked on the whole truth). It built the whole
+/// reference for one state (17 MB on the bench's hour, at every start from
+/// the truth; issue 30).
+///
+/// [`Reference::from_truth`]: crate::reference::Reference::from_truth
 pub fn truth_state(drive: &Drive, t: f64) -> Option<State> {
-    crate::reference::Reference::from_truth(&drive.truth).and_then(|r| r.state_at(t))
+    state_of_truth(&drive.truth, t)
+}
+
+/// [`truth_state`] of the poses `truth`.
+fn state_of_truth(truth: &[crate::drive::TruthPose], t: f64) -> Option<State> {
+    // The first pose after `t`: the state reads it and the one before.
+    let after = truth.partition_point(|p| p.t_s <= t);
+    let upto = if after < truth.len() {
+        (after + 3).min(truth.len())
+    } else {
+        truth.len()
+    };
+    let all_speeds = |p: &[crate::drive::TruthPose]| p.iter().all(|p| p.speed_mps.is_some());
+    let poses = if all_speeds(&truth[..upto]) == all_speeds(truth) {
+        &truth[..upto]
+    } else {
+        truth
+    };
+    crate::reference::Reference::from_truth(poses).and_then(|r| r.state_at(t))
 }
 
 /// The filter's start: time, car state and covariance, as `opts.init` says.
@@ -112,5 +139,46 @@ impl GnssInit {
                 Input::Travel { distance_m: 10.0 }
             },
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::drive::TruthPose;
+    use crate::reference::Reference;
+
+    /// Bug (issue 30): `truth_state` built the reference of the whole truth
+    /// to read one state; from the poses up to `t` it must give the same
+    /// bits, with the yaw wrapping, and with a speed missing after `t` (the
+    /// whole truth then derives every speed).
+    #[test]
+    fn truth_state_built_the_whole_reference_for_one_state() {
+        for missing_speed_at in [None, Some(150)] {
+            let truth: Vec<TruthPose> = (0..200)
+                .map(|i| {
+                    let t = 10.0 + i as f64 * 0.01 + 1e-4 * ((i * 7) % 5) as f64;
+                    TruthPose {
+                        t_s: t,
+                        east_m: 3.0 * t + (0.3 * t).sin(),
+                        north_m: t * t * 0.1,
+                        yaw_rad: crate::angle::wrap(3.0 + 2.5 * t),
+                        speed_mps: (Some(i) != missing_speed_at).then_some(1.0 + 0.01 * i as f64),
+                    }
+                })
+                .collect();
+            let whole = Reference::from_truth(&truth).expect("a reference");
+            for k in 0..=2100 {
+                let t = 9.99 + k as f64 * 0.001;
+                let a = state_of_truth(&truth, t);
+                let b = whole.state_at(t);
+                assert_eq!(a.is_some(), b.is_some(), "t {t}");
+                if let (Some(a), Some(b)) = (a, b) {
+                    for j in 0..5 {
+                        assert_eq!(a[j].to_bits(), b[j].to_bits(), "t {t}, state {j}");
+                    }
+                }
+            }
+        }
     }
 }

@@ -242,54 +242,124 @@ pub struct AidedTracks {
 /// the receiver's wander, [`crate::gnss_error`], smoothed with its `φ`;
 /// the gyro-bias switch), and what its run saw: the one source of these
 /// tracks, for `run` ([`drive_tracks`]) and for the report's trajectories
-/// and filter health.
+/// and filter health ([`aided_run`], which hands them out as they are made).
 pub fn aided_tracks(
     drive: &Drive,
     params: &Params,
     opts: &FilterOptions,
 ) -> Result<AidedTracks, Error> {
-    // The run keeps no epochs: the smoother runs the filter again
-    // ([`Aided::smoothed_each`]).
-    let opts = FilterOptions {
-        record_epochs: false,
-        ..opts.clone()
+    let mut kept = Kept {
+        filtered: Vec::new(),
+        smoothed: Vec::new(),
+        innovations: opts.record_innovations.then(Vec::new),
     };
-    let mut filtered = Vec::new();
-    let mut output = ekf::FilterOutput::default();
-    let f = Aided::run_observed(drive, params, &opts, &mut |e, u| {
-        filtered.push(TrackPoint::from_state(e.t_s, &e.x, &e.p));
-        output
-            .gnss_gated
-            .extend(u.gated_fix_t_s.and_then(|t| ekf::fix_index(drive, t)));
-        if opts.record_innovations {
-            output.innovations.extend(
-                u.updates
-                    .iter()
-                    .map(|u| ekf::InnovationRecord::of(e.t_s, u)),
-            );
-        }
-    })?;
-    output.stats = f.stats();
-    // Smoothed from the last epoch to the first.
-    let mut smoothed = Vec::with_capacity(filtered.len());
-    let mut start = None;
-    f.smoothed_each(drive, params, &opts, &mut |t, x, p| {
-        smoothed.push(TrackPoint::from_state(t, x, p));
-        start = Some((t, *x, *p));
-    })?;
-    smoothed.reverse();
+    let run = aided_run(drive, params, opts, &mut kept)?;
+    let mut output = run.output;
+    output.innovations = kept.innovations.unwrap_or_default();
+    kept.smoothed.reverse();
     let origin = drive.vehicle.origin;
     Ok(AidedTracks {
         filtered: Track {
             name: names::FILTERED.into(),
-            points: filtered,
+            points: kept.filtered,
             origin,
         },
         smoothed: Track {
             name: names::SMOOTHED.into(),
-            points: smoothed,
+            points: kept.smoothed,
             origin,
         },
+        smoothed_start: run.smoothed_start,
+        switch: run.switch,
+        output,
+    })
+}
+
+/// What [`aided_run`] hands out as the filter and the smoother make it
+/// (`Send`, as [`Aided::smoothed_each`]'s visitor is).
+pub trait AidedObserver {
+    /// Each innovation of the run, in its order (of the hypothesis handed
+    /// out with the switch).
+    fn innovation(&mut self, r: ekf::InnovationRecord);
+    /// Each filtered epoch's point, first to last.
+    fn filtered(&mut self, p: TrackPoint);
+    /// Each smoothed epoch's point, last to first (after every filtered one).
+    fn smoothed(&mut self, p: TrackPoint);
+}
+
+/// [`aided_tracks`]'s collector: the points kept, the innovations when
+/// recorded.
+struct Kept {
+    filtered: Vec<TrackPoint>,
+    smoothed: Vec<TrackPoint>,
+    innovations: Option<Vec<ekf::InnovationRecord>>,
+}
+
+impl AidedObserver for Kept {
+    fn innovation(&mut self, r: ekf::InnovationRecord) {
+        if let Some(v) = &mut self.innovations {
+            v.push(r);
+        }
+    }
+    fn filtered(&mut self, p: TrackPoint) {
+        self.filtered.push(p);
+    }
+    fn smoothed(&mut self, p: TrackPoint) {
+        if self.smoothed.is_empty() {
+            self.smoothed.reserve_exact(self.filtered.len());
+        }
+        self.smoothed.push(p);
+    }
+}
+
+/// What [`aided_run`] returns besides what it handed out.
+#[derive(Debug, Clone)]
+pub struct AidedRun {
+    /// The smoothed first epoch's time, car state and covariance.
+    pub smoothed_start: Option<(f64, State, Mat)>,
+    /// What the gyro-bias switch saw (`None` without one).
+    pub switch: Option<BiasSwitch>,
+    /// The run's counters and the indices of the fixes the gate rejected
+    /// (no innovations: they went to the observer; no epochs).
+    pub output: ekf::FilterOutput,
+}
+
+/// The run of [`aided_tracks`], each filtered and smoothed point and each
+/// innovation handed to `obs` as it is made instead of kept: the report
+/// takes only what it draws from them (a [`TrackPoint`] is 120 bytes, an
+/// [`ekf::InnovationRecord`] 48, about seven a wheel epoch; issue 30).
+/// `opts.record_innovations` is not read.
+pub fn aided_run(
+    drive: &Drive,
+    params: &Params,
+    opts: &FilterOptions,
+    obs: &mut (dyn AidedObserver + Send),
+) -> Result<AidedRun, Error> {
+    // The run keeps no epochs: the smoother runs the filter again
+    // ([`Aided::smoothed_each`]).
+    let opts = FilterOptions {
+        record_epochs: false,
+        record_innovations: false,
+        ..opts.clone()
+    };
+    let mut output = ekf::FilterOutput::default();
+    let f = Aided::run_observed(drive, params, &opts, &mut |e, u| {
+        obs.filtered(TrackPoint::from_state(e.t_s, &e.x, &e.p));
+        output
+            .gnss_gated
+            .extend(u.gated_fix_t_s.and_then(|t| ekf::fix_index(drive, t)));
+        for u in u.updates {
+            obs.innovation(ekf::InnovationRecord::of(e.t_s, u));
+        }
+    })?;
+    output.stats = f.stats();
+    // Smoothed from the last epoch to the first.
+    let mut start = None;
+    f.smoothed_each(drive, params, &opts, &mut |t, x, p| {
+        obs.smoothed(TrackPoint::from_state(t, x, p));
+        start = Some((t, *x, *p));
+    })?;
+    Ok(AidedRun {
         smoothed_start: start,
         switch: f.bias_switch(),
         output,

@@ -62,4 +62,8 @@ pub enum Error {
     /// TedriS failed.
     #[error(transparent)]
     Tedris(#[from] deadreckon_tedris::Error),
+    /// A series the report was given did not hold together (its columns
+    /// of different lengths).
+    #[error(transparent)]
+    Report(#[from] deadreckon_report::ReportError),
 }

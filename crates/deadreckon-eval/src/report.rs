@@ -202,53 +202,60 @@ fn sensor_unit(k: SensorKind, ticks: bool) -> &'static str {
 }
 
 /// What [`health`] returns: the report's section, the run's counters, the
-/// filtered and smoothed tracks, and the indices in `drive.gnss` of the
-/// fixes the gate rejected.
-pub type Health = (rp::FilterHealth, FilterStats, Vec<Track>, Vec<usize>);
+/// filtered and smoothed tracks as the report draws them (`t`, east,
+/// north), and the indices in `drive.gnss` of the fixes the gate rejected.
+pub type Health = (rp::FilterHealth, FilterStats, [rp::EnPath; 2], Vec<usize>);
 
 /// Filter health from the GNSS-aided run whose filtered and smoothed
 /// tracks `run` writes ([`tracks::aided_tracks`], the filter of the layout
 /// the vehicle's noise settings call for: the receiver's wander, the gyro
-/// bias as a state, the gyro-bias switch), with its innovations recorded;
+/// bias as a state, the gyro-bias switch), its innovations and points taken
+/// into the report's series as the run makes them ([`tracks::aided_run`]);
 /// the wheel monitor's lines are `run`'s ([`deadreckon_core::ekf::check_wheels`]).
 pub fn health(drive: &Drive, params: &Params) -> Result<Health, Error> {
-    let opts = FilterOptions {
-        record_innovations: true,
-        ..Default::default()
-    };
-    let aided = tracks::aided_tracks(drive, params, &opts)?;
-    let out = aided.output;
-    let tracks = vec![aided.filtered, aided.smoothed];
+    let opts = FilterOptions::default();
+    // The NEES first: its copy of the truth is gone before the run's series
+    // exist.
+    let consistency = consistency(drive, params);
+    let mut taken = Taken::default();
+    let run = tracks::aided_run(drive, params, &opts, &mut taken)?;
+    let out = run.output;
     let wheel_health = deadreckon_core::ekf::check_wheels(drive, params, &opts)?;
     let ticks = matches!(drive.wheels, deadreckon_core::drive::Wheels::Ticks(_));
-    let mut kinds: Vec<SensorKind> = out.innovations.iter().map(|i| i.sensor).collect();
-    kinds.sort();
-    kinds.dedup();
     let mut h = rp::FilterHealth {
         nis_bound_probability: Some(0.95),
         ..Default::default()
     };
-    for k in kinds {
-        let recs: Vec<_> = out.innovations.iter().filter(|i| i.sensor == k).collect();
-        h.innovations.push(rp::InnovationSeries {
+    // Each sensor's series reduced to what its figures draw and say (the
+    // same figures as the whole series', [`rp::DrawnInnovations::of`]) and
+    // dropped before the next: the report holds no series to the end.
+    let p = h.nis_probability();
+    for (k, c) in std::mem::take(&mut taken.by_sensor) {
+        let nis = c.nis();
+        let mut innovations = rp::InnovationSeries {
             sensor: k.name().into(),
             unit: sensor_unit(k, ticks).into(),
-            t_s: recs.iter().map(|r| r.t_s).collect(),
-            innovation: recs.iter().map(|r| r.y).collect(),
-            std: recs.iter().map(|r| r.s.sqrt()).collect(),
-            gated: recs.iter().map(|r| !r.accepted).collect(),
-        });
-        h.nis.push(rp::NisSeries {
+            std: c.s.iter().map(|s| s.sqrt()).collect(),
+            t_s: c.t_s,
+            innovation: c.y,
+            gated: c.gated,
+        };
+        h.drawn_innovations
+            .push(rp::DrawnInnovations::of(&innovations)?);
+        innovations.innovation = Vec::new();
+        innovations.std = Vec::new();
+        let nis = rp::NisSeries {
             sensor: k.name().into(),
             dof: k.dof() as u32,
-            t_s: recs.iter().map(|r| r.t_s).collect(),
-            nis: recs.iter().map(|r| r.nis).collect(),
-            gated: recs.iter().map(|r| !r.accepted).collect(),
+            t_s: innovations.t_s,
+            nis,
+            gated: innovations.gated,
             gate_chi2: Some(deadreckon_core::filter::gate_chi2(&drive.vehicle.noise, k))
                 .filter(|g| g.is_finite()),
-        });
+        };
+        h.drawn_nis.push(rp::DrawnNis::of(&nis, p)?);
     }
-    h.consistency = consistency(drive, params);
+    h.consistency = consistency;
     h.wheel_health = wheel_health.lines();
     for (name, r) in deadreckon_core::wheel_health::WHEEL_NAMES
         .iter()
@@ -263,7 +270,76 @@ pub fn health(drive: &Drive, params: &Params) -> Result<Health, Error> {
             )
         }));
     }
-    Ok((h, out.stats, tracks, out.gnss_gated))
+    let mut smoothed = taken.smoothed;
+    // The smoother handed its points out last to first.
+    smoothed.t_s.reverse();
+    smoothed.east_m.reverse();
+    smoothed.north_m.reverse();
+    Ok((h, out.stats, [taken.filtered, smoothed], out.gnss_gated))
+}
+
+/// What the report takes from the aided run as it goes: each sensor's
+/// innovations (in `SensorKind`'s order, as the report lists them) and
+/// the two tracks' times and positions (the run kept every innovation and
+/// both tracks' whole points first: 105 MB and 43 MB on the hour, issue 30).
+#[derive(Default)]
+struct Taken {
+    by_sensor: std::collections::BTreeMap<SensorKind, Columns>,
+    filtered: rp::EnPath,
+    smoothed: rp::EnPath,
+}
+
+fn push_point(p: &mut rp::EnPath, q: &deadreckon_core::TrackPoint) {
+    p.t_s.push(q.t_s);
+    p.east_m.push(q.east_m);
+    p.north_m.push(q.north_m);
+}
+
+impl tracks::AidedObserver for Taken {
+    fn innovation(&mut self, r: deadreckon_core::ekf::InnovationRecord) {
+        self.by_sensor.entry(r.sensor).or_default().push(&r);
+    }
+    fn filtered(&mut self, p: deadreckon_core::TrackPoint) {
+        push_point(&mut self.filtered, &p);
+    }
+    fn smoothed(&mut self, p: deadreckon_core::TrackPoint) {
+        push_point(&mut self.smoothed, &p);
+    }
+}
+
+/// One sensor's innovations as the run makes them: the columns of its
+/// [`rp::InnovationSeries`] and [`rp::NisSeries`], the NIS kept only where
+/// it is not `y²/S` (a scalar observation's is, bit for bit: 8 bytes an
+/// innovation less, 10 MB on the hour; a GNSS fix's is not).
+#[derive(Default)]
+struct Columns {
+    t_s: Vec<f64>,
+    y: Vec<f64>,
+    s: Vec<f64>,
+    gated: Vec<bool>,
+    /// The NIS where it is not `y²/S`, by index.
+    nis_otherwise: Vec<(usize, f64)>,
+}
+
+impl Columns {
+    fn push(&mut self, r: &deadreckon_core::ekf::InnovationRecord) {
+        if (r.y * r.y / r.s).to_bits() != r.nis.to_bits() {
+            self.nis_otherwise.push((self.t_s.len(), r.nis));
+        }
+        self.t_s.push(r.t_s);
+        self.y.push(r.y);
+        self.s.push(r.s);
+        self.gated.push(!r.accepted);
+    }
+
+    /// Every NIS, as recorded.
+    fn nis(&self) -> Vec<f64> {
+        let mut v: Vec<f64> = self.y.iter().zip(&self.s).map(|(y, s)| y * y / s).collect();
+        for &(k, nis) in &self.nis_otherwise {
+            v[k] = nis;
+        }
+        v
+    }
 }
 
 /// NEES through 30 s dead-reckoning windows every 60 s against the truth
@@ -312,13 +388,6 @@ pub fn four_wheel_input(
         ..Default::default()
     };
     let mut traj = rp::Trajectories::default();
-    if let Some(r) = deadreckon_core::reference::Reference::from_truth(&drive.truth) {
-        traj.truth = Some(rp::EnPath {
-            east_m: r.x.iter().map(|x| x[0]).collect(),
-            north_m: r.x.iter().map(|x| x[1]).collect(),
-            t_s: r.t.clone(),
-        });
-    }
     // Filter health and the aided tracks with the parameters `run` applies
     // to this drive (`deadreckon_api::evaluate::parameters`): the given
     // ones, or else those calibrated on the drive (RTS), or else the last.
@@ -351,11 +420,21 @@ pub fn four_wheel_input(
                     t_s: gg.iter().map(|g| g.t_s).collect(),
                 });
             }
-            traj.filtered = tracks.first().map(path_of);
-            traj.smoothed = tracks.get(1).map(path_of);
+            let [filtered, smoothed] = tracks;
+            traj.filtered = Some(filtered);
+            traj.smoothed = Some(smoothed);
             traj.aided_with = best.map(|m| m.source.name().to_string());
             input.health = Some(h);
         }
+    }
+    // The truth's positions (the reference's east and north are the
+    // poses'), made after the filter health's peak (issue 30).
+    if deadreckon_core::reference::TruthPositions::new(&drive.truth).is_some() {
+        traj.truth = Some(rp::EnPath {
+            east_m: drive.truth.iter().map(|p| p.east_m).collect(),
+            north_m: drive.truth.iter().map(|p| p.north_m).collect(),
+            t_s: drive.truth.iter().map(|p| p.t_s).collect(),
+        });
     }
     // Dead reckoning with each parameter set.
     let opts = FilterOptions::default();

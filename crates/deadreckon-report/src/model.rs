@@ -288,6 +288,101 @@ pub struct NisSeries {
     pub gate_chi2: Option<f64>,
 }
 
+/// An [`InnovationSeries`] reduced to what its figure draws and its
+/// caption says ([`DrawnInnovations::of`]): the counts and quantiles of
+/// every observation, exactly, and the samples the figure draws (at most
+/// [`crate::MAX_POINTS`] of the ±2σ band, [`crate::MAX_SCATTER_POINTS`]
+/// points, [`crate::MAX_POINTS`] gated ones). The figure is the same as the
+/// full series'; a long drive's series need not be held whole (issue 30:
+/// 72 MB on the hour's report).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct DrawnInnovations {
+    /// Sensor and component, as the series'.
+    pub sensor: String,
+    /// Unit of the innovation, as the series'.
+    pub unit: String,
+    /// Observations in the series.
+    pub observations: usize,
+    /// Observations the gate rejected.
+    pub gated: usize,
+    /// Accepted observations outside ±2σ.
+    pub outside_two_sigma: usize,
+    /// Whether the series has its predicted σ.
+    pub has_std: bool,
+    /// Whether the series says which observations were gated.
+    pub has_gated: bool,
+    /// First and last finite time, s (`None`: no figure).
+    pub span_s: Option<(f64, f64)>,
+    /// Half the height of the y range, in `unit`.
+    pub half_range: f64,
+    /// The band's samples drawn: times, s, and 2σ, in `unit`.
+    pub band_t_s: Vec<f64>,
+    /// 2σ at `band_t_s`.
+    pub band_two_sigma: Vec<f64>,
+    /// The points drawn: times, s, and the accepted innovations (NaN where gated).
+    pub points_t_s: Vec<f64>,
+    /// Accepted innovations at `points_t_s`.
+    pub points: Vec<f64>,
+    /// The gated observations drawn: times, s.
+    pub gated_t_s: Vec<f64>,
+    /// Innovations at `gated_t_s`.
+    pub gated_values: Vec<f64>,
+    /// The band's width against the innovations, when it dwarfs them.
+    pub wide_band: Option<WideBand>,
+}
+
+/// A ±2σ band much wider than the innovations it should enclose.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct WideBand {
+    /// The median 2σ, in the series' unit.
+    pub band_half_width: f64,
+    /// The 95th percentile of the accepted |innovation|.
+    pub p95_abs: f64,
+    /// `band_half_width / p95_abs`.
+    pub ratio: f64,
+}
+
+/// A [`NisSeries`] reduced to what its figure draws and its caption says
+/// ([`DrawnNis::of`]), as [`DrawnInnovations`].
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct DrawnNis {
+    /// Sensor, as the series'.
+    pub sensor: String,
+    /// Degrees of freedom, as the series'.
+    pub dof: u32,
+    /// The gate, as the series'.
+    pub gate_chi2: Option<f64>,
+    /// The two-sided probability of the bounds the counts are against.
+    pub probability: f64,
+    /// Observations in the series.
+    pub observations: usize,
+    /// Observations the gate rejected.
+    pub gated: usize,
+    /// Whether the series says which observations were gated.
+    pub has_gated: bool,
+    /// Accepted observations with a finite NIS.
+    pub accepted: usize,
+    /// Of those, inside the bounds.
+    pub inside: usize,
+    /// Their mean (NaN without any).
+    pub mean: f64,
+    /// Their 99th percentile (0 without any).
+    pub p99: f64,
+    /// First and last finite time, s (`None`: no figure).
+    pub span_s: Option<(f64, f64)>,
+    /// The points drawn: times, s, and the accepted NIS (NaN where gated).
+    pub points_t_s: Vec<f64>,
+    /// Accepted NIS at `points_t_s`.
+    pub points: Vec<f64>,
+    /// The gated observations drawn: times, s.
+    pub gated_t_s: Vec<f64>,
+    /// NIS at `gated_t_s`.
+    pub gated_values: Vec<f64>,
+}
+
 /// Filter health: innovations and NIS over time.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
@@ -296,6 +391,11 @@ pub struct FilterHealth {
     pub innovations: Vec<InnovationSeries>,
     /// One series per sensor.
     pub nis: Vec<NisSeries>,
+    /// Series already reduced to their figures ([`DrawnInnovations::of`]),
+    /// drawn after `innovations`.
+    pub drawn_innovations: Vec<DrawnInnovations>,
+    /// NIS series already reduced ([`DrawnNis::of`]), drawn after `nis`.
+    pub drawn_nis: Vec<DrawnNis>,
     /// Two-sided probability of the NIS bounds drawn (default 0.95).
     pub nis_bound_probability: Option<f64>,
     /// The NEES through dead-reckoning windows against the truth (drives

@@ -847,3 +847,37 @@ fn the_comma2k19_trajectory_collapsed_to_one_line() {
     let html = render_html(&old).unwrap();
     assert!(!html.contains("error-time"));
 }
+
+/// Issue 30: the report held every innovation of a long drive (72 MB of
+/// series on the bench's hour) to draw a few thousand points of each.
+/// Series reduced before the report is made ([`DrawnInnovations::of`],
+/// [`DrawnNis::of`]: the counts and quantiles of every observation, the
+/// samples drawn) must draw the same page, byte for byte, with gated
+/// observations and series longer than the figures draw.
+#[test]
+fn series_reduced_before_the_report_draw_the_same_page() {
+    let full = sample_input(1800.0);
+    let h = full.health.as_ref().expect("the sample's filter health");
+    assert!(h.innovations.iter().any(|s| s.t_s.len() > 2 * MAX_POINTS));
+    assert!(h.innovations.iter().any(|s| s.gated.iter().any(|g| *g)));
+    let mut reduced = full.clone();
+    let h = reduced.health.as_mut().expect("the sample's filter health");
+    let p = h.nis_probability();
+    h.drawn_innovations = h
+        .innovations
+        .drain(..)
+        .map(|s| DrawnInnovations::of(&s).expect("a whole series"))
+        .collect();
+    h.drawn_nis = h
+        .nis
+        .drain(..)
+        .map(|s| DrawnNis::of(&s, p).expect("a whole series"))
+        .collect();
+    assert!(h
+        .drawn_innovations
+        .iter()
+        .all(|d| d.points.len() <= MAX_SCATTER_POINTS && d.band_t_s.len() <= MAX_POINTS));
+    let (a, b) = (render_html(&full).unwrap(), render_html(&reduced).unwrap());
+    assert!(a.contains("health-innovation-2") && a.contains("health-nis-1"));
+    assert!(a == b, "the reduced series drew another page");
+}
