@@ -10,13 +10,16 @@
 //! The per-pair table: `cargo test --release -p deadreckon-tedris --test
 //! family_outages -- --nocapture`.
 //!
-//! Cars 1–12's drives and trained models are made once per process and
-//! shared by the tests that use them (the family test, car 8's regression
-//! tests, `short_training_drives`' test drives), and the cars of a family
-//! run in parallel (rayon), printed in car order: the same figures as one
-//! car after another, in less time (CI's 2 cores, `CI=1 cargo test
-//! --workspace --profile ci --test family_outages`: 197 → 148 s wall, 134 →
-//! 130 s of CPU, back to back on a loaded machine).
+//! The drives and trained models of cars 1–12 and 201–212 are made once
+//! per process and shared by the tests that use them (the family tests, car
+//! 8's regression tests, `short_training_drives`' test drives, and the
+//! module [`calibration_std`], which was a test binary of its own), and the
+//! cars of a family run in parallel (rayon), printed in car order: the same
+//! figures as one car after another, in less time. `CI=1 cargo test
+//! --workspace --profile ci --test family_outages`, back to back on CI's 2
+//! cores with other work running: this file alone 197 → 148 s wall (134 →
+//! 130 s of CPU); with `calibration_std` merged, the two old binaries' 256 s
+//! wall (220 s of CPU) → 192 s (167 s of CPU), peak memory 70 → 332 MB.
 
 use std::fmt::Write as _;
 use std::sync::OnceLock;
@@ -29,8 +32,22 @@ use deadreckon_tedris::machine::CourseConvention;
 use deadreckon_tedris::{run_outages, train, Outage, TedrisConfig, TedrisModel};
 use rayon::prelude::*;
 
-/// The development cars whose drives several tests share: 1–12.
-const SHARED_CARS: std::ops::RangeInclusive<u64> = 1..=12;
+/// The joint calibration's standard errors on the same cars' training
+/// drives (its own file: `family_outages/calibration_std.rs`).
+#[path = "family_outages/calibration_std.rs"]
+mod calibration_std;
+
+/// The slot of car `seed` among those whose drives several tests share:
+/// the development cars 1–12 and the held-out cars 201–212 (the family
+/// tests, car 8's regression tests, `short_training_drives`' test drives,
+/// and [`calibration_std`]'s training drives and models).
+fn shared_slot(seed: u64) -> Option<usize> {
+    match seed {
+        1..=12 => Some((seed - 1) as usize),
+        201..=212 => Some((seed - 201 + 12) as usize),
+        _ => None,
+    }
+}
 
 /// Car `seed`'s 500 s test drive (seed `2000 + seed`): the family's test
 /// drive and `short_training_drives`' for every training length.
@@ -56,24 +73,26 @@ fn train_car(seed: u64) -> Trained {
 }
 
 /// Computed once per process for the shared cars, on the first test that
-/// asks (the family test, car 8's regression tests and
-/// `short_training_drives` use the same drives); others computed each time.
-static TEST_DRIVES: [OnceLock<SimOutput>; 12] = [const { OnceLock::new() }; 12];
-static TRAINED: [OnceLock<Trained>; 12] = [const { OnceLock::new() }; 12];
+/// asks; other cars' are computed each time.
+static TEST_DRIVES: [OnceLock<SimOutput>; 24] = [const { OnceLock::new() }; 24];
+static TRAINED: [OnceLock<Trained>; 24] = [const { OnceLock::new() }; 24];
 
-/// Shared car `seed`'s test drive (one of [`SHARED_CARS`]).
+/// Shared car `seed`'s test drive (`seed` has a [`shared_slot`]).
 fn shared_test_drive(seed: u64) -> &'static SimOutput {
-    TEST_DRIVES[(seed - SHARED_CARS.start()) as usize].get_or_init(|| simulate_test_drive(seed))
+    let slot = shared_slot(seed).expect("a shared car");
+    TEST_DRIVES[slot].get_or_init(|| simulate_test_drive(seed))
 }
 
-/// Shared car `seed`'s training drive and model (one of [`SHARED_CARS`]).
+/// Shared car `seed`'s training drive and model (`seed` has a
+/// [`shared_slot`]).
 fn shared_trained(seed: u64) -> &'static Trained {
-    TRAINED[(seed - SHARED_CARS.start()) as usize].get_or_init(|| train_car(seed))
+    let slot = shared_slot(seed).expect("a shared car");
+    TRAINED[slot].get_or_init(|| train_car(seed))
 }
 
 /// Runs `f` on car `seed`'s test drive, from the shared ones when it is one.
 fn with_test_drive<R>(seed: u64, f: impl FnOnce(&SimOutput) -> R) -> R {
-    if SHARED_CARS.contains(&seed) {
+    if shared_slot(seed).is_some() {
         f(shared_test_drive(seed))
     } else {
         f(&simulate_test_drive(seed))
@@ -83,7 +102,7 @@ fn with_test_drive<R>(seed: u64, f: impl FnOnce(&SimOutput) -> R) -> R {
 /// Runs `f` on car `seed`'s training drive and model, from the shared ones
 /// when it is one.
 fn with_trained<R>(seed: u64, f: impl FnOnce(&Trained) -> R) -> R {
-    if SHARED_CARS.contains(&seed) {
+    if shared_slot(seed).is_some() {
         f(shared_trained(seed))
     } else {
         f(&train_car(seed))
