@@ -699,7 +699,7 @@ fn courses_while_reversing_turned_the_anchored_heading() {
         p.t_s > o.start_s - 20.0 && p.t_s < o.start_s && p.speed_mps.unwrap_or(0.0) < -0.5
     });
     assert!(reversed, "the drive no longer backs up before the outage");
-    let r = run_outages(&test.drive, &model, &[o]).expect("run");
+    let r = run_outages(&test.drive, model, &[o]).expect("run");
     let e = &r.outages[0];
     eprintln!(
         "courses while reversing: {}; outage mean {:.2} m, max {:.2} m",
@@ -745,7 +745,7 @@ fn a_course_held_since_reversing_turned_the_anchored_heading() {
         held.len() > 20 && held.iter().all(|c| *c == held[held.len() - 1]),
         "the drive no longer holds a course after reversing: {held:?}"
     );
-    let r = run_outages(&test.drive, &model, &[o]).expect("run");
+    let r = run_outages(&test.drive, model, &[o]).expect("run");
     let e = &r.outages[0];
     let yaw0 = r
         .track
@@ -803,8 +803,8 @@ fn a_quantised_course_on_a_fast_straight_was_skipped_as_held() {
             fast_repeats += 1;
         }
     }
-    let raw = run_outages(&test.drive, &model, &[o]).expect("run");
-    let round = run_outages(&rounded, &model, &[o]).expect("run rounded");
+    let raw = run_outages(&test.drive, model, &[o]).expect("run");
+    let round = run_outages(&rounded, model, &[o]).expect("run rounded");
     let (n_raw, n_round) = (
         raw.machine.checks().repeated_courses,
         round.machine.checks().repeated_courses,
@@ -843,7 +843,7 @@ fn a_model_run_on_a_new_drive_numbered_its_blocks_among_the_training_drives() {
         start_s: 320.0,
         end_s: 400.0,
     };
-    let r = run_outages(&test.drive, &model, &[o]).expect("run");
+    let r = run_outages(&test.drive, model, &[o]).expect("run");
     let after = r
         .machine
         .model()
