@@ -18,7 +18,7 @@ use deadreckon_tedris::input::{drive_input, Event};
 use deadreckon_tedris::{Tedris, TedrisConfig};
 use rayon::prelude::*;
 
-use super::{with_trained, Trained};
+use super::shared::{first_car, with_trained, Trained};
 
 /// One car's installed distance term against its truth.
 struct Row {
@@ -176,10 +176,7 @@ fn family(first: u64) -> (usize, f64, f64, usize) {
 fn the_calibrations_standard_errors_ignored_the_autocorrelated_heading() {
     // TEDRIS_FAMILY_FIRST_CAR=101 runs cars 101–112 (seen by choices since);
     // cars 201–212 are the untouched set, below.
-    let first: u64 = std::env::var("TEDRIS_FAMILY_FIRST_CAR")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(1);
+    let first = first_car();
     let (estimated, worst_robust, _, ols_off) = family(first);
     assert!(estimated > 0);
     if first == 1 {
