@@ -209,8 +209,19 @@ fn tick_family_new_held_out_members_80s_outages() {
 
 /// A drive of a 48-tooth tick counter at 100 Hz (the issue's) in a
 /// kinematic world with tooth errors, where the turn gain's truth is
-/// exact: the rear wheels' true mean circumference over the nominal one.
-fn ticks_48_at_100_hz() -> (DynamicCar, deadreckon_core::Drive) {
+/// exact: the rear wheels' true mean circumference over the nominal one;
+/// and the model TedriS's defaults train on it. Made once per process for
+/// the two tests that use it.
+fn ticks_48_at_100_hz() -> &'static (DynamicCar, TedrisModel) {
+    static CAR: std::sync::OnceLock<(DynamicCar, TedrisModel)> = std::sync::OnceLock::new();
+    CAR.get_or_init(|| {
+        let (car, drive) = simulate_ticks_48_at_100_hz();
+        let (model, _) = train(&drive, TedrisConfig::default(), None).expect("trained");
+        (car, model)
+    })
+}
+
+fn simulate_ticks_48_at_100_hz() -> (DynamicCar, deadreckon_core::Drive) {
     let mut car = DynamicCar::draw_tick_counter(1);
     car.base.vehicle.ticks_per_rev = 48;
     car.wheel_rate_hz = 100.0;
@@ -229,11 +240,10 @@ fn ticks_48_at_100_hz() -> (DynamicCar, deadreckon_core::Drive) {
 
 #[test]
 fn quantised_ticks_attenuated_the_turn_gain_48_teeth_100_hz() {
-    let (car, drive) = ticks_48_at_100_hz();
+    let (car, model) = ticks_48_at_100_hz();
     let v = &car.base.vehicle;
     let e = &car.base.errors;
     let truth = 0.5 * (e.circumference_rl_m + e.circumference_rr_m) / v.wheel_circumference_m;
-    let (model, _) = train(&drive, TedrisConfig::default(), None).expect("trained");
     let f = model.chosen_fit();
     let alpha1 = f
         .global
@@ -243,7 +253,7 @@ fn quantised_ticks_attenuated_the_turn_gain_48_teeth_100_hz() {
         .expect("alpha1")
         .estimate;
     let fitted = alpha1 * v.track_rear_m;
-    let calibrated = accepted_gain(&model, v.track_rear_m, "trained");
+    let calibrated = accepted_gain(model, v.track_rear_m, "trained");
     let blocks = model.blocks.expect("quantised blocks");
     eprintln!(
         "truth {truth:.4}, fitted α1·track {fitted:.4} ({:?}), calibrated {calibrated:.4}; {}",
@@ -268,9 +278,8 @@ fn quantised_ticks_attenuated_the_turn_gain_48_teeth_100_hz() {
 
 #[test]
 fn a_model_turning_a_tenth_of_the_wheels_turn_is_refused() {
-    let (car, drive) = ticks_48_at_100_hz();
+    let (car, model) = ticks_48_at_100_hz();
     let track = car.base.vehicle.track_rear_m;
-    let (model, _) = train(&drive, TedrisConfig::default(), None).expect("trained");
     // The model: α1 ten times too small, in every kind but the baseline.
     let mut m = model.clone();
     m.chosen = ModelKind::Distance;
@@ -309,7 +318,7 @@ fn a_model_turning_a_tenth_of_the_wheels_turn_is_refused() {
     );
     // A cross-correlation peak far below what the turning should give
     // refuses every kind.
-    let acc = acceptance::check(&model, track, Some(10.0));
+    let acc = acceptance::check(model, track, Some(10.0));
     assert!(acc.kinds.iter().all(|k| k
         .refused
         .as_deref()

@@ -4,14 +4,21 @@
 //! per-metre term of the extended variant with a GNSS course is the whole
 //! straight-line heading rate, set by the rear tyres' radius mismatch.
 //!
-//! The table: `cargo test --profile ci -p deadreckon-tedris --test
+//! The table: `cargo test --workspace --profile ci --test family_outages
 //! calibration_std -- --nocapture` (`TEDRIS_FAMILY_FIRST_CAR=101` for the
-//! cars never looked at while developing).
+//! cars 101–112).
+//!
+//! A module of `family_outages.rs` (it was the test binary
+//! `calibration_std`): the training drives and the models [`train`] makes
+//! on them are that file's, made once for both (cars 1–12 and 201–212), and
+//! the cars run in parallel (rayon), printed in car order.
 
 use deadreckon_sim::family::CarFamily;
-use deadreckon_sim::simulate;
 use deadreckon_tedris::input::{drive_input, Event};
-use deadreckon_tedris::{train, Tedris, TedrisConfig};
+use deadreckon_tedris::{Tedris, TedrisConfig};
+use rayon::prelude::*;
+
+use super::shared::{first_car, with_trained, Trained};
 
 /// One car's installed distance term against its truth.
 struct Row {
@@ -39,15 +46,18 @@ fn truth_rad_per_m(car: &CarFamily) -> f64 {
     mismatch * (mean / car.vehicle.wheel_circumference_m) / car.vehicle.track_rear_m
 }
 
-/// Trains on the car's 900 s training drive (as `family_outages.rs`) the
-/// way [`train`] does, keeping the machine for its last calibration, and
-/// checks that [`train`] installs the same values and standard errors.
+/// Trains on the car's 900 s training drive (`family_outages.rs`'s) the
+/// way [`train`](deadreckon_tedris::train) does, keeping the machine for
+/// its last calibration, and checks that `train` installed the same values
+/// and standard errors in the model it made on that drive.
 fn run_car(seed: u64) -> Option<Row> {
+    with_trained(seed, |t| row(seed, t))
+}
+
+fn row(seed: u64, t: &Trained) -> Option<Row> {
     let car = CarFamily::draw(seed);
-    let drive = simulate(&car.drive(1000 + seed, 900.0), 1000 + seed)
-        .expect("train drive")
-        .drive;
-    let input = drive_input(&drive, None, &[]).expect("input");
+    let drive = &t.drive;
+    let input = drive_input(drive, None, &[]).expect("input");
     let mut m = Tedris::new(TedrisConfig::default(), input.geometry).expect("machine");
     if let Some((e, n, y)) = input.initial_pose {
         m.set_pose(e, n, y);
@@ -61,7 +71,7 @@ fn run_car(seed: u64) -> Option<Row> {
         };
     }
     let model = m.model().expect("trained").clone();
-    let (trained, _) = train(&drive, TedrisConfig::default(), None).expect("trained");
+    let trained = &t.model;
     assert_eq!(
         (
             trained.dcf_distance_rad_per_m,
@@ -124,8 +134,9 @@ fn run_car(seed: u64) -> Option<Row> {
 /// worst |z| robust and OLS, and on how many the OLS one is beyond 3.
 fn family(first: u64) -> (usize, f64, f64, usize) {
     let (mut worst_robust, mut worst_ols, mut estimated, mut ols_off) = (0.0f64, 0.0f64, 0, 0);
-    for car in first..first + 12 {
-        let Some(r) = run_car(car) else {
+    let rows: Vec<Option<Row>> = (first..first + 12).into_par_iter().map(run_car).collect();
+    for (car, row) in (first..first + 12).zip(rows) {
+        let Some(r) = row else {
             eprintln!("car {car}: no joint calibration installed a distance term");
             continue;
         };
@@ -165,10 +176,7 @@ fn family(first: u64) -> (usize, f64, f64, usize) {
 fn the_calibrations_standard_errors_ignored_the_autocorrelated_heading() {
     // TEDRIS_FAMILY_FIRST_CAR=101 runs cars 101–112 (seen by choices since);
     // cars 201–212 are the untouched set, below.
-    let first: u64 = std::env::var("TEDRIS_FAMILY_FIRST_CAR")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(1);
+    let first = first_car();
     let (estimated, worst_robust, _, ols_off) = family(first);
     assert!(estimated > 0);
     if first == 1 {
