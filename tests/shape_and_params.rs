@@ -192,19 +192,22 @@ fn run_and_evaluate_had_two_defaults_for_no_params() {
 /// default corrections (`auto`) and measure on the corrected drive. Now
 /// `compare` goes through the same rule (`evaluate::default_parameters`,
 /// with the outages hidden). With its one outage after the drive's last fix
-/// (672.637 s; the drive ends at 672.944 s) nothing is hidden, so its parameters and corrections are exactly
+/// (672.737 s; the drive ends at 672.944 s) nothing is hidden, so its parameters and corrections are exactly
 /// `calibrate`'s and `evaluate`'s on the whole drive. The simulated
-/// evaluation drive of seed 2 is one where `auto` applies the GNSS and gyro
-/// delays, so the corrections are not empty.
+/// evaluation drive of seed 2 with its receiver 0.1 s late, so that `auto`
+/// applies the GNSS delay and the corrections are not empty (without the
+/// latency, since stop 50, it applies nothing there).
 #[test]
 fn compare_calibrated_without_the_corrections_evaluate_applies() {
     let tmp = tempfile::tempdir().unwrap();
     let d = tmp.path().join("s2");
-    common::simulate_into(&d, "evaluation", "2");
+    let scenario = tmp.path().join("late_receiver.toml");
+    std::fs::write(&scenario, common::evaluation_with_late_receiver()).unwrap();
+    common::simulate_into(&d, scenario.to_str().unwrap(), "2");
     let d = d.to_str().unwrap();
     let cal = json(&["calibrate", d, "--json"]);
     let ev = json(&["evaluate", d, "--outage", "30", "--step", "120", "--json"]);
-    let cmp = json(&["compare", d, "--outage", "672.7:672.9", "--json"]);
+    let cmp = json(&["compare", d, "--outage", "672.8:672.9", "--json"]);
     // The corrections: evaluate's, and some applied.
     assert_eq!(cmp["corrections"], ev["corrections"], "{cmp}");
     assert_eq!(cmp["corrections"], cal["corrections"], "{cmp}");

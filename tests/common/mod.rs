@@ -111,6 +111,18 @@ pub fn simulate_into(dir: &std::path::Path, scenario: &str, seed: &str) {
     ]);
 }
 
+/// The built-in evaluation scenario's TOML with its receiver 0.1 s late
+/// (as `tests/golden/scenario.toml`'s): a drive on which the default
+/// corrections apply the GNSS delay.
+pub fn evaluation_with_late_receiver() -> String {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("crates/deadreckon-sim/scenarios/evaluation.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    let gnss = "[sensors.gnss]\n";
+    assert!(text.contains(gnss) && !text.contains("latency_s"));
+    text.replace(gnss, &format!("{gnss}latency_s = 0.1\n"))
+}
+
 /// The built-in `scenario` simulated in-process with `seed` (the drive and
 /// its true parameters).
 pub fn sim(scenario: &str, seed: u64) -> deadreckon_sim::SimOutput {

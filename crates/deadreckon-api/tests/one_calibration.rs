@@ -105,12 +105,14 @@ fn calibrate_wrote_circumferences_that_evaluate_refuses() {
 /// estimators read it) as a params.toml's are applied
 /// (`evaluate::applied_corrections`). The whole drive so corrected, with
 /// the outages hidden, is the drive the rule calibrated on: every stream
-/// equal. The simulated evaluation drive of seed 2 is one where `auto`
-/// applies the GNSS and gyro delays.
+/// equal. The simulated evaluation drive of seed 2 with its receiver 0.1 s
+/// late, so that `auto` applies the GNSS delay (without the latency, since
+/// stop 50, it applies nothing there).
 #[test]
 fn compare_applies_to_the_whole_drive_the_corrections_the_rule_applied_with_the_outages_hidden() {
     use deadreckon_api::evaluate::{default_parameters, parameters_outages_hidden};
-    let sc = deadreckon_sim::Scenario::builtin("evaluation").expect("built in");
+    let mut sc = deadreckon_sim::Scenario::builtin("evaluation").expect("built in");
+    sc.sensors.gnss.as_mut().expect("fixes").latency_s = 0.1;
     let drive = simulate(&sc, 2).expect("simulated").drive;
     let windows = [(100.0, 130.0), (200.0, 230.0)];
     let (chosen, whole) =

@@ -395,21 +395,8 @@ impl Feeder {
         let first = self.stats.epochs == 0 && self.intervals.len() == 1;
         let fresh_gyro = !self.interval_gyro.is_empty();
         let gyro_live = use_.gyro && self.gyro.is_live(end);
-        let gap_q = f.noise().gyro_gap_process_yaw_rate_rps;
-        let prediction = if gap_q > 0.0 && gyro_live && !fresh_gyro {
-            self.stats.gyro_gap_epochs += 1;
-            let q = gap_q.min(f.noise().process_yaw_rate_rps);
-            f.predict_to_with_yaw_rate_noise(start, q, self.predictions)
-        } else {
-            self.predict(f, start)
-        };
-        if use_.wheels {
-            if gap {
-                self.stats.wheel_gaps += 1;
-            } else {
-                self.wheel_updates(f, m, interval)?;
-            }
-        }
+        let prediction = self.predict_epoch(f, start, gyro_live && !fresh_gyro);
+        self.wheel_row(f, m, interval, gap)?;
         for i in 0..self.interval_gyro.len() {
             self.updates.push(f.update_gyro(self.interval_gyro[i])?);
         }
@@ -418,13 +405,7 @@ impl Feeder {
         }
         self.interval_gyro.clear();
         self.interval_speed.clear();
-        if fresh_gyro || !gyro_live {
-            if let Some(v) = self.pending_steering.take() {
-                self.updates.push(f.update_steering(v)?);
-            }
-        } else if self.pending_steering.is_some() {
-            self.stats.steering_deferred += 1;
-        }
+        self.steering_update(f, fresh_gyro || !gyro_live)?;
         if let Some(fix) = self.due_gnss.take() {
             self.gnss_update(f, &fix)?;
         }
@@ -460,6 +441,62 @@ impl Feeder {
             self.gnss_update(f, &fix)?;
         }
         self.hand_out(f, prediction.as_ref(), epoch);
+        Ok(())
+    }
+
+    /// The prediction to the epoch at `t`. `gyro_gap`: the gyro is live
+    /// but has no reading for the epoch, so the step takes the gyro gap's
+    /// yaw-rate noise when the vehicle sets one ([`crate::gyro_hold`]).
+    fn predict_epoch<L: Layout<N>, const N: usize>(
+        &mut self,
+        f: &mut Filter<L, N>,
+        t: f64,
+        gyro_gap: bool,
+    ) -> Option<Prediction<N>> {
+        let gap_q = f.noise().gyro_gap_process_yaw_rate_rps;
+        if gyro_gap && gap_q > 0.0 {
+            self.stats.gyro_gap_epochs += 1;
+            let q = gap_q.min(f.noise().process_yaw_rate_rps);
+            f.predict_to_with_yaw_rate_noise(t, q, self.predictions)
+        } else {
+            self.predict(f, t)
+        }
+    }
+
+    /// The wheel row `m` over `interval` (when the wheels are used),
+    /// counted and skipped when it closes a `gap`.
+    fn wheel_row<L: Layout<N>, const N: usize>(
+        &mut self,
+        f: &mut Filter<L, N>,
+        m: &Measurement,
+        interval: f64,
+        gap: bool,
+    ) -> Result<(), Error> {
+        if !self.sensors.wheels {
+            return Ok(());
+        }
+        if gap {
+            self.stats.wheel_gaps += 1;
+            return Ok(());
+        }
+        self.wheel_updates(f, m, interval)
+    }
+
+    /// The steering reading waiting, applied when `now` (an epoch with a
+    /// gyro reading of its own, or no live gyro), else left waiting and
+    /// counted as deferred.
+    fn steering_update<L: Layout<N>, const N: usize>(
+        &mut self,
+        f: &mut Filter<L, N>,
+        now: bool,
+    ) -> Result<(), Error> {
+        if now {
+            if let Some(v) = self.pending_steering.take() {
+                self.updates.push(f.update_steering(v)?);
+            }
+        } else if self.pending_steering.is_some() {
+            self.stats.steering_deferred += 1;
+        }
         Ok(())
     }
 
@@ -601,25 +638,9 @@ impl Feeder {
                     // A gyro reading late by a few milliseconds leaves this
                     // epoch without one: the yaw rate keeps the last
                     // reading's instead of taking the wheels' (gyro_hold).
-                    let gap_q = f.noise().gyro_gap_process_yaw_rate_rps;
-                    let prediction = if gap_q > 0.0
-                        && use_.gyro
-                        && self.pending_gyro.is_none()
-                        && self.gyro.is_live(t)
-                    {
-                        self.stats.gyro_gap_epochs += 1;
-                        let q = gap_q.min(f.noise().process_yaw_rate_rps);
-                        f.predict_to_with_yaw_rate_noise(t, q, self.predictions)
-                    } else {
-                        self.predict(f, t)
-                    };
-                    if use_.wheels {
-                        if gap {
-                            self.stats.wheel_gaps += 1;
-                        } else {
-                            self.wheel_updates(f, &ev.measurement, interval)?;
-                        }
-                    }
+                    let gyro_gap = use_.gyro && self.pending_gyro.is_none() && self.gyro.is_live(t);
+                    let prediction = self.predict_epoch(f, t, gyro_gap);
+                    self.wheel_row(f, &ev.measurement, interval, gap)?;
                     let fresh_gyro = self.pending_gyro.is_some();
                     if let Some(v) = self.pending_gyro.take() {
                         self.updates.push(f.update_gyro(v)?);
@@ -629,13 +650,7 @@ impl Feeder {
                     }
                     // While the gyro is live, the steering waits for an
                     // epoch with a gyro reading of its own (crate::gyro_hold).
-                    if fresh_gyro || !(use_.gyro && self.gyro.is_live(t)) {
-                        if let Some(v) = self.pending_steering.take() {
-                            self.updates.push(f.update_steering(v)?);
-                        }
-                    } else if self.pending_steering.is_some() {
-                        self.stats.steering_deferred += 1;
-                    }
+                    self.steering_update(f, fresh_gyro || !(use_.gyro && self.gyro.is_live(t)))?;
                     if let Some(fix) = self.pending_gnss.take() {
                         self.gnss_update(f, &fix)?;
                     }
