@@ -78,10 +78,12 @@ fn gnss_delay_states_at_fixes_equal_the_recorded_run_interpolated() {
 }
 
 /// With each wheel row used over the interval it describes
-/// (`WheelRows::Interval`), an epoch is handed out one wheel row late; the
-/// checkpointed smoother's forward pass keeps no predictions, so a
-/// checkpoint taken while an epoch was held would have re-run it without
-/// one. Equal, bit for bit, to smoothing the recorded run.
+/// (`WheelRows::Interval`), an epoch is handed out one wheel row late (until
+/// stop 50 it was held, predicted, while the next row was awaited, and the
+/// checkpointed smoother's forward pass, which keeps no predictions, could
+/// have re-run it without one; now it is predicted when the row arrives).
+/// Equal, bit for bit, to smoothing the recorded run, with the paper's
+/// scheme's epoch times.
 #[test]
 fn checkpointed_smoothing_with_interval_wheel_rows_equals_the_recorded_run() {
     let d = drive(29, 240.0);

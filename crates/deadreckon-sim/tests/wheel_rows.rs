@@ -3,7 +3,9 @@
 //! describes (`Interval`), on family cars 1–8: calibrated on one 300 s drive
 //! and evaluated on another (30 s outages every 10 s), with the same scheme
 //! for both. Mean final error, in brackets the mean error at the windows'
-//! start, m (run once; nothing was chosen on it):
+//! start, m (run once, before stop 50 took each gyro and CAN speed reading
+//! into the interval it is stamped in; not re-run since; nothing was chosen
+//! on it):
 //!
 //! | family | instant | interval |
 //! |---|---|---|
