@@ -152,6 +152,7 @@ fn stream_disagreed_with_run_on_stored_delays() {
                 "rear_slip_gradient_rad_per_mps2 = 0.005\n\
                  gyro_bias_walk_rps_per_sqrt_s = 3e-6\n\
                  gnss_recovery_after_s = 10.0\n\
+                 wheel_rows_over_interval = true\n\
                  [steering]\n\
                  steering_ratio = 16.2\n\
                  steering_offset_rad = 0.01\n\
@@ -249,6 +250,8 @@ fn stream_disagreed_with_run_on_stored_delays() {
             // The receiver's wander with the walking bias: run and stream
             // both carry both (issues 28, 36).
             assert_eq!(c.model.gnss_wander.map(|w| w.std_m), Some(0.7));
+            // Each wheel row over its interval (issue 28): both run it.
+            assert_eq!(c.model.wheel_rows_over_interval, Some(true));
         }
         if c.traction_slip_per_mps2 != 0.0 {
             assert!(c.traction_mean_force_mps2.is_some(), "{stored}");

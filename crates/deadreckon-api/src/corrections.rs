@@ -24,8 +24,10 @@ fn delay_json(d: &Delay) -> Value {
     })
 }
 
-/// The words after "applied" when the filter applies another GNSS delay
-/// than the receiver's (`Delay::step_offset_s`, issue 29), else nothing.
+/// The words after "applied" when the filter applies another delay than
+/// the estimate (`Delay::step_offset_s`: the GNSS's with the paper's step,
+/// issue 29; the scalar streams' half wheel period over the wheel
+/// intervals, issue 28), else nothing.
 pub fn step_offset_words(d: &Delay) -> String {
     if d.step_offset_s == 0.0 {
         return String::new();

@@ -112,7 +112,7 @@ impl<L: Layout<N>, const N: usize> Run<L, N> {
             .with_covariance_form(opts.covariance_form);
         Ok(Run {
             // A standing car does not turn (crate::standstill).
-            feeder: Feeder::new(opts, t0).with_standstill(),
+            feeder: Feeder::new(opts, vehicle, t0).with_standstill(),
             filter,
         })
     }
@@ -127,13 +127,19 @@ impl<L: Layout<N>, const N: usize> Run<L, N> {
             .push(&mut self.filter, ev, &mut |f, e| epoch(f, &e))
     }
 
-    /// Runs what is waiting.
+    /// Runs what is waiting: at the end of the stream (`end`,
+    /// [`Feeder::finish`]) or before more ([`Feeder::settle`]).
     fn finish_raw(
         &mut self,
+        end: bool,
         epoch: &mut dyn FnMut(&Filter<L, N>, &EpochOut<'_, N>),
     ) -> Result<(), Error> {
-        self.feeder
-            .finish(&mut self.filter, &mut |f, e| epoch(f, &e))
+        let mut e = |f: &mut Filter<L, N>, e: EpochOut<'_, N>| epoch(f, &e);
+        if end {
+            self.feeder.finish(&mut self.filter, &mut e)
+        } else {
+            self.feeder.settle(&mut self.filter, &mut e)
+        }
     }
 
     fn push(&mut self, ev: Event, epoch: &mut Observe<'_>) -> Result<(), Error> {
@@ -142,8 +148,10 @@ impl<L: Layout<N>, const N: usize> Run<L, N> {
         })
     }
 
-    fn finish(&mut self, epoch: &mut Observe<'_>) -> Result<(), Error> {
-        self.finish_raw(&mut |f, e| epoch(&AidedEpoch::of(f), &EpochUpdates::of(e)))
+    fn finish(&mut self, end: bool, epoch: &mut Observe<'_>) -> Result<(), Error> {
+        self.finish_raw(end, &mut |f, e| {
+            epoch(&AidedEpoch::of(f), &EpochUpdates::of(e))
+        })
     }
 
     fn dead_reckon(&mut self) {
@@ -315,7 +323,7 @@ impl Aided {
         for ev in events.take_while(|e| e.t_s <= end) {
             each!(&mut a, |r| r.push(ev, epoch))?;
         }
-        each!(&mut a, |r| r.finish(epoch))?;
+        each!(&mut a, |r| r.finish(true, epoch))?;
         Ok(a)
     }
 
@@ -325,10 +333,17 @@ impl Aided {
         each!(self, |r| r.push(ev, &mut |e, _| epoch(e)))
     }
 
-    /// Runs what is still waiting (at the end of a stream, or before a
-    /// clone dead-reckons).
+    /// Runs what is still waiting, at the end of a stream
+    /// ([`Feeder::finish`]).
     pub fn finish(&mut self, epoch: &mut dyn FnMut(&AidedEpoch)) -> Result<(), Error> {
-        each!(self, |r| r.finish(&mut |e, _| epoch(e)))
+        each!(self, |r| r.finish(true, &mut |e, _| epoch(e)))
+    }
+
+    /// Runs the epoch of the events pushed so far when every later event
+    /// is later (a live stream after each input, a run paused for a clone
+    /// to dead-reckon from; [`Feeder::settle`]).
+    pub fn settle(&mut self, epoch: &mut dyn FnMut(&AidedEpoch)) -> Result<(), Error> {
+        each!(self, |r| r.finish(false, &mut |e, _| epoch(e)))
     }
 
     /// From now on no GNSS ([`Feeder::dead_reckon`]).

@@ -155,7 +155,7 @@ pub fn feed<'a>(drive: &'a Drive, opts: &FilterOptions, t0_s: f64) -> (Feeder, D
         f64::NEG_INFINITY
     };
     (
-        Feeder::new(opts, t0_s),
+        Feeder::new(opts, &drive.vehicle, t0_s),
         DriveEvents::new(drive, before_first),
     )
 }

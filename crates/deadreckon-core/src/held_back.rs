@@ -285,6 +285,7 @@ pub fn prepare_calibrated(
         return timing::prepare_with(drive, copts, o, which).map(|(d, c)| (d, c, None));
     }
     let (_, mut corrections) = timing::prepare_with(drive, copts, o, Which::All)?;
+    let interval_delays = corrections.delays.for_wheel_intervals(drive);
     let windows = windows(drive);
     let short = windows[0].len() + windows[1].len() < MIN_WINDOWS;
     let min_z = if short { SHORT_MIN_Z } else { MIN_Z };
@@ -314,7 +315,12 @@ pub fn prepare_calibrated(
     // its calibration: the start of every fold's passes, and the estimates
     // of the model's additions (side slip, steering) that are candidates.
     let base_drive = judged_drive(
-        &known(&corrections, &base, &ModelOptions::default()),
+        &known(
+            &corrections,
+            &interval_delays,
+            &base,
+            &ModelOptions::default(),
+        ),
         drive,
         copts,
     );
@@ -399,7 +405,11 @@ pub fn prepare_calibrated(
             let mut best: Option<(usize, HeldBackRun, f64)> = None;
             for (i, &(c, z)) in left.iter().enumerate() {
                 let with: Vec<Correction> = set.iter().copied().chain([c]).collect();
-                let d = judged_drive(&known(&corrections, &with, &model_values), drive, copts);
+                let d = judged_drive(
+                    &known(&corrections, &interval_delays, &with, &model_values),
+                    drive,
+                    copts,
+                );
                 // The calibration holds the gyro bias constant: with a
                 // walking bias the folds calibrate as without it.
                 let same_calibration =
@@ -445,7 +455,11 @@ pub fn prepare_calibrated(
         // judged last. The calibration keeps white fixes, so the folds
         // calibrate as without it.
         let fitted = wander_may_be_fitted(drive).then(|| {
-            let d = judged_drive(&known(&corrections, &set, &model_values), drive, copts);
+            let d = judged_drive(
+                &known(&corrections, &interval_delays, &set, &model_values),
+                drive,
+                copts,
+            );
             let cal = if set == base {
                 base_calibration.clone()
             } else {
@@ -459,7 +473,11 @@ pub fn prepare_calibrated(
                 model_values.gnss_wander = Some(w);
                 let c = Correction::Model(ModelOption::GnssWander);
                 let with: Vec<Correction> = set.iter().copied().chain([c]).collect();
-                let d = judged_drive(&known(&corrections, &with, &model_values), drive, copts);
+                let d = judged_drive(
+                    &known(&corrections, &interval_delays, &with, &model_values),
+                    drive,
+                    copts,
+                );
                 let run =
                     held_back_errors(&d, copts, [initial; 2], &windows, Some(&current.params))?;
                 let (_, t) = paired(&run.errors, &current.errors);
@@ -487,8 +505,12 @@ pub fn prepare_calibrated(
         held.judged.extend(tried);
         chosen.extend(won);
     }
+    if chosen.contains(&Correction::Model(ModelOption::WheelIntervals)) {
+        // What params.toml and the JSON report as applied.
+        corrections.delays = interval_delays.clone();
+    }
     mark(&mut corrections, &held, &chosen);
-    let applied = known(&corrections, &chosen, &model_values);
+    let applied = known(&corrections, &interval_delays, &chosen, &model_values);
     let out = applied.apply(drive);
     corrections.model = applied.model;
     corrections.held_back = Some(held);
@@ -554,7 +576,20 @@ fn candidates(c: &Corrections, min_z: f64) -> Vec<(Correction, f64)> {
 
 /// The corrections of `set`, with the values of `c` and of `model` for
 /// the model's additions.
-fn known(c: &Corrections, set: &[Correction], model: &ModelOptions) -> KnownCorrections {
+///
+/// With the wheel intervals in `set`, the delays are applied as such a
+/// filter needs them (`interval`: [`timing::Delays::for_wheel_intervals`]).
+fn known(
+    c: &Corrections,
+    interval: &timing::Delays,
+    set: &[Correction],
+    model: &ModelOptions,
+) -> KnownCorrections {
+    let delays = if set.contains(&Correction::Model(ModelOption::WheelIntervals)) {
+        interval
+    } else {
+        &c.delays
+    };
     let mut k = KnownCorrections::default();
     for &what in set {
         match what {
@@ -568,7 +603,7 @@ fn known(c: &Corrections, set: &[Correction], model: &ModelOptions) -> KnownCorr
                 let i = Stream::ALL.iter().position(|&x| x == s).unwrap_or(0);
                 // As `Delays::apply`: the GNSS delay with the filter's step
                 // offset.
-                k.delays_s[i] = c.delays.get(s).applied_s();
+                k.delays_s[i] = delays.get(s).applied_s();
             }
             Correction::GyroScale => {
                 if let Some(g) = &c.gyro_scale {

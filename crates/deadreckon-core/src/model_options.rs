@@ -1,14 +1,16 @@
 //! Additions to the paper's model that a drive's own GNSS may ask for
 //! (issue 28): the rear axle's side slip, the steering's ratio, offset and
 //! understeer, a gyro bias that walks, a GNSS recovery that waits out a
-//! multipath burst, a yaw rate held through a missed gyro reading, and the
-//! receiver's slowly wandering error carried as filter states.
+//! multipath burst, a yaw rate held through a missed gyro reading, the
+//! receiver's slowly wandering error carried as filter states, and each
+//! wheel row used over the interval it describes.
 //!
 //! Each is built and measured on its own ([`crate::side_slip`],
 //! [`crate::kinematics::steering`], [`crate::gyro_drift`],
 //! [`crate::vehicle::Noise::gnss_recovery_after_s`],
 //! [`crate::vehicle::Noise::gyro_gap_process_yaw_rate_rps`],
-//! [`crate::gnss_error`]); none is the paper's,
+//! [`crate::gnss_error`], [`crate::ekf::WheelRows::Interval`]); none is
+//! the paper's,
 //! and each costs where its effect is absent (the walking bias 9 % on
 //! held-out cars whose gyro does not drift; the recovery's wait held a
 //! really lost filter out longer on held-out car 108, 3.12 → 6.18 m). So
@@ -17,7 +19,8 @@
 //! held-back GNSS, with the streams' corrections, and applied only when it
 //! lowers the error there. The estimated ones (side slip, steering) are
 //! candidates only at [`crate::held_back::MIN_Z`] standard errors from the
-//! paper's model; the three settings (walk, recovery, gyro gap) have no estimate and are
+//! paper's model; the four settings (walk, recovery, gyro gap, wheel
+//! intervals) have no estimate and are
 //! judged on the held-back fixes alone, so a drive too short to judge keeps
 //! the paper's model for them.
 //!
@@ -108,6 +111,10 @@ pub struct ModelOptions {
     /// `gnss_wander_tau_s`), as fitted on the calibration drive.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gnss_wander: Option<Wander>,
+    /// Each wheel row used over the interval it describes (the vehicle's
+    /// `[noise] wheel_rows_over_interval`; only `true` is written).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wheel_rows_over_interval: Option<bool>,
 }
 
 /// One model addition.
@@ -127,17 +134,32 @@ pub enum ModelOption {
     /// The receiver's wander as filter states ([`crate::gnss_error`]),
     /// fitted on the drive's fixes ([`crate::wander_fit`]).
     GnssWander,
+    /// Each wheel row used over the interval it describes
+    /// ([`crate::ekf::WheelRows::Interval`]).
+    ///
+    /// Why an option and not the filter's step: with each reading in its
+    /// own interval (issue 28, stop 50) the evaluation scenario's seed 2
+    /// took 30 s outages from 0.459 to 0.395 m, and with a receiver 0.1 s
+    /// late seeds 2 and 3 from 0.521 to 0.407 m and from 0.587 to 0.366 m,
+    /// but the comma2k19 segment (CAN wheel speeds at about 100 Hz, the
+    /// phone's gyro on its own clock) went from 0.595 to 0.890 m
+    /// (docs/calibration.md, "When a wheel row is used"). With it, the GNSS
+    /// delay is applied without the paper's step offset and each scalar
+    /// stream's delay on true time
+    /// ([`crate::timing::Delays::for_wheel_intervals`]).
+    WheelIntervals,
 }
 
 impl ModelOption {
     /// Every option, in the order they are reported.
-    pub const ALL: [ModelOption; 6] = [
+    pub const ALL: [ModelOption; 7] = [
         ModelOption::SideSlip,
         ModelOption::Steering,
         ModelOption::GyroWalk,
         ModelOption::GnssRecovery,
         ModelOption::GyroGap,
         ModelOption::GnssWander,
+        ModelOption::WheelIntervals,
     ];
 
     /// Words for people.
@@ -149,6 +171,7 @@ impl ModelOption {
             ModelOption::GnssRecovery => "GNSS recovery after 10 s",
             ModelOption::GyroGap => "yaw rate held through a missed gyro reading",
             ModelOption::GnssWander => "receiver's wander",
+            ModelOption::WheelIntervals => "wheel rows over their intervals",
         }
     }
 
@@ -161,6 +184,7 @@ impl ModelOption {
             ModelOption::GnssRecovery => "gnss_recovery",
             ModelOption::GyroGap => "gyro_gap",
             ModelOption::GnssWander => "gnss_wander",
+            ModelOption::WheelIntervals => "wheel_intervals",
         }
     }
 }
@@ -186,6 +210,9 @@ impl ModelOptions {
                 self.gyro_gap_process_yaw_rate_rps = from.gyro_gap_process_yaw_rate_rps
             }
             ModelOption::GnssWander => self.gnss_wander = from.gnss_wander,
+            ModelOption::WheelIntervals => {
+                self.wheel_rows_over_interval = from.wheel_rows_over_interval
+            }
         }
         self
     }
@@ -199,6 +226,7 @@ impl ModelOptions {
             ModelOption::GnssRecovery => self.gnss_recovery_after_s.is_some(),
             ModelOption::GyroGap => self.gyro_gap_process_yaw_rate_rps.is_some(),
             ModelOption::GnssWander => self.gnss_wander.is_some(),
+            ModelOption::WheelIntervals => self.wheel_rows_over_interval.is_some(),
         }
     }
 
@@ -224,6 +252,9 @@ impl ModelOptions {
         if let Some(w) = self.gnss_wander {
             vehicle.noise.gnss_wander_std_m = w.std_m;
             vehicle.noise.gnss_wander_tau_s = w.tau_s;
+        }
+        if let Some(i) = self.wheel_rows_over_interval {
+            vehicle.noise.wheel_rows_over_interval = i;
         }
     }
 
@@ -267,6 +298,9 @@ impl ModelOptions {
                 w.std_m, w.tau_s
             ));
         }
+        if self.wheel_rows_over_interval == Some(true) {
+            parts.push("wheel rows over their intervals".into());
+        }
         parts.join(", ")
     }
 }
@@ -279,7 +313,9 @@ impl ModelOptions {
 /// when the drive has a gyro and its vehicle does not walk already, the
 /// recovery's wait when the vehicle has none, the held yaw rate when at
 /// least [`MIN_GYRO_GAP_SHARE`] of the wheel epochs have no gyro reading
-/// ([`gyro_gap_share`]) and the vehicle does not hold it already.
+/// ([`gyro_gap_share`]) and the vehicle does not hold it already, the
+/// wheel intervals when the drive has wheel rows and the vehicle does not
+/// use the intervals already.
 pub fn candidates(
     drive: &Drive,
     cal: &Calibration,
@@ -345,6 +381,10 @@ pub fn candidates(
         values.gyro_gap_process_yaw_rate_rps = Some(GYRO_GAP_PROCESS_YAW_RATE_RPS);
         out.push((ModelOption::GyroGap, f64::NAN));
     }
+    if !drive.vehicle.noise.wheel_rows_over_interval && !drive.wheels.is_empty() {
+        values.wheel_rows_over_interval = Some(true);
+        out.push((ModelOption::WheelIntervals, f64::NAN));
+    }
     (out, values)
 }
 
@@ -404,6 +444,7 @@ mod tests {
                 std_m: 1.0,
                 tau_s: 60.0,
             }),
+            wheel_rows_over_interval: Some(true),
         };
         let only_walk = ModelOptions::default().with(ModelOption::GyroWalk, &all);
         let mut v = v0.clone();
@@ -428,6 +469,7 @@ mod tests {
             (1.0, 60.0)
         );
         assert_eq!(v.noise.gnss_wander_std_m, 0.0);
+        assert!(w.noise.wheel_rows_over_interval && !v.noise.wheel_rows_over_interval);
         assert!(all.validate().is_ok());
         for o in ModelOption::ALL {
             assert!(all.has(o) && !ModelOptions::default().has(o));

@@ -31,8 +31,8 @@ use serde::{Deserialize, Serialize};
 use crate::aided::Aided;
 use crate::bound::BoundFit;
 use crate::bound_pose::{point_bound_m, FixFloor, Pose};
-use crate::ekf::{Event, Feeder, FilterOptions, FilterStats, GnssInit};
-use crate::filter::AugmentedFilter;
+use crate::ekf::{EpochOut, Event, Feeder, FilterOptions, FilterStats, GnssInit};
+use crate::filter::{AugmentedFilter, N_AUG};
 use crate::live_corrections::LiveCorrections;
 use crate::model::{Mat, State};
 use crate::track::{car_point, TrackPoint};
@@ -221,7 +221,7 @@ impl Online {
                     AugmentedFilter::new(&self.vehicle, &self.params, Some(sd), t0, x0, p0)?
                         .with_covariance_form(self.opts.covariance_form),
                 ),
-                feeder: Box::new(Feeder::new(&self.opts, t0)),
+                feeder: Box::new(Feeder::new(&self.opts, &self.vehicle, t0)),
             },
         })
     }
@@ -277,7 +277,7 @@ impl Online {
         let r = live.push(ev, &mut |e| self.feed(e, out));
         self.live = live;
         r?;
-        self.settle(out)
+        self.settle(out, false)
     }
 
     /// Runs what no later event can change and keeps what the corrections
@@ -294,7 +294,7 @@ impl Online {
         let r = live.pause(&mut |e| self.feed(e, out));
         self.live = live;
         r?;
-        self.settle(out)?;
+        self.settle(out, false)?;
         self.waiting_error()
     }
 
@@ -311,7 +311,7 @@ impl Online {
         let r = live.end(&mut |e| self.feed(e, out));
         self.live = live;
         r?;
-        self.settle(out)?;
+        self.settle(out, true)?;
         self.waiting_error()
     }
 
@@ -374,7 +374,11 @@ impl Online {
 
     /// Runs the filter's epoch of the last time fed: every event released
     /// so far is earlier than any still to come.
-    fn settle(&mut self, out: &mut dyn FnMut(Pose)) -> Result<(), Error> {
+    ///
+    /// At the end of the stream (`end`) the epoch no later row closes is
+    /// run too ([`Feeder::finish`]); before it, the wheel interval still
+    /// open stays open ([`Feeder::settle`]).
+    fn settle(&mut self, out: &mut dyn FnMut(Pose), end: bool) -> Result<(), Error> {
         let (fit, floor) = (self.bound, &mut self.floor);
         let mut emit = |p: TrackPoint| {
             let s = floor.std_at(p.t_s);
@@ -385,10 +389,20 @@ impl Online {
         };
         match &mut self.stage {
             Stage::Waiting { .. } => Ok(()),
-            Stage::Learning { filter, feeder } => feeder.finish(filter.as_mut(), &mut |f, _| {
-                emit(car_point(f.time_s(), f.state(), f.covariance()))
-            }),
-            Stage::Aided(a) => a.finish(&mut |e| emit(TrackPoint::from_state(e.t_s, &e.x, &e.p))),
+            Stage::Learning { filter, feeder } => {
+                let mut e = |f: &mut AugmentedFilter, _: EpochOut<'_, N_AUG>| {
+                    emit(car_point(f.time_s(), f.state(), f.covariance()))
+                };
+                if end {
+                    feeder.finish(filter.as_mut(), &mut e)
+                } else {
+                    feeder.settle(filter.as_mut(), &mut e)
+                }
+            }
+            Stage::Aided(a) if end => {
+                a.finish(&mut |e| emit(TrackPoint::from_state(e.t_s, &e.x, &e.p)))
+            }
+            Stage::Aided(a) => a.settle(&mut |e| emit(TrackPoint::from_state(e.t_s, &e.x, &e.p))),
         }
     }
 

@@ -322,12 +322,13 @@ fn evaluate_in(
     let mut gates = GateCounts::default();
     for &start in &starts {
         let end = start + outage_s;
-        // Every epoch at or before the start, then the pending ones.
+        // Every epoch at or before the start, then the pending ones (the
+        // run goes on: a wheel interval still open stays open).
         while let Some(ev) = upcoming.filter(|e| e.t_s <= start) {
             f.push(ev, &mut noop)?;
             upcoming = events.next();
         }
-        f.finish(&mut noop)?;
+        f.settle(&mut noop)?;
         let t0 = f.time_s();
         let yaw_std = f
             .now()

@@ -92,13 +92,16 @@ pub struct Delay {
     pub samples: usize,
     /// Estimated, or why not.
     pub status: Status,
-    /// What the filter's own step adds to the delay it applies, s (the GNSS
-    /// only, else 0): `delay_s` is the receiver's delay against true time,
-    /// while the paper's wheel step ([`crate::ekf::WheelRows::Instant`], the
-    /// default) dead-reckons positions that trail by about a wheel period
-    /// and the scalar streams as they are corrected; the filter applies the
-    /// delay its own dead reckoning matches ([`Delay::applied_s`]). Issue 29;
-    /// see [`gnss_delay`].
+    /// What the filter's own step adds to the delay it applies, s (with the
+    /// paper's step, the GNSS only, else 0): `delay_s` is the receiver's
+    /// delay against true time, while the paper's wheel step
+    /// ([`crate::ekf::WheelRows::Instant`], the default) dead-reckons
+    /// positions that trail by about a wheel period and the scalar streams
+    /// as they are corrected; the filter applies the delay its own dead
+    /// reckoning matches ([`Delay::applied_s`]). Issue 29; see
+    /// [`gnss_delay`]. With the wheel rows over their intervals
+    /// ([`Delays::for_wheel_intervals`]) the GNSS's is 0 and each estimated
+    /// scalar stream's is half a wheel period (its delay on true time).
     pub step_offset_s: f64,
 }
 
@@ -140,6 +143,27 @@ pub struct Delays {
 pub const NOT_ASKED: &str = "not asked for";
 
 impl Delays {
+    /// The delays as a filter that uses each wheel row over the interval it
+    /// describes ([`crate::ekf::WheelRows::Interval`], the model option
+    /// [`crate::model_options::ModelOption::WheelIntervals`]) applies them:
+    /// the receiver's delay without the paper's step offset (the GNSS
+    /// delay's reference takes the rows over their intervals,
+    /// [`REFERENCE_WHEEL_ROWS`]), and each estimated scalar stream on true
+    /// time, half a wheel period later than as estimated ([`on_true_time`]:
+    /// the estimate aligns the stream with the paper's step). The
+    /// estimates themselves are unchanged; the offsets are in
+    /// [`Delay::step_offset_s`].
+    pub fn for_wheel_intervals(&self, drive: &Drive) -> Delays {
+        let half = wheel_half_period_s(drive);
+        let mut out = self.clone();
+        for s in [Stream::Gyro, Stream::Speed, Stream::Steering] {
+            let d = out.get_mut(s);
+            d.step_offset_s = if d.status.is_estimated() { half } else { 0.0 };
+        }
+        out.gnss.step_offset_s = 0.0;
+        out
+    }
+
     /// No delay asked for any stream ([`Which::None`]).
     pub fn none() -> Delays {
         let n = || Delay::not_estimated(NOT_ASKED);

@@ -136,6 +136,14 @@ pub struct Noise {
     /// ([`crate::gyro_hold`]).
     #[serde(skip_serializing_if = "is_zero")]
     pub gyro_gap_process_yaw_rate_rps: f64,
+    /// Each wheel row used over the interval it describes
+    /// ([`crate::ekf::WheelRows::Interval`]) by every filter run on this
+    /// vehicle, whatever the filter options say (default false: the
+    /// paper's step, [`crate::ekf::WheelRows::Instant`], unless the options
+    /// ask for the interval). A model option `--corrections auto` judges
+    /// on the drive's held-back fixes ([`crate::model_options`]).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub wheel_rows_over_interval: bool,
     /// χ² gate (1 degree of freedom) of each wheel reading, ticks or speed
     /// (default [`GROSS_FAULT_CHI2`]: only gross faults such as a spinning
     /// wheel or a counter glitch are rejected; `inf` switches the gate off).
@@ -271,6 +279,7 @@ impl Default for Noise {
             gnss_wander_tau_s: DEFAULT_GNSS_WANDER_TAU_S,
             gyro_bias_walk_rps_per_sqrt_s: 0.0,
             gyro_gap_process_yaw_rate_rps: 0.0,
+            wheel_rows_over_interval: false,
             gyro_bias_drive_std_rps: defaults::DEFAULT_DRIVE_STD_RPS,
             gyro_bias_switch_llr: defaults::DEFAULT_THRESHOLD_LLR,
             wheel_gate_chi2: GROSS_FAULT_CHI2,

@@ -97,3 +97,55 @@ fn interval_wheel_rows_against_the_papers_step_on_family_cars() {
     assert!(interval < instant, "{interval} {instant}");
     assert!((instant - 0.499).abs() < 0.01 && (interval - 0.482).abs() < 0.01);
 }
+
+/// The wheel intervals as a model option of `--corrections auto` (issue
+/// 28): on the evaluation scenario, seed 3 (no delays, 50 Hz ticks), the
+/// held-back fixes prefer them (0.798 → 0.744 m mean over 21 windows of
+/// 20 s when measured; `evaluate --outage 30 --step 10` 0.488 → 0.323 m),
+/// and with them every applied delay is the one a filter over the
+/// intervals needs: the GNSS's without the paper's step offset, each
+/// scalar stream's on true time (half a wheel period after its estimate).
+/// The bug this pins: a filter over the intervals handed the delays that
+/// align the streams with the paper's step.
+#[test]
+fn the_wheel_intervals_took_the_delays_of_the_papers_step() {
+    use deadreckon_core::held_back::{self, Correction};
+    use deadreckon_core::model_options::ModelOption;
+    use deadreckon_core::timing::{wheel_half_period_s, DelayOptions, Stream, Which};
+    let sim = simulate(&deadreckon_sim::Scenario::builtin("evaluation").unwrap(), 3).unwrap();
+    let (out, c) = held_back::prepare(
+        &sim.drive,
+        &CalibrationOptions::default(),
+        &DelayOptions::default(),
+        Which::Auto,
+    )
+    .unwrap();
+    let held = c.held_back.as_ref().unwrap();
+    let j = held
+        .decision(Correction::Model(ModelOption::WheelIntervals))
+        .expect("a candidate");
+    println!("{j:?}");
+    assert!(j.applied && j.t <= -1.0 && j.with_m < j.against_m, "{j:?}");
+    assert_eq!(c.model.wheel_rows_over_interval, Some(true));
+    assert!(out.vehicle.noise.wheel_rows_over_interval);
+    // The paper's step would have applied a GNSS delay with its offset.
+    let half = wheel_half_period_s(&sim.drive);
+    assert!((half - 0.01).abs() < 1e-3, "{half}");
+    assert_eq!(c.delays.gnss.step_offset_s, 0.0);
+    for s in [Stream::Gyro, Stream::Speed, Stream::Steering] {
+        let d = c.delays.get(s);
+        if d.status.is_estimated() {
+            assert_eq!(d.step_offset_s, half, "{s:?}");
+        } else {
+            assert_eq!(d.applied_s(), 0.0, "{s:?}");
+        }
+    }
+    // A delay applied (the gyro's, chosen with the intervals when
+    // measured) is shifted by that half period from its estimate.
+    assert!(c.delays.gyro.status.is_estimated());
+    assert!(
+        (c.delays.gyro.applied_s() - (c.delays.gyro.delay_s + half)).abs() < 1e-12,
+        "{:?}",
+        c.delays.gyro
+    );
+}

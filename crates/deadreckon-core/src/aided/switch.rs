@@ -137,28 +137,28 @@ impl<C: Layout<NC>, const NC: usize, S: Layout<NS>, const NS: usize> Switch<C, N
     /// Feeds one event to both hypotheses; `epoch` after every epoch with
     /// the chosen one's state and updates.
     pub(super) fn push(&mut self, ev: Event, epoch: &mut Observe<'_>) -> Result<(), Error> {
-        self.step(Some(ev), epoch)
+        self.step(Some(ev), false, epoch)
     }
 
-    /// Runs what is waiting in both.
-    pub(super) fn finish(&mut self, epoch: &mut Observe<'_>) -> Result<(), Error> {
-        self.step(None, epoch)
+    /// Runs what is waiting in both (at the end of the stream: `end`).
+    pub(super) fn finish(&mut self, end: bool, epoch: &mut Observe<'_>) -> Result<(), Error> {
+        self.step(None, end, epoch)
     }
 
     /// [`Switch::push`] (`Some`) or [`Switch::finish`] (`None`).
-    fn step(&mut self, ev: Option<Event>, epoch: &mut Observe<'_>) -> Result<(), Error> {
+    fn step(&mut self, ev: Option<Event>, end: bool, epoch: &mut Observe<'_>) -> Result<(), Error> {
         let (c, s) = match (&mut self.constant, &mut self.state) {
             (Some(c), Some(s)) => (c, s),
             (Some(c), None) => {
                 return match ev {
                     Some(ev) => c.push(ev, epoch),
-                    None => c.finish(epoch),
+                    None => c.finish(end, epoch),
                 }
             }
             (None, Some(s)) => {
                 return match ev {
                     Some(ev) => s.push(ev, epoch),
-                    None => s.finish(epoch),
+                    None => s.finish(end, epoch),
                 }
             }
             (None, None) => return Ok(()),
@@ -182,7 +182,7 @@ impl<C: Layout<NC>, const NC: usize, S: Layout<NS>, const NS: usize> Switch<C, N
         };
         match ev {
             Some(ev) => s.push_raw(ev, &mut keep)?,
-            None => s.finish_raw(&mut keep)?,
+            None => s.finish_raw(end, &mut keep)?,
         }
         let report = &mut self.report;
         let mut pair = |f: &Filter<C, NC>, e: &EpochOut<'_, NC>| {
@@ -213,7 +213,7 @@ impl<C: Layout<NC>, const NC: usize, S: Layout<NS>, const NS: usize> Switch<C, N
         };
         match ev {
             Some(ev) => c.push_raw(ev, &mut pair)?,
-            None => c.finish_raw(&mut pair)?,
+            None => c.finish_raw(end, &mut pair)?,
         }
         if self.report.fired_at_s.is_some() {
             self.constant = None;

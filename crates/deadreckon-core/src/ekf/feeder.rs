@@ -111,7 +111,10 @@ impl Feeder {
     /// A feeder for a filter started at `start_s`: readings before it (and other
     /// sensors' readings at it) are ignored; the first wheel row at or after it
     /// opens the first wheel interval.
-    pub fn new(opts: &FilterOptions, start_s: f64) -> Self {
+    ///
+    /// The wheel-row scheme is the one a filter on `vehicle` runs
+    /// ([`FilterOptions::wheel_rows_for`]).
+    pub fn new(opts: &FilterOptions, vehicle: &crate::vehicle::Vehicle, start_s: f64) -> Self {
         Feeder {
             timing: opts.timing,
             sensors: opts.sensors,
@@ -133,7 +136,7 @@ impl Feeder {
             gated_fix_t_s: None,
             predictions: opts.record_epochs,
             monitor: opts.wheel_monitor.map(WheelMonitor::new),
-            wheel_rows: opts.wheel_rows,
+            wheel_rows: opts.wheel_rows_for(vehicle),
             interval_gyro: Vec::new(),
             interval_speed: Vec::new(),
             due_gnss: None,
@@ -304,7 +307,9 @@ impl Feeder {
         Ok(())
     }
 
-    /// Runs what is still waiting (at the end of a stream).
+    /// Runs what is still waiting (at the end of a stream): [`Feeder::settle`],
+    /// and with [`WheelRows::Interval`] the epoch at the last wheel row,
+    /// which no later row will close.
     pub fn finish<L: Layout<N>, const N: usize>(
         &mut self,
         f: &mut Filter<L, N>,
@@ -314,11 +319,30 @@ impl Feeder {
         if self.wheel_rows == WheelRows::Interval {
             self.last_interval_epoch(f, epoch)?;
         }
-        // The epochs' scratch (not serialised): a feeder that has finished
-        // equals its saved and loaded copy.
+        self.clear_scratch();
+        Ok(())
+    }
+
+    /// Runs the epoch of the readings fed so far, when every later reading
+    /// is later than them (a live stream after each input, a run paused to
+    /// dead-reckon from): the same epochs as if the stream went on. With
+    /// [`WheelRows::Interval`] the last row's interval stays open, for the
+    /// next row to close (its epoch would otherwise be handed out twice).
+    pub fn settle<L: Layout<N>, const N: usize>(
+        &mut self,
+        f: &mut Filter<L, N>,
+        epoch: &mut dyn FnMut(&mut Filter<L, N>, EpochOut<'_, N>),
+    ) -> Result<(), Error> {
+        self.process_batch(f, epoch)?;
+        self.clear_scratch();
+        Ok(())
+    }
+
+    /// The epochs' scratch (not serialised): a feeder that has finished or
+    /// settled equals its saved and loaded copy.
+    fn clear_scratch(&mut self) {
         self.updates.clear();
         self.gated_fix_t_s = None;
-        Ok(())
     }
 
     fn hidden(&self, t: f64) -> bool {

@@ -140,6 +140,19 @@ pub struct FilterOptions {
     pub wheel_rows: WheelRows,
 }
 
+impl FilterOptions {
+    /// The wheel-row scheme a filter on `vehicle` runs: the interval when
+    /// the vehicle asks for it (`[noise] wheel_rows_over_interval`, a model
+    /// option of `--corrections auto`), else the options' [`WheelRows`].
+    pub fn wheel_rows_for(&self, vehicle: &crate::vehicle::Vehicle) -> WheelRows {
+        if vehicle.noise.wheel_rows_over_interval {
+            WheelRows::Interval
+        } else {
+            self.wheel_rows
+        }
+    }
+}
+
 impl Default for FilterOptions {
     fn default() -> Self {
         FilterOptions {

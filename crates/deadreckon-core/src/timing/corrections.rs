@@ -52,11 +52,21 @@ pub fn estimate_with_params_owned(
         gnss: Delay::not_estimated("not estimated"),
     };
     let true_time = on_true_time(&delays, &drive);
+    let intervals = drive.vehicle.noise.wheel_rows_over_interval;
+    if intervals {
+        // A filter over the wheel intervals takes the streams on true time.
+        delays = delays.for_wheel_intervals(&drive);
+    }
     true_time.apply_in_place(&mut drive);
     let partly = drive;
-    // The filter's streams are moved by the delays as estimated.
-    let view = [Stream::Gyro, Stream::Speed, Stream::Steering]
-        .map(|s| delays.get(s).applied_s() - true_time.get(s).applied_s());
+    // The filter's streams are moved by the delays as estimated (on true
+    // time over the intervals: as the reference's, exactly).
+    let view = if intervals {
+        [0.0; 3]
+    } else {
+        [Stream::Gyro, Stream::Speed, Stream::Steering]
+            .map(|s| delays.get(s).applied_s() - true_time.get(s).applied_s())
+    };
     let (g, params) = gnss_delay_of(partly, copts, o, view)?;
     delays.gnss = g;
     Ok((delays, params))
@@ -87,6 +97,9 @@ pub fn on_true_time(delays: &Delays, drive: &Drive) -> Delays {
         if d.status.is_estimated() {
             d.delay_s += half;
         }
+        // The estimate's own offset (`Delays::for_wheel_intervals`) is in
+        // the half period already.
+        d.step_offset_s = 0.0;
     }
     out.gnss = Delay::not_estimated("not estimated");
     out

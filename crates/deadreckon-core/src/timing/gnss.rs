@@ -219,7 +219,7 @@ fn step_offset_s(
     window_s: f64,
     std_s: f64,
 ) -> f64 {
-    if opts.wheel_rows == REFERENCE_WHEEL_ROWS && filter_view_s == [0.0; 3] {
+    if opts.wheel_rows_for(&drive.vehicle) == REFERENCE_WHEEL_ROWS && filter_view_s == [0.0; 3] {
         return 0.0;
     }
     let [g, sp, st] = filter_view_s;
