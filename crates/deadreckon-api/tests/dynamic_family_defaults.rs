@@ -31,6 +31,11 @@
 //! aided filter's heading error against the truth, its yaw standard
 //! deviation and its position error each second through `[t0, t1]`.
 //!
+//! **With the wheel intervals a model option of `auto`** (stop 51, code of
+//! 9f6ea9f; the same command, 7 min): dev 1–6 none 0.383, latency 0.395,
+//! all_but_wander 1.176; held out none 0.466, latency 0.544,
+//! all_but_wander 1.080 (×2.32 of none). Chosen in 12 of 45 judgements.
+//!
 //! **After the GNSS delay's reference took each reading into its own wheel
 //! interval** (stop 50, code of b126f2f; `RAYON_NUM_THREADS=2
 //! DEFAULTS_SAY=1 DEFAULTS_ONLY_AUTO=1 DEFAULTS_HELD_OUT=1

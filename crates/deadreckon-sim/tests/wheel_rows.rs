@@ -16,7 +16,9 @@
 //! Tick-count drives change little (a count is already the interval's). On
 //! the comma2k19 segment `Interval` loses (`evaluate --outage 20 --step 5`:
 //! 0.886 / 0.856 m mean / median against 0.592 / 0.613 m), which is why it
-//! is not the default (docs/calibration.md, "When a wheel row is used").
+//! is not the default (docs/calibration.md, "When a wheel row is used"):
+//! it is a model option `--corrections auto` judges on a drive's held-back
+//! fixes (`the_wheel_intervals_took_the_delays_of_the_papers_step`).
 //!
 //! ```text
 //! cargo test --profile ci -p deadreckon-sim --test wheel_rows -- --ignored --nocapture
