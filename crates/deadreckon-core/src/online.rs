@@ -283,7 +283,10 @@ impl Online {
     /// Runs what no later event can change and keeps what the corrections
     /// hold back (in the state: a stream resumed from it, with later
     /// events, continues as if never cut). With nothing held back, all that
-    /// is waiting runs.
+    /// is waiting runs, but for the epoch of the last wheel row when each
+    /// row is used over its interval (the vehicle's
+    /// `wheel_rows_over_interval`): the next row, or [`Online::end`], closes
+    /// it.
     pub fn finish(&mut self, out: &mut dyn FnMut(TrackPoint)) -> Result<(), Error> {
         self.finish_poses(&mut |p| out(p.point))
     }
