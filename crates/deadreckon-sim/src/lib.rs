@@ -16,7 +16,7 @@
 //!
 //! | stream | model |
 //! |---|---|
-//! | wheel ticks | each wheel's ground distance (eq. 6 of Welte et al., 2019) divided by its **true** circumference, times ticks per revolution; the emitted count is the floor of the cumulative count minus what was already emitted, so fractions carry over |
+//! | wheel ticks | each wheel's ground distance (eq. 6 of Welte et al., 2019) divided by its **true** circumference, times ticks per revolution; the emitted count is the floor of the cumulative count minus what was already emitted, so fractions carry over. Each wheel's tone ring starts at its own phase between two edges (uniform, seeded), as a parked wheel stops anywhere: a counter is as often ahead of the true distance as behind it (starting every ring at an edge, the counts trailed by half a tooth on average, which the GNSS delay read as −5.7, −5.7 and −1.7 ms on the evaluation scenario with 0.05 m fixes and ticks at 25, 50 and 100 Hz) |
 //! | wheel speeds | the rotation over the last period times the **nominal** circumference (what an ECU reports), plus noise, quantised |
 //! | gyro | yaw rate + bias + white noise (eq. 4) |
 //! | CAN speed | scale × speed + white noise (eq. 5, literally: at standstill it reads the noise, sign included) |

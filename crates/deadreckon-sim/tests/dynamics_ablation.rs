@@ -455,24 +455,38 @@ fn tooth_errors_move_the_edges_by_the_drawn_amount() {
         let expected = car.tooth_error_std * (2.0 / std::f64::consts::PI).sqrt();
         // The cumulative count differs from the even ring's where the wheel
         // stands between a tooth's place and where it is: on a share E|e| of
-        // the moving epochs.
+        // the moving epochs. Both rings start at the same phase past edge
+        // 0's place; where the misplaced edge 0 still lies ahead of the
+        // wheel, the rough ring counts one edge more all drive long, and
+        // where edge 1 already lies behind it, one fewer. So the difference
+        // is counted from each wheel's most frequent one (car 3's RR: −1;
+        // counted from 0, 0.252 of the epochs differed).
         let (a, b) = (wheel_values(&none.drive), wheel_values(&with.drive));
         let (mut cum_a, mut cum_b) = ([0.0; 4], [0.0; 4]);
-        let (mut moving, mut differ) = (0usize, 0usize);
+        let mut diffs: [Vec<i64>; 4] = Default::default();
         for (p, q) in a.iter().zip(&b) {
             for i in 0..4 {
                 cum_a[i] += p[i];
                 cum_b[i] += q[i];
                 if p[i] != 0.0 {
-                    moving += 1;
-                    differ += usize::from(cum_a[i] != cum_b[i]);
+                    diffs[i].push((cum_b[i] - cum_a[i]) as i64);
                 }
             }
         }
+        let usual = diffs.clone().map(|mut d| {
+            d.sort_unstable();
+            let runs = d.chunk_by(|x, y| x == y);
+            runs.max_by_key(|r| r.len()).map_or(0, |r| r[0])
+        });
+        let moving: usize = diffs.iter().map(Vec::len).sum();
+        let differ: usize = (0..4)
+            .map(|i| diffs[i].iter().filter(|&&d| d != usual[i]).count())
+            .sum();
         let share = differ as f64 / moving as f64;
         println!(
             "car {seed}: tooth error σ {:.4} pitch drawn; mean |e| {mean_abs:.5} (expected \
-             {expected:.5}); counts off on {share:.5} of moving epochs",
+             {expected:.5}); counts off on {share:.5} of moving epochs, usually by \
+             {usual:?} (FL, FR, RL, RR)",
             car.tooth_error_std
         );
         assert!((mean_abs / expected - 1.0).abs() < 0.15, "car {seed}");
@@ -480,8 +494,9 @@ fn tooth_errors_move_the_edges_by_the_drawn_amount() {
         // events); the mean |e| within 7 % of σ·√(2/π).
         assert!((share / mean_abs - 1.0).abs() < 0.2, "car {seed}: {share}");
         for i in 0..4 {
+            assert!(usual[i].abs() <= 1, "car {seed}: {usual:?}");
             assert!(
-                (cum_a[i] - cum_b[i]).abs() <= 1.0,
+                diffs[i].iter().all(|&d| (d - usual[i]).abs() <= 1),
                 "car {seed}: the ring lost a tooth"
             );
         }

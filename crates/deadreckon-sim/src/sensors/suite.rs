@@ -113,10 +113,31 @@ pub(crate) struct Suite {
     stamps: [Option<EcuClock>; 5],
     /// Tone rings with tooth-spacing errors.
     rings: Option<ToneRings>,
+    /// Where each wheel's ring stands at the start (FL, FR, RL, RR), in
+    /// pitches past an edge, uniform in [0, 1) from its own stream (15): a
+    /// parked wheel stops anywhere between two edges. Tick counters count
+    /// the edges passed from there ([`edges_passed`]). With every ring
+    /// starting at an edge, the counted distance trailed the true one by
+    /// half a pitch on average through a whole drive (2 cm on 48 teeth),
+    /// which the GNSS delay read as −5.7, −5.7 and −1.7 ms on the
+    /// evaluation scenario's ticks at 25, 50 and 100 Hz. Speeds do not use
+    /// it: they are differences of the rotation, which where a ring starts
+    /// does not bias.
+    ring_phase: [f64; 4],
     /// The gyro's drifting bias.
     gyro_drift: Option<GaussMarkov>,
     /// The receiver's multipath bursts.
     multipath: Option<Multipath>,
+}
+
+/// Edges of `wheel`'s ring passed at `u` pitches of rotation (signed,
+/// cumulative from edge 0): ⌊u⌋ on an even ring, the misplaced edges on one
+/// with tooth errors.
+fn edges_passed(rings: Option<&ToneRings>, wheel: usize, u: f64) -> i64 {
+    match rings {
+        None => u.floor() as i64,
+        Some(r) => r.edges(wheel, u),
+    }
 }
 
 const WHEELS: usize = 0;
@@ -152,10 +173,23 @@ impl Suite {
             Some(Clock::new(spec.truth_rate_hz, 0.0)),
         ];
         let noise = [1, 2, 3, 4, 5].map(|k| Noise::new(seed, k));
+        let rings = (spec.wheels.tooth_error_std > 0.0).then(|| {
+            ToneRings::draw(
+                vehicle.ticks_per_rev,
+                spec.wheels.tooth_error_std,
+                &mut Noise::new(seed, 12),
+            )
+        });
+        let ring_phase = {
+            let mut n = Noise::new(seed, 15);
+            [0; 4].map(|_| n.uniform())
+        };
         let wheels = match spec.wheels.kind {
             WheelKind::Ticks => WheelState::Ticks {
                 out: Vec::new(),
-                emitted: [0; 4],
+                // The edges already passed where each ring stands at the
+                // start: the counters count from there.
+                emitted: [0, 1, 2, 3].map(|i| edges_passed(rings.as_ref(), i, ring_phase[i])),
             },
             WheelKind::Speeds => WheelState::Speeds {
                 out: Vec::new(),
@@ -214,13 +248,8 @@ impl Suite {
                         })
                 })
             },
-            rings: (spec.wheels.tooth_error_std > 0.0).then(|| {
-                ToneRings::draw(
-                    vehicle.ticks_per_rev,
-                    spec.wheels.tooth_error_std,
-                    &mut Noise::new(seed, 12),
-                )
-            }),
+            rings,
+            ring_phase,
             gyro_drift: spec
                 .gyro
                 .as_ref()
@@ -379,12 +408,9 @@ impl Suite {
             WheelState::Ticks { out, emitted } => {
                 let mut d = [0i64; 4];
                 for i in 0..4 {
-                    // Cumulative ticks, floored: fractions of a tick carry
-                    // over (the edges passed, on rings with tooth errors).
-                    let cum = match &self.rings {
-                        None => (rot[i] * n).floor() as i64,
-                        Some(r) => r.edges(i, rot[i] * n),
-                    };
+                    // Cumulative edges passed from where the ring stood at
+                    // the start: fractions of a tick carry over.
+                    let cum = edges_passed(self.rings.as_ref(), i, rot[i] * n + self.ring_phase[i]);
                     d[i] = cum - emitted[i];
                     emitted[i] = cum;
                 }
@@ -563,5 +589,119 @@ impl Suite {
                 accel: self.imu_accel,
             },
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Noise;
+    use crate::{simulate, Scenario};
+    use deadreckon_core::drive::Wheels;
+
+    /// A 2 km straight at up to 50 km/h, 48-tooth ticks at 100 Hz sampled
+    /// with the truth, tooth errors of `tooth_error_std` pitches.
+    fn straight(tooth_error_std: f64) -> Scenario {
+        Scenario::from_toml_str(&format!(
+            "name = \"straight\"\nvehicle = \"paper-car\"\n\
+             [route]\nstart_yaw_deg = 0.0\nsegments = [{{ kind = \"straight\", length_m = 2000 }}]\n\
+             [speed]\nstart_stop_s = 2\nend_stop_s = 2\n\
+             [sensors]\ntruth_rate_hz = 100\n\
+             [sensors.wheels]\nkind = \"ticks\"\nrate_hz = 100\ntooth_error_std = {tooth_error_std}\n"
+        ))
+        .unwrap()
+    }
+
+    /// Per wheel (FL, FR, RL, RR), the mean of the counted rotation less the
+    /// true one while the car moves, in pitches, and every count emitted.
+    fn counted_less_true(scenario: &Scenario, seed: u64) -> ([f64; 4], Vec<[i64; 4]>) {
+        let out = simulate(scenario, seed).unwrap();
+        let Wheels::Ticks(ticks) = &out.drive.wheels else {
+            panic!("ticks expected");
+        };
+        let n = f64::from(out.drive.vehicle.ticks_per_rev);
+        let circ = out.truth_params.circumferences();
+        let (mut sum, mut count, mut cum) = ([0.0; 4], 0usize, [0i64; 4]);
+        let mut counts = Vec::new();
+        // The wheel clock and the truth's tick at the same instants.
+        for (w, p) in ticks.iter().zip(&out.drive.truth) {
+            assert!((w.t_s - p.t_s).abs() < 1e-9, "{} vs {}", w.t_s, p.t_s);
+            let d = [w.fl, w.fr, w.rl, w.rr];
+            counts.push(d);
+            for i in 0..4 {
+                cum[i] += d[i];
+            }
+            if p.speed_mps.unwrap() > 1.0 {
+                // On a straight every wheel rolls what M drives.
+                let driven = p.east_m.hypot(p.north_m);
+                for i in 0..4 {
+                    sum[i] += cum[i] as f64 - driven / circ[i] * n;
+                }
+                count += 1;
+            }
+        }
+        assert!(count > 10_000, "{count}");
+        (sum.map(|s| s / count as f64), counts)
+    }
+
+    /// Over 40 wheels (10 drives) the counters' mean offset is 0 (±0.05 for
+    /// 1σ of 40 uniform draws), not the −½ pitch of rings started at an edge.
+    fn assert_zero_on_average(offsets: &[f64]) {
+        assert_eq!(offsets.len(), 40);
+        let mean = offsets.iter().sum::<f64>() / offsets.len() as f64;
+        assert!(mean.abs() < 0.15, "{mean:+.3} pitch: {offsets:?}");
+    }
+
+    /// Regression: every simulated tick counter started standing exactly at
+    /// a tone-ring edge, so through a whole drive the counted distance
+    /// trailed the true one by half a pitch on average (2 cm on 48 teeth),
+    /// on every wheel of every drive, and the GNSS delay read it as −5.7,
+    /// −5.7 and −1.7 ms on the evaluation scenario's ticks at 25, 50 and
+    /// 100 Hz. Now each ring stands at its own phase φ in [0, 1) pitch: a
+    /// counter is φ − ½ pitch ahead on average, −½ to +½ from wheel to
+    /// wheel, zero over wheels and drives.
+    #[test]
+    fn tick_counters_trailed_the_true_distance_by_half_a_pitch() {
+        let even = straight(0.0);
+        let mut all = Vec::new();
+        for seed in 1..=10 {
+            let (offsets, counts) = counted_less_true(&even, seed);
+            let mut phase = Noise::new(seed, 15);
+            for (i, m) in offsets.into_iter().enumerate() {
+                // φ − ½: the ring's own phase, not a drift (its mean over
+                // some 14 000 moving samples is within a few thousandths).
+                let expected = phase.uniform() - 0.5;
+                assert!(
+                    (m - expected).abs() < 0.03,
+                    "seed {seed} wheel {i}: {m:+.3} pitch, expected {expected:+.3}"
+                );
+                all.push(m);
+            }
+            // Standing at the start, no count.
+            assert_eq!(counts[0], [0; 4], "seed {seed}");
+        }
+        // Some wheels count ahead, which none could before.
+        assert_zero_on_average(&all);
+        assert!(all.iter().any(|&m| m > 0.1), "{all:?}");
+        assert!(all.iter().any(|&m| m < -0.1), "{all:?}");
+    }
+
+    /// With tooth errors the counters start at the misplaced edges already
+    /// passed: a ring standing short of its edge 0, placed late, counts no
+    /// −1 at the first sample (counted from 0, seed 8 did), and a forward
+    /// drive counts nothing backwards.
+    #[test]
+    fn tick_counters_start_at_the_misplaced_edges_already_passed() {
+        let rough = straight(0.1);
+        let mut all = Vec::new();
+        for seed in 1..=10 {
+            let (offsets, counts) = counted_less_true(&rough, seed);
+            assert_eq!(counts[0], [0; 4], "seed {seed}");
+            assert!(
+                counts.iter().flatten().all(|&d| d >= 0),
+                "seed {seed}: a negative count"
+            );
+            all.extend(offsets);
+        }
+        assert_zero_on_average(&all);
     }
 }
