@@ -337,8 +337,36 @@ pub fn estimate_and_apply_calibrated(
         &timing::DelayOptions::default(),
         which,
     )
-    .map_err(|source| crate::Error::Calibration {
+    .map_err(estimating)
+}
+
+/// [`estimate_and_apply_calibrated`] of a drive handed over, corrected in
+/// place ([`deadreckon_core::held_back::prepare_calibrated_owned`]).
+pub fn estimate_and_apply_owned(
+    drive: Drive,
+    copts: &deadreckon_core::calibrate::CalibrationOptions,
+    which: timing::Which,
+) -> Result<
+    (
+        Drive,
+        Corrections,
+        Option<deadreckon_core::calibrate::Calibration>,
+    ),
+    crate::Error,
+> {
+    deadreckon_core::held_back::prepare_calibrated_owned(
+        drive,
+        copts,
+        &timing::DelayOptions::default(),
+        which,
+    )
+    .map_err(estimating)
+}
+
+/// The error of estimating the corrections.
+fn estimating(source: deadreckon_core::Error) -> crate::Error {
+    crate::Error::Calibration {
         what: "estimating the streams' delays and the IMU tilt",
         source,
-    })
+    }
 }
