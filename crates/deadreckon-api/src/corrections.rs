@@ -316,6 +316,14 @@ pub fn estimate_and_apply(
     estimate_and_apply_calibrated(drive, copts, which).map(|(d, c, _)| (d, c))
 }
 
+/// The corrected drive, what was found, and the drive's calibration when
+/// choosing the corrections ran it already.
+pub type Corrected = (
+    Drive,
+    Corrections,
+    Option<deadreckon_core::calibrate::Calibration>,
+);
+
 /// [`estimate_and_apply`], also returning the corrected drive's calibration
 /// with `copts` when choosing the corrections ran it already
 /// ([`deadreckon_core::held_back::prepare_calibrated`]).
@@ -323,14 +331,7 @@ pub fn estimate_and_apply_calibrated(
     drive: &Drive,
     copts: &deadreckon_core::calibrate::CalibrationOptions,
     which: timing::Which,
-) -> Result<
-    (
-        Drive,
-        Corrections,
-        Option<deadreckon_core::calibrate::Calibration>,
-    ),
-    crate::Error,
-> {
+) -> Result<Corrected, crate::Error> {
     deadreckon_core::held_back::prepare_calibrated(
         drive,
         copts,
@@ -346,14 +347,7 @@ pub fn estimate_and_apply_owned(
     drive: Drive,
     copts: &deadreckon_core::calibrate::CalibrationOptions,
     which: timing::Which,
-) -> Result<
-    (
-        Drive,
-        Corrections,
-        Option<deadreckon_core::calibrate::Calibration>,
-    ),
-    crate::Error,
-> {
+) -> Result<Corrected, crate::Error> {
     deadreckon_core::held_back::prepare_calibrated_owned(
         drive,
         copts,
