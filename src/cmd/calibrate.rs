@@ -39,7 +39,7 @@ pub fn run(a: CalibrateArgs, load: &common::Loader) -> Result<()> {
     let drive = deadreckon_api::load::cut(drive, a.from_s, a.until_s)?;
     // The drive handed over (held once: its corrections are applied in
     // place); the files written take the noise of the drive as read.
-    let noise = drive.vehicle.noise.clone();
+    let noise = drive.vehicle.noise;
     let (cc, _) = deadreckon_api::calibration::calibrate_owned(
         drive,
         &request,
