@@ -37,15 +37,16 @@ pub fn run(a: CalibrateArgs, load: &common::Loader) -> Result<()> {
         None => load.drive_with(&a.dir, &read)?,
     };
     let drive = deadreckon_api::load::cut(drive, a.from_s, a.until_s)?;
-    let cc =
-        deadreckon_api::calibration::calibrate(&drive, &request, &a.dir.display().to_string())?;
+    // The drive handed over (held once: its corrections are applied in
+    // place); the files written take the noise of the drive as read.
+    let noise = drive.vehicle.noise;
+    let (cc, _) = deadreckon_api::calibration::calibrate_owned(
+        drive,
+        &request,
+        &a.dir.display().to_string(),
+    )?;
     let written = match &a.out {
-        Some(out) => cc.write(
-            out,
-            a.format.into(),
-            &drive.vehicle.noise,
-            &a.dir.display().to_string(),
-        )?,
+        Some(out) => cc.write(out, a.format.into(), &noise, &a.dir.display().to_string())?,
         None => Vec::new(),
     };
     if a.json {

@@ -189,16 +189,60 @@ pub fn calibrate_corrected(
     request: &CalibrationRequest,
     name: &str,
 ) -> Result<(CarCalibration, Option<Drive>), Error> {
-    let options = &request.options;
     // Without corrections the drive is calibrated as it is, not a copy.
     let (corrected, corrections, calibrated) = if request.corrections == Which::None {
         (None, Corrections::none(), None)
     } else {
-        let (d, c, cal) =
-            crate::corrections::estimate_and_apply_calibrated(drive, options, request.corrections)?;
+        let (d, c, cal) = crate::corrections::estimate_and_apply_calibrated(
+            drive,
+            &request.options,
+            request.corrections,
+        )?;
         (Some(d), c, cal)
     };
-    let drive = corrected.as_ref().unwrap_or(drive);
+    let car = calibrate_prepared(
+        corrected.as_ref().unwrap_or(drive),
+        corrections,
+        calibrated,
+        request,
+        name,
+    )?;
+    Ok((car, corrected))
+}
+
+/// [`calibrate_corrected`] of a drive handed over (the command line's
+/// `calibrate`, which reads nothing of the drive afterwards): the
+/// corrections' working drives borrow its streams and the corrections are
+/// applied to it in place, so the drive is held once instead of twice
+/// ([`deadreckon_core::held_back::prepare_calibrated_owned`];
+/// docs/performance.md, "Eighth round"). Returns the calibration and the
+/// drive it holds for (the corrected drive, or the drive itself). The same
+/// numbers bit for bit.
+pub fn calibrate_owned(
+    drive: Drive,
+    request: &CalibrationRequest,
+    name: &str,
+) -> Result<(CarCalibration, Drive), Error> {
+    let (drive, corrections, calibrated) = if request.corrections == Which::None {
+        (drive, Corrections::none(), None)
+    } else {
+        crate::corrections::estimate_and_apply_owned(drive, &request.options, request.corrections)?
+    };
+    let car = calibrate_prepared(&drive, corrections, calibrated, request, name)?;
+    Ok((car, drive))
+}
+
+/// The rest of [`calibrate_corrected`] once the corrections are applied to
+/// `drive`: the calibration (`calibrated`, if the choice of corrections
+/// ran it already), its plausibility, the steering, the bound.
+fn calibrate_prepared(
+    drive: &Drive,
+    corrections: Corrections,
+    calibrated: Option<calibrate::Calibration>,
+    request: &CalibrationRequest,
+    name: &str,
+) -> Result<CarCalibration, Error> {
+    let options = &request.options;
     // The choice of corrections may have calibrated this drive already.
     let calibration = match calibrated {
         Some(c) => c,
@@ -254,7 +298,7 @@ pub fn calibrate_corrected(
         bound,
         bound_reach_1m,
     };
-    Ok((car, corrected))
+    Ok(car)
 }
 
 #[cfg(test)]

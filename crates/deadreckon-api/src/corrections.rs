@@ -318,6 +318,14 @@ pub fn estimate_and_apply(
     estimate_and_apply_calibrated(drive, copts, which).map(|(d, c, _)| (d, c))
 }
 
+/// The corrected drive, what was found, and the drive's calibration when
+/// choosing the corrections ran it already.
+pub type Corrected = (
+    Drive,
+    Corrections,
+    Option<deadreckon_core::calibrate::Calibration>,
+);
+
 /// [`estimate_and_apply`], also returning the corrected drive's calibration
 /// with `copts` when choosing the corrections ran it already
 /// ([`deadreckon_core::held_back::prepare_calibrated`]).
@@ -325,22 +333,36 @@ pub fn estimate_and_apply_calibrated(
     drive: &Drive,
     copts: &deadreckon_core::calibrate::CalibrationOptions,
     which: timing::Which,
-) -> Result<
-    (
-        Drive,
-        Corrections,
-        Option<deadreckon_core::calibrate::Calibration>,
-    ),
-    crate::Error,
-> {
+) -> Result<Corrected, crate::Error> {
     deadreckon_core::held_back::prepare_calibrated(
         drive,
         copts,
         &timing::DelayOptions::default(),
         which,
     )
-    .map_err(|source| crate::Error::Calibration {
+    .map_err(estimating)
+}
+
+/// [`estimate_and_apply_calibrated`] of a drive handed over, corrected in
+/// place ([`deadreckon_core::held_back::prepare_calibrated_owned`]).
+pub fn estimate_and_apply_owned(
+    drive: Drive,
+    copts: &deadreckon_core::calibrate::CalibrationOptions,
+    which: timing::Which,
+) -> Result<Corrected, crate::Error> {
+    deadreckon_core::held_back::prepare_calibrated_owned(
+        drive,
+        copts,
+        &timing::DelayOptions::default(),
+        which,
+    )
+    .map_err(estimating)
+}
+
+/// The error of estimating the corrections.
+fn estimating(source: deadreckon_core::Error) -> crate::Error {
+    crate::Error::Calibration {
         what: "estimating the streams' delays and the IMU tilt",
         source,
-    })
+    }
 }

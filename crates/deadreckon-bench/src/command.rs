@@ -89,13 +89,15 @@ impl Command {
                     Command::CalibrateNone => Which::None,
                     _ => Which::default(),
                 };
-                let cc = deadreckon_api::calibration::calibrate(
-                    &drive,
+                // As the command line: the drive handed over.
+                let epochs = drive.wheels.len();
+                let (cc, _) = deadreckon_api::calibration::calibrate_owned(
+                    drive,
                     &deadreckon_api::calibration::CalibrationRequest::with_corrections(which),
                     "drive",
                 )?;
                 std::hint::black_box(cc.json());
-                Ok(drive.wheels.len())
+                Ok(epochs)
             }
             Command::EvaluateOutage => {
                 use deadreckon_api::evaluate;

@@ -30,6 +30,18 @@ use crate::Error;
 /// Smallest segment length, epochs.
 const MIN_SEGMENT: usize = 64;
 
+/// A pass on one of rayon's workers (the held-back folds) keeps segments
+/// this many times the √(events) of the calling thread's passes: 2. Its
+/// backward pass holds one segment's epochs (2.3 KB each with 11 states)
+/// instead of four, beside a checkpoint per segment (about 63 KB on the
+/// bench's hour, mostly the wheel monitor's windows: heaptrack of
+/// `deadreckon calibrate` on `command_cost write DIR 3600`), so the
+/// memory of checkpoints plus buffer is least near twice the segment
+/// (docs/performance.md, "Eighth round"). The numbers do not depend on it:
+/// every segment re-runs the forward pass's own steps
+/// (`held_back_parallel.rs` compares the pools' numbers bit for bit).
+const WORKER_SEGMENT_FACTOR: usize = 2;
+
 struct Checkpoint<'a, L: Layout<N>, const N: usize> {
     filter: Filter<L, N>,
     feeder: Feeder,
@@ -61,7 +73,15 @@ fn forward<'a, L: Layout<N>, const N: usize>(
         + drive.speed.len()
         + drive.steering.len()
         + drive.gnss.len();
-    let segment = ((total_events as f64).sqrt() as usize).max(MIN_SEGMENT);
+    // On one of rayon's workers the backward pass re-runs one segment at a
+    // time through one buffer instead of four ([`backward`]): segments
+    // [`WORKER_SEGMENT_FACTOR`] times as long there.
+    let per = if rayon::current_thread_index().is_some() {
+        WORKER_SEGMENT_FACTOR
+    } else {
+        1
+    };
+    let segment = ((total_events as f64).sqrt() as usize * per).max(MIN_SEGMENT);
 
     let mut cps = vec![Checkpoint {
         filter: f.clone(),

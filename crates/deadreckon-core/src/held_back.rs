@@ -88,6 +88,7 @@
 
 use crate::calibrate::{self, CalibrationOptions};
 use crate::drive::Drive;
+use crate::lend;
 use crate::model_options::{self, ModelOption, ModelOptions};
 use crate::timing::{self, Corrections, DelayOptions, KnownCorrections, Status, Stream, Which};
 use crate::Error;
@@ -286,8 +287,33 @@ pub fn prepare_calibrated(
     if which != Which::Auto {
         return timing::prepare_with(drive, copts, o, which).map(|(d, c)| (d, c, None));
     }
-    let (_, mut corrections) = timing::prepare_with(drive, copts, o, Which::All)?;
-    let interval_delays = corrections.delays.for_wheel_intervals(drive);
+    // A copy without the truth (unless the calibration reads it), which
+    // the working drives borrow from; the truth joins the drive returned
+    // (no correction changes it).
+    let (mut out, c, cal) = prepare_calibrated_owned(copts.working_copy(drive), copts, o, which)?;
+    if out.truth.is_empty() {
+        out.truth = drive.truth.clone();
+    }
+    Ok((out, c, cal))
+}
+
+/// [`prepare_calibrated`] of a drive handed over: its streams are lent to
+/// the judgement's working drives ([`crate::lend`]) instead of copied, and
+/// the chosen corrections are applied to it in place (the default
+/// `calibrate`'s peak: docs/performance.md, "Eighth round"). The same
+/// drive, corrections and calibration bit for bit.
+pub fn prepare_calibrated_owned(
+    mut source: Drive,
+    copts: &CalibrationOptions,
+    o: &DelayOptions,
+    which: Which,
+) -> Result<(Drive, Corrections, Option<crate::calibrate::Calibration>), Error> {
+    if which != Which::Auto {
+        return timing::prepare_owned(source, copts, o, which).map(|(d, c)| (d, c, None));
+    }
+    let mut corrections = timing::estimate_lent(&mut source, copts, o, Which::All)?;
+    let interval_delays = corrections.delays.for_wheel_intervals(&source);
+    let drive = &mut source;
     let windows = windows(drive);
     let short = windows[0].len() + windows[1].len() < MIN_WINDOWS;
     let min_z = if short { SHORT_MIN_Z } else { MIN_Z };
@@ -316,7 +342,7 @@ pub fn prepare_calibrated(
     // The drive with the GNSS delay (if chosen) and the paper's model, and
     // its calibration: the start of every fold's passes, and the estimates
     // of the model's additions (side slip, steering) that are candidates.
-    let base_drive = judged_drive(
+    let (base_drive, base_loan) = lend::corrected(
         &known(
             &corrections,
             &interval_delays,
@@ -324,7 +350,7 @@ pub fn prepare_calibrated(
             &ModelOptions::default(),
         ),
         drive,
-        copts,
+        copts.reads_truth(),
     );
     let base_calibration = calibrate::calibrate(&base_drive, copts).ok();
     let initial = base_calibration.as_ref().map(|c| c.estimate.params);
@@ -364,9 +390,9 @@ pub fn prepare_calibrated(
         .collect();
     if judged.is_empty() {
         // Nothing to judge: no filter runs.
-        drop(base_drive);
+        lend::give_back(drive, base_drive, base_loan);
     } else if short {
-        drop(base_drive);
+        lend::give_back(drive, base_drive, base_loan);
         held.not_judged = Some(format!(
             "{} held-back windows of {:.0} s, at least {MIN_WINDOWS} needed: the drive is too short to judge a correction on its own GNSS, so each is applied on its significance",
             held.windows, held.window_s
@@ -389,9 +415,8 @@ pub fn prepare_calibrated(
         // with it in the next round.
         let mut current = held_back_errors(&base_drive, copts, [initial; 2], &windows, None)?;
         // The baseline's drive is not read again (each candidate's drive is
-        // made from `drive`): one copy of the drive less while the
-        // candidates' folds run, the default's peak (issue 30).
-        drop(base_drive);
+        // made from `drive`): its streams go back for the candidates'.
+        lend::give_back(drive, base_drive, base_loan);
         held.without_m = mean(&current.errors);
         // A recovery that waits can change nothing where the filter never
         // recovered: then it is no candidate (and costs no run).
@@ -407,11 +432,7 @@ pub fn prepare_calibrated(
             let mut best: Option<(usize, HeldBackRun, f64)> = None;
             for (i, &(c, z)) in left.iter().enumerate() {
                 let with: Vec<Correction> = set.iter().copied().chain([c]).collect();
-                let d = judged_drive(
-                    &known(&corrections, &interval_delays, &with, &model_values),
-                    drive,
-                    copts,
-                );
+                let k = known(&corrections, &interval_delays, &with, &model_values);
                 // The calibration holds the gyro bias constant: with a
                 // walking bias the folds calibrate as without it.
                 let same_calibration =
@@ -420,7 +441,9 @@ pub fn prepare_calibrated(
                 // calibration without the candidate (module docs, "Warm
                 // starts").
                 let start = current.params.map(|p| p.or(initial));
-                let run = held_back_errors(&d, copts, start, &windows, same_calibration)?;
+                let run = lend::with_corrected(&k, drive, copts.reads_truth(), |d| {
+                    held_back_errors(d, copts, start, &windows, same_calibration)
+                })?;
                 let (diff_m, t) = paired(&run.errors, &current.errors);
                 let j = Judged {
                     correction: c,
@@ -457,31 +480,26 @@ pub fn prepare_calibrated(
         // judged last. The calibration keeps white fixes, so the folds
         // calibrate as without it.
         let fitted = wander_may_be_fitted(drive).then(|| {
-            let d = judged_drive(
-                &known(&corrections, &interval_delays, &set, &model_values),
-                drive,
-                copts,
-            );
-            let cal = if set == base {
-                base_calibration.clone()
-            } else {
-                calibrate::calibrate(&d, copts).ok()
-            }?;
-            let w = model_options::wander_candidate(&d, &cal.estimate.params, &copts.filter);
-            Some((cal, w))
+            let k = known(&corrections, &interval_delays, &set, &model_values);
+            lend::with_corrected(&k, drive, copts.reads_truth(), |d| {
+                let cal = if set == base {
+                    base_calibration.clone()
+                } else {
+                    calibrate::calibrate(d, copts).ok()
+                }?;
+                let w = model_options::wander_candidate(d, &cal.estimate.params, &copts.filter);
+                Some((cal, w))
+            })
         });
         if let Some((cal, wander)) = fitted.flatten() {
             if let Some(w) = wander {
                 model_values.gnss_wander = Some(w);
                 let c = Correction::Model(ModelOption::GnssWander);
                 let with: Vec<Correction> = set.iter().copied().chain([c]).collect();
-                let d = judged_drive(
-                    &known(&corrections, &interval_delays, &with, &model_values),
-                    drive,
-                    copts,
-                );
-                let run =
-                    held_back_errors(&d, copts, [initial; 2], &windows, Some(&current.params))?;
+                let k = known(&corrections, &interval_delays, &with, &model_values);
+                let run = lend::with_corrected(&k, drive, copts.reads_truth(), |d| {
+                    held_back_errors(d, copts, [initial; 2], &windows, Some(&current.params))
+                })?;
                 let (_, t) = paired(&run.errors, &current.errors);
                 let applied = t <= -MIN_T;
                 tried.push(Judged {
@@ -513,20 +531,13 @@ pub fn prepare_calibrated(
     }
     mark(&mut corrections, &held, &chosen);
     let applied = known(&corrections, &interval_delays, &chosen, &model_values);
-    let out = applied.apply(drive);
+    let out = applied.apply_to(source);
     corrections.model = applied.model;
     corrections.held_back = Some(held);
     // Nothing chosen beyond the baseline: `out` is the baseline's drive
     // (the same known corrections), whose calibration is at hand.
     let calibration = chosen_calibration.or(base_calibration.filter(|_| chosen == base));
     Ok((out, corrections, calibration))
-}
-
-/// `drive` with the corrections `k` for a judgement's passes: copied without
-/// its truth unless the calibration reads it
-/// ([`CalibrationOptions::reads_truth`]); the drive returned keeps it.
-fn judged_drive(k: &KnownCorrections, drive: &Drive, copts: &CalibrationOptions) -> Drive {
-    k.apply_to(copts.working_copy(drive))
 }
 
 /// Whether the receiver's wander can be a candidate: the drive has fixes

@@ -51,6 +51,7 @@ pub mod imu;
 pub mod init;
 pub mod kalman;
 pub mod kinematics;
+pub mod lend;
 pub mod live_corrections;
 pub mod metrics;
 pub mod model;

@@ -293,8 +293,9 @@ mod gnss;
 mod scalar;
 
 pub use corrections::{
-    apply_known, apply_known_in_place, estimate, estimate_with_params, estimate_with_params_owned,
-    on_true_time, prepare, prepare_with, wheel_half_period_s, Corrections, KnownCorrections, Which,
+    apply_known, apply_known_in_place, estimate, estimate_lent, estimate_with_params,
+    estimate_with_params_owned, on_true_time, prepare, prepare_owned, prepare_with,
+    wheel_half_period_s, Corrections, KnownCorrections, Which,
 };
 pub use gnss::{gnss_delay, regress_gnss, states_at_fixes, REFERENCE_WHEEL_ROWS};
 pub use scalar::{gyro_delay, scalar_delay, speed_delay, steering_delay};

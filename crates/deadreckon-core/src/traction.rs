@@ -261,16 +261,24 @@ pub fn mean_force_mps2(drive: &Drive) -> Option<f64> {
 /// [`apply`] with `f̄` given (`Some`: the level of the drive the slip was
 /// estimated on, as params.toml stores it) or the drive's own (`None`).
 pub fn apply_at(drive: &Drive, slip_per_mps2: f64, mean_mps2: Option<f64>) -> Drive {
-    let f = forward_force(drive);
     let mut d = drive.clone();
+    apply_at_in_place(&mut d, slip_per_mps2, mean_mps2);
+    d
+}
+
+/// [`apply_at`] in place (no copy): `f` and `f̄` are taken from the drive
+/// before its wheel speeds are corrected, as [`apply_at`] takes them from
+/// the drive it copies.
+pub fn apply_at_in_place(d: &mut Drive, slip_per_mps2: f64, mean_mps2: Option<f64>) {
+    let f = forward_force(d);
     if !matches!(d.wheels, Wheels::Speeds(_)) || f.is_empty() || slip_per_mps2 == 0.0 {
-        return d;
+        return;
     }
-    let Some(mean) = mean_mps2.or_else(|| mean_force_mps2(drive)) else {
-        return d;
+    let Some(mean) = mean_mps2.or_else(|| mean_force_mps2(d)) else {
+        return;
     };
     let Wheels::Speeds(ws) = &mut d.wheels else {
-        return d;
+        return;
     };
     // Running sums for the ±0.5 s means.
     let mut cum = Vec::with_capacity(f.len() + 1);
@@ -297,5 +305,4 @@ pub fn apply_at(drive: &Drive, slip_per_mps2: f64, mean_mps2: Option<f64>) -> Dr
             w.rr_mps /= scale;
         }
     }
-    d
 }

@@ -321,14 +321,19 @@ pub fn calibrate_steering_understeer(
     let a = DMatrix::from_fn(n, 3, |i, j| rows[i][j]);
     drop(rows);
     let y = DVector::from_column_slice(&s);
-    // How far a_y is from a multiple of the angle (plus a constant).
+    drop(s);
+    // How far a_y is from a multiple of the angle (plus a constant); the
+    // residual in a_y's own column, the copies dropped once it is known
+    // (the peak of `--corrections none` on the bench's hour: issue 30).
     let a2 = a.columns(0, 2).into_owned();
-    let ay = a.column(2).into_owned();
+    let mut ay_resid = a.column(2).into_owned();
     let Some(ata2) = (a2.transpose() * &a2).try_inverse() else {
         return Ok(without("the wheel angles are singular".into()));
     };
-    let ay_resid = &ay - &a2 * (&ata2 * (a2.transpose() * &ay));
+    ay_resid -= &a2 * (&ata2 * (a2.transpose() * &ay_resid));
+    drop(a2);
     let spread = (ay_resid.norm_squared() / n as f64).sqrt();
+    drop(ay_resid);
     let few_speeds = |detail: String| {
         without(format!(
             "the turns were taken at too few speeds: the lateral acceleration spreads {spread:.3} m/s² about a multiple of the wheel angle{detail}"

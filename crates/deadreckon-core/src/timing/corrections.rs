@@ -6,6 +6,7 @@ use super::scalar::{gyro_delay, speed_delay, steering_delay};
 use super::{shift_in_place, Delay, DelayOptions, Delays, Status, Stream, MEASURED_NOT_APPLIED};
 use crate::calibrate::{self, CalibrationOptions};
 use crate::drive::Drive;
+use crate::lend::{Change, Changes};
 use crate::{Error, Params};
 
 /// Every stream's delay: the scalar streams on `drive` as given, then the
@@ -39,6 +40,18 @@ pub fn estimate_with_params_owned(
     copts: &CalibrationOptions,
     o: &DelayOptions,
 ) -> Result<(Delays, Option<Params>), Error> {
+    estimate_with_params_in(&mut drive, copts, o)
+}
+
+/// [`estimate_with_params_owned`] on a drive it may change: moved in place
+/// to the scalar streams' true time, its fixes to the GNSS delay's last
+/// step (only timestamps and the vehicle change: a drive lent its streams,
+/// [`crate::lend`], gives them back as they were).
+fn estimate_with_params_in(
+    drive: &mut Drive,
+    copts: &CalibrationOptions,
+    o: &DelayOptions,
+) -> Result<(Delays, Option<Params>), Error> {
     // One after the other on the calling thread: run in parallel (rayon)
     // they saved 0.1 s of wall time on the bench's 10-minute drive but
     // their temporaries went to a worker thread's malloc arena, which the
@@ -46,19 +59,18 @@ pub fn estimate_with_params_owned(
     // with `--corrections gnss` rose from 113.6 to 138.0 MB with one
     // thread (issue 30; the same with MALLOC_ARENA_MAX=1: 111 MB).
     let mut delays = Delays {
-        gyro: gyro_delay(&drive, o),
-        speed: speed_delay(&drive, o),
-        steering: steering_delay(&drive, o),
+        gyro: gyro_delay(drive, o),
+        speed: speed_delay(drive, o),
+        steering: steering_delay(drive, o),
         gnss: Delay::not_estimated("not estimated"),
     };
-    let true_time = on_true_time(&delays, &drive);
+    let true_time = on_true_time(&delays, drive);
     let intervals = drive.vehicle.noise.wheel_rows_over_interval;
     if intervals {
         // A filter over the wheel intervals takes the streams on true time.
-        delays = delays.for_wheel_intervals(&drive);
+        delays = delays.for_wheel_intervals(drive);
     }
-    true_time.apply_in_place(&mut drive);
-    let partly = drive;
+    true_time.apply_in_place(drive);
     // The filter's streams are moved by the delays as estimated (on true
     // time over the intervals: as the reference's, exactly).
     let view = if intervals {
@@ -67,7 +79,7 @@ pub fn estimate_with_params_owned(
         [Stream::Gyro, Stream::Speed, Stream::Steering]
             .map(|s| delays.get(s).applied_s() - true_time.get(s).applied_s())
     };
-    let (g, params) = gnss_delay_of(partly, copts, o, view)?;
+    let (g, params) = gnss_delay_of(drive, copts, o, view)?;
     delays.gnss = g;
     Ok((delays, params))
 }
@@ -209,9 +221,57 @@ pub fn prepare_with(
     o: &DelayOptions,
     which: Which,
 ) -> Result<(Drive, Corrections), Error> {
+    prepare_owned(drive.clone(), copts, o, which)
+}
+
+/// [`prepare_with`] on a drive handed over: the corrections estimated on
+/// working drives lent its streams ([`estimate_lent`]), then applied to it
+/// in place. The same drive and corrections bit for bit.
+pub fn prepare_owned(
+    mut drive: Drive,
+    copts: &CalibrationOptions,
+    o: &DelayOptions,
+    which: Which,
+) -> Result<(Drive, Corrections), Error> {
     if which == Which::None {
-        return Ok((drive.clone(), Corrections::none()));
+        return Ok((drive, Corrections::none()));
     }
+    let c = estimate_lent(&mut drive, copts, o, which)?;
+    if let Some(t) = c.traction.as_ref().filter(|t| t.is_estimated()) {
+        crate::traction::apply_at_in_place(&mut drive, t.slip_per_mps2, None);
+    }
+    levelled_and_delayed(&mut drive, &c.tilt, &c.delays);
+    if let Some(g) = c.gyro_scale.as_ref().filter(|g| g.is_estimated()) {
+        crate::gyro_scale::apply_in_place(&mut drive, g.scale_error);
+    }
+    Ok((drive, c))
+}
+
+/// The drive levelled by `tilt` and moved by the applied `delays`, in place.
+fn levelled_and_delayed(d: &mut Drive, tilt: &Option<crate::imu::Tilt>, delays: &Delays) {
+    crate::imu::level_in_place(d, tilt.as_ref());
+    delays.apply_in_place(d);
+}
+
+/// What [`levelled_and_delayed`] changes.
+fn level_and_delay_changes(tilt: &Option<crate::imu::Tilt>, delays: &Delays) -> Changes {
+    Changes::of_delays(Stream::ALL.map(|s| delays.get(s).applied_s()))
+        .yaw_values(tilt.as_ref().is_some_and(|t| t.is_estimated()))
+}
+
+/// The corrections [`prepare_with`] estimates (`which`: not [`Which::None`]
+/// or [`Which::Auto`]), on working drives lent `source`'s streams
+/// ([`crate::lend`]: moved, with their timestamps kept where a delay moves
+/// them, copied where a correction changes their values) and given back:
+/// `source` is as it was. The same corrections bit for bit as on copies
+/// of the drive (the default `calibrate`'s peak: docs/performance.md,
+/// "Eighth round").
+pub fn estimate_lent(
+    source: &mut Drive,
+    copts: &CalibrationOptions,
+    o: &DelayOptions,
+    which: Which,
+) -> Result<Corrections, Error> {
     if which == Which::Auto {
         return Err(Error::param(
             "corrections",
@@ -223,23 +283,44 @@ pub fn prepare_with(
     }
     // The driven axle's slip first: the wheels are the clock and the scale
     // every other correction is measured against.
-    let traction = crate::traction::estimate(drive);
-    let slipped;
-    let drive = match &traction {
-        Some(t) if t.is_estimated() => {
-            slipped = crate::traction::apply(drive, t.slip_per_mps2);
-            &slipped
+    let traction = crate::traction::estimate(source);
+    match traction.as_ref().filter(|t| t.is_estimated()) {
+        Some(t) => {
+            let changes = Changes {
+                wheels: Change::Values,
+                ..Changes::default()
+            };
+            let (mut slipped, loan) = crate::lend::lend(source, changes, true);
+            crate::traction::apply_at_in_place(&mut slipped, t.slip_per_mps2, None);
+            let c = estimate_slipped(&mut slipped, traction.clone(), copts, o, which);
+            crate::lend::give_back(source, slipped, loan);
+            c
         }
-        _ => drive,
-    };
-    // The levelled drive (as `imu::level`) is handed to the GNSS delay's
-    // steps and made again afterwards (bit for bit: `imu::levelled`), not
-    // held beside their copy; without the truth unless the calibration
-    // reads it.
-    let tilt = crate::imu::estimate_tilt(drive);
-    let mut levelled = copts.working_copy(drive);
+        None => estimate_slipped(source, traction, copts, o, which),
+    }
+}
+
+/// [`estimate_lent`] after the slip (`d`: the drive with it applied).
+fn estimate_slipped(
+    d: &mut Drive,
+    traction: Option<crate::traction::TractionSlip>,
+    copts: &CalibrationOptions,
+    o: &DelayOptions,
+    which: Which,
+) -> Result<Corrections, Error> {
+    // The GNSS delay's steps on the levelled drive moved in place (as
+    // `imu::level`), without the truth unless the calibration reads it.
+    let tilt = crate::imu::estimate_tilt(d);
+    let levels = tilt.as_ref().is_some_and(|t| t.is_estimated());
+    let (mut levelled, loan) = crate::lend::lend(
+        d,
+        Changes::ALL_TIMES.yaw_values(levels),
+        copts.reads_truth(),
+    );
     crate::imu::level_in_place(&mut levelled, tilt.as_ref());
-    let (mut delays, params) = estimate_with_params_owned(levelled, copts, o)?;
+    let steps = estimate_with_params_in(&mut levelled, copts, o);
+    crate::lend::give_back(d, levelled, loan);
+    let (mut delays, params) = steps?;
     if which == Which::Gnss {
         for d in [&mut delays.gyro, &mut delays.speed, &mut delays.steering] {
             if d.status.is_estimated() {
@@ -248,8 +329,14 @@ pub fn prepare_with(
             }
         }
     }
-    let mut out = crate::imu::levelled(drive, tilt.as_ref());
-    delays.apply_in_place(&mut out);
+    // The gyro scale on the drive levelled and delayed (the drive
+    // `prepare_with` returns before the scale), truth as the steps'.
+    let (mut out, loan) = crate::lend::lend(
+        d,
+        level_and_delay_changes(&tilt, &delays),
+        copts.reads_truth(),
+    );
+    levelled_and_delayed(&mut out, &tilt, &delays);
     // The bias of the calibration at the final GNSS delay (a time shift of
     // the gyro does not change its bias), else of a calibration here.
     let params = match params {
@@ -259,20 +346,15 @@ pub fn prepare_with(
             .map(|c| c.estimate.params),
     };
     let gyro_scale = params.map(|p| crate::gyro_scale::estimate(&out, p.gyro_bias_rps));
-    if let Some(g) = gyro_scale.as_ref().filter(|g| g.is_estimated()) {
-        crate::gyro_scale::apply_in_place(&mut out, g.scale_error);
-    }
-    Ok((
-        out,
-        Corrections {
-            traction,
-            tilt,
-            delays,
-            gyro_scale,
-            held_back: None,
-            model: Default::default(),
-        },
-    ))
+    crate::lend::give_back(d, out, loan);
+    Ok(Corrections {
+        traction,
+        tilt,
+        delays,
+        gyro_scale,
+        held_back: None,
+        model: Default::default(),
+    })
 }
 
 /// Applies known corrections (e.g. from a params.toml): the yaw rate
@@ -350,18 +432,33 @@ impl KnownCorrections {
     /// place (a copy only for the traction slip's wheel speeds), e.g. a copy
     /// made without the truth ([`Drive::clone_without_truth`]).
     pub fn apply_to(&self, drive: Drive) -> Drive {
-        let mut out = if self.traction_slip_per_mps2 != 0.0 {
-            crate::traction::apply_at(
-                &drive,
+        let mut out = drive;
+        if self.traction_slip_per_mps2 != 0.0 {
+            crate::traction::apply_at_in_place(
+                &mut out,
                 self.traction_slip_per_mps2,
                 self.traction_mean_force_mps2,
-            )
-        } else {
-            drive
-        };
+            );
+        }
         apply_known_in_place(&mut out, self.delays_s, self.up, self.gyro_scale_error);
         self.model.apply_to(&mut out.vehicle);
         out
+    }
+
+    /// What [`KnownCorrections::apply_to`] changes in each stream, for a
+    /// working drive lent the others ([`crate::lend`]): the wheel speeds
+    /// with the slip, the yaw rate's values levelled or rescaled, the
+    /// three-axis gyro rescaled, each delayed stream's timestamps.
+    pub fn changes(&self) -> Changes {
+        let mut c = Changes::of_delays(self.delays_s)
+            .yaw_values(self.up.is_some() || self.gyro_scale_error != 0.0);
+        if self.gyro_scale_error != 0.0 {
+            c.imu_gyro = Change::Values;
+        }
+        if self.traction_slip_per_mps2 != 0.0 {
+            c.wheels = Change::Values;
+        }
+        c
     }
 
     /// Whether there is nothing to apply.

@@ -37,7 +37,7 @@ pub fn gnss_delay(
     copts: &CalibrationOptions,
     o: &DelayOptions,
 ) -> Result<(Delay, Option<Params>), Error> {
-    gnss_delay_of(drive.clone(), copts, o, [0.0; 3])
+    gnss_delay_of(&mut drive.clone(), copts, o, [0.0; 3])
 }
 
 /// [`gnss_delay`] of a drive it may change: its fixes are moved to each
@@ -46,12 +46,12 @@ pub fn gnss_delay(
 /// moved by, minus those `shifted`'s were moved by, for the step offset
 /// ([`Delay::step_offset_s`]).
 pub(super) fn gnss_delay_of(
-    mut shifted: Drive,
+    shifted: &mut Drive,
     copts: &CalibrationOptions,
     o: &DelayOptions,
     filter_view_s: [f64; 3],
 ) -> Result<(Delay, Option<Params>), Error> {
-    let drive = &shifted;
+    let drive = &*shifted;
     if drive.gnss.len() < o.min_samples {
         return Ok((
             Delay::not_estimated(format!(
@@ -87,7 +87,7 @@ pub(super) fn gnss_delay_of(
             },
             None => copts.clone(),
         };
-        let cal = calibrate::calibrate_parameters(&shifted, &step_opts)?;
+        let cal = calibrate::calibrate_parameters(shifted, &step_opts)?;
         let params = cal.estimate.params;
         // Only the smoothed start is used: smoothed in O(√N) memory
         // (checkpointed re-runs), equal to the first of `rts::smooth` over
@@ -97,8 +97,8 @@ pub(super) fn gnss_delay_of(
             ..copts.filter.clone()
         };
         let s0 = crate::checkpoint::smoothed_start(
-            &shifted,
-            ekf::car_filter(&shifted, &params, &fopts)?,
+            shifted,
+            ekf::car_filter(shifted, &params, &fopts)?,
             &fopts,
         )?;
         // Dead reckoning (no GNSS) from the smoothed start: a reference the
@@ -128,7 +128,7 @@ pub(super) fn gnss_delay_of(
             ..copts.filter.clone()
         };
         let reference = states_at_fixes(
-            &shifted,
+            shifted,
             &params,
             &FilterOptions {
                 wheel_rows: REFERENCE_WHEEL_ROWS,
@@ -179,7 +179,7 @@ pub(super) fn gnss_delay_of(
     let mut delay = status_of(d, std, n, o);
     if delay.status.is_estimated() && o.gnss_step_offset {
         delay.step_offset_s = step_offset_s(
-            &mut shifted,
+            shifted,
             &params,
             &dr_opts,
             filter_view_s,

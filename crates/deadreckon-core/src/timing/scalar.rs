@@ -338,10 +338,12 @@ fn wheel_yaw_rate(drive: &Drive) -> Option<Vec<(f64, f64)>> {
         return None;
     }
     let track = drive.vehicle.track_rear_m;
+    // From the rows borrowed, not consumed: a collect in place would keep
+    // the rows' allocation (40 B a row) under the 16 B ones (issue 30).
     Some(
         crate::plausibility::wheel_rows(drive)
-            .into_iter()
-            .map(|(t, v)| (t, (v[3] - v[2]) / track))
+            .iter()
+            .map(|&(t, v)| (t, (v[3] - v[2]) / track))
             .collect(),
     )
 }
@@ -390,6 +392,7 @@ pub fn steering_delay(drive: &Drive, o: &DelayOptions) -> Delay {
             (s > MIN_CURVATURE_SPEED_MPS).then(|| (t, ratio * (wheelbase * wz / s).atan()))
         })
         .collect();
+    drop(w);
     let keep = |t: f64| interp(&v, t).is_some_and(|s| s > MIN_CURVATURE_SPEED_MPS + 0.5);
     scalar_delay(&curvature, &pairs(&drive.steering), &keep, o)
 }
