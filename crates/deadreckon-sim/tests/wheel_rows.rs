@@ -103,7 +103,8 @@ fn interval_wheel_rows_against_the_papers_step_on_family_cars() {
 /// The wheel intervals as a model option of `--corrections auto` (issue
 /// 28): on the evaluation scenario, seed 3 (no delays, 50 Hz ticks), the
 /// held-back fixes prefer them (0.798 → 0.744 m mean over 21 windows of
-/// 20 s when measured; `evaluate --outage 30 --step 10` 0.488 → 0.323 m),
+/// 20 s, t −1.3, with each tone ring at its own phase; `evaluate --outage
+/// 30 --step 10` 0.488 → 0.323 m before the ring phase),
 /// and with them every applied delay is the one a filter over the
 /// intervals needs: the GNSS's without the paper's step offset, each
 /// scalar stream's on true time (half a wheel period after its estimate).
@@ -134,20 +135,23 @@ fn the_wheel_intervals_took_the_delays_of_the_papers_step() {
     let half = wheel_half_period_s(&sim.drive);
     assert!((half - 0.01).abs() < 1e-3, "{half}");
     assert_eq!(c.delays.gnss.step_offset_s, 0.0);
+    // Each scalar stream the judgement estimated (its `delay_s` kept when
+    // not applied) carries the half period; what is applied is the
+    // estimate plus it, or nothing.
+    let mut estimated = 0;
     for s in [Stream::Gyro, Stream::Speed, Stream::Steering] {
         let d = c.delays.get(s);
-        if d.status.is_estimated() {
-            assert_eq!(d.step_offset_s, half, "{s:?}");
-        } else {
-            assert_eq!(d.applied_s(), 0.0, "{s:?}");
+        if !d.delay_s.is_finite() {
+            continue;
         }
+        estimated += 1;
+        assert_eq!(d.step_offset_s, half, "{s:?}");
+        let want = if d.status.is_estimated() {
+            d.delay_s + half
+        } else {
+            0.0
+        };
+        assert!((d.applied_s() - want).abs() < 1e-12, "{s:?}: {d:?}");
     }
-    // A delay applied (the gyro's, chosen with the intervals when
-    // measured) is shifted by that half period from its estimate.
-    assert!(c.delays.gyro.status.is_estimated());
-    assert!(
-        (c.delays.gyro.applied_s() - (c.delays.gyro.delay_s + half)).abs() < 1e-12,
-        "{:?}",
-        c.delays.gyro
-    );
+    assert!(estimated >= 2, "{:?}", c.delays);
 }
