@@ -35,6 +35,10 @@
 //! 9f6ea9f; the same command, 7 min): dev 1–6 none 0.383, latency 0.395,
 //! all_but_wander 1.176; held out none 0.466, latency 0.544,
 //! all_but_wander 1.080 (×2.32 of none). Chosen in 12 of 45 judgements.
+//! With each simulated tone ring at its own start phase too (main at
+//! 676ba88): dev 0.375, 0.395, 1.275; held out 0.433, 0.524, 1.101 (×2.54;
+//! the ring phase alone, helper's run: dev 0.391, 0.459, 1.275, held out
+//! 0.472, 0.530, 1.117). Chosen in 13 of 45.
 //!
 //! **After the GNSS delay's reference took each reading into its own wheel
 //! interval** (stop 50, code of b126f2f; `RAYON_NUM_THREADS=2
