@@ -134,12 +134,8 @@ impl<L: Layout<N>, const N: usize> Run<L, N> {
         end: bool,
         epoch: &mut dyn FnMut(&Filter<L, N>, &EpochOut<'_, N>),
     ) -> Result<(), Error> {
-        let mut e = |f: &mut Filter<L, N>, e: EpochOut<'_, N>| epoch(f, &e);
-        if end {
-            self.feeder.finish(&mut self.filter, &mut e)
-        } else {
-            self.feeder.settle(&mut self.filter, &mut e)
-        }
+        self.feeder
+            .run_waiting(end, &mut self.filter, &mut |f, e| epoch(f, &e))
     }
 
     fn push(&mut self, ev: Event, epoch: &mut Observe<'_>) -> Result<(), Error> {

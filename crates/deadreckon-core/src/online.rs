@@ -31,8 +31,8 @@ use serde::{Deserialize, Serialize};
 use crate::aided::Aided;
 use crate::bound::BoundFit;
 use crate::bound_pose::{point_bound_m, FixFloor, Pose};
-use crate::ekf::{EpochOut, Event, Feeder, FilterOptions, FilterStats, GnssInit};
-use crate::filter::{AugmentedFilter, N_AUG};
+use crate::ekf::{Event, Feeder, FilterOptions, FilterStats, GnssInit};
+use crate::filter::AugmentedFilter;
 use crate::live_corrections::LiveCorrections;
 use crate::model::{Mat, State};
 use crate::track::{car_point, TrackPoint};
@@ -393,14 +393,9 @@ impl Online {
         match &mut self.stage {
             Stage::Waiting { .. } => Ok(()),
             Stage::Learning { filter, feeder } => {
-                let mut e = |f: &mut AugmentedFilter, _: EpochOut<'_, N_AUG>| {
+                feeder.run_waiting(end, filter.as_mut(), &mut |f, _| {
                     emit(car_point(f.time_s(), f.state(), f.covariance()))
-                };
-                if end {
-                    feeder.finish(filter.as_mut(), &mut e)
-                } else {
-                    feeder.settle(filter.as_mut(), &mut e)
-                }
+                })
             }
             Stage::Aided(a) if end => {
                 a.finish(&mut |e| emit(TrackPoint::from_state(e.t_s, &e.x, &e.p)))

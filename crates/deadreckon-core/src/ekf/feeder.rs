@@ -315,12 +315,7 @@ impl Feeder {
         f: &mut Filter<L, N>,
         epoch: &mut dyn FnMut(&mut Filter<L, N>, EpochOut<'_, N>),
     ) -> Result<(), Error> {
-        self.process_batch(f, epoch)?;
-        if self.wheel_rows == WheelRows::Interval {
-            self.last_interval_epoch(f, epoch)?;
-        }
-        self.clear_scratch();
-        Ok(())
+        self.run_waiting(true, f, epoch)
     }
 
     /// Runs the epoch of the readings fed so far, when every later reading
@@ -333,7 +328,21 @@ impl Feeder {
         f: &mut Filter<L, N>,
         epoch: &mut dyn FnMut(&mut Filter<L, N>, EpochOut<'_, N>),
     ) -> Result<(), Error> {
+        self.run_waiting(false, f, epoch)
+    }
+
+    /// [`Feeder::finish`] at the end of the stream (`end`), else
+    /// [`Feeder::settle`].
+    pub fn run_waiting<L: Layout<N>, const N: usize>(
+        &mut self,
+        end: bool,
+        f: &mut Filter<L, N>,
+        epoch: &mut dyn FnMut(&mut Filter<L, N>, EpochOut<'_, N>),
+    ) -> Result<(), Error> {
         self.process_batch(f, epoch)?;
+        if end && self.wheel_rows == WheelRows::Interval {
+            self.last_interval_epoch(f, epoch)?;
+        }
         self.clear_scratch();
         Ok(())
     }
