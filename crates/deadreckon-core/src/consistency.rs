@@ -215,7 +215,8 @@ pub fn windows(drive: &Drive, outage_s: f64, step_s: f64, warmup_s: f64) -> Vec<
 }
 
 /// The NEES of pose and motion through `windows` (GNSS hidden in each, `base`
-/// otherwise), against the drive's truth.
+/// otherwise), against the drive's truth, with the filter's own covariance
+/// ([`WindowErrors::consistency`] with [`Reported::FILTER`]).
 ///
 /// The filter is the one the vehicle's noise settings call for
 /// ([`crate::aided`]), as in the outage evaluation
@@ -231,6 +232,91 @@ pub fn nees_through_windows(
     windows: &[(f64, f64)],
     base: &FilterOptions,
 ) -> Result<Consistency, Error> {
+    errors_through_windows(drive, params, windows, base)?.consistency(&Reported::FILTER)
+}
+
+/// The covariance a dead-reckoned pose is reported with: the filter's
+/// `P` inflated by `k²`, plus the receiver's floor on the position (per
+/// axis, m²): `k² P + diag(F, F, 0)` on `[x, y, ψ]`, `k² P` on the motion.
+/// The error bound's construction (docs/bound.md, [`crate::bound`]) as a
+/// covariance.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Reported {
+    /// The factor on the filter's standard deviations.
+    pub k: f64,
+    /// The receiver's floor per axis, m² (0: none).
+    pub floor_m2: f64,
+}
+
+impl Reported {
+    /// The filter's own covariance.
+    pub const FILTER: Reported = Reported {
+        k: 1.0,
+        floor_m2: 0.0,
+    };
+}
+
+/// One point of one window: the errors of pose and motion against the
+/// truth and the filter's covariance of each block.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PointError {
+    /// Index into [`WINDOW_POINTS`].
+    pub point: usize,
+    /// `[x, y, ψ]` estimate minus truth (yaw wrapped).
+    pub pose: Vector3<f64>,
+    /// The filter's covariance of the pose.
+    pub pose_cov: Matrix3<f64>,
+    /// `[v, ψ̇]` estimate minus truth.
+    pub motion: Vector2<f64>,
+    /// The filter's covariance of the motion.
+    pub motion_cov: Matrix2<f64>,
+}
+
+/// The errors at every point of every window ([`errors_through_windows`]),
+/// from which the NEES under any reported covariance is computed without
+/// running the filter again.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WindowErrors {
+    /// Longest window, s.
+    pub outage_s: f64,
+    /// Per window, its points that had an epoch inside it and a truth.
+    pub windows: Vec<Vec<PointError>>,
+}
+
+impl WindowErrors {
+    /// The NEES of pose and motion with the covariance `reported` says.
+    pub fn consistency(&self, reported: &Reported) -> Result<Consistency, Error> {
+        let k2 = reported.k * reported.k;
+        let mut pose = vec![Vec::new(); WINDOW_POINTS.len()];
+        let mut motion = vec![Vec::new(); WINDOW_POINTS.len()];
+        for pe in self.windows.iter().flatten() {
+            let mut p3 = pe.pose_cov * k2;
+            p3[(0, 0)] += reported.floor_m2;
+            p3[(1, 1)] += reported.floor_m2;
+            if let Some(inv) = p3.try_inverse() {
+                pose[pe.point].push((pe.pose.transpose() * inv * pe.pose)[0]);
+            }
+            if let Some(inv) = (pe.motion_cov * k2).try_inverse() {
+                motion[pe.point].push((pe.motion.transpose() * inv * pe.motion)[0]);
+            }
+        }
+        Ok(Consistency {
+            outage_s: self.outage_s,
+            pose: BlockNees::from_values("pose", 3, pose)?,
+            motion: BlockNees::from_values("motion", 2, motion)?,
+        })
+    }
+}
+
+/// The errors of pose and motion at [`WINDOW_POINTS`] of `windows` (GNSS
+/// hidden in each, `base` otherwise) against the drive's truth, with the
+/// filter's covariances; the filter as in [`nees_through_windows`].
+pub fn errors_through_windows(
+    drive: &Drive,
+    params: &Params,
+    windows: &[(f64, f64)],
+    base: &FilterOptions,
+) -> Result<WindowErrors, Error> {
     let truth = Reference::from_truth(&drive.truth)
         .ok_or_else(|| Error::needs(Task::Nees, Input::Truth { min_poses: 0 }))?;
     if windows.is_empty() {
@@ -262,9 +348,9 @@ pub fn nees_through_windows(
     for &i in &order[next..] {
         seen[i] = last;
     }
-    let mut pose = vec![Vec::new(); WINDOW_POINTS.len()];
-    let mut motion = vec![Vec::new(); WINDOW_POINTS.len()];
+    let mut out = Vec::with_capacity(windows.len());
     for (w, &(a, _)) in windows.iter().enumerate() {
+        let mut points = Vec::new();
         for j in 0..WINDOW_POINTS.len() {
             // The last epoch at or before the point, inside the window.
             let Some((ts, x, p)) = &seen[w * WINDOW_POINTS.len() + j] else {
@@ -276,23 +362,20 @@ pub fn nees_through_windows(
             let Some(r) = truth.state_at(*ts) else {
                 continue;
             };
-            let e3 = Vector3::new(x[X] - r[X], x[Y] - r[Y], angle::diff(x[YAW], r[YAW]));
-            let p3: Matrix3<f64> = p.fixed_view::<3, 3>(0, 0).into_owned();
-            if let Some(inv) = p3.try_inverse() {
-                pose[j].push((e3.transpose() * inv * e3)[0]);
-            }
-            let e2 = Vector2::new(x[V] - r[V], x[YAW_RATE] - r[YAW_RATE]);
-            let p2: Matrix2<f64> = p.fixed_view::<2, 2>(V, V).into_owned();
-            if let Some(inv) = p2.try_inverse() {
-                motion[j].push((e2.transpose() * inv * e2)[0]);
-            }
+            points.push(PointError {
+                point: j,
+                pose: Vector3::new(x[X] - r[X], x[Y] - r[Y], angle::diff(x[YAW], r[YAW])),
+                pose_cov: p.fixed_view::<3, 3>(0, 0).into_owned(),
+                motion: Vector2::new(x[V] - r[V], x[YAW_RATE] - r[YAW_RATE]),
+                motion_cov: p.fixed_view::<2, 2>(V, V).into_owned(),
+            });
         }
+        out.push(points);
     }
     let outage_s = windows.iter().map(|w| w.1 - w.0).fold(0.0, f64::max);
-    Ok(Consistency {
+    Ok(WindowErrors {
         outage_s,
-        pose: BlockNees::from_values("pose", 3, pose)?,
-        motion: BlockNees::from_values("motion", 2, motion)?,
+        windows: out,
     })
 }
 
@@ -319,5 +402,42 @@ mod tests {
         assert_eq!(p.verdict, Verdict::UnderConfident(4.0));
         let p = point(1.0, 2, &[2.0; 50]).unwrap();
         assert_eq!(p.verdict, Verdict::Consistent);
+    }
+
+    #[test]
+    fn the_reported_covariance_scales_and_floors_the_nees() {
+        // One point: pose error (3, 4, 0.1) with P = diag(1, 1, 0.01), motion
+        // error (1, 0) with P = I: NEES 25 + 1 = 26 and 1.
+        let pe = PointError {
+            point: 3,
+            pose: Vector3::new(3.0, 4.0, 0.1),
+            pose_cov: Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, 0.01)),
+            motion: Vector2::new(1.0, 0.0),
+            motion_cov: Matrix2::identity(),
+        };
+        let e = WindowErrors {
+            outage_s: 30.0,
+            windows: vec![vec![pe]],
+        };
+        let nees = |r: &Reported| {
+            let c = e.consistency(r).unwrap();
+            (c.pose.values[3][0], c.motion.values[3][0])
+        };
+        let (p, m) = nees(&Reported::FILTER);
+        assert!((p - 26.0).abs() < 1e-9 && (m - 1.0).abs() < 1e-9);
+        // k = 2: every variance ×4.
+        let (p, m) = nees(&Reported {
+            k: 2.0,
+            floor_m2: 0.0,
+        });
+        assert!((p - 6.5).abs() < 1e-9 && (m - 0.25).abs() < 1e-9);
+        // A floor of 4 m² on the position only: 25/5 + 1 = 6; motion as is.
+        let (p, m) = nees(&Reported {
+            k: 1.0,
+            floor_m2: 4.0,
+        });
+        assert!((p - 6.0).abs() < 1e-9 && (m - 1.0).abs() < 1e-9);
+        // The other points saw no window.
+        assert!(e.consistency(&Reported::FILTER).unwrap().pose.values[0].is_empty());
     }
 }

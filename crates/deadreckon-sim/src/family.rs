@@ -305,6 +305,36 @@ fn random_segment(r: &mut Pcg64, shunts: &mut Pcg64, shunt_share: f64) -> Segmen
     }
 }
 
+/// Issue 36's family (`calibration_noise_family.rs`, deadreckon-api's
+/// `pose_nees_family.rs`): car `seed` of [`CarFamily`] with a gyro drawn
+/// between 0.0003 and 0.003 rad/s per reading (log-uniform; vehicle.toml
+/// declares it), a gyro bias within ±0.005 rad/s and a 50 Hz CAN speed
+/// stream (so the speed scale is calibrated too): the 600 s scenario of
+/// drive `drive_seed`, and the gyro's noise.
+pub fn good_gyro_car(seed: u64, drive_seed: u64) -> (Scenario, f64) {
+    let mut car = CarFamily::draw(seed);
+    let r = &mut Pcg64::seed_from_u64(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 36);
+    let gyro_rps = 0.0003 * 10f64.powf(r.random::<f64>());
+    car.errors.gyro_bias_rps = -0.005 + 0.01 * r.random::<f64>();
+    car.vehicle.noise.gyro_rps = gyro_rps;
+    let mut s = car.drive(drive_seed, 600.0);
+    if let Some(g) = s.sensors.gyro.as_mut() {
+        g.noise_std = gyro_rps;
+    }
+    s.sensors.speed = Some(ScalarSpec {
+        rate_hz: 50.0,
+        offset_s: 0.0,
+        noise_std: 0.1,
+        latency_s: 0.0,
+        scale_error: 0.0,
+        tilt_deg: None,
+        bias_drift_std_rps: 0.0,
+        bias_drift_tau_s: 300.0,
+        clock: None,
+    });
+    (s, gyro_rps)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -55,10 +55,7 @@ use deadreckon_core::ekf::FilterOptions;
 use deadreckon_core::Params;
 use deadreckon_sim::family::CarFamily;
 use deadreckon_sim::scenario::Scenario;
-use deadreckon_sim::sensors::ScalarSpec;
 use deadreckon_sim::simulate;
-use rand::{RngExt, SeedableRng};
-use rand_pcg::Pcg64;
 use rayon::prelude::*;
 
 /// The family members the default was chosen on.
@@ -76,32 +73,7 @@ fn at_the_vehicles_yaw_noise() -> CalibrationOptions {
     }
 }
 
-/// Car `seed` of the family with its gyro (noise, bias) and a CAN speed
-/// stream drawn from `seed`: the scenario of drive `drive_seed`, and the
-/// gyro's noise.
-fn scenario(seed: u64, drive_seed: u64) -> (Scenario, f64) {
-    let mut car = CarFamily::draw(seed);
-    let r = &mut Pcg64::seed_from_u64(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 36);
-    let gyro_rps = 0.0003 * 10f64.powf(r.random::<f64>());
-    car.errors.gyro_bias_rps = -0.005 + 0.01 * r.random::<f64>();
-    car.vehicle.noise.gyro_rps = gyro_rps;
-    let mut s = car.drive(drive_seed, 600.0);
-    if let Some(g) = s.sensors.gyro.as_mut() {
-        g.noise_std = gyro_rps;
-    }
-    s.sensors.speed = Some(ScalarSpec {
-        rate_hz: 50.0,
-        offset_s: 0.0,
-        noise_std: 0.1,
-        latency_s: 0.0,
-        scale_error: 0.0,
-        tilt_deg: None,
-        bias_drift_std_rps: 0.0,
-        bias_drift_tau_s: 300.0,
-        clock: None,
-    });
-    (s, gyro_rps)
-}
+use deadreckon_sim::family::good_gyro_car as scenario;
 
 /// Errors in standard errors, in [`Params::to_array`] order.
 fn z(est: &Params, std: &Params, truth: &Params) -> [f64; 6] {
