@@ -39,6 +39,11 @@
 //! 676ba88): dev 0.375, 0.395, 1.275; held out 0.433, 0.524, 1.101 (×2.54;
 //! the ring phase alone, helper's run: dev 0.391, 0.459, 1.275, held out
 //! 0.472, 0.530, 1.117). Chosen in 13 of 45.
+//! With the receiver's wander applied below a held-back t of 0 (issue 36,
+//! `held_back::WANDER_MIN_T`; `DEFAULTS_EFFECTS=none,wander,all,all_but_wander`,
+//! at −1 then 0): dev 0.375 / 1.744 / 3.042 / 1.275 → 0.377 / 1.534 /
+//! 2.873 / 1.306; held out 0.433 / 1.122 / 1.621 / 1.101 → 0.433 / 1.018 /
+//! 1.636 / 1.207 (all but the wander ×2.54 → ×2.79 of none).
 //!
 //! **After the GNSS delay's reference took each reading into its own wheel
 //! interval** (stop 50, code of b126f2f; `RAYON_NUM_THREADS=2

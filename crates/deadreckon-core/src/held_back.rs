@@ -27,7 +27,8 @@
 //!    to those chosen so far and adds the one that lowers the mean held-back
 //!    error most, if its paired t statistic over the windows is at most
 //!    −[`MIN_T`] (the gyro scale: below
-//!    −[`crate::gyro_scale::HELD_BACK_MIN_T`]); the
+//!    −[`crate::gyro_scale::HELD_BACK_MIN_T`]; the receiver's wander, judged
+//!    last: below −[`WANDER_MIN_T`]); the
 //!    selection stops when no candidate does. Corrections
 //!    interact (a gyro's delay and its scale error both turn the heading in
 //!    turns): judged one by one from none, a gyro 0.12 s late and 1.5 % off
@@ -155,11 +156,28 @@ pub const SHORT_MIN_Z: f64 = std::f64::consts::SQRT_2;
 /// cars 101–110.
 pub const MIN_T: f64 = 1.0;
 
+/// The receiver's wander ([`ModelOption::GnssWander`], judged last) is
+/// applied when it lowers the held-back error at all: paired t below
+/// minus this, 0 (issue 36). At [`MIN_T`] it was left out of receivers
+/// whose fixes wander, at t between −1 and 0, and their pose covariance
+/// stayed the white-fix filter's: over-confident by ×16–×24 on choice cars
+/// 74, 75 and 81, where the wander filter's is within ×2–×3. Chosen among 1, 0.5 and 0 on issue 36's choice
+/// cars 65–88 (`deadreckon-api/tests/pose_nees_family.rs`: mean final
+/// error of 30 s outages 0.967 / 0.945 / 0.937 m, pose NEES merged over
+/// the cars ×6.6 / ×5.4 / ×3.9 over-confident) and the dynamic family's
+/// development cars 1–6 (`dynamic_family_defaults.rs`, effects none /
+/// wander / all / all but the wander: 0.375 / 1.744 / 3.042 / 1.275 m,
+/// 0.377 / 1.602 / 2.873 / 1.275 m, 0.377 / 1.534 / 2.873 / 1.306 m);
+/// checked on check cars 89–112 and held-out cars 101–110 (docs/gnss-wander.md).
+pub const WANDER_MIN_T: f64 = 0.0;
+
 /// Whether candidate `c` judged at paired t `t` is applied: at most −[`MIN_T`],
-/// below −[`crate::gyro_scale::HELD_BACK_MIN_T`] for the gyro scale.
+/// below −[`crate::gyro_scale::HELD_BACK_MIN_T`] for the gyro scale, below
+/// −[`WANDER_MIN_T`] for the receiver's wander.
 fn wins(c: Correction, t: f64) -> bool {
     match c {
         Correction::GyroScale => t < -crate::gyro_scale::HELD_BACK_MIN_T,
+        Correction::Model(ModelOption::GnssWander) => t < -WANDER_MIN_T,
         _ => t <= -MIN_T,
     }
 }
@@ -501,7 +519,7 @@ pub fn prepare_calibrated_owned(
                     held_back_errors(d, copts, [initial; 2], &windows, Some(&current.params))
                 })?;
                 let (_, t) = paired(&run.errors, &current.errors);
-                let applied = t <= -MIN_T;
+                let applied = wins(c, t);
                 tried.push(Judged {
                     correction: c,
                     z: f64::NAN,
