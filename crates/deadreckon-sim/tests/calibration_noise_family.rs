@@ -641,7 +641,11 @@ type AutoRow = (
 /// applied to the evaluation drive), so the columns differ only in the
 /// receiver model. `NEES_CARS=choice` or `check` (default both).
 ///
-/// Measured (each set run once, 220 s and 133 s at a load of 7): choice
+/// Measured with the wander applied at a held-back t of −1 or below (the
+/// rule until issue 36's fourth stop; now below 0,
+/// `held_back::WANDER_MIN_T`, measured through the user's path in
+/// `deadreckon-api/tests/pose_nees_family.rs`; each set run once, 220 s
+/// and 133 s at a load of 7): choice
 /// cars 65–88, the wander chosen on 12/24, pose NEES consistent 0/24
 /// white, 6/24 with auto's choice (where chosen ×1.8–×3.0 or consistent;
 /// the wander always carried: 12/24); check cars 89–112, chosen on 13/24,
