@@ -2,10 +2,11 @@
 //! calibration's long drives.
 //!
 //! The forward pass keeps no epochs: every about √N epochs it keeps a
-//! checkpoint (the step filter, its [`Feeder`] and the position in the drive's
-//! events, all a few kilobytes). The backward pass then takes the segments from
+//! checkpoint (the step filter, its [`Feeder`] without the wheel monitor and
+//! the position in the drive's events, all a few kilobytes). The backward pass then takes the segments from
 //! the last to the first: it re-runs the filter from the segment's checkpoint
-//! (the same events in the same order, so the same epochs bit for bit) and
+//! (the same events in the same order, with the wheel monitor's verdicts that
+//! the forward pass recorded, so the same epochs bit for bit) and
 //! smooths through them with eq. (20) and (22), carrying the smoothed state and
 //! the first epoch of the following segment across the boundary. The result
 //! equals [`crate::rts::smooth_states`] over a recorded run exactly, at twice
@@ -18,6 +19,8 @@
 //! with others (on one of rayon's workers: the held-back folds) re-runs its
 //! segments one after the other through one buffer.
 
+use std::sync::Arc;
+
 use nalgebra::{Cholesky, SVector};
 
 use crate::drive::Drive;
@@ -25,6 +28,7 @@ use crate::ekf::{self, DriveEvents, Epoch, Feeder, FilterOptions, FilterStats};
 use crate::filter::{Filter, Layout};
 use crate::model::State;
 use crate::rts::{Smoothed, WanderStates};
+use crate::wheel_health::Verdict;
 use crate::Error;
 
 /// Smallest segment length, epochs.
@@ -34,9 +38,10 @@ const MIN_SEGMENT: usize = 64;
 /// this many times the √(events) of the calling thread's passes: 2. Its
 /// backward pass holds one segment's epochs (2.3 KB each with 11 states)
 /// instead of four, beside a checkpoint per segment (about 63 KB on the
-/// bench's hour, mostly the wheel monitor's windows: heaptrack of
-/// `deadreckon calibrate` on `command_cost write DIR 3600`), so the
-/// memory of checkpoints plus buffer is least near twice the segment
+/// bench's hour until the ninth round, mostly the wheel monitor's windows:
+/// heaptrack of `deadreckon calibrate` on `command_cost write DIR 3600`;
+/// a few KB since the checkpoints replay the monitor's verdicts), so the
+/// memory of checkpoints plus buffer was least near twice the segment
 /// (docs/performance.md, "Eighth round"). The numbers do not depend on it:
 /// every segment re-runs the forward pass's own steps
 /// (`held_back_parallel.rs` compares the pools' numbers bit for bit).
@@ -44,21 +49,33 @@ const WORKER_SEGMENT_FACTOR: usize = 2;
 
 struct Checkpoint<'a, L: Layout<N>, const N: usize> {
     filter: Filter<L, N>,
+    /// The feeder without its wheel monitor ([`Feeder::resume_point`]).
     feeder: Feeder,
     events: DriveEvents<'a>,
     /// Epochs run before this checkpoint.
     epochs_before: usize,
 }
 
+/// What the forward pass keeps.
+struct Forward<'a, L: Layout<N>, const N: usize> {
+    /// A checkpoint every about √N epochs.
+    cps: Vec<Checkpoint<'a, L, N>>,
+    /// The number of epochs.
+    total: usize,
+    /// The filter's counters.
+    stats: FilterStats,
+    /// The wheel monitor's verdicts, which the re-runs replay.
+    verdicts: Arc<[Verdict]>,
+}
+
 /// The forward pass: `f` run over `drive` keeping only a checkpoint every
-/// about √N epochs. Returns the checkpoints, the number of epochs and the
-/// filter's counters.
+/// about √N epochs.
 fn forward<'a, L: Layout<N>, const N: usize>(
     drive: &'a Drive,
     f: Filter<L, N>,
     opts: &FilterOptions,
     standstill: bool,
-) -> Result<(Vec<Checkpoint<'a, L, N>>, usize, FilterStats), Error> {
+) -> Result<Forward<'a, L, N>, Error> {
     let (feeder, events) = ekf::feed(drive, opts, f.time_s());
     // The aided filter's standstill (crate::standstill), as its run had it.
     let mut feeder = if standstill {
@@ -66,8 +83,10 @@ fn forward<'a, L: Layout<N>, const N: usize>(
     } else {
         feeder
     };
-    // The forward pass keeps no predictions; the re-runs do.
+    // The forward pass keeps no predictions; the re-runs do. It records
+    // the wheel monitor's verdicts, which the re-runs replay.
     feeder.keep_predictions(false);
+    feeder.record_verdicts();
     let total_events = drive.wheels.len()
         + drive.yaw_rate.len()
         + drive.speed.len()
@@ -85,7 +104,7 @@ fn forward<'a, L: Layout<N>, const N: usize>(
 
     let mut cps = vec![Checkpoint {
         filter: f.clone(),
-        feeder: feeder.clone(),
+        feeder: feeder.resume_point(),
         events: events.clone(),
         epochs_before: 0,
     }];
@@ -97,7 +116,7 @@ fn forward<'a, L: Layout<N>, const N: usize>(
         if n >= cps.last().map_or(0, |c| c.epochs_before) + segment {
             cps.push(Checkpoint {
                 filter: f.clone(),
-                feeder: feeder.clone(),
+                feeder: feeder.resume_point(),
                 events: events.clone(),
                 epochs_before: n,
             });
@@ -109,19 +128,31 @@ fn forward<'a, L: Layout<N>, const N: usize>(
     if cps.last().is_some_and(|c| c.epochs_before == total) && cps.len() > 1 {
         cps.pop();
     }
-    Ok((cps, total, stats))
+    Ok(Forward {
+        cps,
+        total,
+        stats,
+        verdicts: feeder.take_verdicts(),
+    })
 }
 
 impl<L: Layout<N>, const N: usize> Checkpoint<'_, L, N> {
     /// Re-runs the filter from this checkpoint to epoch `end` (exclusive),
-    /// recording the epochs into `buf` (cleared first).
-    fn rerun(&self, end: usize, buf: &mut Vec<Epoch<N>>) -> Result<(), Error> {
+    /// recording the epochs into `buf` (cleared first), with the forward
+    /// pass's wheel verdicts.
+    fn rerun(
+        &self,
+        end: usize,
+        verdicts: &Arc<[Verdict]>,
+        buf: &mut Vec<Epoch<N>>,
+    ) -> Result<(), Error> {
         let (mut f, mut feeder, mut events) = (
             self.filter.clone(),
             self.feeder.clone(),
             self.events.clone(),
         );
         feeder.keep_predictions(true);
+        feeder.replay_verdicts(Arc::clone(verdicts));
         buf.clear();
         // The segment's epochs exactly: no doubled capacity to carry.
         buf.reserve_exact(end.saturating_sub(self.epochs_before));
@@ -162,6 +193,7 @@ impl<L: Layout<N>, const N: usize> Checkpoint<'_, L, N> {
 fn backward<'a, L: Layout<N>, const N: usize>(
     cps: &[Checkpoint<'a, L, N>],
     total: usize,
+    verdicts: &Arc<[Verdict]>,
     mut visit: impl FnMut(usize, &mut Vec<Epoch<N>>) -> Result<(), Error> + Send,
 ) -> Result<(), Error>
 where
@@ -177,7 +209,7 @@ where
     if rayon::current_thread_index().is_some() {
         let mut buf = Vec::new();
         for j in (0..cps.len()).rev() {
-            cps[j].rerun(end_of(j), &mut buf)?;
+            cps[j].rerun(end_of(j), verdicts, &mut buf)?;
             visit(j, &mut buf)?;
         }
         return Ok(());
@@ -188,11 +220,11 @@ where
         let [b1, b0] = bufs;
         match hi - lo {
             0 => Ok(()),
-            1 => cps[lo].rerun(end_of(lo), b1),
+            1 => cps[lo].rerun(end_of(lo), verdicts, b1),
             _ => {
                 let (r1, r0) = rayon::join(
-                    || cps[hi - 1].rerun(end_of(hi - 1), b1),
-                    || cps[hi - 2].rerun(end_of(hi - 2), b0),
+                    || cps[hi - 1].rerun(end_of(hi - 1), verdicts, b1),
+                    || cps[hi - 2].rerun(end_of(hi - 2), verdicts, b0),
                 );
                 r1.and(r0)
             }
@@ -243,7 +275,12 @@ pub fn smooth_car_columns<L: Layout<N> + Send + Sync, const N: usize>(
     f: Filter<L, N>,
     opts: &FilterOptions,
 ) -> Result<(Vec<f64>, Vec<State>, FilterStats), Error> {
-    let (cps, total, stats) = forward(drive, f, opts, false)?;
+    let Forward {
+        cps,
+        total,
+        stats,
+        verdicts,
+    } = forward(drive, f, opts, false)?;
     if total == 0 {
         return Ok((Vec::new(), Vec::new(), stats));
     }
@@ -252,7 +289,7 @@ pub fn smooth_car_columns<L: Layout<N> + Send + Sync, const N: usize>(
     let mut out_x = vec![State::zeros(); total];
     // The first epoch of the following segment and its smoothed state.
     let mut next: Option<(Epoch<N>, SVector<f64, N>)> = None;
-    backward(&cps, total, |j, buf| {
+    backward(&cps, total, &verdicts, |j, buf| {
         let end = cps.get(j + 1).map_or(total, |c| c.epochs_before);
         let before = cps[j].epochs_before;
         // The epoch after the segment's last and its smoothed state: the
@@ -319,13 +356,18 @@ pub fn smooth_each<L: Layout<N> + Send + Sync, const N: usize>(
     standstill: bool,
     mut visit: impl FnMut(&Smoothed<N>) + Send,
 ) -> Result<usize, Error> {
-    let (cps, total, _) = forward(drive, f, opts, standstill)?;
+    let Forward {
+        cps,
+        total,
+        verdicts,
+        ..
+    } = forward(drive, f, opts, standstill)?;
     if total == 0 {
         return Ok(0);
     }
     // The first epoch of the following segment and its smoothed state.
     let mut next: Option<(Epoch<N>, Smoothed<N>)> = None;
-    backward(&cps, total, |_, buf| {
+    backward(&cps, total, &verdicts, |_, buf| {
         let (carried, mut s1) = match next.take() {
             Some(n) => n,
             None => {
