@@ -12,7 +12,7 @@
 //! equals [`crate::rts::smooth_states`] over a recorded run exactly, at twice
 //! the filter time and with memory for the output states, √N checkpoints and
 //! four segments of epochs instead of every epoch (2.3 KB each with 11
-//! states). The re-runs go two at a time in parallel while the segments
+//! states), the segments' length balancing the two ([`segment_len`]). The re-runs go two at a time in parallel while the segments
 //! before them are smoothed (the same numbers: each re-run is the forward
 //! pass's own steps), so the backward pass takes about half the forward
 //! pass's wall time more on two cores; a pass that already runs in parallel
@@ -34,18 +34,54 @@ use crate::Error;
 /// Smallest segment length, epochs.
 const MIN_SEGMENT: usize = 64;
 
-/// A pass on one of rayon's workers (the held-back folds) keeps segments
-/// this many times the √(events) of the calling thread's passes: 2. Its
-/// backward pass holds one segment's epochs (2.3 KB each with 11 states)
-/// instead of four, beside a checkpoint per segment (about 63 KB on the
-/// bench's hour until the ninth round, mostly the wheel monitor's windows:
-/// heaptrack of `deadreckon calibrate` on `command_cost write DIR 3600`;
-/// a few KB since the checkpoints replay the monitor's verdicts), so the
-/// memory of checkpoints plus buffer was least near twice the segment
-/// (docs/performance.md, "Eighth round"). The numbers do not depend on it:
-/// every segment re-runs the forward pass's own steps
-/// (`held_back_parallel.rs` compares the pools' numbers bit for bit).
-const WORKER_SEGMENT_FACTOR: usize = 2;
+/// The heap a checkpoint's feeder holds besides its own size, B: its
+/// vectors (the first wheel intervals for the gap rule, the waiting
+/// events). Measured: 0.31 MB for the 234 checkpoints of the two held-back
+/// folds of `deadreckon calibrate` on `command_cost write DIR 3600`
+/// (heaptrack, docs/performance.md, "Ninth round"), 1.3 KB each. Only
+/// sets the segments' length ([`segment_len`]), which no number depends
+/// on.
+const FEEDER_HEAP_BYTES: usize = 1300;
+
+/// The segment length, epochs, that holds the least memory in the
+/// checkpoints and the re-run buffers together: `E` epochs in segments of
+/// `s` keep about `E / s` checkpoints of `c` bytes and `k` buffers of `s`
+/// epochs of `b` bytes, `E·c/s + k·s·b`, least at `s = √(E·c / (k·b))`
+/// (then the two parts are equal). `k` is 1 on one of rayon's workers,
+/// whose backward pass re-runs one segment at a time, and 4 on the
+/// calling thread ([`backward`]). `E` is the wheel rows with the paper's
+/// wheel epochs, every event with an epoch per measurement.
+///
+/// Until the ninth round of docs/performance.md the segments were √(events)
+/// long (twice that on rayon's workers), when a checkpoint held a copy of
+/// the wheel monitor's windows (about 63 KB on the bench's hour); with
+/// its verdicts replayed a checkpoint is about the size of one epoch, and
+/// the buffers were most of the memory (heaptrack of `deadreckon
+/// calibrate` on `command_cost write DIR 3600`). The numbers do not
+/// depend on the length: every segment re-runs the forward pass's own
+/// steps (`held_back_parallel.rs` compares the pools' numbers bit for
+/// bit; `tests/lean_passes.rs` and `tests/stream.rs` smoothing a recorded
+/// run).
+fn segment_len<L: Layout<N>, const N: usize>(drive: &Drive, opts: &FilterOptions) -> usize {
+    let events = drive.wheels.len()
+        + drive.yaw_rate.len()
+        + drive.speed.len()
+        + drive.steering.len()
+        + drive.gnss.len();
+    let epochs = match opts.timing {
+        ekf::Timing::WheelEpochs => drive.wheels.len(),
+        ekf::Timing::EachMeasurement => events,
+    };
+    let buffers = if rayon::current_thread_index().is_some() {
+        1
+    } else {
+        4
+    };
+    let c = std::mem::size_of::<Checkpoint<'_, L, N>>() + FEEDER_HEAP_BYTES;
+    let b = std::mem::size_of::<Epoch<N>>();
+    let s = (epochs as f64 * c as f64 / (buffers * b) as f64).sqrt();
+    (s as usize).max(MIN_SEGMENT)
+}
 
 struct Checkpoint<'a, L: Layout<N>, const N: usize> {
     filter: Filter<L, N>,
@@ -87,20 +123,7 @@ fn forward<'a, L: Layout<N>, const N: usize>(
     // the wheel monitor's verdicts, which the re-runs replay.
     feeder.keep_predictions(false);
     feeder.record_verdicts();
-    let total_events = drive.wheels.len()
-        + drive.yaw_rate.len()
-        + drive.speed.len()
-        + drive.steering.len()
-        + drive.gnss.len();
-    // On one of rayon's workers the backward pass re-runs one segment at a
-    // time through one buffer instead of four ([`backward`]): segments
-    // [`WORKER_SEGMENT_FACTOR`] times as long there.
-    let per = if rayon::current_thread_index().is_some() {
-        WORKER_SEGMENT_FACTOR
-    } else {
-        1
-    };
-    let segment = ((total_events as f64).sqrt() as usize * per).max(MIN_SEGMENT);
+    let segment = segment_len::<L, N>(drive, opts);
 
     let mut cps = vec![Checkpoint {
         filter: f.clone(),
