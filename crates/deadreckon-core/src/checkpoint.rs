@@ -2,22 +2,24 @@
 //! calibration's long drives.
 //!
 //! The forward pass keeps no epochs: every about √N epochs it keeps a
-//! checkpoint (the step filter, its [`Feeder`] without the wheel monitor and
-//! the position in the drive's events, all a few kilobytes). The backward pass then takes the segments from
-//! the last to the first: it re-runs the filter from the segment's checkpoint
-//! (the same events in the same order, with the wheel monitor's verdicts that
-//! the forward pass recorded, so the same epochs bit for bit) and
-//! smooths through them with eq. (20) and (22), carrying the smoothed state and
-//! the first epoch of the following segment across the boundary. The result
-//! equals [`crate::rts::smooth_states`] over a recorded run exactly, at twice
-//! the filter time and with memory for the output states, √N checkpoints and
+//! checkpoint (the step filter, its [`Feeder`] without the wheel monitor
+//! and the position in the drive's events, all a few kilobytes). The
+//! backward pass then takes the segments from the last to the first: it
+//! re-runs the filter from the segment's checkpoint (the same events in the
+//! same order, with the wheel monitor's verdicts that the forward pass
+//! recorded, so the same epochs bit for bit) and smooths through them with
+//! eq. (20) and (22), carrying the smoothed state and the first epoch of
+//! the following segment across the boundary. The result equals
+//! [`crate::rts::smooth_states`] over a recorded run exactly, at twice the
+//! filter time and with memory for the output states, √N checkpoints and
 //! four segments of epochs instead of every epoch (2.3 KB each with 11
-//! states), the segments' length balancing the two ([`segment_len`]). The re-runs go two at a time in parallel while the segments
-//! before them are smoothed (the same numbers: each re-run is the forward
-//! pass's own steps), so the backward pass takes about half the forward
-//! pass's wall time more on two cores; a pass that already runs in parallel
-//! with others (on one of rayon's workers: the held-back folds) re-runs its
-//! segments one after the other through one buffer.
+//! states), the segments' length balancing the two (`segment_len`). The
+//! re-runs go two at a time in parallel while the segments before them are
+//! smoothed (the same numbers: each re-run is the forward pass's own
+//! steps), so the backward pass takes about half the forward pass's wall
+//! time more on two cores; a pass that already runs in parallel with others
+//! (on one of rayon's workers: the held-back folds) re-runs its segments
+//! one after the other through one buffer.
 
 use std::sync::Arc;
 
