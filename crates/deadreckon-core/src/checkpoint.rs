@@ -2,21 +2,26 @@
 //! calibration's long drives.
 //!
 //! The forward pass keeps no epochs: every about √N epochs it keeps a
-//! checkpoint (the step filter, its [`Feeder`] and the position in the drive's
-//! events, all a few kilobytes). The backward pass then takes the segments from
-//! the last to the first: it re-runs the filter from the segment's checkpoint
-//! (the same events in the same order, so the same epochs bit for bit) and
-//! smooths through them with eq. (20) and (22), carrying the smoothed state and
-//! the first epoch of the following segment across the boundary. The result
-//! equals [`crate::rts::smooth_states`] over a recorded run exactly, at twice
-//! the filter time and with memory for the output states, √N checkpoints and
+//! checkpoint (the step filter, its [`Feeder`] without the wheel monitor
+//! and the position in the drive's events, all a few kilobytes). The
+//! backward pass then takes the segments from the last to the first: it
+//! re-runs the filter from the segment's checkpoint (the same events in the
+//! same order, with the wheel monitor's verdicts that the forward pass
+//! recorded, so the same epochs bit for bit) and smooths through them with
+//! eq. (20) and (22), carrying the smoothed state and the first epoch of
+//! the following segment across the boundary. The result equals
+//! [`crate::rts::smooth_states`] over a recorded run exactly, at twice the
+//! filter time and with memory for the output states, √N checkpoints and
 //! four segments of epochs instead of every epoch (2.3 KB each with 11
-//! states). The re-runs go two at a time in parallel while the segments
-//! before them are smoothed (the same numbers: each re-run is the forward
-//! pass's own steps), so the backward pass takes about half the forward
-//! pass's wall time more on two cores; a pass that already runs in parallel
-//! with others (on one of rayon's workers: the held-back folds) re-runs its
-//! segments one after the other through one buffer.
+//! states), the segments' length balancing the two (`segment_len`). The
+//! re-runs go two at a time in parallel while the segments before them are
+//! smoothed (the same numbers: each re-run is the forward pass's own
+//! steps), so the backward pass takes about half the forward pass's wall
+//! time more on two cores; a pass that already runs in parallel with others
+//! (on one of rayon's workers: the held-back folds) re-runs its segments
+//! one after the other through one buffer.
+
+use std::sync::Arc;
 
 use nalgebra::{Cholesky, SVector};
 
@@ -25,40 +30,90 @@ use crate::ekf::{self, DriveEvents, Epoch, Feeder, FilterOptions, FilterStats};
 use crate::filter::{Filter, Layout};
 use crate::model::State;
 use crate::rts::{Smoothed, WanderStates};
+use crate::wheel_health::Verdict;
 use crate::Error;
 
 /// Smallest segment length, epochs.
 const MIN_SEGMENT: usize = 64;
 
-/// A pass on one of rayon's workers (the held-back folds) keeps segments
-/// this many times the √(events) of the calling thread's passes: 2. Its
-/// backward pass holds one segment's epochs (2.3 KB each with 11 states)
-/// instead of four, beside a checkpoint per segment (about 63 KB on the
-/// bench's hour, mostly the wheel monitor's windows: heaptrack of
-/// `deadreckon calibrate` on `command_cost write DIR 3600`), so the
-/// memory of checkpoints plus buffer is least near twice the segment
-/// (docs/performance.md, "Eighth round"). The numbers do not depend on it:
-/// every segment re-runs the forward pass's own steps
-/// (`held_back_parallel.rs` compares the pools' numbers bit for bit).
-const WORKER_SEGMENT_FACTOR: usize = 2;
+/// The heap a checkpoint's feeder holds besides its own size, B: its
+/// vectors (the first wheel intervals for the gap rule, the waiting
+/// events). Measured: 0.31 MB for the 234 checkpoints of the two held-back
+/// folds of `deadreckon calibrate` on `command_cost write DIR 3600`
+/// (heaptrack, docs/performance.md, "Ninth round"), 1.3 KB each. Only
+/// sets the segments' length ([`segment_len`]), which no number depends
+/// on.
+const FEEDER_HEAP_BYTES: usize = 1300;
+
+/// The segment length, epochs, that holds the least memory in the
+/// checkpoints and the re-run buffers together: `E` epochs in segments of
+/// `s` keep about `E / s` checkpoints of `c` bytes and `k` buffers of `s`
+/// epochs of `b` bytes, `E·c/s + k·s·b`, least at `s = √(E·c / (k·b))`
+/// (then the two parts are equal). `k` is 1 on one of rayon's workers,
+/// whose backward pass re-runs one segment at a time, and 4 on the
+/// calling thread ([`backward`]). `E` is the wheel rows with the paper's
+/// wheel epochs, every event with an epoch per measurement.
+///
+/// Until the ninth round of docs/performance.md the segments were √(events)
+/// long (twice that on rayon's workers), when a checkpoint held a copy of
+/// the wheel monitor's windows (about 63 KB on the bench's hour); with
+/// its verdicts replayed a checkpoint is about the size of one epoch, and
+/// the buffers were most of the memory (heaptrack of `deadreckon
+/// calibrate` on `command_cost write DIR 3600`). The numbers do not
+/// depend on the length: every segment re-runs the forward pass's own
+/// steps (`held_back_parallel.rs` compares the pools' numbers bit for
+/// bit; `tests/lean_passes.rs` and `tests/stream.rs` smoothing a recorded
+/// run).
+fn segment_len<L: Layout<N>, const N: usize>(drive: &Drive, opts: &FilterOptions) -> usize {
+    let events = drive.wheels.len()
+        + drive.yaw_rate.len()
+        + drive.speed.len()
+        + drive.steering.len()
+        + drive.gnss.len();
+    let epochs = match opts.timing {
+        ekf::Timing::WheelEpochs => drive.wheels.len(),
+        ekf::Timing::EachMeasurement => events,
+    };
+    let buffers = if rayon::current_thread_index().is_some() {
+        1
+    } else {
+        4
+    };
+    let c = std::mem::size_of::<Checkpoint<'_, L, N>>() + FEEDER_HEAP_BYTES;
+    let b = std::mem::size_of::<Epoch<N>>();
+    let s = (epochs as f64 * c as f64 / (buffers * b) as f64).sqrt();
+    (s as usize).max(MIN_SEGMENT)
+}
 
 struct Checkpoint<'a, L: Layout<N>, const N: usize> {
     filter: Filter<L, N>,
+    /// The feeder without its wheel monitor ([`Feeder::resume_point`]).
     feeder: Feeder,
     events: DriveEvents<'a>,
     /// Epochs run before this checkpoint.
     epochs_before: usize,
 }
 
+/// What the forward pass keeps.
+struct Forward<'a, L: Layout<N>, const N: usize> {
+    /// A checkpoint every about √N epochs.
+    cps: Vec<Checkpoint<'a, L, N>>,
+    /// The number of epochs.
+    total: usize,
+    /// The filter's counters.
+    stats: FilterStats,
+    /// The wheel monitor's verdicts, which the re-runs replay.
+    verdicts: Arc<[Verdict]>,
+}
+
 /// The forward pass: `f` run over `drive` keeping only a checkpoint every
-/// about √N epochs. Returns the checkpoints, the number of epochs and the
-/// filter's counters.
+/// about √N epochs.
 fn forward<'a, L: Layout<N>, const N: usize>(
     drive: &'a Drive,
     f: Filter<L, N>,
     opts: &FilterOptions,
     standstill: bool,
-) -> Result<(Vec<Checkpoint<'a, L, N>>, usize, FilterStats), Error> {
+) -> Result<Forward<'a, L, N>, Error> {
     let (feeder, events) = ekf::feed(drive, opts, f.time_s());
     // The aided filter's standstill (crate::standstill), as its run had it.
     let mut feeder = if standstill {
@@ -66,26 +121,15 @@ fn forward<'a, L: Layout<N>, const N: usize>(
     } else {
         feeder
     };
-    // The forward pass keeps no predictions; the re-runs do.
+    // The forward pass keeps no predictions; the re-runs do. It records
+    // the wheel monitor's verdicts, which the re-runs replay.
     feeder.keep_predictions(false);
-    let total_events = drive.wheels.len()
-        + drive.yaw_rate.len()
-        + drive.speed.len()
-        + drive.steering.len()
-        + drive.gnss.len();
-    // On one of rayon's workers the backward pass re-runs one segment at a
-    // time through one buffer instead of four ([`backward`]): segments
-    // [`WORKER_SEGMENT_FACTOR`] times as long there.
-    let per = if rayon::current_thread_index().is_some() {
-        WORKER_SEGMENT_FACTOR
-    } else {
-        1
-    };
-    let segment = ((total_events as f64).sqrt() as usize * per).max(MIN_SEGMENT);
+    feeder.record_verdicts();
+    let segment = segment_len::<L, N>(drive, opts);
 
     let mut cps = vec![Checkpoint {
         filter: f.clone(),
-        feeder: feeder.clone(),
+        feeder: feeder.resume_point(),
         events: events.clone(),
         epochs_before: 0,
     }];
@@ -97,7 +141,7 @@ fn forward<'a, L: Layout<N>, const N: usize>(
         if n >= cps.last().map_or(0, |c| c.epochs_before) + segment {
             cps.push(Checkpoint {
                 filter: f.clone(),
-                feeder: feeder.clone(),
+                feeder: feeder.resume_point(),
                 events: events.clone(),
                 epochs_before: n,
             });
@@ -109,19 +153,31 @@ fn forward<'a, L: Layout<N>, const N: usize>(
     if cps.last().is_some_and(|c| c.epochs_before == total) && cps.len() > 1 {
         cps.pop();
     }
-    Ok((cps, total, stats))
+    Ok(Forward {
+        cps,
+        total,
+        stats,
+        verdicts: feeder.take_verdicts(),
+    })
 }
 
 impl<L: Layout<N>, const N: usize> Checkpoint<'_, L, N> {
     /// Re-runs the filter from this checkpoint to epoch `end` (exclusive),
-    /// recording the epochs into `buf` (cleared first).
-    fn rerun(&self, end: usize, buf: &mut Vec<Epoch<N>>) -> Result<(), Error> {
+    /// recording the epochs into `buf` (cleared first), with the forward
+    /// pass's wheel verdicts.
+    fn rerun(
+        &self,
+        end: usize,
+        verdicts: &Arc<[Verdict]>,
+        buf: &mut Vec<Epoch<N>>,
+    ) -> Result<(), Error> {
         let (mut f, mut feeder, mut events) = (
             self.filter.clone(),
             self.feeder.clone(),
             self.events.clone(),
         );
         feeder.keep_predictions(true);
+        feeder.replay_verdicts(Arc::clone(verdicts));
         buf.clear();
         // The segment's epochs exactly: no doubled capacity to carry.
         buf.reserve_exact(end.saturating_sub(self.epochs_before));
@@ -162,6 +218,7 @@ impl<L: Layout<N>, const N: usize> Checkpoint<'_, L, N> {
 fn backward<'a, L: Layout<N>, const N: usize>(
     cps: &[Checkpoint<'a, L, N>],
     total: usize,
+    verdicts: &Arc<[Verdict]>,
     mut visit: impl FnMut(usize, &mut Vec<Epoch<N>>) -> Result<(), Error> + Send,
 ) -> Result<(), Error>
 where
@@ -177,7 +234,7 @@ where
     if rayon::current_thread_index().is_some() {
         let mut buf = Vec::new();
         for j in (0..cps.len()).rev() {
-            cps[j].rerun(end_of(j), &mut buf)?;
+            cps[j].rerun(end_of(j), verdicts, &mut buf)?;
             visit(j, &mut buf)?;
         }
         return Ok(());
@@ -188,11 +245,11 @@ where
         let [b1, b0] = bufs;
         match hi - lo {
             0 => Ok(()),
-            1 => cps[lo].rerun(end_of(lo), b1),
+            1 => cps[lo].rerun(end_of(lo), verdicts, b1),
             _ => {
                 let (r1, r0) = rayon::join(
-                    || cps[hi - 1].rerun(end_of(hi - 1), b1),
-                    || cps[hi - 2].rerun(end_of(hi - 2), b0),
+                    || cps[hi - 1].rerun(end_of(hi - 1), verdicts, b1),
+                    || cps[hi - 2].rerun(end_of(hi - 2), verdicts, b0),
                 );
                 r1.and(r0)
             }
@@ -243,7 +300,12 @@ pub fn smooth_car_columns<L: Layout<N> + Send + Sync, const N: usize>(
     f: Filter<L, N>,
     opts: &FilterOptions,
 ) -> Result<(Vec<f64>, Vec<State>, FilterStats), Error> {
-    let (cps, total, stats) = forward(drive, f, opts, false)?;
+    let Forward {
+        cps,
+        total,
+        stats,
+        verdicts,
+    } = forward(drive, f, opts, false)?;
     if total == 0 {
         return Ok((Vec::new(), Vec::new(), stats));
     }
@@ -252,7 +314,7 @@ pub fn smooth_car_columns<L: Layout<N> + Send + Sync, const N: usize>(
     let mut out_x = vec![State::zeros(); total];
     // The first epoch of the following segment and its smoothed state.
     let mut next: Option<(Epoch<N>, SVector<f64, N>)> = None;
-    backward(&cps, total, |j, buf| {
+    backward(&cps, total, &verdicts, |j, buf| {
         let end = cps.get(j + 1).map_or(total, |c| c.epochs_before);
         let before = cps[j].epochs_before;
         // The epoch after the segment's last and its smoothed state: the
@@ -319,13 +381,18 @@ pub fn smooth_each<L: Layout<N> + Send + Sync, const N: usize>(
     standstill: bool,
     mut visit: impl FnMut(&Smoothed<N>) + Send,
 ) -> Result<usize, Error> {
-    let (cps, total, _) = forward(drive, f, opts, standstill)?;
+    let Forward {
+        cps,
+        total,
+        verdicts,
+        ..
+    } = forward(drive, f, opts, standstill)?;
     if total == 0 {
         return Ok(0);
     }
     // The first epoch of the following segment and its smoothed state.
     let mut next: Option<(Epoch<N>, Smoothed<N>)> = None;
-    backward(&cps, total, |_, buf| {
+    backward(&cps, total, &verdicts, |_, buf| {
         let (carried, mut s1) = match next.take() {
             Some(n) => n,
             None => {

@@ -384,11 +384,12 @@ impl<L: Layout<N>, const N: usize> Filter<L, N> {
         self.p
             .fixed_view_mut::<{ model::N }, { model::N }>(0, 0)
             .copy_from(&n11);
-        // Column j ≥ 5 (its car rows) and its mirror, row j of the car columns.
+        // Column j ≥ 5 (its car rows) and its mirror, row j of the car
+        // columns (F's shape checked by `propagate_covariance` above).
         let (car_cols, param_cols) = self.p.data.0.split_at_mut(model::N);
         for (j, col) in param_cols.iter_mut().enumerate() {
             let head: [f64; model::N] = std::array::from_fn(|i| col[i]);
-            let nc = model::jacobian_times(&f5, &head);
+            let nc = model::shaped_times(&f5, &head);
             for (i, (&v, car_col)) in nc.iter().zip(car_cols.iter_mut()).enumerate() {
                 col[i] = v;
                 car_col[model::N + j] = v;

@@ -152,6 +152,17 @@ pub fn jacobian_slipping(x: &State, dt: f64, slip_gradient: f64) -> Mat {
 #[inline]
 pub fn jacobian_times(f: &Mat, c: &[f64; N]) -> [f64; N] {
     debug_assert!(has_jacobian_shape(f));
+    shaped_times(f, c)
+}
+
+/// [`jacobian_times`] without its `debug_assert!` of `f`'s shape, for a
+/// caller that checked it once for every column it multiplies (the check,
+/// 25 comparisons, made for each of the 10–16 columns of a prediction was
+/// 5.8 % of the default `calibrate`'s CPU time in the `ci` profile, which
+/// keeps debug assertions: `perf record` on the 10-minute drive,
+/// docs/performance.md, "Ninth round").
+#[inline]
+pub(crate) fn shaped_times(f: &Mat, c: &[f64; N]) -> [f64; N] {
     let (a, b, e) = (f[(X, YAW)], f[(X, V)], f[(X, YAW_RATE)]);
     let (g, h, k) = (f[(Y, YAW)], f[(Y, V)], f[(Y, YAW_RATE)]);
     let l = f[(YAW, YAW_RATE)];
@@ -169,17 +180,19 @@ pub fn jacobian_times(f: &Mat, c: &[f64; N]) -> [f64; N] {
 /// [`crate::kalman::predict_covariance`] to the last bit (but for the sign of
 /// a zero) in about a fifth of the operations.
 pub fn propagate_covariance(p: &Mat, f: &Mat, q: &Mat) -> Mat {
+    // The shape checked once for the ten products below.
+    debug_assert!(has_jacobian_shape(f));
     // A = F P, column by column.
     let mut a = Mat::zeros();
     for j in 0..N {
         let col: [f64; N] = std::array::from_fn(|i| p[(i, j)]);
-        a.column_mut(j).copy_from_slice(&jacobian_times(f, &col));
+        a.column_mut(j).copy_from_slice(&shaped_times(f, &col));
     }
     // (A Fᵀ)ᵀ = F Aᵀ: row i of A Fᵀ is F times row i of A.
     let mut pp = Mat::zeros();
     for i in 0..N {
         let row: [f64; N] = std::array::from_fn(|k| a[(i, k)]);
-        let r = jacobian_times(f, &row);
+        let r = shaped_times(f, &row);
         for j in 0..N {
             pp[(i, j)] = r[j] + q[(i, j)];
         }

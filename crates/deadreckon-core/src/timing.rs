@@ -298,4 +298,4 @@ pub use corrections::{
     wheel_half_period_s, Corrections, KnownCorrections, Which,
 };
 pub use gnss::{gnss_delay, regress_gnss, states_at_fixes, REFERENCE_WHEEL_ROWS};
-pub use scalar::{gyro_delay, scalar_delay, speed_delay, steering_delay};
+pub use scalar::{gyro_delay, scalar_delay, speed_delay, steering_delay, TimedSample};

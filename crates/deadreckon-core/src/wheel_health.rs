@@ -38,11 +38,19 @@
 //! least `min_drop_s`. While it is out its residual is taken against the other
 //! sensors alone, so a wheel that stays wrong stays out. Each dropped stretch
 //! is recorded with the reason and counted per wheel ([`WheelHealth`]).
+//!
+//! A run's verdicts (which wheel went out or came back, at which check) can
+//! be recorded and replayed ([`Verdicts`]): the checkpointed smoother
+//! ([`crate::checkpoint`]) re-runs stretches of its forward pass with the
+//! verdicts that pass reached instead of a copy of the monitor's windows in
+//! every checkpoint.
 
 use std::collections::VecDeque;
+use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 
+use crate::event::Measurement;
 use crate::filter::{Filter, Layout};
 use crate::model::V;
 
@@ -305,6 +313,33 @@ pub enum WheelReading {
     },
 }
 
+impl WheelReading {
+    /// A wheel row's four readings over `interval_s` (`None`: `m` is not a
+    /// wheel row).
+    pub fn of_row(m: &Measurement, interval_s: f64) -> Option<[Option<WheelReading>; 4]> {
+        Some(match *m {
+            Measurement::WheelTicks { fl, fr, rl, rr } => [fl, fr, rl, rr].map(|z| {
+                Some(WheelReading::Ticks {
+                    ticks: z as f64,
+                    interval_s,
+                })
+            }),
+            Measurement::WheelSpeeds {
+                fl_mps,
+                fr_mps,
+                rl_mps,
+                rr_mps,
+            } => [fl_mps, fr_mps, rl_mps, rr_mps].map(|z| {
+                Some(WheelReading::Speed {
+                    speed_mps: z,
+                    interval_s,
+                })
+            }),
+            _ => return None,
+        })
+    }
+}
+
 /// The monitor; see the module documentation.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct WheelMonitor {
@@ -468,5 +503,118 @@ impl WheelMonitor {
                 }
             }
         }
+    }
+}
+
+/// One verdict of the monitor: at its `check`-th check of a run (counted
+/// from the start of the recording), wheel `wheel` went out of the fusion
+/// (`excluded`) or came back.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Verdict {
+    check: u64,
+    wheel: u8,
+    excluded: bool,
+}
+
+/// The monitor's verdicts of one run, recorded or replayed.
+///
+/// The monitor changes the filter only through its verdicts
+/// ([`Filter::set_wheel_excluded`], after an epoch's updates). A run that
+/// records them ([`Verdicts::recording`]) can hand a re-run of any stretch
+/// of it (the same events in the same order from a saved filter) the
+/// verdicts instead of the monitor: the re-run takes the same wheels out
+/// and back at the same checks, so its epochs are the run's bit for bit,
+/// and the saved copy ([`Verdicts::resume_point`]) holds two counters
+/// instead of the monitor's windows (about 63 KB on the bench's hour, most
+/// of a checkpoint of [`crate::checkpoint`]: docs/performance.md, "Ninth
+/// round"). Outside a recording or a replay the checks are not counted:
+/// a feeder's verdicts are then the default and compare equal to a saved
+/// and loaded feeder's.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Verdicts {
+    /// Checks so far, while recording or replaying.
+    checks: u64,
+    /// The verdicts so far of a run recording them.
+    recorded: Option<Vec<Verdict>>,
+    /// The verdicts of the run being replayed, the next at `next`.
+    replay: Option<Arc<[Verdict]>>,
+    next: usize,
+}
+
+impl Verdicts {
+    /// Verdicts that record from now on.
+    pub fn recording() -> Self {
+        Verdicts {
+            recorded: Some(Vec::new()),
+            ..Verdicts::default()
+        }
+    }
+
+    /// Where a re-run resumes from this point of a recording: the checks
+    /// so far and the index of the next verdict, with nothing recorded and
+    /// nothing to replay yet ([`Verdicts::replaying`]).
+    pub fn resume_point(&self) -> Self {
+        Verdicts {
+            checks: self.checks,
+            recorded: None,
+            replay: None,
+            next: self.recorded.as_ref().map_or(self.next, Vec::len),
+        }
+    }
+
+    /// These verdicts replaying `all` (a whole recording, from
+    /// [`Verdicts::take_recorded`]) from their resume point.
+    pub fn replaying(self, all: Arc<[Verdict]>) -> Self {
+        Verdicts {
+            replay: Some(all),
+            recorded: None,
+            ..self
+        }
+    }
+
+    /// What was recorded (empty when nothing was), recording no more.
+    pub fn take_recorded(&mut self) -> Arc<[Verdict]> {
+        self.recorded.take().unwrap_or_default().into()
+    }
+
+    /// One check of an epoch's wheel `readings`: by `monitor` where there
+    /// is one ([`WheelMonitor::check`]; its verdicts recorded when
+    /// recording), else the replayed run's verdicts of this check.
+    pub fn check<L: Layout<N>, const N: usize>(
+        &mut self,
+        monitor: Option<&mut WheelMonitor>,
+        f: &mut Filter<L, N>,
+        readings: [Option<WheelReading>; 4],
+    ) {
+        match monitor {
+            Some(mon) => {
+                let Some(rec) = self.recorded.as_mut() else {
+                    mon.check(f, readings);
+                    return;
+                };
+                let before: [bool; 4] = std::array::from_fn(|i| f.wheel_excluded(i));
+                mon.check(f, readings);
+                for (i, was) in before.into_iter().enumerate() {
+                    let now = f.wheel_excluded(i);
+                    if now != was {
+                        rec.push(Verdict {
+                            check: self.checks,
+                            wheel: i as u8,
+                            excluded: now,
+                        });
+                    }
+                }
+            }
+            None => {
+                let Some(all) = self.replay.as_ref() else {
+                    return;
+                };
+                while let Some(v) = all.get(self.next).filter(|v| v.check == self.checks) {
+                    f.set_wheel_excluded(usize::from(v.wheel), v.excluded);
+                    self.next += 1;
+                }
+            }
+        }
+        self.checks += 1;
     }
 }

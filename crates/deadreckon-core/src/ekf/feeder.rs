@@ -2,6 +2,8 @@
 //! the two timing schemes, causally (see the module documentation of
 //! [`crate::ekf`]).
 
+use std::sync::Arc;
+
 use serde::{Deserialize, Serialize};
 
 use super::{FilterOptions, FilterStats, SensorSet, Timing, WheelRows};
@@ -11,7 +13,7 @@ use crate::filter::{Filter, Layout, Prediction, SensorKind, Update};
 use crate::gyro_hold::GyroHold;
 use crate::standstill::Standstill;
 use crate::tick_interval::CountingInterval;
-use crate::wheel_health::{WheelHealth, WheelMonitor, WheelReading};
+use crate::wheel_health::{Verdict, Verdicts, WheelHealth, WheelMonitor, WheelReading};
 use crate::Error;
 
 /// Wheel intervals longer than this many times the median interval are gaps:
@@ -66,6 +68,10 @@ pub struct Feeder {
     /// The wheel-health monitor, when asked for.
     #[serde(default)]
     monitor: Option<WheelMonitor>,
+    /// The monitor's verdicts, recorded or replayed (not saved: a stream
+    /// neither records nor replays).
+    #[serde(skip)]
+    verdicts: Verdicts,
     /// When a wheel row is used (a feeder saved before this was chosen
     /// goes on as it began: [`WheelRows::Instant`]).
     #[serde(default = "instant")]
@@ -136,6 +142,7 @@ impl Feeder {
             gated_fix_t_s: None,
             predictions: opts.record_epochs,
             monitor: opts.wheel_monitor.map(WheelMonitor::new),
+            verdicts: Verdicts::default(),
             wheel_rows: opts.wheel_rows_for(vehicle),
             interval_gyro: Vec::new(),
             interval_speed: Vec::new(),
@@ -199,37 +206,44 @@ impl Feeder {
     }
 
     /// Hands the epoch's wheel readings to the monitor (after the epoch's
-    /// updates: it compares them with the updated state).
+    /// updates: it compares them with the updated state), or replays its
+    /// recorded verdicts ([`Verdicts`]).
     fn monitor_wheels<L: Layout<N>, const N: usize>(
         &mut self,
         f: &mut Filter<L, N>,
         m: &Measurement,
         interval_s: f64,
     ) {
-        let Some(mon) = self.monitor.as_mut() else {
-            return;
-        };
-        let readings = match *m {
-            Measurement::WheelTicks { fl, fr, rl, rr } => [fl, fr, rl, rr].map(|z| {
-                Some(WheelReading::Ticks {
-                    ticks: z as f64,
-                    interval_s,
-                })
-            }),
-            Measurement::WheelSpeeds {
-                fl_mps,
-                fr_mps,
-                rl_mps,
-                rr_mps,
-            } => [fl_mps, fr_mps, rl_mps, rr_mps].map(|z| {
-                Some(WheelReading::Speed {
-                    speed_mps: z,
-                    interval_s,
-                })
-            }),
-            _ => return,
-        };
-        mon.check(f, readings);
+        if let Some(readings) = WheelReading::of_row(m, interval_s) {
+            self.verdicts.check(self.monitor.as_mut(), f, readings);
+        }
+    }
+
+    /// From now on, records the wheel monitor's verdicts
+    /// ([`Feeder::take_verdicts`]).
+    pub(crate) fn record_verdicts(&mut self) {
+        self.verdicts = Verdicts::recording();
+    }
+
+    /// The verdicts recorded since [`Feeder::record_verdicts`].
+    pub(crate) fn take_verdicts(&mut self) -> Arc<[Verdict]> {
+        self.verdicts.take_recorded()
+    }
+
+    /// This feeder without its wheel monitor, to re-run from here with the
+    /// recorded run's verdicts ([`Feeder::replay_verdicts`]): the same
+    /// epochs, without a copy of the monitor's windows.
+    pub(crate) fn resume_point(&self) -> Feeder {
+        Feeder {
+            monitor: None,
+            verdicts: self.verdicts.resume_point(),
+            ..self.clone()
+        }
+    }
+
+    /// A [`Feeder::resume_point`] replaying `all`, the whole recording.
+    pub(crate) fn replay_verdicts(&mut self, all: Arc<[Verdict]>) {
+        self.verdicts = std::mem::take(&mut self.verdicts).replaying(all);
     }
 
     /// From now on, feeds no GNSS (fixes nor courses; a fix waiting for the
