@@ -90,6 +90,8 @@ pub enum ModelChoice {
     /// calibrated heading has the smallest residual on the held-back quarter
     /// of its window (not on the data it was fitted on); in the per-metre form
     /// (a GNSS course) the paper, distance and baseline kinds are candidates.
+    /// A speed kind the physical acceptance passed (its ω·d² term
+    /// significant) leaves out the kinds it nests ([`ModelKind::nests`]).
     Auto,
     /// Always this kind.
     Fixed(ModelKind),

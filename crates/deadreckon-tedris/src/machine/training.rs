@@ -252,7 +252,6 @@ impl Tedris {
         }
         let Some(old) = &self.model else { return };
         let guarded = old.complete && old.config.joint_calibration();
-        let kind = old.chosen;
         let convention = old.course_convention;
         let scale = old.distance_scale;
         let (gain, per_metre, dist, dcf, joint) = (
@@ -268,15 +267,6 @@ impl Tedris {
             old.dcf_std_rad,
         );
         if let Ok(mut m) = old.refit() {
-            // The kind the calibrations chose stays (the calibrated values
-            // below are that kind's); the refit's own choice is the block
-            // BIC's, which never looked at the calibrated heading. Keeping
-            // the refit's choice once put tick car 8 of the dynamic family
-            // on the baseline kind with the speed kind's turn gain until
-            // the next calibration.
-            if joint && m.fits.iter().any(|f| f.kind == kind) {
-                m.chosen = kind;
-            }
             m.turn_gain = gain;
             m.turn_gain_std = gain_std;
             m.distance_scale = scale;
