@@ -56,17 +56,6 @@ impl ModelKind {
         }
     }
 
-    /// True when `other` is this kind with columns left out: its regressors
-    /// are a proper subset of this kind's (the speed kind nests the paper,
-    /// distance and baseline kinds).
-    pub fn nests(self, other: ModelKind) -> bool {
-        self != other
-            && other
-                .regressors()
-                .iter()
-                .all(|r| self.regressors().contains(r))
-    }
-
     /// The snake-case name.
     pub fn name(self) -> &'static str {
         match self {
@@ -90,8 +79,6 @@ pub enum ModelChoice {
     /// calibrated heading has the smallest residual on the held-back quarter
     /// of its window (not on the data it was fitted on); in the per-metre form
     /// (a GNSS course) the paper, distance and baseline kinds are candidates.
-    /// A speed kind the physical acceptance passed (its ω·d² term
-    /// significant) leaves out the kinds it nests ([`ModelKind::nests`]).
     Auto,
     /// Always this kind.
     Fixed(ModelKind),
@@ -401,23 +388,4 @@ impl TedrisConfig {
 
 fn default_max_distance_scale_error() -> f64 {
     0.05
-}
-
-#[cfg(test)]
-mod tests {
-    use super::ModelKind;
-
-    #[test]
-    fn the_speed_kind_nests_the_kinds_without_its_speed_term() {
-        for k in [ModelKind::Paper, ModelKind::Distance, ModelKind::Baseline] {
-            assert!(ModelKind::Speed.nests(k), "{k:?}");
-            assert!(!k.nests(ModelKind::Speed), "{k:?}");
-        }
-        // ARX has columns the speed kind lacks; no kind nests itself.
-        assert!(!ModelKind::Speed.nests(ModelKind::Arx));
-        assert!(!ModelKind::Arx.nests(ModelKind::Speed));
-        assert!(ModelKind::ALL.iter().all(|&k| !k.nests(k)));
-        assert!(ModelKind::Distance.nests(ModelKind::Paper));
-        assert!(ModelKind::Distance.nests(ModelKind::Baseline));
-    }
 }

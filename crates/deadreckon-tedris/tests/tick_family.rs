@@ -195,20 +195,17 @@ fn tick_family_dev_members_80s_outages() {
     // 4.04 m against 7.53 m, was 4.14 against 7.56; 109–116: 6.46 m
     // against 7.18 m, was 6.26 against 7.42).
     //
-    // Since a usable speed kind (its ω·d² term significant) keeps the kinds
-    // it nests out of the calibration's choice, and a rebuilt model keeps
-    // the heading per metre (`cargo test --workspace --profile ci --test
-    // tick_family -- --nocapture`): cars 1–3 read TedriS 3.53 m (worst
-    // 7.98 m: car 1's [120, 200); car 1's [200, 280) 3.47 m) against the
-    // block baseline's 7.41 m, lower on 3 of 3. Dev cars 1–9
-    // (`TEDRIS_TICK_CARS=1,...,9`): 6.61 m (worst 45.68 m: car 9's
-    // [200, 280), baseline 44.18 m) against 7.72 m, lower on 6 of 9 (above
-    // on 4: 13.95 m against 11.67 m; 7: 3.03 against 2.08; 8: 9.35 against
-    // 7.24). The bounds follow these figures.
+    // The bounds follow the dev cars' figures with each ring at its own
+    // phase: before issue 35 they read 74.0 m. Tried and withdrawn (the
+    // held-out cars 109–116 went from 6.46 to 10.74 m; docs/tedris.md):
+    // keeping the kinds a significant speed term nests out of the
+    // calibration's choice, and a rebuilt model keeping the heading per
+    // metre, which read 3.53 m (worst 7.98 m) on cars 1–3 and 6.61 m on
+    // cars 1–9.
     eprintln!("cars {cars:?}: tedris {t:.2} m, block baseline {b:.2} m, worst {worst:.2} m");
     if cars == [1, 2, 3] {
-        assert!(t < 4.0, "TedriS mean {t} m (measured 3.53 m)");
-        assert!(worst < 9.0, "TedriS worst {worst} m (measured 7.98 m)");
+        assert!(t < 7.0, "TedriS mean {t} m (measured 6.31 m)");
+        assert!(worst < 36.0, "TedriS worst {worst} m (measured 32.80 m)");
         assert!(b > 6.0, "block baseline {b} m (measured 7.41 m)");
     }
 }
@@ -425,38 +422,4 @@ fn the_speed_kind_without_loaded_tyres_is_refused() {
         .expect("the speed kind refused");
     assert!(r.reason.contains("speed term"), "{}", r.reason);
     assert_ne!(model.chosen, ModelKind::Speed);
-}
-
-/// Tick car 1's [200, 280) outage read 32.8 m against the block baseline's
-/// 5.9 m: the speed kind (its ω·d² term significant, so accepted) was
-/// replaced by the held-back choice with kinds it nests — the baseline kind
-/// at 63 s of the run drive, the paper kind at 193 s — which over-turned
-/// the fast right turn just before the outage by 0.055 rad and drifted
-/// 0.066 rad on the 80 s straight after. The kinds without the significant
-/// term are no longer candidates; the speed kind holds through the run.
-#[test]
-fn the_held_back_choice_dropped_the_significant_speed_term_tick_car_1() {
-    let car = DynamicCar::draw_tick_counter(1);
-    let effects = Effects::all();
-    let train_drive = simulate(&car.drive(1001, 900.0, &effects), 1001)
-        .expect("train drive")
-        .drive;
-    let test_drive = simulate(&car.drive(2001, 500.0, &effects), 2001)
-        .expect("test drive")
-        .drive;
-    let (model, _) = train(&train_drive, TedrisConfig::default(), None).expect("trained");
-    assert_eq!(model.chosen, ModelKind::Speed);
-    let o = Outage {
-        start_s: 200.0,
-        end_s: 280.0,
-    };
-    let run = run_outages(&test_drive, &model, &[o]).expect("run");
-    let held = run.machine.model().expect("a model");
-    let base = Baseline::fit_blocks(&train_drive, 2.0).expect("block baseline");
-    let b = base.run_outage(&test_drive, &o).expect("baseline run");
-    let t = run.outages[0].mean_error_m();
-    eprintln!("tedris {t:.2} m, block baseline {:.2} m", b.mean_error_m());
-    // Measured: 3.47 m against the block baseline's 5.94 m (32.80 m before).
-    assert_eq!(held.chosen, ModelKind::Speed);
-    assert!(t < 5.0 && t < b.mean_error_m(), "{t} m");
 }

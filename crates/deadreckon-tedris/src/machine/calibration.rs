@@ -332,30 +332,17 @@ impl Tedris {
 
 /// The kinds a joint calibration tries: every usable kind with the
 /// automatic choice, else the chosen one.
-///
-/// A usable speed kind passed the physical acceptance, whose t test found
-/// its ω·d² term significant (`tuning::SPEED_TERM_TEST_LEVEL`): the kinds
-/// it nests (paper, distance, baseline: its columns without ω·d²) then omit
-/// a term the blocks show is there, and are not candidates. The held-back
-/// quarter alone (about 150 s of cumulative heading) could not tell them
-/// apart: on the tick family's dev car 1 it moved the speed kind's model to
-/// the baseline kind at 63 s of the run drive and to the paper kind at
-/// 193 s, which over-turned the right turn before the [200, 280) outage by
-/// 0.055 rad and drifted 0.066 rad on the straight after (32.8 m; the speed
-/// kind 3.5 m, the block baseline 5.9 m).
 fn calibration_kinds(model: &TedrisModel) -> Vec<crate::config::ModelKind> {
-    use crate::config::ModelKind;
-    if model.config.model != crate::config::ModelChoice::Auto {
-        return vec![model.chosen];
+    if model.config.model == crate::config::ModelChoice::Auto {
+        model
+            .fits
+            .iter()
+            .map(|f| f.kind)
+            .filter(|k| model.kind_usable(*k))
+            .collect()
+    } else {
+        vec![model.chosen]
     }
-    let usable = |k: ModelKind| model.fits.iter().any(|f| f.kind == k) && model.kind_usable(k);
-    let speed_term = usable(ModelKind::Speed);
-    model
-        .fits
-        .iter()
-        .map(|f| f.kind)
-        .filter(|&k| usable(k) && !(speed_term && ModelKind::Speed.nests(k)))
-        .collect()
 }
 
 /// What the refit guard decided ([`Tedris::refit_verdict`]).

@@ -166,19 +166,9 @@ impl Tedris {
         match TedrisModel::fit(c.clone(), period, lag, ccf, repos, blocks) {
             Ok(mut model) => {
                 model.per_metre_straight = per_metre;
-                // A rebuilt model keeps the scale (the tyres did not change),
-                // and in the per-metre form the calibrated heading per metre
-                // on a straight line (unequal rear radii) until a calibration
-                // replaces it: rebuilt from a run drive's first minute (the
-                // course convention decided there), tick car 22 of the
-                // dynamic family ran 160 s with none, 2·10⁻³ rad/m of
-                // drift, and ended its [120, 200) outage 166 m off.
+                // A rebuilt model keeps the scale (the tyres did not change).
                 if let Some(old) = &self.model {
                     model.distance_scale = old.distance_scale;
-                    if per_metre && old.per_metre_straight {
-                        model.dcf_distance_rad_per_m = old.dcf_distance_rad_per_m;
-                        model.dcf_distance_std_rad_per_m = old.dcf_distance_std_rad_per_m;
-                    }
                 }
                 model.course_convention = self
                     .model
