@@ -251,15 +251,8 @@ impl CarFamily {
             sensors: SensorsSpec {
                 wheels,
                 gyro: Some(ScalarSpec {
-                    rate_hz: 100.0,
                     offset_s: between(r, 0.0, 0.01),
-                    noise_std: 0.003,
-                    latency_s: 0.0,
-                    scale_error: 0.0,
-                    tilt_deg: None,
-                    bias_drift_std_rps: 0.0,
-                    bias_drift_tau_s: 300.0,
-                    clock: None,
+                    ..ScalarSpec::plain(100.0, 0.003)
                 }),
                 speed: None,
                 steering: None,
@@ -321,17 +314,7 @@ pub fn good_gyro_car(seed: u64, drive_seed: u64) -> (Scenario, f64) {
     if let Some(g) = s.sensors.gyro.as_mut() {
         g.noise_std = gyro_rps;
     }
-    s.sensors.speed = Some(ScalarSpec {
-        rate_hz: 50.0,
-        offset_s: 0.0,
-        noise_std: 0.1,
-        latency_s: 0.0,
-        scale_error: 0.0,
-        tilt_deg: None,
-        bias_drift_std_rps: 0.0,
-        bias_drift_tau_s: 300.0,
-        clock: None,
-    });
+    s.sensors.speed = Some(ScalarSpec::plain(50.0, 0.1));
     (s, gyro_rps)
 }
 

@@ -108,6 +108,25 @@ pub struct ScalarSpec {
     pub clock: Option<ClockSpec>,
 }
 
+impl ScalarSpec {
+    /// A stream at `rate_hz` with white noise `noise_std` and nothing else:
+    /// on the sensor's clock, no offset, latency, scale error, tilt or
+    /// bias drift (the drift's τ at its default).
+    pub fn plain(rate_hz: f64, noise_std: f64) -> ScalarSpec {
+        ScalarSpec {
+            rate_hz,
+            offset_s: 0.0,
+            noise_std,
+            latency_s: 0.0,
+            scale_error: 0.0,
+            tilt_deg: None,
+            bias_drift_std_rps: 0.0,
+            bias_drift_tau_s: default_bias_drift_tau(),
+            clock: None,
+        }
+    }
+}
+
 fn default_bias_drift_tau() -> f64 {
     300.0
 }
