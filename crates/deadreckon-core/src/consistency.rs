@@ -285,6 +285,12 @@ pub struct WindowErrors {
 
 impl WindowErrors {
     /// The NEES of pose and motion with the covariance `reported` says.
+    ///
+    /// A covariance that cannot be inverted (the bound's with `k` = 0 has
+    /// no heading variance) claims an error of zero in some direction: its
+    /// NEES is +∞, over-confident without limit, unless the whole error is
+    /// exactly zero (0). Such a point is counted, never left out: a
+    /// block whose every point was left out used to read "consistent".
     pub fn consistency(&self, reported: &Reported) -> Result<Consistency, Error> {
         let k2 = reported.k * reported.k;
         let mut pose = vec![Vec::new(); WINDOW_POINTS.len()];
@@ -293,18 +299,23 @@ impl WindowErrors {
             let mut p3 = pe.pose_cov * k2;
             p3[(0, 0)] += reported.floor_m2;
             p3[(1, 1)] += reported.floor_m2;
-            if let Some(inv) = p3.try_inverse() {
-                pose[pe.point].push((pe.pose.transpose() * inv * pe.pose)[0]);
-            }
-            if let Some(inv) = (pe.motion_cov * k2).try_inverse() {
-                motion[pe.point].push((pe.motion.transpose() * inv * pe.motion)[0]);
-            }
+            pose[pe.point].push(nees(&pe.pose, p3));
+            motion[pe.point].push(nees(&pe.motion, pe.motion_cov * k2));
         }
         Ok(Consistency {
             outage_s: self.outage_s,
             pose: BlockNees::from_values("pose", 3, pose)?,
             motion: BlockNees::from_values("motion", 2, motion)?,
         })
+    }
+}
+
+/// `eᵀ P⁻¹ e`; +∞ where `P` cannot be inverted and `e` is not zero.
+fn nees<const D: usize>(e: &nalgebra::SVector<f64, D>, p: nalgebra::SMatrix<f64, D, D>) -> f64 {
+    match p.try_inverse() {
+        Some(inv) => (e.transpose() * inv * e)[0],
+        None if e.iter().all(|v| *v == 0.0) => 0.0,
+        None => f64::INFINITY,
     }
 }
 
@@ -439,5 +450,44 @@ mod tests {
         assert!((p - 6.0).abs() < 1e-9 && (m - 1.0).abs() < 1e-9);
         // The other points saw no window.
         assert!(e.consistency(&Reported::FILTER).unwrap().pose.values[0].is_empty());
+    }
+
+    #[test]
+    fn a_covariance_without_heading_variance_read_as_consistent() {
+        // The bound's covariance with k = 0: a floor on the position and
+        // nothing on the heading. Its points were left out, and a block
+        // without points read "consistent"; a heading error against zero
+        // variance is over-confident without limit.
+        let pe = |yaw: f64| PointError {
+            point: 3,
+            pose: Vector3::new(0.5, -0.5, yaw),
+            pose_cov: Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, 0.01)),
+            motion: Vector2::new(0.1, 0.0),
+            motion_cov: Matrix2::identity(),
+        };
+        let zero_k = Reported {
+            k: 0.0,
+            floor_m2: 1.0,
+        };
+        let e = WindowErrors {
+            outage_s: 30.0,
+            windows: vec![vec![pe(0.02)], vec![pe(-0.01)]],
+        };
+        let c = e.consistency(&zero_k).unwrap();
+        assert_eq!(c.pose.points.len(), 1);
+        assert_eq!(c.pose.points[0].windows, 2);
+        assert_eq!(c.pose.verdict(), Verdict::OverConfident(f64::INFINITY));
+        assert_eq!(c.motion.verdict(), Verdict::OverConfident(f64::INFINITY));
+        // Only an error of exactly zero costs nothing against no variance.
+        let exact = WindowErrors {
+            outage_s: 30.0,
+            windows: vec![vec![PointError {
+                motion: Vector2::zeros(),
+                ..pe(0.0)
+            }]],
+        };
+        let c = exact.consistency(&zero_k).unwrap();
+        assert_eq!(c.pose.values[3][0], f64::INFINITY);
+        assert_eq!(c.motion.values[3][0], 0.0);
     }
 }

@@ -50,7 +50,9 @@
 
 use deadreckon_core::bound;
 use deadreckon_core::calibrate::{calibrate, CalibrationOptions};
-use deadreckon_core::consistency::{averaged_nees_bounds, nees_through_windows, windows, Verdict};
+use deadreckon_core::consistency::{
+    errors_through_windows, nees_through_windows, windows, Reported, Verdict,
+};
 use deadreckon_core::ekf::FilterOptions;
 use deadreckon_core::Params;
 use deadreckon_sim::family::CarFamily;
@@ -103,29 +105,6 @@ struct Member {
     pose_wander: Verdict,
 }
 
-/// The verdict on the NEES `values` (per point of the windows, `dof`
-/// degrees of freedom) with the covariance scaled by `variance_factor`:
-/// as `BlockNees::verdict`, the point farthest from its bounds.
-fn scaled_verdict(values: &[Vec<f64>], dof: usize, variance_factor: f64) -> Verdict {
-    let mut worst = (1.0, Verdict::Consistent);
-    for v in values.iter().filter(|v| !v.is_empty()) {
-        let mean = v.iter().sum::<f64>() / v.len() as f64 / variance_factor;
-        let (lo, hi) = averaged_nees_bounds(dof, v.len()).unwrap();
-        let n = dof as f64;
-        let (f, verdict) = if mean > hi {
-            (mean / n, Verdict::OverConfident(mean / n))
-        } else if mean < lo {
-            (n / mean, Verdict::UnderConfident(n / mean))
-        } else {
-            (1.0, Verdict::Consistent)
-        };
-        if f > worst.0 {
-            worst = (f, verdict);
-        }
-    }
-    worst.1
-}
-
 fn member(seed: u64) -> Result<Member, String> {
     let (s, gyro_rps) = scenario(seed, 100 + seed);
     let cal = simulate(&s, 100 + seed).map_err(|e| e.to_string())?;
@@ -136,7 +115,18 @@ fn member(seed: u64) -> Result<Member, String> {
     let (s, _) = scenario(seed, 200 + seed);
     let ev = simulate(&s, 200 + seed).map_err(|e| e.to_string())?;
     let w = windows(&ev.drive, 30.0, 60.0, 60.0);
-    let n = nees_through_windows(&ev.drive, params, &w, &FilterOptions::default())
+    let errors = errors_through_windows(&ev.drive, params, &w, &FilterOptions::default())
+        .map_err(|e| e.to_string())?;
+    let n = errors
+        .consistency(&Reported::FILTER)
+        .map_err(|e| e.to_string())?;
+    // The bound's factor alone on the filter's covariance (its floor left
+    // out): with k = 0 no heading variance is left, over-confident by ∞.
+    let bound = errors
+        .consistency(&Reported {
+            k: fit.k,
+            floor_m2: 0.0,
+        })
         .map_err(|e| e.to_string())?;
     let wander = deadreckon_core::wander_fit::fit(&cal.drive, params, &FilterOptions::default())
         .map_err(|e| e.to_string())?
@@ -155,7 +145,7 @@ fn member(seed: u64) -> Result<Member, String> {
         z_vehicle: z(&old.estimate.params, &old.estimate.std, &cal.truth_params),
         pose: n.pose.verdict(),
         k: fit.k,
-        pose_bound: scaled_verdict(&n.pose.values, n.pose.dof, fit.k * fit.k),
+        pose_bound: bound.pose.verdict(),
         wander,
         pose_wander: nw.pose.verdict(),
     })
