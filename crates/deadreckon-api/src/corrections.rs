@@ -103,6 +103,7 @@ fn held_back_json(h: &deadreckon_core::held_back::HeldBack) -> Value {
             "with_m": num(j.with_m),
             "against_m": num(j.against_m),
             "t": num(j.t),
+            "score_t": num(j.score_t),
             "applied": j.applied,
             "by_significance": j.by_significance,
         })).collect::<Vec<_>>(),

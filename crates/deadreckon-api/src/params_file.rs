@@ -233,6 +233,7 @@ mod tests {
             with_m: Some(0.61),
             against_m: Some(0.65),
             t: Some(-2.03),
+            score_t: None,
             applied,
             by_significance: !applied,
         };

@@ -342,6 +342,10 @@ pub struct JudgedTable {
     /// The paired t statistic.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub t: Option<f64>,
+    /// The receiver's wander: the paired t statistic of the hidden fixes'
+    /// log-likelihood (`held_back::Judged::score_t`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub score_t: Option<f64>,
     /// Whether it was applied.
     pub applied: bool,
     /// Applied by significance alone (written only when true).
@@ -481,6 +485,7 @@ pub fn corrections_tables(c: &Corrections, t: &mut ParamsTables) {
                         with_m: finite(j.with_m),
                         against_m: finite(j.against_m),
                         t: finite(j.t),
+                        score_t: finite(j.score_t),
                         applied: j.applied,
                         by_significance: j.by_significance,
                     },

@@ -161,11 +161,16 @@ pub fn held_back_line(h: &deadreckon_core::held_back::HeldBack) -> String {
                 )
             } else if j.with_m.is_finite() {
                 format!(
-                    "{} {:.3} m against {:.3} m, t {:+.1} ({})",
+                    "{} {:.3} m against {:.3} m, t {:+.1}{} ({})",
                     j.correction,
                     j.with_m,
                     j.against_m,
                     j.t,
+                    if j.score_t.is_finite() {
+                        format!(", the hidden fixes' likelihood t {:+.1}", j.score_t)
+                    } else {
+                        String::new()
+                    },
                     if j.applied { "applied" } else { "not applied" }
                 )
             } else {

@@ -44,6 +44,10 @@
 //! at −1 then 0): dev 0.375 / 1.744 / 3.042 / 1.275 → 0.377 / 1.534 /
 //! 2.873 / 1.306; held out 0.433 / 1.122 / 1.621 / 1.101 → 0.433 / 1.018 /
 //! 1.636 / 1.207 (all but the wander ×2.54 → ×2.79 of none).
+//! With the wander also applied where the hidden fixes are more likely
+//! under it (`held_back::wander_wins`, issue 36's fifth stop): dev 0.377 /
+//! 1.534 / 2.770 / 1.306; held out 0.433 / 0.978 / 1.644 / 1.207 (every
+//! effect ×3.80 of none).
 //!
 //! **After the GNSS delay's reference took each reading into its own wheel
 //! interval** (stop 50, code of b126f2f; `RAYON_NUM_THREADS=2

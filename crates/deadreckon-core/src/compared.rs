@@ -79,6 +79,11 @@ impl<P: Point> Position<P> {
     pub fn distance_to(&self, other: &Position<P>) -> f64 {
         (self.east_m - other.east_m).hypot(self.north_m - other.north_m)
     }
+
+    /// This position less another of the same point, `[east, north]`, m.
+    pub fn offset_from(&self, other: &Position<P>) -> [f64; 2] {
+        [self.east_m - other.east_m, self.north_m - other.north_m]
+    }
 }
 
 impl Position<RearAxle> {
@@ -175,6 +180,16 @@ pub struct OutageResult {
     /// hidden fix's noise; zero for the truth, and without
     /// `covariances_m2`).
     pub reference_m2: crate::bound::Cov2,
+    /// The last error as east and north, m (estimate less reference),
+    /// where the comparison is against fixes
+    /// ([`crate::outage::through_windows_against_fixes`]; `None` otherwise).
+    pub final_offset_m: Option<[f64; 2]>,
+    /// The log-likelihood of the last hidden fix under the dead
+    /// reckoning's own prediction of it: the antenna plus the wander the
+    /// filter still expects, with their covariance and the fix's declared
+    /// noise (`None` where not computed:
+    /// [`crate::outage::through_windows_against_fixes`] computes it).
+    pub fix_log_likelihood: Option<f64>,
 }
 
 impl OutageResult {
@@ -201,6 +216,8 @@ impl OutageResult {
             covariances_m2: Vec::new(),
             floor_m2: crate::bound::Cov2::circular(0.0),
             reference_m2: crate::bound::Cov2::circular(0.0),
+            final_offset_m: None,
+            fix_log_likelihood: None,
         }
     }
 

@@ -487,6 +487,7 @@ fn window_errors(
         .collect();
     let states: Vec<(f64, State)> = states.iter().filter(|s| inside(s)).copied().collect();
     let mut errors = Vec::new();
+    let mut last_offset = None;
     match truth {
         Some(t) => {
             for (k, (ts, x)) in states.iter().enumerate() {
@@ -513,6 +514,7 @@ fn window_errors(
                     let antenna = Position::<RearAxle>::new(x[X], x[Y]).antenna(x[YAW], lever);
                     let fix = Position::<Antenna>::new(g.east_m, g.north_m);
                     errors.push((g.t_s - t0, antenna.distance_to(&fix)));
+                    last_offset = Some(antenna.offset_from(&fix));
                     // The covariance of the last epoch at or before the fix.
                     let k = states.partition_point(|s| s.0 <= g.t_s).saturating_sub(1);
                     if let Some(c) = covs.get(k) {
@@ -547,6 +549,7 @@ fn window_errors(
             OutageResult::new::<Antenna>(start, end, Against::Gnss, errors, travelled, distance_m)
         }
     };
+    out.final_offset_m = last_offset;
     if cov_at.len() == out.errors.len() {
         out.covariances_m2 = cov_at;
         // The floor and the reference's own covariance hold for the whole
@@ -615,14 +618,33 @@ fn through_windows_in(
     // The gyro bias and the receiver's wander are carried where the
     // vehicle says so, as in `evaluate`, `run`'s tracks and `stream`.
     let mut hook = Collect::default();
+    // Against fixes, each window's last hidden fix is also scored: the
+    // epoch at or before it is kept (its state and covariance).
+    let last_fix: Vec<Option<usize>> = match truth {
+        Some(_) => Vec::new(),
+        None => windows.iter().map(|&w| last_fix_in(drive, w)).collect(),
+    };
+    let mut at_fix: Vec<Option<AtFix>> = vec![None; last_fix.len()];
+    let mut open = 0;
     let aided = Aided::run(drive, params, &opts, &mut |e| {
         hook.states.push((e.t_s, e.x));
         if e.wander_cov.is_some() {
             hook.wander.push(e.wander_m);
         }
+        while open < last_fix.len() && windows[open].1 < e.t_s {
+            open += 1;
+        }
+        for k in open..last_fix.len() {
+            if windows[k].0 >= e.t_s {
+                break;
+            }
+            if last_fix[k].is_some_and(|i| e.t_s <= drive.gnss[i].t_s) {
+                at_fix[k] = Some((e.x, pose_block(&e.p), e.wander_cov));
+            }
+        }
     })?;
     let mut out = Vec::new();
-    for &(a, b) in windows {
+    for (k, &(a, b)) in windows.iter().enumerate() {
         // Dead reckoning starts at the last epoch before the window.
         let i = hook.states.partition_point(|s| s.0 < a);
         let t0 = hook
@@ -643,6 +665,14 @@ fn through_windows_in(
             a,
             b,
         ) {
+            let mut w = w;
+            if let (Some(i), Some(Some(at)), Some(d)) = (
+                last_fix.get(k).copied().flatten(),
+                at_fix.get(k),
+                w.final_offset_m,
+            ) {
+                w.fix_log_likelihood = Some(fix_log_likelihood(drive, &drive.gnss[i], at, d));
+            }
             out.push(w);
         }
     }
@@ -655,6 +685,36 @@ fn through_windows_in(
         heading_limit_rad: f64::INFINITY,
         bias_switch: aided.bias_switch(),
     })
+}
+
+/// The car state, its pose covariance and the wander's part of the
+/// covariance at the last epoch at or before a window's last fix.
+type AtFix = (State, [[f64; 3]; 3], Option<WanderCov>);
+
+/// The index of the last fix inside `(a, b]`.
+fn last_fix_in(drive: &Drive, (a, b): (f64, f64)) -> Option<usize> {
+    let k = drive.gnss.partition_point(|g| g.t_s <= b);
+    (k > 0 && drive.gnss[k - 1].t_s > a).then(|| k - 1)
+}
+
+/// `ln N(d; 0, S)` of a hidden fix `fix` off the dead-reckoned antenna by
+/// `d` (east, north, m), with `S` the antenna's covariance at `at` (the
+/// pose's carried to the antenna, plus the wander's where the filter
+/// carries it) and the fix's declared noise, as the filter's update
+/// would take it.
+fn fix_log_likelihood(drive: &Drive, fix: &crate::drive::GnssFix, at: &AtFix, d: [f64; 2]) -> f64 {
+    let (x, p3, wander) = at;
+    let lever = drive.vehicle.gnss_lever_arm_m;
+    let antenna = Cov2::ahead(p3, x[YAW], lever);
+    let s = wander.map_or(antenna, |w| w.fix_cov(antenna, x[YAW], lever));
+    let r = crate::bound::receiver_std_m(fix).powi(2);
+    let (a, b, c) = (s.ee_m2 + r, s.en_m2, s.nn_m2 + r);
+    let det = a * c - b * b;
+    if det.is_nan() || det <= 0.0 {
+        return f64::NEG_INFINITY;
+    }
+    let nis = (c * d[0] * d[0] - 2.0 * b * d[0] * d[1] + a * d[1] * d[1]) / det;
+    -(2.0 * std::f64::consts::PI).ln() - 0.5 * det.ln() - 0.5 * nis
 }
 
 /// Every epoch's time and car state, and the receiver's wander estimate
@@ -719,5 +779,31 @@ mod window_tests {
             e.contains("100.000–110.000 s"),
             "the message names the drive's span: {e}"
         );
+    }
+
+    #[test]
+    fn a_hidden_fix_is_scored_by_the_dead_reckonings_own_prediction() {
+        // The car heading east (the lever along east), pose variances 1 and
+        // 4 m², no heading variance; the fix's own noise 1 m: S = diag(2, 5).
+        let mut d = drive();
+        d.vehicle.gnss_lever_arm_m = 1.0;
+        let fix = crate::drive::GnssFix {
+            t_s: 105.0,
+            east_m: 0.0,
+            north_m: 0.0,
+            std_m: 1.0,
+            course_deg: None,
+            speed_mps: None,
+        };
+        let p3 = [[1.0, 0.0, 0.0], [0.0, 4.0, 0.0], [0.0, 0.0, 0.0]];
+        let at: AtFix = (State::zeros(), p3, None);
+        let ll = fix_log_likelihood(&d, &fix, &at, [2.0, -5.0]);
+        let want =
+            -(2.0 * std::f64::consts::PI).ln() - 0.5 * 10f64.ln() - 0.5 * (4.0 / 2.0 + 25.0 / 5.0);
+        assert!((ll - want).abs() < 1e-12, "{ll} {want}");
+        // The same offset is less likely under a prediction that claims
+        // less: the white-fix filter's over-confidence costs it.
+        let tight = [[0.01, 0.0, 0.0], [0.0, 0.01, 0.0], [0.0, 0.0, 0.0]];
+        assert!(fix_log_likelihood(&d, &fix, &(State::zeros(), tight, None), [2.0, -5.0]) < ll);
     }
 }

@@ -60,6 +60,11 @@ type WindowErrors = Vec<(f64, f64)>;
 /// how many GNSS recoveries the dead reckoning's filter made.
 pub(super) struct HeldBackRun {
     pub(super) errors: WindowErrors,
+    /// The log-likelihood of each window's last hidden fix under the dead
+    /// reckoning's prediction of it
+    /// ([`crate::compared::OutageResult::fix_log_likelihood`]), keyed by
+    /// the window's start as `errors`.
+    pub(super) scores: WindowErrors,
     /// Per fold, the parameters dead-reckoned with (`None`: the fold was
     /// skipped).
     pub(super) params: [Option<Params>; 2],
@@ -88,6 +93,7 @@ pub(super) fn held_back_errors(
         .collect();
     let mut out = HeldBackRun {
         errors: Vec::new(),
+        scores: Vec::new(),
         params: [None, None],
         recoveries: 0,
     };
@@ -98,6 +104,7 @@ pub(super) fn held_back_errors(
         out.params[k] = Some(run.params);
         out.recoveries += run.recoveries;
         out.errors.extend(run.errors);
+        out.scores.extend(run.scores);
     }
     Ok(out)
 }
@@ -107,6 +114,7 @@ pub(super) fn held_back_errors(
 struct FoldRun {
     params: Params,
     errors: WindowErrors,
+    scores: WindowErrors,
     recoveries: u64,
 }
 
@@ -152,6 +160,11 @@ fn fold_run(
             .windows
             .iter()
             .map(|w| (w.start_s, w.final_m()))
+            .collect(),
+        scores: ev
+            .windows
+            .iter()
+            .filter_map(|w| w.fix_log_likelihood.map(|s| (w.start_s, s)))
             .collect(),
     }))
 }
