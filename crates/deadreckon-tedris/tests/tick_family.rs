@@ -172,7 +172,7 @@ fn tick_family_dev_members_80s_outages() {
             .collect()
     });
     assert!(
-        cars.iter().all(|c| !(101..=116).contains(c)),
+        cars.iter().all(|c| !(101..=132).contains(c)),
         "held-out cars"
     );
     let (t, b, worst) = run_family(&cars);
@@ -239,6 +239,16 @@ fn tick_family_new_held_out_members_80s_outages() {
     // each tone ring at its own start phase: 6.46 m (worst 33.9 m) against
     // 7.18 m (worst 33.1 m), higher on 113 (5.45 m against 4.68 m) and 116
     // (10.90 m against 7.83 m).
+    assert!(t <= b, "TedriS {t} m against the block baseline's {b} m");
+}
+
+#[test]
+#[ignore = "held-out members drawn for the third stop (issue 28), about two minutes on two cores; run once at the end"]
+fn tick_family_third_held_out_members_80s_outages() {
+    // Drawn before any change of the third stop (the losing outages of dev
+    // cars 1, 2, 4, 6, 7), run once after its last change.
+    let (t, b, worst) = run_family(&(117..=132).collect::<Vec<_>>());
+    eprintln!("third held out: tedris {t:.2} m, block baseline {b:.2} m, worst {worst:.2} m");
     assert!(t <= b, "TedriS {t} m against the block baseline's {b} m");
 }
 
