@@ -433,3 +433,103 @@ fn the_speed_kind_without_loaded_tyres_is_refused() {
     assert!(r.reason.contains("speed term"), "{}", r.reason);
     assert_ne!(model.chosen, ModelKind::Speed);
 }
+
+/// The truth's yaw at `t`, the nearest truth pose's.
+fn truth_yaw(drive: &deadreckon_core::Drive, t: f64) -> Option<f64> {
+    let i = drive.truth.partition_point(|p| p.t_s < t);
+    drive.truth.get(i).map(|p| p.yaw_rad)
+}
+
+/// The wrapped difference `a − b`, rad.
+fn wrap(a: f64) -> f64 {
+    (a + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI) - std::f64::consts::PI
+}
+
+/// What TedriS did on a dev car's run drive, outage by outage: the trained
+/// kind and convention, every change of the held kind (time, kind, turn
+/// gain, heading per metre) before the outage, and the heading error at the
+/// outage's start and end against the truth. A diagnosis, not a check:
+/// `TEDRIS_TICK_CARS=1,2 cargo test --workspace --profile ci --test
+/// tick_family diagnose -- --ignored --nocapture`.
+#[test]
+#[ignore = "a diagnosis of the dev cars' outages, printed"]
+fn tick_family_diagnose_dev_outages() {
+    use deadreckon_tedris::input::{drive_input, Event};
+    use deadreckon_tedris::Tedris;
+    let cars: Vec<u64> = std::env::var("TEDRIS_TICK_CARS").map_or(vec![1], |v| {
+        v.split(',')
+            .map(|c| c.trim().parse().expect("car seeds"))
+            .collect()
+    });
+    assert!(
+        cars.iter().all(|c| !(101..=132).contains(c)),
+        "held-out cars"
+    );
+    for seed in cars {
+        let car = DynamicCar::draw_tick_counter(seed);
+        let effects = Effects::all();
+        let train_drive = simulate(&car.drive(1000 + seed, 900.0, &effects), 1000 + seed)
+            .expect("train drive")
+            .drive;
+        let test_drive = simulate(&car.drive(2000 + seed, 500.0, &effects), 2000 + seed)
+            .expect("test drive")
+            .drive;
+        let (model, _) = train(&train_drive, TedrisConfig::default(), None).expect("trained");
+        eprintln!(
+            "car {seed}: trained {:?} gain {:.3} per metre {:.2e} convention {:?}",
+            model.chosen, model.turn_gain, model.dcf_distance_rad_per_m, model.course_convention
+        );
+        for start_s in OUTAGE_STARTS_S {
+            let end_s = start_s + 80.0;
+            let input = drive_input(&test_drive, None, &[(start_s, end_s)]).expect("input");
+            let mut m = Tedris::with_model(model.clone(), input.geometry).expect("machine");
+            let mut last: Option<(ModelKind, Option<bool>)> = None;
+            let mut changes = Vec::new();
+            let (mut at_start, mut at_end) = (None, None);
+            for e in &input.events {
+                match e {
+                    Event::Wheel(w) => {
+                        let Ok(est) = m.push_wheel(*w) else { continue };
+                        if let Some(h) = m.model() {
+                            let now = (
+                                h.chosen,
+                                h.course_convention.map(|c| c.convention.is_antenna()),
+                            );
+                            if last != Some(now) && w.t_s < end_s {
+                                changes.push(format!(
+                                    "{:.0} s {:?} gain {:.3} /m {:.2e} antenna {:?}",
+                                    w.t_s,
+                                    h.chosen,
+                                    h.turn_gain,
+                                    h.dcf_distance_rad_per_m,
+                                    now.1
+                                ));
+                                last = Some(now);
+                            }
+                        }
+                        let err = truth_yaw(&test_drive, est.t_s).map(|y| wrap(est.yaw_rad - y));
+                        if at_start.is_none() && est.t_s >= start_s {
+                            at_start = err.map(|e| {
+                                (e, m.model().map(|h| (h.chosen, h.turn_gain)))
+                            });
+                        }
+                        if at_end.is_none() && est.t_s >= end_s - 0.05 {
+                            at_end = err;
+                        }
+                    }
+                    Event::Heading(h) => {
+                        let _ = m.push_heading(*h);
+                    }
+                    Event::Fix(f) => {
+                        let _ = m.push_fix(*f);
+                    }
+                }
+            }
+            eprintln!(
+                "  [{start_s:.0}, {end_s:.0}): heading error at start {:?}, at end {:?}; kinds: {}",
+                at_start, at_end,
+                changes.join("; ")
+            );
+        }
+    }
+}

@@ -248,9 +248,9 @@ impl Tedris {
         };
         let kinds = calibration_kinds(model);
         let mut current_rms = f64::INFINITY;
-        // The best kind, its calibration, held-back RMS, and its fit rows'
-        // segments and times (for the standard errors).
-        let mut best: Option<(crate::config::ModelKind, Calibration, f64, FitRows)> = None;
+        // Every kind that calibrates within the bounds, with its held-back
+        // residuals.
+        let mut candidates: Vec<Candidate> = Vec::new();
         let mut refused = false;
         for kind in kinds {
             let mut m = model.clone();
@@ -267,7 +267,6 @@ impl Tedris {
                 .partition_point(|&x| x < first + FIT_SHARE * (last - first));
             let (fit_rows, held) = rows.rows.split_at(split);
             let (fit_segs, held_segs) = rows.segments.split_at(split);
-            let fit_times = &rows.times[..split];
             if kind == model.chosen {
                 current_rms = held_rms(
                     held,
@@ -279,27 +278,63 @@ impl Tedris {
             }
             match self.calibration_fit(&m, fit_rows, fit_segs) {
                 Some(c) => {
-                    let rms = held_rms(
+                    let held_residuals = held_residuals(
                         held,
                         held_segs,
                         c.dcf_rad,
                         c.distance_rad_per_m.unwrap_or(model.dcf_distance_rad_per_m),
                         c.gain.unwrap_or(model.turn_gain),
                     );
-                    if rms.is_finite() && best.as_ref().is_none_or(|b| rms < b.2) {
-                        let fit_part = (fit_segs.to_vec(), fit_times.to_vec());
-                        best = Some((kind, c, rms, fit_part));
+                    let rms = rms_of(&held_residuals);
+                    if rms.is_finite() {
+                        candidates.push(Candidate {
+                            kind,
+                            calibration: c,
+                            rms,
+                            fit_part: (fit_segs.to_vec(), rows.times[..split].to_vec()),
+                            held_residuals,
+                            held_times: rows.times[split..].to_vec(),
+                        });
                     }
                 }
                 None => refused = true,
             }
         }
-        let Some((kind, c, rms, fit_part)) = best else {
+        let Some(best) = candidates
+            .iter()
+            .enumerate()
+            .min_by(|a, b| a.1.rms.total_cmp(&b.1.rms))
+            .map(|b| b.0)
+        else {
             if refused {
                 self.refused_calibrations += 1;
             }
             return;
         };
+        // A kind switch needs strong evidence: the incumbent (the kind the
+        // last calibration installed, else the model's), itself
+        // recalibrated on the same rows, must be significantly worse on the
+        // held-back stretch than the best kind ([`kind_switch_evidence`]);
+        // otherwise the incumbent, recalibrated, is kept.
+        let incumbent = self.calibrated_kind.unwrap_or(model.chosen);
+        let mut pick = best;
+        if candidates[best].kind != incumbent {
+            if let Some(cur) = candidates.iter().position(|c| c.kind == incumbent) {
+                let (cu, be) = (&candidates[cur], &candidates[best]);
+                if !kind_switch_evidence(&cu.held_residuals, &be.held_residuals, &be.held_times)
+                {
+                    self.kept_kinds += 1;
+                    pick = cur;
+                }
+            }
+        }
+        let Candidate {
+            kind,
+            calibration: c,
+            rms,
+            fit_part,
+            ..
+        } = candidates.swap_remove(pick);
         if rms > current_rms {
             self.refused_calibrations += 1;
             return;
@@ -316,6 +351,7 @@ impl Tedris {
             std.map(|s| s[j])
         };
         model.chosen = kind;
+        self.calibrated_kind = Some(kind);
         model.dcf_rad = c.dcf_rad;
         model.dcf_std_rad = se("dcf");
         if let Some(d) = c.distance_rad_per_m {
@@ -396,14 +432,8 @@ impl Tedris {
                 c.distance_rad_per_m.unwrap_or(model.dcf_distance_rad_per_m),
                 c.gain.unwrap_or(model.turn_gain),
             );
-            let mut e: Vec<Vec<f64>> = held
-                .iter()
-                .map(|r| vec![r[3] - c.dcf_rad * r[0] - dist * r[1] - (gain - 1.0) * r[2]])
-                .collect();
-            centre_per_segment(&mut e, held_segs);
-            let residuals: Vec<f64> = e.into_iter().map(|r| r[0]).collect();
-            let rms =
-                (residuals.iter().map(|v| v * v).sum::<f64>() / residuals.len() as f64).sqrt();
+            let residuals = held_residuals(held, held_segs, c.dcf_rad, dist, gain);
+            let rms = rms_of(&residuals);
             if rms.is_finite() && best.as_ref().is_none_or(|b| rms < b.0) {
                 let times = rows.times[split..].to_vec();
                 best = Some((rms, HeldBack { times, residuals }));
@@ -457,25 +487,26 @@ impl Tedris {
             .collect();
         // Batches at least REFIT_TEST_DECORRELATIONS correlation times of
         // the loss difference long, so that their means are independent.
-        let d: Vec<f64> = new_sq.iter().zip(&old_sq).map(|(a, b)| a - b).collect();
-        let (Some(tc), Some(&t0), Some(&t1)) = (
-            correlation_time(&d, &new.times),
-            new.times.first(),
-            new.times.last(),
-        ) else {
-            return RefitVerdict::Untested;
-        };
-        let fit = ((t1 - t0) / (REFIT_TEST_DECORRELATIONS * tc)).floor();
-        if tc <= 0.0 || fit.is_nan() || fit < REFIT_TEST_MIN_BATCHES as f64 {
-            return RefitVerdict::Untested;
-        }
-        let batches = (fit as usize).min(REFIT_TEST_BATCHES);
-        match paired_batch_test(&new_sq, &old_sq, batches) {
+        match held_back_test(&new_sq, &old_sq, &new.times) {
             Some(p) if p.p_a_larger < REFIT_TEST_LEVEL => RefitVerdict::Refused(Some(p)),
             Some(p) => RefitVerdict::Accepted(p),
             None => RefitVerdict::Untested,
         }
     }
+}
+
+/// One kind calibrated by [`Tedris::calibrate`].
+struct Candidate {
+    kind: crate::config::ModelKind,
+    calibration: Calibration,
+    /// RMS of `held_residuals`, rad.
+    rms: f64,
+    /// The fit rows' segments and times (for the standard errors).
+    fit_part: FitRows,
+    /// Heading residuals on the held-back stretch, about each segment's
+    /// mean, rad.
+    held_residuals: Vec<f64>,
+    held_times: Vec<f64>,
 }
 
 /// The rows of a joint calibration: `[n, Σd, ΣT, θ − Σb]` with each row's
@@ -490,14 +521,58 @@ struct CalibrationRows {
 /// The RMS heading residual of calibration values on `rows`, with an
 /// intercept per segment; infinite without rows.
 pub(super) fn held_rms(rows: &[[f64; 4]], segments: &[u32], dcf: f64, dist: f64, gain: f64) -> f64 {
-    if rows.is_empty() {
+    rms_of(&held_residuals(rows, segments, dcf, dist, gain))
+}
+
+/// The heading residuals of calibration values on `rows`, about each
+/// heading segment's mean, rad.
+fn held_residuals(rows: &[[f64; 4]], segments: &[u32], dcf: f64, dist: f64, gain: f64) -> Vec<f64> {
+    let mut e: Vec<Vec<f64>> = rows
+        .iter()
+        .map(|r| vec![r[3] - dcf * r[0] - dist * r[1] - (gain - 1.0) * r[2]])
+        .collect();
+    centre_per_segment(&mut e, segments);
+    e.into_iter().map(|r| r[0]).collect()
+}
+
+/// The RMS of `e`; infinite without values.
+fn rms_of(e: &[f64]) -> f64 {
+    if e.is_empty() {
         return f64::INFINITY;
     }
-    let e: Vec<f64> = rows
+    (e.iter().map(|v| v * v).sum::<f64>() / e.len() as f64).sqrt()
+}
+
+/// A paired test of the squared losses `a` against `b` over the same
+/// held-back rows at `times` ([`crate::stats::paired_batch_test`]), the
+/// batches at least `REFIT_TEST_DECORRELATIONS` correlation times of the
+/// loss difference long, between `REFIT_TEST_MIN_BATCHES` and
+/// `REFIT_TEST_BATCHES` of them; `None` when it cannot be made.
+fn held_back_test(a_sq: &[f64], b_sq: &[f64], times: &[f64]) -> Option<PairedTest> {
+    let d: Vec<f64> = a_sq.iter().zip(b_sq).map(|(a, b)| a - b).collect();
+    let (tc, &t0, &t1) = (correlation_time(&d, times)?, times.first()?, times.last()?);
+    let fit = ((t1 - t0) / (REFIT_TEST_DECORRELATIONS * tc)).floor();
+    if tc <= 0.0 || fit.is_nan() || fit < REFIT_TEST_MIN_BATCHES as f64 {
+        return None;
+    }
+    paired_batch_test(a_sq, b_sq, (fit as usize).min(REFIT_TEST_BATCHES))
+}
+
+/// Whether the held-back residuals justify leaving the current kind for a
+/// challenger (both recalibrated on the same rows): the current kind's
+/// squared residuals must exceed the challenger's grown by
+/// `KIND_SWITCH_MARGIN`, at the one-sided level `KIND_SWITCH_LEVEL`
+/// ([`held_back_test`]). An untestable stretch keeps the current kind.
+fn kind_switch_evidence(current: &[f64], challenger: &[f64], times: &[f64]) -> bool {
+    if current.len() != challenger.len() || current.len() != times.len() {
+        return false;
+    }
+    let cur_sq: Vec<f64> = current.iter().map(|e| e * e).collect();
+    let new_sq: Vec<f64> = challenger
         .iter()
-        .map(|r| r[3] - dcf * r[0] - dist * r[1] - (gain - 1.0) * r[2])
+        .map(|e| e * e * (1.0 + KIND_SWITCH_MARGIN))
         .collect();
-    rms_about_segment_means(&e, segments)
+    held_back_test(&cur_sq, &new_sq, times).is_some_and(|p| p.p_a_larger < KIND_SWITCH_LEVEL)
 }
 
 /// The heading segments and times of a calibration's fit rows.
