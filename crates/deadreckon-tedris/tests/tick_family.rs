@@ -203,9 +203,16 @@ fn tick_family_dev_members_80s_outages() {
     // metre, which read 3.53 m (worst 7.98 m) on cars 1–3 and 6.61 m on
     // cars 1–9.
     eprintln!("cars {cars:?}: tedris {t:.2} m, block baseline {b:.2} m, worst {worst:.2} m");
+    //
+    // Issue 28's third stop (a kind switch on a run needs a 10 % lower
+    // held-back mean square, `tuning::KIND_SWITCH_MARGIN`): cars 1–3 3.84 m
+    // (worst 7.96 m, car 1's [120, 200); car 1's [200, 280) 32.80 → 3.58 m),
+    // cars 1–9 6.64 m (worst 45.68 m) against 7.72 m, lower on 6 of 9
+    // (`TEDRIS_TICK_CARS=1,2,3,4,5,6,7,8,9 cargo test --workspace --profile
+    // ci --test tick_family dev_members -- --nocapture`).
     if cars == [1, 2, 3] {
-        assert!(t < 7.0, "TedriS mean {t} m (measured 6.31 m)");
-        assert!(worst < 36.0, "TedriS worst {worst} m (measured 32.80 m)");
+        assert!(t < 4.3, "TedriS mean {t} m (measured 3.84 m)");
+        assert!(worst < 9.0, "TedriS worst {worst} m (measured 7.96 m)");
         assert!(b > 6.0, "block baseline {b} m (measured 7.41 m)");
     }
 }
@@ -532,4 +539,96 @@ fn tick_family_diagnose_dev_outages() {
             );
         }
     }
+}
+
+/// The kinds the machine held on `drive` with GNSS blanked in `outage`,
+/// from `model`: (time, kind) at the start and at every change before the
+/// outage's end.
+fn held_kinds(
+    model: &TedrisModel,
+    drive: &deadreckon_core::Drive,
+    outage: &Outage,
+) -> Vec<(f64, ModelKind)> {
+    use deadreckon_tedris::input::{drive_input, Event};
+    let input = drive_input(drive, None, &[(outage.start_s, outage.end_s)]).expect("input");
+    let mut m = deadreckon_tedris::Tedris::with_model(model.clone(), input.geometry).expect("machine");
+    let mut kinds: Vec<(f64, ModelKind)> = Vec::new();
+    for e in &input.events {
+        match e {
+            Event::Wheel(w) if w.t_s < outage.end_s => {
+                let _ = m.push_wheel(*w);
+                let k = m.model().expect("a model").chosen;
+                if kinds.last().is_none_or(|l| l.1 != k) {
+                    kinds.push((w.t_s, k));
+                }
+            }
+            Event::Wheel(_) => break,
+            Event::Heading(h) => {
+                let _ = m.push_heading(*h);
+            }
+            Event::Fix(f) => {
+                let _ = m.push_fix(*f);
+            }
+        }
+    }
+    kinds
+}
+
+/// Tick car 1 (dev): its [200, 280) outage, an 80 s straight after a fast
+/// right turn, read 32.8 m against the block baseline's 5.9 m. On the run
+/// drive the held kind changed five times before 280 s: each refit took the
+/// block statistics' kind with the former kind's calibrated values (speed →
+/// baseline at 63 s), and each calibration the kind with the smallest
+/// held-back residual however small the difference (paper at 193 s, turn
+/// gain 1.023, entering the outage 0.055 rad off after over-turning the
+/// turn). On a machine started from a trained model a calibration now
+/// leaves the incumbent kind only when the challenger's held-back mean
+/// square is lower by more than `tuning::KIND_SWITCH_MARGIN`.
+#[test]
+fn the_run_drives_kind_flips_over_turned_car_1s_fast_turn_tick_car_1() {
+    let seed = 1;
+    let car = DynamicCar::draw_tick_counter(seed);
+    let effects = Effects::all();
+    let train_drive = simulate(&car.drive(1000 + seed, 900.0, &effects), 1000 + seed)
+        .expect("train drive")
+        .drive;
+    let test_drive = simulate(&car.drive(2000 + seed, 500.0, &effects), 2000 + seed)
+        .expect("test drive")
+        .drive;
+    let (model, _) = train(&train_drive, TedrisConfig::default(), None).expect("trained");
+    let o = Outage {
+        start_s: 200.0,
+        end_s: 280.0,
+    };
+    let kinds = held_kinds(&model, &test_drive, &o);
+    let run = run_outages(&test_drive, &model, &[o]).expect("run");
+    let e = run.outages[0].mean_error_m();
+    let base = Baseline::fit_blocks(&train_drive, 2.0)
+        .expect("block baseline")
+        .run_outage(&test_drive, &o)
+        .expect("baseline run")
+        .mean_error_m();
+    eprintln!(
+        "held kinds {kinds:?}; kind switches kept {}; outage {e:.2} m, block baseline {base:.2} m",
+        run.machine.kept_kinds()
+    );
+    // Measured: held speed (trained), baseline at 63 s (a refit's), speed
+    // again at 193 s (the calibration kept the trained kind where the paper
+    // kind's held-back residual was lower by less than the margin); 6
+    // calibrations kept the kind; outage 3.58 m against the block
+    // baseline's 5.94 m. Before: speed, baseline at 63 s, paper at 193 s
+    // (turn gain 1.023), 32.80 m.
+    let at_start = kinds
+        .iter()
+        .rev()
+        .find(|k| k.0 < o.start_s)
+        .expect("a kind")
+        .1;
+    assert_eq!(at_start, model.chosen, "held kinds {kinds:?}");
+    assert!(
+        !kinds.iter().any(|k| k.1 == ModelKind::Paper),
+        "held kinds {kinds:?}"
+    );
+    assert!(run.machine.kept_kinds() > 0);
+    assert!(e < 5.0, "outage mean {e} m (32.8 m with the kind flips)");
 }

@@ -293,7 +293,6 @@ impl Tedris {
                             rms,
                             fit_part: (fit_segs.to_vec(), rows.times[..split].to_vec()),
                             held_residuals,
-                            held_times: rows.times[split..].to_vec(),
                         });
                     }
                 }
@@ -311,18 +310,19 @@ impl Tedris {
             }
             return;
         };
-        // A kind switch needs strong evidence: the incumbent (the kind the
-        // last calibration installed, else the model's), itself
-        // recalibrated on the same rows, must be significantly worse on the
-        // held-back stretch than the best kind ([`kind_switch_evidence`]);
-        // otherwise the incumbent, recalibrated, is kept.
-        let incumbent = self.calibrated_kind.unwrap_or(model.chosen);
+        // On a machine started from a trained model, a kind switch needs
+        // clear evidence: the incumbent (the trained model's kind, then the
+        // kind each calibration installed), itself recalibrated on the same
+        // rows, must have a held-back mean square larger than the best
+        // kind's by more than a margin ([`kind_switch_evidence`]); otherwise
+        // the incumbent, recalibrated, is kept. While training from scratch
+        // (no incumbent), and where the incumbent does not calibrate, the
+        // best kind is taken.
         let mut pick = best;
-        if candidates[best].kind != incumbent {
+        if let Some(incumbent) = self.calibrated_kind.filter(|&k| k != candidates[best].kind) {
             if let Some(cur) = candidates.iter().position(|c| c.kind == incumbent) {
                 let (cu, be) = (&candidates[cur], &candidates[best]);
-                if !kind_switch_evidence(&cu.held_residuals, &be.held_residuals, &be.held_times)
-                {
+                if !kind_switch_evidence(&cu.held_residuals, &be.held_residuals) {
                     self.kept_kinds += 1;
                     pick = cur;
                 }
@@ -351,7 +351,10 @@ impl Tedris {
             std.map(|s| s[j])
         };
         model.chosen = kind;
-        self.calibrated_kind = Some(kind);
+        // Only a machine started from a trained model holds an incumbent.
+        if self.calibrated_kind.is_some() {
+            self.calibrated_kind = Some(kind);
+        }
         model.dcf_rad = c.dcf_rad;
         model.dcf_std_rad = se("dcf");
         if let Some(d) = c.distance_rad_per_m {
@@ -487,7 +490,20 @@ impl Tedris {
             .collect();
         // Batches at least REFIT_TEST_DECORRELATIONS correlation times of
         // the loss difference long, so that their means are independent.
-        match held_back_test(&new_sq, &old_sq, &new.times) {
+        let d: Vec<f64> = new_sq.iter().zip(&old_sq).map(|(a, b)| a - b).collect();
+        let (Some(tc), Some(&t0), Some(&t1)) = (
+            correlation_time(&d, &new.times),
+            new.times.first(),
+            new.times.last(),
+        ) else {
+            return RefitVerdict::Untested;
+        };
+        let fit = ((t1 - t0) / (REFIT_TEST_DECORRELATIONS * tc)).floor();
+        if tc <= 0.0 || fit.is_nan() || fit < REFIT_TEST_MIN_BATCHES as f64 {
+            return RefitVerdict::Untested;
+        }
+        let batches = (fit as usize).min(REFIT_TEST_BATCHES);
+        match paired_batch_test(&new_sq, &old_sq, batches) {
             Some(p) if p.p_a_larger < REFIT_TEST_LEVEL => RefitVerdict::Refused(Some(p)),
             Some(p) => RefitVerdict::Accepted(p),
             None => RefitVerdict::Untested,
@@ -506,7 +522,6 @@ struct Candidate {
     /// Heading residuals on the held-back stretch, about each segment's
     /// mean, rad.
     held_residuals: Vec<f64>,
-    held_times: Vec<f64>,
 }
 
 /// The rows of a joint calibration: `[n, Σd, ΣT, θ − Σb]` with each row's
@@ -543,36 +558,15 @@ fn rms_of(e: &[f64]) -> f64 {
     (e.iter().map(|v| v * v).sum::<f64>() / e.len() as f64).sqrt()
 }
 
-/// A paired test of the squared losses `a` against `b` over the same
-/// held-back rows at `times` ([`crate::stats::paired_batch_test`]), the
-/// batches at least `REFIT_TEST_DECORRELATIONS` correlation times of the
-/// loss difference long, between `REFIT_TEST_MIN_BATCHES` and
-/// `REFIT_TEST_BATCHES` of them; `None` when it cannot be made.
-fn held_back_test(a_sq: &[f64], b_sq: &[f64], times: &[f64]) -> Option<PairedTest> {
-    let d: Vec<f64> = a_sq.iter().zip(b_sq).map(|(a, b)| a - b).collect();
-    let (tc, &t0, &t1) = (correlation_time(&d, times)?, times.first()?, times.last()?);
-    let fit = ((t1 - t0) / (REFIT_TEST_DECORRELATIONS * tc)).floor();
-    if tc <= 0.0 || fit.is_nan() || fit < REFIT_TEST_MIN_BATCHES as f64 {
-        return None;
-    }
-    paired_batch_test(a_sq, b_sq, (fit as usize).min(REFIT_TEST_BATCHES))
-}
-
-/// Whether the held-back residuals justify leaving the current kind for a
-/// challenger (both recalibrated on the same rows): the current kind's
-/// squared residuals must exceed the challenger's grown by
-/// `KIND_SWITCH_MARGIN`, at the one-sided level `KIND_SWITCH_LEVEL`
-/// ([`held_back_test`]). An untestable stretch keeps the current kind.
-fn kind_switch_evidence(current: &[f64], challenger: &[f64], times: &[f64]) -> bool {
-    if current.len() != challenger.len() || current.len() != times.len() {
-        return false;
-    }
-    let cur_sq: Vec<f64> = current.iter().map(|e| e * e).collect();
-    let new_sq: Vec<f64> = challenger
-        .iter()
-        .map(|e| e * e * (1.0 + KIND_SWITCH_MARGIN))
-        .collect();
-    held_back_test(&cur_sq, &new_sq, times).is_some_and(|p| p.p_a_larger < KIND_SWITCH_LEVEL)
+/// Whether the held-back residuals justify leaving the incumbent kind for
+/// a challenger, both recalibrated on the same rows: the challenger's mean
+/// squared residual grown by `KIND_SWITCH_MARGIN` must still be below the
+/// incumbent's.
+fn kind_switch_evidence(incumbent: &[f64], challenger: &[f64]) -> bool {
+    let ms = |e: &[f64]| e.iter().map(|v| v * v).sum::<f64>() / e.len() as f64;
+    incumbent.len() == challenger.len()
+        && !incumbent.is_empty()
+        && ms(challenger) * (1.0 + KIND_SWITCH_MARGIN) < ms(incumbent)
 }
 
 /// The heading segments and times of a calibration's fit rows.
@@ -710,133 +704,4 @@ pub fn heading_lag(h: &History, max_lag: usize) -> Option<i64> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::input::{drive_input, Event};
-
-    /// A machine trained on the built-in `tedris-car` drive (seed 1), the
-    /// joint calibration on.
-    fn trained() -> Tedris {
-        let sc = deadreckon_sim::Scenario::builtin("tedris-car").expect("scenario");
-        let drive = deadreckon_sim::simulate(&sc, 1).expect("drive").drive;
-        let input = drive_input(&drive, None, &[]).expect("input");
-        let mut m = Tedris::new(TedrisConfig::default(), input.geometry).expect("machine");
-        for e in &input.events {
-            let _ = match e {
-                Event::Wheel(w) => m.push_wheel(*w).map(|_| ()),
-                Event::Heading(h) => m.push_heading(*h),
-                Event::Fix(f) => m.push_fix(*f),
-            };
-        }
-        let model = m.model.as_ref().expect("trained");
-        assert!(model.complete && model.config.joint_calibration());
-        m
-    }
-
-    fn betas(m: &TedrisModel) -> Vec<Vec<f64>> {
-        m.fits.iter().map(|f| f.global_beta.clone()).collect()
-    }
-
-    /// The installed values carry the last calibration's robust standard
-    /// errors; a model file written before they existed loads them as not
-    /// estimated; a negative one is an error naming the key.
-    #[test]
-    fn model_files_carry_the_calibrations_standard_errors() {
-        let m = trained();
-        let model = m.model.as_ref().expect("model");
-        let last = m.last_calibration().expect("a calibration was installed");
-        let std = last.std_error.as_ref().expect("estimated");
-        let j = last
-            .names
-            .iter()
-            .position(|n| n == "dcf_distance")
-            .expect("fitted");
-        assert_eq!(model.dcf_distance_std_rad_per_m, Some(std[j]));
-        assert!(std[j] > 0.0 && std[j] > last.ols_std_error[j], "{last:?}");
-        let mut v = serde_json::to_value(model).expect("serialises");
-        let o = v.as_object_mut().expect("an object");
-        for k in ["dcf_std_rad", "dcf_distance_std_rad_per_m", "turn_gain_std"] {
-            o.remove(k).expect("written");
-        }
-        let old = TedrisModel::from_json(&v.to_string()).expect("loads");
-        assert_eq!(
-            (
-                old.dcf_std_rad,
-                old.dcf_distance_std_rad_per_m,
-                old.turn_gain_std
-            ),
-            (None, None, None)
-        );
-        let mut bad = model.clone();
-        bad.turn_gain_std = Some(-1e-3);
-        let text = serde_json::to_string(&bad).expect("serialises");
-        let e = TedrisModel::from_json(&text).expect_err("refused");
-        assert!(e.to_string().contains("turn_gain_std"), "{e}");
-    }
-
-    #[test]
-    fn a_refit_on_blocks_the_heading_contradicts_replaced_the_regressions() {
-        let mut m = trained();
-        let before = m.model.clone().expect("model");
-        // Each block's γ paired with the ω of a block half the drive away:
-        // regressions on these blocks no longer turn with the wheels
-        // (unguarded, the refit took the ω slope from 0.64 to 0.15).
-        let tuples = before.repositories.all_sorted();
-        let half = tuples.len() / 2;
-        let r = &before.repositories;
-        let mut corrupted = Repositories::new(r.straight, r.min_fill, r.max_fill);
-        for (i, tu) in tuples.iter().enumerate() {
-            let mut x = *tu;
-            x.gamma_rad = tuples[(i + half) % tuples.len()].gamma_rad;
-            corrupted.insert(x);
-        }
-        if let Some(model) = m.model.as_mut() {
-            model.repositories = corrupted;
-        }
-        let (accepted, refused) = (m.accepted_refits, m.refused_refits);
-        let t = m.last_t.expect("samples");
-        m.refit(t);
-        assert_eq!(betas(m.model.as_ref().expect("model")), betas(&before));
-        assert_eq!(
-            (m.accepted_refits, m.refused_refits),
-            (accepted, refused + 1)
-        );
-        assert_eq!(m.checks().refused_refits, refused + 1);
-    }
-
-    #[test]
-    fn a_refit_on_the_drives_own_blocks_is_accepted() {
-        let mut m = trained();
-        // The current regressions fitted on the first three quarters of the
-        // blocks; the refit takes in the last quarter, which the heading
-        // does not contradict.
-        let before = m.model.clone().expect("model");
-        let mut fewer = before.clone();
-        let tuples = before.repositories.all_sorted();
-        let r = &before.repositories;
-        fewer.repositories = Repositories::new(r.straight, r.min_fill, r.max_fill);
-        for tu in &tuples[..tuples.len() * 3 / 4] {
-            fewer.repositories.insert(*tu);
-        }
-        let fitted = fewer.refit().expect("fit");
-        m.model = Some(TedrisModel {
-            dcf_rad: before.dcf_rad,
-            dcf_distance_rad_per_m: before.dcf_distance_rad_per_m,
-            turn_gain: before.turn_gain,
-            distance_scale: before.distance_scale,
-            per_metre_straight: before.per_metre_straight,
-            course_convention: before.course_convention,
-            repositories: before.repositories.clone(),
-            ..fitted.clone()
-        });
-        let (accepted, refused) = (m.accepted_refits, m.refused_refits);
-        let t = m.last_t.expect("samples");
-        m.refit(t);
-        assert_eq!(
-            (m.accepted_refits, m.refused_refits),
-            (accepted + 1, refused)
-        );
-        let after = m.model.as_ref().expect("model");
-        assert_ne!(betas(after), betas(&fitted));
-    }
-}
+mod tests;

@@ -237,9 +237,11 @@ pub struct Tedris {
     /// `machine/calibration.rs`, `kind_switch_evidence`).
     #[serde(default)]
     kept_kinds: u64,
-    /// The kind whose calibrated values the last joint calibration
-    /// installed: the incumbent of the kind switch (a refit may have set
-    /// the model's kind by its block statistics since).
+    /// The incumbent of the kind switch on a machine started from a trained
+    /// model: the trained model's kind, then the kind each joint
+    /// calibration installed (a refit may have set the model's kind by its
+    /// block statistics since); `None` while training from scratch, where
+    /// every calibration takes the kind with the best held-back residual.
     #[serde(default)]
     calibrated_kind: Option<crate::config::ModelKind>,
     /// The joint calibration last installed, with its standard errors.
@@ -352,7 +354,8 @@ impl Tedris {
         m.convention = model.course_convention.map(|c| c.convention);
         // The trained model's kind is the incumbent of the first kind
         // switch on this drive (its calibrated values are that kind's).
-        m.calibrated_kind = (model.complete && model.config.joint_calibration()).then_some(model.chosen);
+        m.calibrated_kind =
+            (model.complete && model.config.joint_calibration()).then_some(model.chosen);
         m.model = Some(model);
         m.fix_slt_window();
         Ok(m)

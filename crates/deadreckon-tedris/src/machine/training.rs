@@ -263,15 +263,6 @@ impl Tedris {
             m.per_metre_straight = per_metre;
             m.course_convention = convention;
             m.settle_kind();
-            // The kind a calibration installed stays: the refit's values are
-            // that kind's, and leaving it takes the kind switch's evidence
-            // (`machine/calibration.rs`, `kind_switch_evidence`), not the
-            // blocks' statistics.
-            if let Some(k) = self.calibrated_kind {
-                if m.fits.iter().any(|f| f.kind == k) && m.kind_usable(k) {
-                    m.chosen = k;
-                }
-            }
             if joint {
                 // The calibrated values stand until a calibration beats them.
                 m.dcf_distance_rad_per_m = dist;
