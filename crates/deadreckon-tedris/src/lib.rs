@@ -95,7 +95,14 @@
 //!   calibration is fitted on the first three quarters of its window and
 //!   accepted only if its heading residual on the last quarter is no larger
 //!   than the current model's, after `min_calibration_span_s` of reference;
-//!   the automatic kind choice uses the same held-back residual. A refit of
+//!   the automatic kind choice uses the same held-back residual. On a
+//!   machine started from a trained model it leaves the incumbent kind (the
+//!   trained model's, then the one each calibration installed) only when
+//!   that kind, recalibrated on the same rows, has a held-back mean square
+//!   larger by more than `tuning::KIND_SWITCH_MARGIN` (10 %;
+//!   [`Tedris::kept_kinds`] counts the calibrations that kept it: without
+//!   the margin the held kind flipped every few calibrations on tick
+//!   counters and over-turned a fast turn into an outage). A refit of
 //!   the regressions once trained (and the closing refit of [`train`]) is
 //!   calibrated the same way beside the current regressions and refused
 //!   when its held-back heading residual is worse by more than

@@ -172,7 +172,7 @@ fn tick_family_dev_members_80s_outages() {
             .collect()
     });
     assert!(
-        cars.iter().all(|c| !(101..=116).contains(c)),
+        cars.iter().all(|c| !(101..=132).contains(c)),
         "held-out cars"
     );
     let (t, b, worst) = run_family(&cars);
@@ -203,9 +203,16 @@ fn tick_family_dev_members_80s_outages() {
     // metre, which read 3.53 m (worst 7.98 m) on cars 1–3 and 6.61 m on
     // cars 1–9.
     eprintln!("cars {cars:?}: tedris {t:.2} m, block baseline {b:.2} m, worst {worst:.2} m");
+    //
+    // Issue 28's third stop (a kind switch on a run needs a 10 % lower
+    // held-back mean square, `tuning::KIND_SWITCH_MARGIN`): cars 1–3 3.84 m
+    // (worst 7.96 m, car 1's [120, 200); car 1's [200, 280) 32.80 → 3.58 m),
+    // cars 1–9 6.64 m (worst 45.68 m) against 7.72 m, lower on 6 of 9
+    // (`TEDRIS_TICK_CARS=1,2,3,4,5,6,7,8,9 cargo test --workspace --profile
+    // ci --test tick_family dev_members -- --nocapture`).
     if cars == [1, 2, 3] {
-        assert!(t < 7.0, "TedriS mean {t} m (measured 6.31 m)");
-        assert!(worst < 36.0, "TedriS worst {worst} m (measured 32.80 m)");
+        assert!(t < 4.3, "TedriS mean {t} m (measured 3.84 m)");
+        assert!(worst < 9.0, "TedriS worst {worst} m (measured 7.96 m)");
         assert!(b > 6.0, "block baseline {b} m (measured 7.41 m)");
     }
 }
@@ -239,6 +246,21 @@ fn tick_family_new_held_out_members_80s_outages() {
     // each tone ring at its own start phase: 6.46 m (worst 33.9 m) against
     // 7.18 m (worst 33.1 m), higher on 113 (5.45 m against 4.68 m) and 116
     // (10.90 m against 7.83 m).
+    assert!(t <= b, "TedriS {t} m against the block baseline's {b} m");
+}
+
+#[test]
+#[ignore = "held-out members drawn for the third stop (issue 28), about two minutes on two cores; run once at the end"]
+fn tick_family_third_held_out_members_80s_outages() {
+    // Drawn before any change of the third stop (the losing outages of dev
+    // cars 1, 2, 4, 6, 7), run once after its last change (64 outages):
+    // TedriS 5.55 m (worst 41.05 m, car 117's [120, 200)) against the block
+    // baseline's 8.44 m (worst 68.35 m), lower on 12 of 16 (higher on 117,
+    // 120, 126, 131). Main's code before the stop, run once on the same set
+    // for the rule written down before: 5.54 m (worst 41.05 m), lower on 11
+    // of 16; kept (within 10 % of main's mean, worst within 1.5 times).
+    let (t, b, worst) = run_family(&(117..=132).collect::<Vec<_>>());
+    eprintln!("third held out: tedris {t:.2} m, block baseline {b:.2} m, worst {worst:.2} m");
     assert!(t <= b, "TedriS {t} m against the block baseline's {b} m");
 }
 
@@ -422,4 +444,196 @@ fn the_speed_kind_without_loaded_tyres_is_refused() {
         .expect("the speed kind refused");
     assert!(r.reason.contains("speed term"), "{}", r.reason);
     assert_ne!(model.chosen, ModelKind::Speed);
+}
+
+/// The truth's yaw at `t`, the nearest truth pose's.
+fn truth_yaw(drive: &deadreckon_core::Drive, t: f64) -> Option<f64> {
+    let i = drive.truth.partition_point(|p| p.t_s < t);
+    drive.truth.get(i).map(|p| p.yaw_rad)
+}
+
+/// The wrapped difference `a − b`, rad.
+fn wrap(a: f64) -> f64 {
+    (a + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI) - std::f64::consts::PI
+}
+
+/// What TedriS did on a dev car's run drive, outage by outage: the trained
+/// kind and convention, every change of the held kind (time, kind, turn
+/// gain, heading per metre) before the outage, and the heading error at the
+/// outage's start and end against the truth. A diagnosis, not a check:
+/// `TEDRIS_TICK_CARS=1,2 cargo test --workspace --profile ci --test
+/// tick_family diagnose -- --ignored --nocapture`.
+#[test]
+#[ignore = "a diagnosis of the dev cars' outages, printed"]
+fn tick_family_diagnose_dev_outages() {
+    use deadreckon_tedris::input::{drive_input, Event};
+    use deadreckon_tedris::Tedris;
+    let cars: Vec<u64> = std::env::var("TEDRIS_TICK_CARS").map_or(vec![1], |v| {
+        v.split(',')
+            .map(|c| c.trim().parse().expect("car seeds"))
+            .collect()
+    });
+    assert!(
+        cars.iter().all(|c| !(101..=132).contains(c)),
+        "held-out cars"
+    );
+    for seed in cars {
+        let car = DynamicCar::draw_tick_counter(seed);
+        let effects = Effects::all();
+        let train_drive = simulate(&car.drive(1000 + seed, 900.0, &effects), 1000 + seed)
+            .expect("train drive")
+            .drive;
+        let test_drive = simulate(&car.drive(2000 + seed, 500.0, &effects), 2000 + seed)
+            .expect("test drive")
+            .drive;
+        let (model, _) = train(&train_drive, TedrisConfig::default(), None).expect("trained");
+        eprintln!(
+            "car {seed}: trained {:?} gain {:.3} per metre {:.2e} convention {:?}",
+            model.chosen, model.turn_gain, model.dcf_distance_rad_per_m, model.course_convention
+        );
+        for start_s in OUTAGE_STARTS_S {
+            let end_s = start_s + 80.0;
+            let input = drive_input(&test_drive, None, &[(start_s, end_s)]).expect("input");
+            let mut m = Tedris::with_model(model.clone(), input.geometry).expect("machine");
+            let mut last: Option<(ModelKind, Option<bool>)> = None;
+            let mut changes = Vec::new();
+            let (mut at_start, mut at_end) = (None, None);
+            for e in &input.events {
+                match e {
+                    Event::Wheel(w) => {
+                        let Ok(est) = m.push_wheel(*w) else { continue };
+                        if let Some(h) = m.model() {
+                            let now = (
+                                h.chosen,
+                                h.course_convention.map(|c| c.convention.is_antenna()),
+                            );
+                            if last != Some(now) && w.t_s < end_s {
+                                changes.push(format!(
+                                    "{:.0} s {:?} gain {:.3} /m {:.2e} antenna {:?}",
+                                    w.t_s,
+                                    h.chosen,
+                                    h.turn_gain,
+                                    h.dcf_distance_rad_per_m,
+                                    now.1
+                                ));
+                                last = Some(now);
+                            }
+                        }
+                        let err = truth_yaw(&test_drive, est.t_s).map(|y| wrap(est.yaw_rad - y));
+                        if at_start.is_none() && est.t_s >= start_s {
+                            at_start = err.map(|e| {
+                                (e, m.model().map(|h| (h.chosen, h.turn_gain)))
+                            });
+                        }
+                        if at_end.is_none() && est.t_s >= end_s - 0.05 {
+                            at_end = err;
+                        }
+                    }
+                    Event::Heading(h) => {
+                        let _ = m.push_heading(*h);
+                    }
+                    Event::Fix(f) => {
+                        let _ = m.push_fix(*f);
+                    }
+                }
+            }
+            eprintln!(
+                "  [{start_s:.0}, {end_s:.0}): heading error at start {:?}, at end {:?}; kinds: {}",
+                at_start, at_end,
+                changes.join("; ")
+            );
+        }
+    }
+}
+
+/// The kinds the machine held on `drive` with GNSS blanked in `outage`,
+/// from `model`: (time, kind) at the start and at every change before the
+/// outage's end.
+fn held_kinds(
+    model: &TedrisModel,
+    drive: &deadreckon_core::Drive,
+    outage: &Outage,
+) -> Vec<(f64, ModelKind)> {
+    use deadreckon_tedris::input::{drive_input, Event};
+    let input = drive_input(drive, None, &[(outage.start_s, outage.end_s)]).expect("input");
+    let mut m = deadreckon_tedris::Tedris::with_model(model.clone(), input.geometry).expect("machine");
+    let mut kinds: Vec<(f64, ModelKind)> = Vec::new();
+    for e in &input.events {
+        match e {
+            Event::Wheel(w) if w.t_s < outage.end_s => {
+                let _ = m.push_wheel(*w);
+                let k = m.model().expect("a model").chosen;
+                if kinds.last().is_none_or(|l| l.1 != k) {
+                    kinds.push((w.t_s, k));
+                }
+            }
+            Event::Wheel(_) => break,
+            Event::Heading(h) => {
+                let _ = m.push_heading(*h);
+            }
+            Event::Fix(f) => {
+                let _ = m.push_fix(*f);
+            }
+        }
+    }
+    kinds
+}
+
+/// Tick car 1 (dev): its [200, 280) outage, an 80 s straight after a fast
+/// right turn, read 32.8 m against the block baseline's 5.9 m. On the run
+/// drive the held kind changed five times before 280 s: each refit took the
+/// block statistics' kind with the former kind's calibrated values (speed →
+/// baseline at 63 s), and each calibration the kind with the smallest
+/// held-back residual however small the difference (paper at 193 s, turn
+/// gain 1.023, entering the outage 0.055 rad off after over-turning the
+/// turn). On a machine started from a trained model a calibration now
+/// leaves the incumbent kind only when the challenger's held-back mean
+/// square is lower by more than `tuning::KIND_SWITCH_MARGIN`.
+#[test]
+fn the_run_drives_kind_flips_over_turned_car_1s_fast_turn_tick_car_1() {
+    let seed = 1;
+    let car = DynamicCar::draw_tick_counter(seed);
+    let effects = Effects::all();
+    let train_drive = simulate(&car.drive(1000 + seed, 900.0, &effects), 1000 + seed)
+        .expect("train drive")
+        .drive;
+    let test_drive = simulate(&car.drive(2000 + seed, 500.0, &effects), 2000 + seed)
+        .expect("test drive")
+        .drive;
+    let (model, _) = train(&train_drive, TedrisConfig::default(), None).expect("trained");
+    let o = Outage {
+        start_s: 200.0,
+        end_s: 280.0,
+    };
+    let kinds = held_kinds(&model, &test_drive, &o);
+    let run = run_outages(&test_drive, &model, &[o]).expect("run");
+    let e = run.outages[0].mean_error_m();
+    let base = Baseline::fit_blocks(&train_drive, 2.0)
+        .expect("block baseline")
+        .run_outage(&test_drive, &o)
+        .expect("baseline run")
+        .mean_error_m();
+    eprintln!(
+        "held kinds {kinds:?}; kind switches kept {}; outage {e:.2} m, block baseline {base:.2} m",
+        run.machine.kept_kinds()
+    );
+    // Measured: held speed (trained), baseline at 63 s (a refit's), speed
+    // again at 193 s (the calibration kept the trained kind where the paper
+    // kind's held-back residual was lower by less than the margin); 6
+    // calibrations kept the kind; outage 3.58 m against the block
+    // baseline's 5.94 m. Before: speed, baseline at 63 s, paper at 193 s
+    // (turn gain 1.023), 32.80 m.
+    let at_start = kinds
+        .iter()
+        .rev()
+        .find(|k| k.0 < o.start_s)
+        .expect("a kind")
+        .1;
+    assert_eq!(at_start, model.chosen, "held kinds {kinds:?}");
+    assert!(
+        !kinds.iter().any(|k| k.1 == ModelKind::Paper),
+        "held kinds {kinds:?}"
+    );
+    assert!(run.machine.kept_kinds() > 0);
+    assert!(e < 5.0, "outage mean {e} m (32.8 m with the kind flips)");
 }

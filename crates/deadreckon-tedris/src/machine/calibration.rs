@@ -248,9 +248,9 @@ impl Tedris {
         };
         let kinds = calibration_kinds(model);
         let mut current_rms = f64::INFINITY;
-        // The best kind, its calibration, held-back RMS, and its fit rows'
-        // segments and times (for the standard errors).
-        let mut best: Option<(crate::config::ModelKind, Calibration, f64, FitRows)> = None;
+        // Every kind that calibrates within the bounds, with its held-back
+        // residuals.
+        let mut candidates: Vec<Candidate> = Vec::new();
         let mut refused = false;
         for kind in kinds {
             let mut m = model.clone();
@@ -267,7 +267,6 @@ impl Tedris {
                 .partition_point(|&x| x < first + FIT_SHARE * (last - first));
             let (fit_rows, held) = rows.rows.split_at(split);
             let (fit_segs, held_segs) = rows.segments.split_at(split);
-            let fit_times = &rows.times[..split];
             if kind == model.chosen {
                 current_rms = held_rms(
                     held,
@@ -279,27 +278,63 @@ impl Tedris {
             }
             match self.calibration_fit(&m, fit_rows, fit_segs) {
                 Some(c) => {
-                    let rms = held_rms(
+                    let held_residuals = held_residuals(
                         held,
                         held_segs,
                         c.dcf_rad,
                         c.distance_rad_per_m.unwrap_or(model.dcf_distance_rad_per_m),
                         c.gain.unwrap_or(model.turn_gain),
                     );
-                    if rms.is_finite() && best.as_ref().is_none_or(|b| rms < b.2) {
-                        let fit_part = (fit_segs.to_vec(), fit_times.to_vec());
-                        best = Some((kind, c, rms, fit_part));
+                    let rms = rms_of(&held_residuals);
+                    if rms.is_finite() {
+                        candidates.push(Candidate {
+                            kind,
+                            calibration: c,
+                            rms,
+                            fit_part: (fit_segs.to_vec(), rows.times[..split].to_vec()),
+                            held_residuals,
+                        });
                     }
                 }
                 None => refused = true,
             }
         }
-        let Some((kind, c, rms, fit_part)) = best else {
+        let Some(best) = candidates
+            .iter()
+            .enumerate()
+            .min_by(|a, b| a.1.rms.total_cmp(&b.1.rms))
+            .map(|b| b.0)
+        else {
             if refused {
                 self.refused_calibrations += 1;
             }
             return;
         };
+        // On a machine started from a trained model, a kind switch needs
+        // clear evidence: the incumbent (the trained model's kind, then the
+        // kind each calibration installed), itself recalibrated on the same
+        // rows, must have a held-back mean square larger than the best
+        // kind's by more than a margin ([`kind_switch_evidence`]); otherwise
+        // the incumbent, recalibrated, is kept. While training from scratch
+        // (no incumbent), and where the incumbent does not calibrate, the
+        // best kind is taken.
+        let mut pick = best;
+        if let Some(incumbent) = self.calibrated_kind.filter(|&k| k != candidates[best].kind) {
+            if let Some(cur) = candidates.iter().position(|c| c.kind == incumbent) {
+                let (cu, be) = (&candidates[cur], &candidates[best]);
+                if !kind_switch_evidence(&cu.held_residuals, &be.held_residuals) {
+                    self.kept_kinds += 1;
+                    pick = cur;
+                }
+            }
+        }
+        let Candidate {
+            kind,
+            calibration: c,
+            rms,
+            fit_part,
+            ..
+        } = candidates.swap_remove(pick);
         if rms > current_rms {
             self.refused_calibrations += 1;
             return;
@@ -316,6 +351,10 @@ impl Tedris {
             std.map(|s| s[j])
         };
         model.chosen = kind;
+        // Only a machine started from a trained model holds an incumbent.
+        if self.calibrated_kind.is_some() {
+            self.calibrated_kind = Some(kind);
+        }
         model.dcf_rad = c.dcf_rad;
         model.dcf_std_rad = se("dcf");
         if let Some(d) = c.distance_rad_per_m {
@@ -396,14 +435,8 @@ impl Tedris {
                 c.distance_rad_per_m.unwrap_or(model.dcf_distance_rad_per_m),
                 c.gain.unwrap_or(model.turn_gain),
             );
-            let mut e: Vec<Vec<f64>> = held
-                .iter()
-                .map(|r| vec![r[3] - c.dcf_rad * r[0] - dist * r[1] - (gain - 1.0) * r[2]])
-                .collect();
-            centre_per_segment(&mut e, held_segs);
-            let residuals: Vec<f64> = e.into_iter().map(|r| r[0]).collect();
-            let rms =
-                (residuals.iter().map(|v| v * v).sum::<f64>() / residuals.len() as f64).sqrt();
+            let residuals = held_residuals(held, held_segs, c.dcf_rad, dist, gain);
+            let rms = rms_of(&residuals);
             if rms.is_finite() && best.as_ref().is_none_or(|b| rms < b.0) {
                 let times = rows.times[split..].to_vec();
                 best = Some((rms, HeldBack { times, residuals }));
@@ -478,6 +511,19 @@ impl Tedris {
     }
 }
 
+/// One kind calibrated by [`Tedris::calibrate`].
+struct Candidate {
+    kind: crate::config::ModelKind,
+    calibration: Calibration,
+    /// RMS of `held_residuals`, rad.
+    rms: f64,
+    /// The fit rows' segments and times (for the standard errors).
+    fit_part: FitRows,
+    /// Heading residuals on the held-back stretch, about each segment's
+    /// mean, rad.
+    held_residuals: Vec<f64>,
+}
+
 /// The rows of a joint calibration: `[n, Σd, ΣT, θ − Σb]` with each row's
 /// heading segment and time.
 #[derive(Debug, Default)]
@@ -490,14 +536,37 @@ struct CalibrationRows {
 /// The RMS heading residual of calibration values on `rows`, with an
 /// intercept per segment; infinite without rows.
 pub(super) fn held_rms(rows: &[[f64; 4]], segments: &[u32], dcf: f64, dist: f64, gain: f64) -> f64 {
-    if rows.is_empty() {
+    rms_of(&held_residuals(rows, segments, dcf, dist, gain))
+}
+
+/// The heading residuals of calibration values on `rows`, about each
+/// heading segment's mean, rad.
+fn held_residuals(rows: &[[f64; 4]], segments: &[u32], dcf: f64, dist: f64, gain: f64) -> Vec<f64> {
+    let mut e: Vec<Vec<f64>> = rows
+        .iter()
+        .map(|r| vec![r[3] - dcf * r[0] - dist * r[1] - (gain - 1.0) * r[2]])
+        .collect();
+    centre_per_segment(&mut e, segments);
+    e.into_iter().map(|r| r[0]).collect()
+}
+
+/// The RMS of `e`; infinite without values.
+fn rms_of(e: &[f64]) -> f64 {
+    if e.is_empty() {
         return f64::INFINITY;
     }
-    let e: Vec<f64> = rows
-        .iter()
-        .map(|r| r[3] - dcf * r[0] - dist * r[1] - (gain - 1.0) * r[2])
-        .collect();
-    rms_about_segment_means(&e, segments)
+    (e.iter().map(|v| v * v).sum::<f64>() / e.len() as f64).sqrt()
+}
+
+/// Whether the held-back residuals justify leaving the incumbent kind for
+/// a challenger, both recalibrated on the same rows: the challenger's mean
+/// squared residual grown by `KIND_SWITCH_MARGIN` must still be below the
+/// incumbent's.
+fn kind_switch_evidence(incumbent: &[f64], challenger: &[f64]) -> bool {
+    let ms = |e: &[f64]| e.iter().map(|v| v * v).sum::<f64>() / e.len() as f64;
+    incumbent.len() == challenger.len()
+        && !incumbent.is_empty()
+        && ms(challenger) * (1.0 + KIND_SWITCH_MARGIN) < ms(incumbent)
 }
 
 /// The heading segments and times of a calibration's fit rows.
@@ -635,133 +704,4 @@ pub fn heading_lag(h: &History, max_lag: usize) -> Option<i64> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::input::{drive_input, Event};
-
-    /// A machine trained on the built-in `tedris-car` drive (seed 1), the
-    /// joint calibration on.
-    fn trained() -> Tedris {
-        let sc = deadreckon_sim::Scenario::builtin("tedris-car").expect("scenario");
-        let drive = deadreckon_sim::simulate(&sc, 1).expect("drive").drive;
-        let input = drive_input(&drive, None, &[]).expect("input");
-        let mut m = Tedris::new(TedrisConfig::default(), input.geometry).expect("machine");
-        for e in &input.events {
-            let _ = match e {
-                Event::Wheel(w) => m.push_wheel(*w).map(|_| ()),
-                Event::Heading(h) => m.push_heading(*h),
-                Event::Fix(f) => m.push_fix(*f),
-            };
-        }
-        let model = m.model.as_ref().expect("trained");
-        assert!(model.complete && model.config.joint_calibration());
-        m
-    }
-
-    fn betas(m: &TedrisModel) -> Vec<Vec<f64>> {
-        m.fits.iter().map(|f| f.global_beta.clone()).collect()
-    }
-
-    /// The installed values carry the last calibration's robust standard
-    /// errors; a model file written before they existed loads them as not
-    /// estimated; a negative one is an error naming the key.
-    #[test]
-    fn model_files_carry_the_calibrations_standard_errors() {
-        let m = trained();
-        let model = m.model.as_ref().expect("model");
-        let last = m.last_calibration().expect("a calibration was installed");
-        let std = last.std_error.as_ref().expect("estimated");
-        let j = last
-            .names
-            .iter()
-            .position(|n| n == "dcf_distance")
-            .expect("fitted");
-        assert_eq!(model.dcf_distance_std_rad_per_m, Some(std[j]));
-        assert!(std[j] > 0.0 && std[j] > last.ols_std_error[j], "{last:?}");
-        let mut v = serde_json::to_value(model).expect("serialises");
-        let o = v.as_object_mut().expect("an object");
-        for k in ["dcf_std_rad", "dcf_distance_std_rad_per_m", "turn_gain_std"] {
-            o.remove(k).expect("written");
-        }
-        let old = TedrisModel::from_json(&v.to_string()).expect("loads");
-        assert_eq!(
-            (
-                old.dcf_std_rad,
-                old.dcf_distance_std_rad_per_m,
-                old.turn_gain_std
-            ),
-            (None, None, None)
-        );
-        let mut bad = model.clone();
-        bad.turn_gain_std = Some(-1e-3);
-        let text = serde_json::to_string(&bad).expect("serialises");
-        let e = TedrisModel::from_json(&text).expect_err("refused");
-        assert!(e.to_string().contains("turn_gain_std"), "{e}");
-    }
-
-    #[test]
-    fn a_refit_on_blocks_the_heading_contradicts_replaced_the_regressions() {
-        let mut m = trained();
-        let before = m.model.clone().expect("model");
-        // Each block's γ paired with the ω of a block half the drive away:
-        // regressions on these blocks no longer turn with the wheels
-        // (unguarded, the refit took the ω slope from 0.64 to 0.15).
-        let tuples = before.repositories.all_sorted();
-        let half = tuples.len() / 2;
-        let r = &before.repositories;
-        let mut corrupted = Repositories::new(r.straight, r.min_fill, r.max_fill);
-        for (i, tu) in tuples.iter().enumerate() {
-            let mut x = *tu;
-            x.gamma_rad = tuples[(i + half) % tuples.len()].gamma_rad;
-            corrupted.insert(x);
-        }
-        if let Some(model) = m.model.as_mut() {
-            model.repositories = corrupted;
-        }
-        let (accepted, refused) = (m.accepted_refits, m.refused_refits);
-        let t = m.last_t.expect("samples");
-        m.refit(t);
-        assert_eq!(betas(m.model.as_ref().expect("model")), betas(&before));
-        assert_eq!(
-            (m.accepted_refits, m.refused_refits),
-            (accepted, refused + 1)
-        );
-        assert_eq!(m.checks().refused_refits, refused + 1);
-    }
-
-    #[test]
-    fn a_refit_on_the_drives_own_blocks_is_accepted() {
-        let mut m = trained();
-        // The current regressions fitted on the first three quarters of the
-        // blocks; the refit takes in the last quarter, which the heading
-        // does not contradict.
-        let before = m.model.clone().expect("model");
-        let mut fewer = before.clone();
-        let tuples = before.repositories.all_sorted();
-        let r = &before.repositories;
-        fewer.repositories = Repositories::new(r.straight, r.min_fill, r.max_fill);
-        for tu in &tuples[..tuples.len() * 3 / 4] {
-            fewer.repositories.insert(*tu);
-        }
-        let fitted = fewer.refit().expect("fit");
-        m.model = Some(TedrisModel {
-            dcf_rad: before.dcf_rad,
-            dcf_distance_rad_per_m: before.dcf_distance_rad_per_m,
-            turn_gain: before.turn_gain,
-            distance_scale: before.distance_scale,
-            per_metre_straight: before.per_metre_straight,
-            course_convention: before.course_convention,
-            repositories: before.repositories.clone(),
-            ..fitted.clone()
-        });
-        let (accepted, refused) = (m.accepted_refits, m.refused_refits);
-        let t = m.last_t.expect("samples");
-        m.refit(t);
-        assert_eq!(
-            (m.accepted_refits, m.refused_refits),
-            (accepted + 1, refused)
-        );
-        let after = m.model.as_ref().expect("model");
-        assert_ne!(betas(after), betas(&fitted));
-    }
-}
+mod tests;

@@ -232,6 +232,18 @@ pub struct Tedris {
     /// regressions (see `Tedris::refit_verdict`).
     #[serde(default)]
     refused_refits: u64,
+    /// Calibrations that kept the current kind though another had the
+    /// smaller held-back residual, not significantly smaller (see
+    /// `machine/calibration.rs`, `kind_switch_evidence`).
+    #[serde(default)]
+    kept_kinds: u64,
+    /// The incumbent of the kind switch on a machine started from a trained
+    /// model: the trained model's kind, then the kind each joint
+    /// calibration installed (a refit may have set the model's kind by its
+    /// block statistics since); `None` while training from scratch, where
+    /// every calibration takes the kind with the best held-back residual.
+    #[serde(default)]
+    calibrated_kind: Option<crate::config::ModelKind>,
     /// The joint calibration last installed, with its standard errors.
     #[serde(default)]
     last_calibration: Option<InstalledCalibration>,
@@ -304,6 +316,8 @@ impl Tedris {
             refused_calibrations: 0,
             accepted_refits: 0,
             refused_refits: 0,
+            kept_kinds: 0,
+            calibrated_kind: None,
             last_calibration: None,
             untrained_because: None,
             model_alarms: 0,
@@ -338,6 +352,10 @@ impl Tedris {
         former.mean = model.block_means();
         m.former = Some(former);
         m.convention = model.course_convention.map(|c| c.convention);
+        // The trained model's kind is the incumbent of the first kind
+        // switch on this drive (its calibrated values are that kind's).
+        m.calibrated_kind =
+            (model.complete && model.config.joint_calibration()).then_some(model.chosen);
         m.model = Some(model);
         m.fix_slt_window();
         Ok(m)
@@ -434,6 +452,14 @@ impl Tedris {
     /// it is better out of sample").
     pub fn refused_refits(&self) -> u64 {
         self.refused_refits
+    }
+
+    /// Calibrations that kept the current model kind though another kind
+    /// had a smaller held-back heading residual, not significantly smaller
+    /// (a kind switch needs strong evidence: the crate docs, "Nothing
+    /// replaces a model unless it is better out of sample").
+    pub fn kept_kinds(&self) -> u64 {
+        self.kept_kinds
     }
 
     /// Without a model: the training requirement that failed last, with its
