@@ -163,6 +163,30 @@ fn summary(name: &str, rows: &[Row], pick: &dyn Fn(&Row) -> usize) {
     );
 }
 
+/// Car `seed`'s row without the always-fitted run, printed.
+fn car(seed: u64) -> Row {
+    let r = row(seed, false).unwrap();
+    println!(
+        "car {seed}: t {:+.2} likelihood t {:+.2} applied {}; auto {} {:.3} m, white {} {:.3} m",
+        r.t,
+        r.score_t,
+        r.applied,
+        r.runs[0].0.pose.verdict(),
+        r.runs[0].1,
+        r.runs[1].0.pose.verdict(),
+        r.runs[1].1
+    );
+    r
+}
+
+/// A verdict's factor (1 when consistent).
+fn factor_of(v: Verdict) -> f64 {
+    match v {
+        Verdict::Consistent => 1.0,
+        Verdict::OverConfident(k) | Verdict::UnderConfident(k) => k,
+    }
+}
+
 /// Issue 36: the receiver's wander was applied only at a held-back t of
 /// −1 or below (`held_back::MIN_T`), so receivers whose fixes wander, where
 /// the wander lowered the held-back error at t between −1 and 0, kept the
@@ -172,22 +196,9 @@ fn summary(name: &str, rows: &[Row], pick: &dyn Fn(&Row) -> usize) {
 /// below t = 0 (`held_back::WANDER_MIN_T`).
 #[test]
 fn a_wander_that_lowered_the_held_back_error_was_left_out() {
-    let r = row(81, false).unwrap();
-    println!(
-        "car 81: t {:+.2} applied {}; auto {} {:.3} m, white {} {:.3} m",
-        r.t,
-        r.applied,
-        r.runs[0].0.pose.verdict(),
-        r.runs[0].1,
-        r.runs[1].0.pose.verdict(),
-        r.runs[1].1
-    );
+    let r = car(81);
     assert!(r.t > -1.0 && r.t < 0.0, "t {}", r.t);
     assert!(r.applied);
-    let factor = |v: Verdict| match v {
-        Verdict::Consistent => 1.0,
-        Verdict::OverConfident(k) | Verdict::UnderConfident(k) => k,
-    };
     // Measured: 0.72 m against 1.26 m; ×3.2 under against ×24.1 over.
     assert!(
         r.runs[0].1 < 0.8 && r.runs[1].1 > 1.15,
@@ -195,8 +206,8 @@ fn a_wander_that_lowered_the_held_back_error_was_left_out() {
         r.runs[0].1,
         r.runs[1].1
     );
-    assert!(factor(r.runs[0].0.pose.verdict()) < 4.0);
-    assert!(factor(r.runs[1].0.pose.verdict()) > 15.0);
+    assert!(factor_of(r.runs[0].0.pose.verdict()) < 4.0);
+    assert!(factor_of(r.runs[1].0.pose.verdict()) > 15.0);
 }
 
 /// Issue 36: the receiver's wander was judged on the held-back error alone,
@@ -209,23 +220,10 @@ fn a_wander_that_lowered_the_held_back_error_was_left_out() {
 /// it raises the error by a standard error (`held_back::wander_wins`).
 #[test]
 fn a_wander_that_made_the_hidden_fixes_likelier_was_left_out() {
-    let r = row(70, false).unwrap();
-    println!(
-        "car 70: t {:+.2} applied {}; auto {} {:.3} m, white {} {:.3} m",
-        r.t,
-        r.applied,
-        r.runs[0].0.pose.verdict(),
-        r.runs[0].1,
-        r.runs[1].0.pose.verdict(),
-        r.runs[1].1
-    );
+    let r = car(70);
     assert!(r.t > 0.0 && r.t < 1.0, "t {}", r.t);
     assert!(r.score_t > 0.0, "likelihood t {}", r.score_t);
     assert!(r.applied);
-    let factor = |v: Verdict| match v {
-        Verdict::Consistent => 1.0,
-        Verdict::OverConfident(k) | Verdict::UnderConfident(k) => k,
-    };
     // Measured: 0.69 m against 0.92 m; ×1.7 against ×45.6 over.
     assert!(
         r.runs[0].1 < 0.75 && r.runs[1].1 > 0.85,
@@ -233,6 +231,6 @@ fn a_wander_that_made_the_hidden_fixes_likelier_was_left_out() {
         r.runs[0].1,
         r.runs[1].1
     );
-    assert!(factor(r.runs[0].0.pose.verdict()) < 2.5);
-    assert!(factor(r.runs[1].0.pose.verdict()) > 30.0);
+    assert!(factor_of(r.runs[0].0.pose.verdict()) < 2.5);
+    assert!(factor_of(r.runs[1].0.pose.verdict()) > 30.0);
 }

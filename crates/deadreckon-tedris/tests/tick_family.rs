@@ -510,20 +510,14 @@ fn tick_family_diagnose_dev_outages() {
                             if last != Some(now) && w.t_s < end_s {
                                 changes.push(format!(
                                     "{:.0} s {:?} gain {:.3} /m {:.2e} antenna {:?}",
-                                    w.t_s,
-                                    h.chosen,
-                                    h.turn_gain,
-                                    h.dcf_distance_rad_per_m,
-                                    now.1
+                                    w.t_s, h.chosen, h.turn_gain, h.dcf_distance_rad_per_m, now.1
                                 ));
                                 last = Some(now);
                             }
                         }
                         let err = truth_yaw(&test_drive, est.t_s).map(|y| wrap(est.yaw_rad - y));
                         if at_start.is_none() && est.t_s >= start_s {
-                            at_start = err.map(|e| {
-                                (e, m.model().map(|h| (h.chosen, h.turn_gain)))
-                            });
+                            at_start = err.map(|e| (e, m.model().map(|h| (h.chosen, h.turn_gain))));
                         }
                         if at_end.is_none() && est.t_s >= end_s - 0.05 {
                             at_end = err;
@@ -539,7 +533,8 @@ fn tick_family_diagnose_dev_outages() {
             }
             eprintln!(
                 "  [{start_s:.0}, {end_s:.0}): heading error at start {:?}, at end {:?}; kinds: {}",
-                at_start, at_end,
+                at_start,
+                at_end,
                 changes.join("; ")
             );
         }
@@ -556,7 +551,8 @@ fn held_kinds(
 ) -> Vec<(f64, ModelKind)> {
     use deadreckon_tedris::input::{drive_input, Event};
     let input = drive_input(drive, None, &[(outage.start_s, outage.end_s)]).expect("input");
-    let mut m = deadreckon_tedris::Tedris::with_model(model.clone(), input.geometry).expect("machine");
+    let mut m =
+        deadreckon_tedris::Tedris::with_model(model.clone(), input.geometry).expect("machine");
     let mut kinds: Vec<(f64, ModelKind)> = Vec::new();
     for e in &input.events {
         match e {
