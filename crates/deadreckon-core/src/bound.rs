@@ -129,6 +129,35 @@ impl Cov2 {
         }
     }
 
+    /// The covariance of the antenna a GNSS fix sees, m²: the pose's
+    /// `p3` carried `lever_m` ahead at `yaw_rad`, plus the receiver's
+    /// wander where the filter carries it (`wander`).
+    pub(crate) fn at_fix(
+        p3: &[[f64; 3]; 3],
+        wander: Option<&WanderCov>,
+        yaw_rad: f64,
+        lever_m: f64,
+    ) -> Cov2 {
+        let antenna = Cov2::ahead(p3, yaw_rad, lever_m);
+        match wander {
+            Some(w) => w.fix_cov(antenna, yaw_rad, lever_m),
+            None => antenna,
+        }
+    }
+
+    /// `ln N(d; 0, self)` of an offset `d = [east, north]`, m: the 2-D
+    /// Gaussian's `−ln 2π − ½ ln det Σ − ½ dᵀΣ⁻¹d` (−∞ where the
+    /// covariance is not positive definite).
+    pub fn log_density(&self, d: [f64; 2]) -> f64 {
+        let (a, b, c) = (self.ee_m2, self.en_m2, self.nn_m2);
+        let det = a * c - b * b;
+        if det.is_nan() || det <= 0.0 {
+            return f64::NEG_INFINITY;
+        }
+        let nis = (c * d[0] * d[0] - 2.0 * b * d[0] * d[1] + a * d[1] * d[1]) / det;
+        -(2.0 * std::f64::consts::PI).ln() - 0.5 * det.ln() - 0.5 * nis
+    }
+
     /// The eigenvalues, largest first, clamped at 0, m².
     pub fn eigenvalues(&self) -> (f64, f64) {
         let m = 0.5 * (self.ee_m2 + self.nn_m2);

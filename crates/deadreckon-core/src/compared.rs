@@ -180,10 +180,6 @@ pub struct OutageResult {
     /// hidden fix's noise; zero for the truth, and without
     /// `covariances_m2`).
     pub reference_m2: crate::bound::Cov2,
-    /// The last error as east and north, m (estimate less reference),
-    /// where the comparison is against fixes
-    /// ([`crate::outage::through_windows_against_fixes`]; `None` otherwise).
-    pub final_offset_m: Option<[f64; 2]>,
     /// The log-likelihood of the last hidden fix under the dead
     /// reckoning's own prediction of it: the antenna plus the wander the
     /// filter still expects, with their covariance and the fix's declared
@@ -216,7 +212,6 @@ impl OutageResult {
             covariances_m2: Vec::new(),
             floor_m2: crate::bound::Cov2::circular(0.0),
             reference_m2: crate::bound::Cov2::circular(0.0),
-            final_offset_m: None,
             fix_log_likelihood: None,
         }
     }

@@ -365,7 +365,7 @@ fn evaluate_in(
                 .checked_sub(1)
                 .map_or(0.0, |i| crate::bound::receiver_std_m(&drive.gnss[i]))
         });
-        if let Some(mut w) = window_errors(
+        if let Some((mut w, _)) = window_errors(
             drive,
             truth.as_ref(),
             &states,
@@ -442,8 +442,9 @@ fn pose_block<const N: usize>(p: &SMatrix<f64, N, N>) -> [[f64; 3]; 3] {
 /// compared — against a fix, the antenna plus the wander), and the window
 /// the two parts that hold for all of it: `receiver`, the declared accuracy
 /// of the last fix before the outage ([`crate::bound`]), and the
-/// reference's own (a fix's is `fix_std_m` per axis). `None` when nothing
-/// compares.
+/// reference's own (a fix's is `fix_std_m` per axis). Against fixes, also
+/// the last error as `[east, north]`, m (estimate less fix). `None` when
+/// nothing compares.
 #[allow(clippy::too_many_arguments)]
 fn window_errors(
     drive: &Drive,
@@ -455,7 +456,7 @@ fn window_errors(
     t0: f64,
     start: f64,
     end: f64,
-) -> Option<OutageResult> {
+) -> Option<(OutageResult, Option<[f64; 2]>)> {
     let lever = drive.vehicle.gnss_lever_arm_m;
     let inside = |s: &(f64, State)| s.0 >= t0 && s.0 <= end;
     let covs: Vec<[[f64; 3]; 3]> = states
@@ -518,11 +519,7 @@ fn window_errors(
                     // The covariance of the last epoch at or before the fix.
                     let k = states.partition_point(|s| s.0 <= g.t_s).saturating_sub(1);
                     if let Some(c) = covs.get(k) {
-                        let antenna = Cov2::ahead(c, x[YAW], lever);
-                        cov_at.push(match wander_covs.get(k) {
-                            Some(w) => w.fix_cov(antenna, x[YAW], lever),
-                            None => antenna,
-                        });
+                        cov_at.push(Cov2::at_fix(c, wander_covs.get(k), x[YAW], lever));
                     }
                 }
             }
@@ -549,7 +546,6 @@ fn window_errors(
             OutageResult::new::<Antenna>(start, end, Against::Gnss, errors, travelled, distance_m)
         }
     };
-    out.final_offset_m = last_offset;
     if cov_at.len() == out.errors.len() {
         out.covariances_m2 = cov_at;
         // The floor and the reference's own covariance hold for the whole
@@ -565,7 +561,7 @@ fn window_errors(
     // again (docs/performance.md, "Fifth round").
     out.errors.shrink_to_fit();
     out.covariances_m2.shrink_to_fit();
-    Some(out)
+    Some((out, last_offset))
 }
 
 /// The GNSS-aided filter run once with GNSS hidden in every window of
@@ -665,11 +661,11 @@ fn through_windows_in(
             a,
             b,
         ) {
-            let mut w = w;
+            let (mut w, last_offset) = w;
             if let (Some(i), Some(Some(at)), Some(d)) = (
                 last_fix.get(k).copied().flatten(),
                 at_fix.get(k),
-                w.final_offset_m,
+                last_offset,
             ) {
                 w.fix_log_likelihood = Some(fix_log_likelihood(drive, &drive.gnss[i], at, d));
             }
@@ -704,17 +700,9 @@ fn last_fix_in(drive: &Drive, (a, b): (f64, f64)) -> Option<usize> {
 /// would take it.
 fn fix_log_likelihood(drive: &Drive, fix: &crate::drive::GnssFix, at: &AtFix, d: [f64; 2]) -> f64 {
     let (x, p3, wander) = at;
-    let lever = drive.vehicle.gnss_lever_arm_m;
-    let antenna = Cov2::ahead(p3, x[YAW], lever);
-    let s = wander.map_or(antenna, |w| w.fix_cov(antenna, x[YAW], lever));
-    let r = crate::bound::receiver_std_m(fix).powi(2);
-    let (a, b, c) = (s.ee_m2 + r, s.en_m2, s.nn_m2 + r);
-    let det = a * c - b * b;
-    if det.is_nan() || det <= 0.0 {
-        return f64::NEG_INFINITY;
-    }
-    let nis = (c * d[0] * d[0] - 2.0 * b * d[0] * d[1] + a * d[1] * d[1]) / det;
-    -(2.0 * std::f64::consts::PI).ln() - 0.5 * det.ln() - 0.5 * nis
+    let s = Cov2::at_fix(p3, wander.as_ref(), x[YAW], drive.vehicle.gnss_lever_arm_m);
+    let noise = Cov2::circular(crate::bound::receiver_std_m(fix));
+    s.scaled_plus(1.0, &noise).log_density(d)
 }
 
 /// Every epoch's time and car state, and the receiver's wander estimate
